@@ -1,0 +1,7 @@
+//! Host companion of `imu-ar`: the independent f64 reference every core is tested against.
+//!
+//! Everything here is a direct solve of the problem an estimator claims to solve (dense linear
+//! algebra from `nalgebra`), never the library's own recursion instantiated at `f64`.
+#![deny(missing_docs)]
+
+pub mod reference;
