@@ -3,7 +3,11 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
+pub mod allan;
 pub mod batch;
+pub mod model;
 pub mod scalar;
+pub mod sim;
 
+pub use model::{ArModel, GaussMarkov, ModelError};
 pub use scalar::Scalar;

@@ -116,14 +116,20 @@ pub fn levinson_durbin<T: Scalar, const P: usize>(
             given: r.len(),
         });
     };
-    if !r.iter().all(|v| v.is_finite()) {
+    levinson(r[0], &core::array::from_fn(|k| r[k + 1]))
+}
+
+/// [`levinson_durbin`] on `r(0)` and `r(1..=P)`, for callers that hold them apart.
+pub(crate) fn levinson<T: Scalar, const P: usize>(
+    r0: T,
+    r: &[T; P],
+) -> Result<Levinson<T, P>, LevinsonError> {
+    if !r0.is_finite() || !r.iter().all(|v| v.is_finite()) {
         return Err(LevinsonError::NonFinite);
     }
-    let r0 = r[0];
     if r0 <= T::ZERO {
         return Err(LevinsonError::NotPositiveDefinite { order: 0 });
     }
-
     let mut a = [T::ZERO; P];
     let mut reflection = [T::ZERO; P];
     let mut error_power = [T::ZERO; P];
@@ -132,8 +138,8 @@ pub fn levinson_durbin<T: Scalar, const P: usize>(
         // k_m = (r(m) - sum_{j=1}^{m-1} a_j r(m-j)) / E_{m-1}
         let acc = a[..m - 1]
             .iter()
-            .zip(r[1..m].iter().rev())
-            .fold(r[m], |acc, (&aj, &rj)| acc - aj * rj);
+            .zip(r[..m - 1].iter().rev())
+            .fold(r[m - 1], |acc, (&aj, &rj)| acc - aj * rj);
         let k = acc / e;
         // Written so that a NaN `k` (E_{m-1} underflowed to zero) is rejected as well.
         let inside_unit_circle = k.abs() < T::ONE;
