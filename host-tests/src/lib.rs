@@ -1,7 +1,9 @@
-//! Host companion of `imu-ar`: the independent f64 reference every core is tested against.
+//! Host companion of `imu-ar`: the independent f64 reference every core is tested against, the
+//! CSV reader and the command-line tool `imu-ar`.
 //!
-//! Everything here is a direct solve of the problem an estimator claims to solve (dense linear
+//! The reference is a direct solve of the problem an estimator claims to solve (dense linear
 //! algebra from `nalgebra`), never the library's own recursion instantiated at `f64`.
 #![deny(missing_docs)]
 
+pub mod data;
 pub mod reference;

@@ -31,3 +31,28 @@ pub fn autocovariance(x: &[f64], p: usize) -> Vec<f64> {
         })
         .collect()
 }
+
+/// Conditional least-squares AR(p) fit by an SVD solve of the `(N - p) x p` data matrix:
+/// `argmin sum_{n=p}^{N-1} (y_n - a^T [y_{n-1} .. y_{n-p}])^2`, `y = x - mean(x)` when `demean`.
+/// Returns `a` and the innovation variance `SSR / (N - p)`.
+pub fn covariance_ls(x: &[f64], p: usize, demean: bool) -> (Vec<f64>, f64) {
+    let mean = if demean {
+        x.iter().sum::<f64>() / x.len() as f64
+    } else {
+        0.0
+    };
+    let y: Vec<f64> = x.iter().map(|v| v - mean).collect();
+    let rows = y.len() - p;
+    let data = DMatrix::from_fn(rows, p, |r, k| y[r + p - 1 - k]);
+    let target = DVector::from_iterator(rows, y[p..].iter().copied());
+    let a = data
+        .clone()
+        .svd(true, true)
+        .solve(&target, 1e-14)
+        .expect("SVD with U and V^T");
+    let resid = target - data * &a;
+    (
+        a.iter().copied().collect(),
+        resid.norm_squared() / rows as f64,
+    )
+}

@@ -1,0 +1,113 @@
+//! Reading one column of CSV sensor logs, with errors that name the file and the line.
+
+use std::fmt;
+use std::fs::File;
+use std::io::{BufReader, IsTerminal, Write};
+use std::path::{Path, PathBuf};
+
+/// A problem with an input file, for a one-line message `FILE[:LINE]: problem`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DataError {
+    /// The file.
+    pub file: PathBuf,
+    /// The 1-based line, where one is to blame.
+    pub line: Option<u64>,
+    /// What is wrong.
+    pub problem: String,
+}
+
+impl fmt::Display for DataError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.file.display())?;
+        if let Some(line) = self.line {
+            write!(f, ":{line}")?;
+        }
+        write!(f, ": {}", self.problem)
+    }
+}
+
+impl std::error::Error for DataError {}
+
+fn error(file: &Path, line: Option<u64>, problem: impl Into<String>) -> DataError {
+    DataError {
+        file: file.to_path_buf(),
+        line,
+        problem: problem.into(),
+    }
+}
+
+/// Reads column `column` of each file in turn (a record split over several files is joined in
+/// order). Files are CSV with a header row; lines starting with `#` are ignored. The files are
+/// streamed row by row; on a terminal, progress goes to stderr every 100,000 rows.
+///
+/// Every cell must be a finite number: a missing column, an empty or non-numeric cell, NaN or
+/// infinity is an error naming the file and line, and so is a file without data rows.
+pub fn read_column(files: &[PathBuf], column: &str) -> Result<Vec<f64>, DataError> {
+    let progress = std::io::stderr().is_terminal();
+    let mut out = Vec::new();
+    for path in files {
+        let file = File::open(path).map_err(|e| error(path, None, format!("cannot open: {e}")))?;
+        let mut reader = csv::ReaderBuilder::new()
+            .comment(Some(b'#'))
+            .trim(csv::Trim::All)
+            .flexible(true)
+            .from_reader(BufReader::with_capacity(1 << 16, file));
+        let headers = reader
+            .headers()
+            .map_err(|e| error(path, None, format!("cannot read the header: {e}")))?
+            .clone();
+        if headers.is_empty() {
+            return Err(error(path, None, "empty file (no header row)"));
+        }
+        let Some(index) = headers.iter().position(|h| h == column) else {
+            let names: Vec<&str> = headers.iter().collect();
+            return Err(error(
+                path,
+                None,
+                format!("no column '{column}' (columns: {})", names.join(", ")),
+            ));
+        };
+        let start = out.len();
+        let mut record = csv::StringRecord::new();
+        loop {
+            match reader.read_record(&mut record) {
+                Ok(false) => break,
+                Ok(true) => {}
+                Err(e) => {
+                    let line = e.position().map(|p| p.line());
+                    return Err(error(path, line, format!("malformed CSV: {e}")));
+                }
+            }
+            let line = record.position().map(|p| p.line());
+            let cell = record.get(index).ok_or_else(|| {
+                error(path, line, format!("column '{column}' missing in this row"))
+            })?;
+            let value: f64 = cell.parse().map_err(|_| {
+                error(
+                    path,
+                    line,
+                    format!("column '{column}': '{cell}' is not a number"),
+                )
+            })?;
+            if !value.is_finite() {
+                return Err(error(
+                    path,
+                    line,
+                    format!("column '{column}': '{cell}' is not a finite number"),
+                ));
+            }
+            out.push(value);
+            if progress && out.len() % 100_000 == 0 {
+                eprint!("\rread {} rows", out.len());
+                let _ = std::io::stderr().flush();
+            }
+        }
+        if out.len() == start {
+            return Err(error(path, None, "no data rows"));
+        }
+    }
+    if progress && out.len() >= 100_000 {
+        eprintln!("\rread {} rows", out.len());
+    }
+    Ok(out)
+}
