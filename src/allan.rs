@@ -188,8 +188,10 @@ impl<const L: usize> AllanStream<L> {
         }
         self.samples += 1;
         let mut block = x.to_f64();
-        for (j, o) in self.octaves.iter_mut().enumerate() {
-            let avg = block / (1u64 << j) as f64;
+        let mut size = 1.0;
+        for o in self.octaves.iter_mut() {
+            let avg = block / size;
+            size *= 2.0;
             if let Some(prev) = o.previous {
                 o.acc += (avg - prev) * (avg - prev);
                 o.count += 1;
