@@ -128,3 +128,25 @@ fn psd_integrates_to_the_variance() {
         .sum();
     assert!((integral - r0).abs() < 1e-6 * r0, "{integral} vs {r0}");
 }
+
+#[test]
+fn ar1_allan_variance_equals_the_closed_form() {
+    // Zhang 2008, Metrologia 45(5):549: AVAR(m) = s2 [m - 3phi - m phi^2 + 4 phi^(m+1)
+    // - phi^(2m+1)] / [m^2 (1-phi)^2 (1-phi^2)]. Evaluated in f64 the closed form itself loses
+    // about eps / (1-phi)^3 relative to cancellation, so phi stops at 0.99 for a 1e-9 check.
+    for phi in [-0.5f64, 0.3, 0.9, 0.99] {
+        let model = ArModel::new([phi], 2.0, 0.0, 0.01).unwrap();
+        for m in [1u32, 2, 3, 7, 64, 1000] {
+            let mf = m as f64;
+            let closed = 2.0
+                * (mf - 3.0 * phi - mf * phi * phi + 4.0 * phi.powi(m as i32 + 1)
+                    - phi.powi(2 * m as i32 + 1))
+                / (mf * mf * (1.0 - phi).powi(2) * (1.0 - phi * phi));
+            let got = model.allan_variance(m).unwrap();
+            assert!(
+                (got - closed).abs() < 1e-9 * closed,
+                "phi {phi}, m {m}: {got} vs {closed}"
+            );
+        }
+    }
+}
