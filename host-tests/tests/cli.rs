@@ -36,6 +36,17 @@ fn json(out: &Output) -> serde_json::Value {
     serde_json::from_slice(&out.stdout).expect("one JSON object")
 }
 
+/// `imu-ar fit FILE --column x --method M --order P --json EXTRA..`, parsed.
+fn fit_json(file: &Path, method: &str, order: &str, extra: &[&str]) -> serde_json::Value {
+    let file = file.to_str().unwrap();
+    let mut args = vec![
+        "fit", file, "--column", "x", "--method", method, "--order", order,
+    ];
+    args.extend_from_slice(extra);
+    args.push("--json");
+    json(&imu_ar(&args))
+}
+
 #[test]
 fn adev_reproduces_the_published_adis16405_table() {
     let Some(dir) = data_dir() else { return };
@@ -98,19 +109,7 @@ fn fit_reports_the_documented_keys_and_convention() {
     assert_eq!(csv.lines().count(), 20_001);
     let file = temp_file("ar1.csv", &csv);
     for method in ["ls", "yule-walker", "burg"] {
-        let v = json(&imu_ar(&[
-            "fit",
-            file.to_str().unwrap(),
-            "--column",
-            "x",
-            "--method",
-            method,
-            "--order",
-            "1",
-            "--rate",
-            "100",
-            "--json",
-        ]));
+        let v = fit_json(&file, method, "1", &["--rate", "100"]);
         assert_eq!(v["method"], method);
         assert_eq!(v["scalar"], "f64");
         assert_eq!(
@@ -347,17 +346,7 @@ fn fits_equal_statsmodels() {
         ),
     ];
     for (method, a, variance) in cases {
-        let v = json(&imu_ar(&[
-            "fit",
-            file.to_str().unwrap(),
-            "--column",
-            "x",
-            "--method",
-            method,
-            "--order",
-            "3",
-            "--json",
-        ]));
+        let v = fit_json(&file, method, "3", &[]);
         for k in 0..3 {
             let got = v["a"][k].as_f64().unwrap();
             assert!(
