@@ -6,6 +6,7 @@
 pub mod allan;
 pub mod batch;
 pub mod model;
+pub mod recursive;
 pub mod scalar;
 pub mod sim;
 

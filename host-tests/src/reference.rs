@@ -56,3 +56,104 @@ pub fn covariance_ls(x: &[f64], p: usize, demean: bool) -> (Vec<f64>, f64) {
         resid.norm_squared() / rows as f64,
     )
 }
+
+/// The exact problem of every recursive core (numerics.md section 0), accumulated sample by
+/// sample and solved directly:
+///
+/// `a_n = argmin sum_{i<=n} lambda^(n-i) (y_i - a^T phi_i)^2 + delta lambda^n a^T D a`, with
+/// prewindowed `phi_i = [y_{i-1} .. y_{i-p}]` (`y_i = 0` for `i <= 0`) and
+/// `D = diag(lambda^(p-1), .., lambda^(p-m))` for order `m <= p`, or `D = I` for the ridge form.
+pub struct Section0 {
+    p: usize,
+    lambda: f64,
+    delta: f64,
+    r: DMatrix<f64>,
+    b: DVector<f64>,
+    yy: f64,
+    phi: Vec<f64>,
+    lambda_n: f64,
+    n: usize,
+}
+
+/// Which regularisation [`Section0`] solves with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Regularisation {
+    /// `delta lambda^n a^T D a`, `D = diag(lambda^(p-1), .., lambda^(p-m))`.
+    ShiftConsistent,
+    /// `delta lambda^n ||a||^2`.
+    Ridge,
+}
+
+impl Section0 {
+    /// An empty problem of order up to `p`.
+    pub fn new(p: usize, lambda: f64, delta: f64) -> Self {
+        Self {
+            p,
+            lambda,
+            delta,
+            r: DMatrix::zeros(p, p),
+            b: DVector::zeros(p),
+            yy: 0.0,
+            phi: vec![0.0; p],
+            lambda_n: 1.0,
+            n: 0,
+        }
+    }
+
+    /// Takes the next sample `y_n`.
+    pub fn push(&mut self, y: f64) {
+        let phi = DVector::from_column_slice(&self.phi);
+        self.r = &self.r * self.lambda + &phi * phi.transpose();
+        self.b = &self.b * self.lambda + &phi * y;
+        self.yy = self.yy * self.lambda + y * y;
+        self.phi.rotate_right(1);
+        self.phi[0] = y;
+        self.lambda_n *= self.lambda;
+        self.n += 1;
+    }
+
+    /// Samples taken.
+    pub fn n(&self) -> usize {
+        self.n
+    }
+
+    /// The order-`m` solution `a` and the energy `min J + delta lambda^(n+p)`.
+    pub fn solve(&self, m: usize, reg: Regularisation) -> (Vec<f64>, f64) {
+        let mut r = self.r.view((0, 0), (m, m)).into_owned();
+        for k in 0..m {
+            let d = match reg {
+                Regularisation::ShiftConsistent => self.lambda.powi((self.p - 1 - k) as i32),
+                Regularisation::Ridge => 1.0,
+            };
+            r[(k, k)] += self.delta * self.lambda_n * d;
+        }
+        let b = self.b.rows(0, m).into_owned();
+        let a = r
+            .cholesky()
+            .expect("regularised system is positive definite")
+            .solve(&b);
+        let energy =
+            self.yy - b.dot(&a) + self.delta * self.lambda_n * self.lambda.powi(self.p as i32);
+        (a.iter().copied().collect(), energy)
+    }
+
+    /// The a-priori error `y - a^T phi` of a coming sample `y` under coefficients `a`.
+    pub fn a_priori_error(&self, a: &[f64], y: f64) -> f64 {
+        y - a.iter().zip(&self.phi).map(|(a, p)| a * p).sum::<f64>()
+    }
+}
+
+/// The exponentially weighted running mean removal the recursive cores document, in `f64`:
+/// `y_n = x_n - m_{n-1}` (`m_0 = x_1`), `m_n = m_{n-1} + y_n / W_n`, `W_n = lambda W_{n-1} + 1`.
+pub fn running_mean_removed(x: &[f64], lambda: f64) -> Vec<f64> {
+    let mut mean = x.first().copied().unwrap_or(0.0);
+    let mut w = 0.0;
+    x.iter()
+        .map(|&v| {
+            let y = v - mean;
+            w = lambda * w + 1.0;
+            mean += y / w;
+            y
+        })
+        .collect()
+}

@@ -1,0 +1,132 @@
+//! f64 exactness of the recursive cores against the direct solve of numerics.md section 0.
+
+use imu_ar::ArModel;
+use imu_ar::recursive::{Config, Lattice, Rls, RlsInit};
+use imu_ar::sim::ArSimulator;
+use imu_ar_host::reference::{Regularisation, Section0, running_mean_removed};
+use rand_chacha::ChaCha8Rng;
+use rand_core::SeedableRng;
+
+const DELTA: f64 = 0.7;
+
+fn data(n: usize, seed: u64) -> Vec<f64> {
+    let model = ArModel::new([1.2, -0.5, 0.1, 0.05], 1.0, 0.0, 0.01).unwrap();
+    let mut sim = ArSimulator::new(model);
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    sim.burn_in(&mut rng, 500);
+    (0..n).map(|_| sim.next(&mut rng)).collect()
+}
+
+/// `max |x - y| / max |y|` (0 when both are 0).
+fn rel(x: &[f64], y: &[f64]) -> f64 {
+    let scale = y.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let err = x
+        .iter()
+        .zip(y)
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    if err == 0.0 { 0.0 } else { err / scale }
+}
+
+/// Runs lattice and both RLS starts over `x`, checking against the direct solve at every
+/// `n` in `checked`; returns the worst relative differences (lattice a, lattice energy,
+/// lattice a-priori error, RLS, RLS ridge).
+fn check<const P: usize>(
+    x: &[f64],
+    lambda: f64,
+    demean: bool,
+    checked: impl Fn(usize) -> bool,
+) -> [f64; 5] {
+    let config = Config::new(lambda, DELTA, 0.01)
+        .unwrap()
+        .with_demean(demean);
+    let mut lattice = Lattice::<f64, P>::new(&config);
+    let mut rls = Rls::<f64, P>::new(&config, RlsInit::ShiftConsistent);
+    let mut ridge = Rls::<f64, P>::new(&config, RlsInit::Ridge);
+    let y = if demean {
+        running_mean_removed(x, lambda)
+    } else {
+        x.to_vec()
+    };
+    let mut reference = Section0::new(P, lambda, DELTA);
+    let mut worst = [0.0f64; 5];
+    let mut previous = vec![0.0; P];
+    for (n, (&xn, &yn)) in x.iter().zip(&y).enumerate() {
+        let err_ref = reference.a_priori_error(&previous, yn);
+        reference.push(yn);
+        let e = lattice.update(&config, xn).unwrap();
+        rls.update(&config, xn).unwrap();
+        ridge.update(&config, xn).unwrap();
+        previous = reference.solve(P, Regularisation::ShiftConsistent).0;
+        if !checked(n + 1) {
+            continue;
+        }
+        worst[2] = worst[2].max((e - err_ref).abs() / err_ref.abs().max(1e-300));
+        for m in 1..=P {
+            let (a_ref, energy_ref) = reference.solve(m, Regularisation::ShiftConsistent);
+            let a = lattice.coefficients(m).unwrap();
+            worst[0] = worst[0].max(rel(&a[..m], &a_ref));
+            let energy = lattice.energy(m).unwrap();
+            worst[1] = worst[1].max((energy - energy_ref).abs() / energy_ref);
+        }
+        let (a_ref, _) = reference.solve(P, Regularisation::ShiftConsistent);
+        worst[3] = worst[3].max(rel(rls.coefficients(), &a_ref));
+        let (a_ridge, _) = reference.solve(P, Regularisation::Ridge);
+        worst[4] = worst[4].max(rel(ridge.coefficients(), &a_ridge));
+    }
+    assert_eq!(
+        lattice.health().restarts + rls.health().restarts + ridge.health().restarts,
+        0
+    );
+    worst
+}
+
+fn assert_exact(name: &str, worst: [f64; 5]) {
+    let labels = [
+        "lattice a",
+        "lattice energy",
+        "lattice a-priori error",
+        "RLS (delta D)^-1",
+        "RLS I/delta vs ridge",
+    ];
+    println!("{name}: {worst:?}");
+    for (label, w) in labels.iter().zip(worst) {
+        assert!(w < 1e-9, "{name}: {label}: relative difference {w:e}");
+    }
+}
+
+macro_rules! for_orders {
+    ($x:expr, $lambda:expr, $demean:expr, $checked:expr, $tag:expr) => {
+        for (p, worst) in [
+            (1, check::<1>($x, $lambda, $demean, $checked)),
+            (2, check::<2>($x, $lambda, $demean, $checked)),
+            (4, check::<4>($x, $lambda, $demean, $checked)),
+            (8, check::<8>($x, $lambda, $demean, $checked)),
+        ] {
+            assert_exact(&format!("{} p = {p}, lambda = {}", $tag, $lambda), worst);
+        }
+    };
+}
+
+#[test]
+fn every_sample_of_the_first_400() {
+    let x = data(400, 1);
+    for lambda in [0.98, 0.999, 1.0] {
+        for_orders!(&x, lambda, false, |_| true, "n <= 400");
+    }
+}
+
+#[test]
+fn after_100_000_samples() {
+    let x = data(100_000, 2);
+    for lambda in [0.98, 0.999, 1.0] {
+        for_orders!(&x, lambda, false, |n| n == 100_000, "n = 1e5");
+    }
+}
+
+#[test]
+fn with_running_mean_removal() {
+    let x: Vec<f64> = data(3_000, 3).iter().map(|v| v + 5.0).collect();
+    for lambda in [0.98, 0.999] {
+        for_orders!(&x, lambda, true, |n| n % 100 == 0, "demeaned");
+    }
+}

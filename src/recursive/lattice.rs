@@ -1,0 +1,338 @@
+//! The a-priori least-squares lattice with error feedback (EF-LSL), `O(P)` per sample.
+
+use super::{Config, Health, RunningMean, WeightSum};
+use crate::{ArModel, Scalar};
+
+/// Exponentially weighted least-squares AR estimator of all orders `0..=P` at `O(P)` cost: the
+/// a-priori lattice with error feedback of Ling, Manolakis & Proakis (1986, IEEE Trans. ASSP
+/// 34(4):837-845), as written in numerics.md section 2.1.
+///
+/// Stage `i` maps order `i` to order `i + 1`; per sample, with `f_0 = psi_0 = y_n`, `g_0 = 1`:
+///
+/// ```text
+/// F_i      <- lambda F_i + (gp_i f_i) f_i                 forward energy F_i(n)
+/// f_{i+1}   = f_i  - kf_{i+1} bp_i                         a-priori forward error
+/// psi_{i+1} = bp_i - kb_{i+1} f_i                          a-priori backward error
+/// kf_{i+1} <- kf_{i+1} + (gp_i bp_i) f_{i+1} / B_i          B_i still B_i(n-1)
+/// kb_{i+1} <- kb_{i+1} + (gp_i f_i) psi_{i+1} / F_i
+/// B_i      <- lambda B_i + (g_i psi_i) psi_i               backward energy B_i(n)
+/// g_{i+1}   = g_i - (g_i psi_i)^2 / B_i                    conversion factor gamma_{i+1}(n)
+/// ```
+///
+/// then `bp_i <- psi_i`, `gp_i <- g_i`. The reflection coefficients are updated directly, not
+/// as a ratio of two accumulators, which is why this form stays accurate in `f32` and fixed
+/// point as `lambda -> 1`. After every sample it holds, for every order `m <= P`, the a-priori
+/// error `f_m(n) = y_n - a^(m)_{n-1}^T phi_n` (the one-step prediction error, the paper's
+/// figure of merit) and the exact weighted energy `F_m(n) = min J^(m)_n + delta lambda^(n+P)` of
+/// the problem in the [module docs](super) (with `D_m = diag(lambda^(P-1), .., lambda^(P-m))`).
+///
+/// The transversal coefficients `a_1..a_m` are computed on request ([`Lattice::coefficients`],
+/// [`Lattice::model`]) exactly, from the reflection coefficients of the last `P` samples
+/// (numerics.md section 1, option 1): `O(P^3/3)` operations per request, `O(P)` per sample.
+///
+/// Safeguards: the energies are floored at a tiny positive value and the conversion factor
+/// is kept in `[0, 1]`; a non-finite state re-initialises the lattice (counted in
+/// [`Health::restarts`]) and [`Lattice::model`] keeps returning the last good model for
+/// `3/(1 - lambda)` samples.
+///
+/// ```
+/// use imu_ar::recursive::{Config, Lattice};
+///
+/// let config = Config::new(0.99f32, 0.1, 0.01).unwrap().with_demean(false);
+/// let mut lattice = Lattice::<f32, 2>::new(&config);
+/// let mut x = [0.0f32; 2];
+/// for n in 0..2000 {
+///     // x[n] = 1.2 x[n-1] - 0.5 x[n-2] + w, w from a fixed pseudo-random sequence
+///     let w = ((n * 7919 % 1000) as f32 / 1000.0) - 0.5;
+///     let xn = 1.2 * x[0] - 0.5 * x[1] + w;
+///     lattice.update(&config, xn);
+///     x = [xn, x[0]];
+/// }
+/// let model = lattice.model(&config).unwrap();
+/// assert!((model.a()[0] - 1.2).abs() < 0.05 && (model.a()[1] + 0.5).abs() < 0.05);
+/// ```
+#[derive(Clone, Copy, Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Lattice<T, const P: usize> {
+    /// Forward energies `F_0..F_{P-1}`.
+    f_energy: [T; P],
+    /// `F_P`.
+    f_energy_p: T,
+    /// Backward energies `B_0..B_{P-1}`, holding `B_i(n-1)` between samples.
+    b_energy: [T; P],
+    /// `kf_1..kf_P` (index `m - 1` for order `m`).
+    kf: [T; P],
+    /// `kb_1..kb_P`.
+    kb: [T; P],
+    /// `psi_i(n-1)`, i = 0..P-1.
+    bp: [T; P],
+    /// `gamma_i(n-1)`, i = 0..P-1.
+    gp: [T; P],
+    /// `gamma_P(n-1)`.
+    gp_p: T,
+    /// A-priori forward errors `f_1..f_P` of the last sample; `f_0` is `input`.
+    errors: [T; P],
+    /// `y_n` of the last sample, the order-0 error.
+    input: T,
+    /// Reflection coefficients of the last `P` samples, newest at `head`.
+    ring_kf: [[T; P]; P],
+    ring_kb: [[T; P]; P],
+    head: usize,
+    weight: WeightSum<T>,
+    mean: RunningMean<T>,
+    health: Health,
+    /// The last model handed out, held through a restart.
+    published: Option<ArModel<T, P>>,
+    /// Samples to go before a restarted lattice publishes again.
+    hold: u32,
+}
+
+impl<T: Scalar, const P: usize> Lattice<T, P> {
+    /// A lattice at the initial state of the problem: `F_i = delta lambda^P`,
+    /// `B_i = delta lambda^(P-i)`, zero reflection coefficients, unit conversion factors.
+    pub fn new(config: &Config<T>) -> Self {
+        const { assert!(P > 0, "the model order P must be at least 1") };
+        let mut s = Self {
+            f_energy: [T::ZERO; P],
+            f_energy_p: T::ZERO,
+            b_energy: [T::ZERO; P],
+            kf: [T::ZERO; P],
+            kb: [T::ZERO; P],
+            bp: [T::ZERO; P],
+            gp: [T::ONE; P],
+            gp_p: T::ONE,
+            errors: [T::ZERO; P],
+            input: T::ZERO,
+            ring_kf: [[T::ZERO; P]; P],
+            ring_kb: [[T::ZERO; P]; P],
+            head: 0,
+            weight: WeightSum(T::ZERO),
+            mean: RunningMean::new(),
+            health: Health::default(),
+            published: None,
+            hold: 0,
+        };
+        s.initialise(config);
+        s
+    }
+
+    fn initialise(&mut self, config: &Config<T>) {
+        let f0 = config.delta_lambda_pow(P);
+        self.f_energy = [f0; P];
+        self.f_energy_p = f0;
+        for (i, b) in self.b_energy.iter_mut().enumerate() {
+            *b = config.delta_lambda_pow(P - i);
+        }
+        self.kf = [T::ZERO; P];
+        self.kb = [T::ZERO; P];
+        self.bp = [T::ZERO; P];
+        self.gp = [T::ONE; P];
+        self.gp_p = T::ONE;
+        self.errors = [T::ZERO; P];
+        self.input = T::ZERO;
+        self.ring_kf = [[T::ZERO; P]; P];
+        self.ring_kb = [[T::ZERO; P]; P];
+        self.head = 0;
+        self.weight = WeightSum(T::ZERO);
+        self.mean = RunningMean::new();
+    }
+
+    /// Takes one sample and returns the a-priori order-`P` prediction error `x_n - xhat_n`.
+    ///
+    /// Returns `None` when the sample was rejected (NaN, infinite or saturated: counted in
+    /// [`Lattice::health`], the state is unchanged) or when it broke the recursion down, which
+    /// re-initialises the lattice (counted as a restart).
+    pub fn update(&mut self, config: &Config<T>, x: T) -> Option<T> {
+        if let Err(why) = config.screen(x) {
+            self.health.reject(why);
+            return None;
+        }
+        self.health.samples += 1;
+        self.hold = self.hold.saturating_sub(1);
+        let lambda = config.lambda();
+        let y = if config.demean() {
+            self.mean.center(lambda, x)
+        } else {
+            x
+        };
+        self.weight.push(lambda);
+
+        let tiny = T::from_f64(1e-30);
+        let (mut f, mut psi, mut g) = (y, y, T::ONE);
+        let mut check = T::ZERO;
+        for i in 0..P {
+            let gf = self.gp[i] * f;
+            let fe = floor(lambda * self.f_energy[i] + gf * f, tiny);
+            let f_next = f - self.kf[i] * self.bp[i];
+            let psi_next = self.bp[i] - self.kb[i] * f;
+            self.kf[i] += self.gp[i] * self.bp[i] * f_next / self.b_energy[i];
+            self.kb[i] += gf * psi_next / fe;
+            let gpsi = g * psi;
+            let be = floor(lambda * self.b_energy[i] + gpsi * psi, tiny);
+            let g_next = clamp_unit(g - gpsi * gpsi / be);
+            self.f_energy[i] = fe;
+            self.b_energy[i] = be;
+            self.bp[i] = psi;
+            self.gp[i] = g;
+            self.errors[i] = f_next;
+            check += self.kf[i] + self.kb[i] + fe + be;
+            f = f_next;
+            psi = psi_next;
+            g = g_next;
+        }
+        self.f_energy_p = floor(lambda * self.f_energy_p + self.gp_p * f * f, tiny);
+        self.gp_p = g;
+        self.input = y;
+        check += self.f_energy_p;
+
+        if !check.is_finite() {
+            self.restart(config);
+            return None;
+        }
+        self.head = if self.head == 0 { P - 1 } else { self.head - 1 };
+        self.ring_kf[self.head] = self.kf;
+        self.ring_kb[self.head] = self.kb;
+        Some(f)
+    }
+
+    fn restart(&mut self, config: &Config<T>) {
+        self.health.restarts += 1;
+        self.initialise(config);
+        let lambda = config.lambda().to_f64();
+        let memory = if lambda < 1.0 {
+            3.0 / (1.0 - lambda)
+        } else {
+            3.0e6
+        };
+        self.hold = if memory < u32::MAX as f64 {
+            memory as u32
+        } else {
+            u32::MAX
+        };
+    }
+
+    /// A-priori forward prediction errors `f_1(n)..f_P(n)` of the last accepted sample
+    /// (`f_m(n) = y_n - a^(m)_{n-1}^T phi_n`); `f_0(n) = y_n` is [`Lattice::input`].
+    pub fn errors(&self) -> &[T; P] {
+        &self.errors
+    }
+
+    /// The last accepted sample after mean removal, `y_n` (the order-0 prediction error).
+    pub fn input(&self) -> T {
+        self.input
+    }
+
+    /// Forward energy `F_m(n) = min J^(m)_n + delta lambda^(n+P)` of order `m` in `0..=P`;
+    /// `None` above `P`.
+    pub fn energy(&self, m: usize) -> Option<T> {
+        if m == P {
+            Some(self.f_energy_p)
+        } else {
+            self.f_energy.get(m).copied()
+        }
+    }
+
+    /// Innovation variance of order `m`: `F_m(n) / W_n`, `W_n = sum_{i<=n} lambda^(n-i)`
+    /// (`= F_m (1 - lambda)/(1 - lambda^n)`); `None` above `P` or before the first sample.
+    pub fn innovation_variance(&self, m: usize) -> Option<T> {
+        let w = self.weight.0;
+        (w > T::ZERO).then_some(())?;
+        self.energy(m).map(|e| e / w)
+    }
+
+    /// Forward reflection coefficients `kf_1..kf_P` (lattice sign: `kf_1 = a_1` of the
+    /// order-1 model, minus the error-filter reflection coefficient).
+    pub fn forward_reflection(&self) -> &[T; P] {
+        &self.kf
+    }
+
+    /// Backward reflection coefficients `kb_1..kb_P`.
+    pub fn backward_reflection(&self) -> &[T; P] {
+        &self.kb
+    }
+
+    /// The weighted running mean removed from the input (0 without mean removal).
+    pub fn mean(&self) -> T {
+        self.mean.mean()
+    }
+
+    /// What happened to the samples so far.
+    pub fn health(&self) -> Health {
+        self.health
+    }
+
+    /// The exact least-squares coefficients `a_1..a_m` of order `m <= P` after the last
+    /// sample (entries past `m` are zero), from the reflection coefficients of the last `m`
+    /// samples by the order updates
+    ///
+    /// ```text
+    /// A_m(n) = [A_{m-1}(n); 0] - kf_m(n) [0; B_{m-1}(n-1)]
+    /// B_m(n) = [0; B_{m-1}(n-1)] - kb_m(n) [A_{m-1}(n); 0]
+    /// ```
+    ///
+    /// with `A_m = [1, -a^(m)]`. `O(m^3/3)` operations, no allocation; `None` for `m > P`.
+    pub fn coefficients(&self, m: usize) -> Option<[T; P]> {
+        if m > P {
+            return None;
+        }
+        // slots[j][..j]: the leading j coefficients of B_j (its last one is 1) at the time
+        // being built; alpha: the tail of A_k (its first one is 1).
+        let mut slots = [[T::ZERO; P]; P];
+        let mut alpha = [T::ZERO; P];
+        for t in (0..m).rev() {
+            let slot = (self.head + t) % P;
+            let (kf, kb) = (&self.ring_kf[slot], &self.ring_kb[slot]);
+            let top = m - t;
+            alpha = [T::ZERO; P];
+            // B_{k-1}(n-t-1), read from the slot before this time step overwrites it.
+            let mut b_prev = [T::ZERO; P];
+            for k in 1..=top {
+                let saved = if k < P { slots[k] } else { [T::ZERO; P] };
+                let b_full_prev = |i: usize| if i + 1 == k { T::ONE } else { b_prev[i] };
+                if t > 0 {
+                    // B_k(n-t), needed by the next newer time step (k <= top <= P - 1 here).
+                    for i in 0..k {
+                        let shifted = if i == 0 { T::ZERO } else { b_full_prev(i - 1) };
+                        let a_full = if i == 0 { T::ONE } else { alpha[i - 1] };
+                        slots[k][i] = shifted - kb[k - 1] * a_full;
+                    }
+                }
+                for (j, aj) in alpha[..k].iter_mut().enumerate() {
+                    *aj -= kf[k - 1] * b_full_prev(j);
+                }
+                b_prev = saved;
+            }
+        }
+        Some(alpha.map(|v| -v))
+    }
+
+    /// The order-`P` model after the last sample: coefficients, innovation variance
+    /// `F_P / W_n`, the running mean and `dt`. Returns the last good model while a restarted
+    /// lattice settles, and `None` before the first sample or if no finite model exists yet.
+    pub fn model(&mut self, config: &Config<T>) -> Option<ArModel<T, P>> {
+        if self.hold == 0 {
+            let a = self.coefficients(P)?;
+            let variance = self.innovation_variance(P)?;
+            if let Ok(m) = ArModel::new(a, variance, self.mean(), config.dt()) {
+                self.published = Some(m);
+            }
+        }
+        self.published
+    }
+}
+
+#[inline]
+fn floor<T: Scalar>(x: T, min: T) -> T {
+    if x > min { x } else { min }
+}
+
+#[inline]
+fn clamp_unit<T: Scalar>(g: T) -> T {
+    if g > T::ONE {
+        T::ONE
+    } else if g > T::ZERO {
+        g
+    } else {
+        T::ZERO
+    }
+}

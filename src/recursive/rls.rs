@@ -1,0 +1,214 @@
+//! Conventional recursive least squares, `O(P^2)` per sample, in Bierman's U-D form.
+
+use super::{Config, Health, RunningMean, WeightSum};
+use crate::{ArModel, Scalar};
+
+/// The initial inverse correlation matrix `P_0` of [`Rls`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum RlsInit {
+    /// `P_0 = (delta D)^-1`, `D = diag(lambda^(P-1), .., 1)`: the exact problem of the
+    /// [module docs](super), the one the lattice solves.
+    #[default]
+    ShiftConsistent,
+    /// `P_0 = I / delta`: the textbook ridge start, weight `delta lambda^n ||a||^2`
+    /// (Haykin, *Adaptive Filter Theory*, RLS chapter).
+    Ridge,
+}
+
+/// Exponentially weighted recursive least-squares AR estimator, `O(P^2)` per sample.
+///
+/// Per sample, with `phi_n = [y_{n-1} .. y_{n-P}]`:
+///
+/// ```text
+/// e_n   = y_n - a^T phi_n                       a-priori error
+/// k_n   = P phi_n / (lambda + phi_n^T P phi_n)  gain
+/// a    <- a + k_n e_n
+/// P    <- (P - k_n phi_n^T P) / lambda
+/// ```
+///
+/// `P` is kept as `U D U^T` (unit upper-triangular `U`, diagonal `D`) and updated by Bierman's
+/// square-root-free algorithm (Bierman 1977, *Factorization Methods for Discrete Sequential
+/// Estimation*), about `1.5 P^2` multiplications. This form keeps `P` symmetric and positive
+/// definite by construction: the textbook `P <- (P - k (P phi)^T)/lambda` loses positive
+/// definiteness even in `f64` on quantised, weakly exciting sensor records (numerics.md
+/// section 3), which is exactly the data this crate sees.
+///
+/// The innovation variance is `E_n / W_n` with `E_n = lambda E_{n-1} + e_n eps_n` (a-priori
+/// times a-posteriori error, `E_0 = delta lambda^P`) and `W_n = sum lambda^(n-i)`.
+///
+/// Safeguards: a non-finite or non-positive factor re-initialises the state (counted in
+/// [`Health::restarts`]) while [`Rls::model`] returns the last good model for `3/(1-lambda)`
+/// samples.
+#[derive(Clone, Copy, Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Rls<T, const P: usize> {
+    a: [T; P],
+    /// Strictly upper part of `U`.
+    u: [[T; P]; P],
+    d: [T; P],
+    /// `y_{n-1} .. y_{n-P}` for the next sample.
+    phi: [T; P],
+    energy: T,
+    error: T,
+    weight: WeightSum<T>,
+    mean: RunningMean<T>,
+    init: RlsInit,
+    health: Health,
+    published: Option<ArModel<T, P>>,
+    hold: u32,
+}
+
+impl<T: Scalar, const P: usize> Rls<T, P> {
+    /// A state at `a = 0` with the chosen `P_0`.
+    pub fn new(config: &Config<T>, init: RlsInit) -> Self {
+        const { assert!(P > 0, "the model order P must be at least 1") };
+        let mut s = Self {
+            a: [T::ZERO; P],
+            u: [[T::ZERO; P]; P],
+            d: [T::ZERO; P],
+            phi: [T::ZERO; P],
+            energy: T::ZERO,
+            error: T::ZERO,
+            weight: WeightSum(T::ZERO),
+            mean: RunningMean::new(),
+            init,
+            health: Health::default(),
+            published: None,
+            hold: 0,
+        };
+        s.initialise(config);
+        s
+    }
+
+    fn initialise(&mut self, config: &Config<T>) {
+        self.a = [T::ZERO; P];
+        self.u = [[T::ZERO; P]; P];
+        for (k, d) in self.d.iter_mut().enumerate() {
+            *d = match self.init {
+                RlsInit::ShiftConsistent => T::ONE / config.delta_lambda_pow(P - 1 - k),
+                RlsInit::Ridge => T::ONE / config.delta(),
+            };
+        }
+        self.phi = [T::ZERO; P];
+        self.energy = config.delta_lambda_pow(P);
+        self.error = T::ZERO;
+        self.weight = WeightSum(T::ZERO);
+        self.mean = RunningMean::new();
+    }
+
+    /// Takes one sample and returns the a-priori prediction error `x_n - xhat_n`.
+    ///
+    /// Returns `None` when the sample was rejected (NaN, infinite or saturated: counted, the
+    /// state is unchanged) or broke the recursion down (re-initialised, counted as a restart).
+    // Bierman's algorithm reads best with the indices of its published form.
+    #[allow(clippy::needless_range_loop)]
+    pub fn update(&mut self, config: &Config<T>, x: T) -> Option<T> {
+        if let Err(why) = config.screen(x) {
+            self.health.reject(why);
+            return None;
+        }
+        self.health.samples += 1;
+        self.hold = self.hold.saturating_sub(1);
+        let lambda = config.lambda();
+        let y = if config.demean() {
+            self.mean.center(lambda, x)
+        } else {
+            x
+        };
+        let e = self
+            .a
+            .iter()
+            .zip(&self.phi)
+            .fold(y, |e, (&a, &p)| e - a * p);
+
+        // Bierman's update of U D U^T with measurement variance lambda, then D /= lambda.
+        let mut f = self.phi;
+        for j in 1..P {
+            for i in 0..j {
+                f[j] += self.u[i][j] * self.phi[i];
+            }
+        }
+        let v: [T; P] = core::array::from_fn(|j| self.d[j] * f[j]);
+        let mut gain = [T::ZERO; P];
+        let mut alpha = lambda + v[0] * f[0];
+        let mut healthy = alpha > T::ZERO;
+        self.d[0] = self.d[0] * lambda / alpha;
+        gain[0] = v[0];
+        for j in 1..P {
+            let beta = alpha;
+            alpha += v[j] * f[j];
+            let mu = -f[j] / beta;
+            self.d[j] = self.d[j] * beta / alpha;
+            gain[j] = v[j];
+            for i in 0..j {
+                let t = self.u[i][j];
+                self.u[i][j] = t + gain[i] * mu;
+                gain[i] += v[j] * t;
+            }
+        }
+        let mut check = T::ZERO;
+        for k in 0..P {
+            self.a[k] += gain[k] / alpha * e;
+            self.d[k] = self.d[k] / lambda;
+            healthy &= self.d[k] > T::ZERO;
+            check += self.a[k] + self.d[k];
+        }
+        // a-posteriori error eps = e lambda / alpha
+        self.energy = lambda * self.energy + e * (e * lambda / alpha);
+        check += self.energy;
+        if !(healthy && check.is_finite()) {
+            self.health.restarts += 1;
+            self.initialise(config);
+            let lam = lambda.to_f64();
+            let memory = if lam < 1.0 { 3.0 / (1.0 - lam) } else { 3.0e6 };
+            self.hold = if memory < u32::MAX as f64 {
+                memory as u32
+            } else {
+                u32::MAX
+            };
+            return None;
+        }
+        self.weight.push(lambda);
+        self.phi.copy_within(0..P - 1, 1);
+        self.phi[0] = y;
+        self.error = e;
+        Some(e)
+    }
+
+    /// The coefficients `a_1..a_P` after the last sample.
+    pub fn coefficients(&self) -> &[T; P] {
+        &self.a
+    }
+
+    /// The last a-priori prediction error.
+    pub fn error(&self) -> T {
+        self.error
+    }
+
+    /// Innovation variance `E_n / W_n`; `None` before the first sample.
+    pub fn innovation_variance(&self) -> Option<T> {
+        (self.weight.0 > T::ZERO).then(|| self.energy / self.weight.0)
+    }
+
+    /// The weighted running mean removed from the input (0 without mean removal).
+    pub fn mean(&self) -> T {
+        self.mean.mean()
+    }
+
+    /// What happened to the samples so far.
+    pub fn health(&self) -> Health {
+        self.health
+    }
+
+    /// The model after the last sample; the last good one while a restarted state settles.
+    pub fn model(&mut self, config: &Config<T>) -> Option<ArModel<T, P>> {
+        if self.hold == 0 {
+            let variance = self.innovation_variance()?;
+            if let Ok(m) = ArModel::new(self.a, variance, self.mean(), config.dt()) {
+                self.published = Some(m);
+            }
+        }
+        self.published
+    }
+}
