@@ -37,19 +37,26 @@ use crate::{ArModel, Scalar};
 ///
 /// ```
 /// use imu_ar::recursive::{Config, Lattice};
+/// use imu_ar::{ArModel, sim::ArSimulator};
+/// # struct Lcg(u64);
+/// # impl rand_core::RngCore for Lcg {
+/// #     fn next_u32(&mut self) -> u32 { (self.next_u64() >> 32) as u32 }
+/// #     fn next_u64(&mut self) -> u64 { self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407); self.0 }
+/// #     fn fill_bytes(&mut self, d: &mut [u8]) { rand_core::impls::fill_bytes_via_next(self, d) }
+/// # }
 ///
-/// let config = Config::new(0.99f32, 0.1, 0.01).unwrap().with_demean(false);
+/// let truth = ArModel::new([1.2f32, -0.5], 1.0, 0.0, 0.01).unwrap();
+/// let mut sensor = ArSimulator::new(truth);
+/// let mut rng = Lcg(7);
+///
+/// let config = Config::new(0.999f32, 0.1, 0.01).unwrap();
 /// let mut lattice = Lattice::<f32, 2>::new(&config);
-/// let mut x = [0.0f32; 2];
-/// for n in 0..2000 {
-///     // x[n] = 1.2 x[n-1] - 0.5 x[n-2] + w, w from a fixed pseudo-random sequence
-///     let w = ((n * 7919 % 1000) as f32 / 1000.0) - 0.5;
-///     let xn = 1.2 * x[0] - 0.5 * x[1] + w;
-///     lattice.update(&config, xn);
-///     x = [xn, x[0]];
+/// for _ in 0..20_000 {
+///     lattice.update(&config, sensor.next(&mut rng));
 /// }
 /// let model = lattice.model(&config).unwrap();
 /// assert!((model.a()[0] - 1.2).abs() < 0.05 && (model.a()[1] + 0.5).abs() < 0.05);
+/// assert_eq!(lattice.health().restarts, 0);
 /// ```
 #[derive(Clone, Copy, Debug)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
