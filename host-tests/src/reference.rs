@@ -102,13 +102,17 @@ impl Section0 {
 
     /// Takes the next sample `y_n`.
     pub fn push(&mut self, y: f64) {
-        let phi = DVector::from_column_slice(&self.phi);
-        self.r = &self.r * self.lambda + &phi * phi.transpose();
-        self.b = &self.b * self.lambda + &phi * y;
-        self.yy = self.yy * self.lambda + y * y;
+        let (lambda, p) = (self.lambda, self.p);
+        for i in 0..p {
+            for j in 0..p {
+                self.r[(i, j)] = lambda * self.r[(i, j)] + self.phi[i] * self.phi[j];
+            }
+            self.b[i] = lambda * self.b[i] + self.phi[i] * y;
+        }
+        self.yy = lambda * self.yy + y * y;
         self.phi.rotate_right(1);
         self.phi[0] = y;
-        self.lambda_n *= self.lambda;
+        self.lambda_n *= lambda;
         self.n += 1;
     }
 

@@ -10,10 +10,20 @@ use crate::Scalar;
 /// bias otherwise drives `a_1` towards 1 (numerics.md section 2.4). The sample is centred with
 /// the mean *before* it (`y_n = x_n - m_{n-1}`, `m_0 = x_1`), so the a-priori prediction error of
 /// `y` is that of `x` and the prediction `xhat_n = m_{n-1} + yhat_n` is causal.
+///
+/// The mean is held as `x_1 + c`, and `c` tracks the mean of `x - x_1`: a sensor's offset is
+/// usually much larger than its noise (an accelerometer axis at -1 g with 4 mg of noise), and
+/// in `f32` the increments `y_n / W_n` of a mean held directly would be rounded to the grid of
+/// the offset (ulp(1) = 1.2e-7 against increments of 4e-7 at `lambda = 0.9999`). Measured on
+/// the ADIS16405 `az` record, order 8, `lambda = 0.9999`: the held-directly mean cost 7.4e-4 in
+/// the coefficients, this form 1.5e-6.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct RunningMean<T> {
-    mean: T,
+    /// `x_1`.
+    origin: T,
+    /// Weighted mean of `x - x_1`.
+    offset: T,
     weight: WeightSum<T>,
     started: bool,
 }
@@ -22,7 +32,8 @@ impl<T: Scalar> RunningMean<T> {
     /// No samples yet; the mean is 0 until the first.
     pub fn new() -> Self {
         Self {
-            mean: T::ZERO,
+            origin: T::ZERO,
+            offset: T::ZERO,
             weight: WeightSum(T::ZERO),
             started: false,
         }
@@ -30,7 +41,7 @@ impl<T: Scalar> RunningMean<T> {
 
     /// The current mean.
     pub fn mean(&self) -> T {
-        self.mean
+        self.origin + self.offset
     }
 
     /// Centres `x` with the mean before it and then takes `x` into the mean.
@@ -45,12 +56,12 @@ impl<T: Scalar> RunningMean<T> {
     /// ```
     pub fn center(&mut self, lambda: T, x: T) -> T {
         if !self.started {
-            self.mean = x;
+            self.origin = x;
             self.started = true;
         }
-        let y = x - self.mean;
+        let y = (x - self.origin) - self.offset;
         self.weight.push(lambda);
-        self.mean += y / self.weight.0;
+        self.offset += y / self.weight.0;
         y
     }
 }
