@@ -196,7 +196,8 @@ impl<T: Scalar, const P: usize> Lattice<T, P> {
             self.restart(config);
             return None;
         }
-        self.head = if self.head == 0 { P - 1 } else { self.head - 1 };
+        // `% P` keeps the index provably in range: no bounds check on the per-sample path.
+        self.head = (self.head + P - 1) % P;
         self.ring_kf[self.head] = self.kf;
         self.ring_kb[self.head] = self.kb;
         Some(f)
@@ -289,23 +290,29 @@ impl<T: Scalar, const P: usize> Lattice<T, P> {
         for t in (0..m).rev() {
             let slot = (self.head + t) % P;
             let (kf, kb) = (&self.ring_kf[slot], &self.ring_kb[slot]);
-            let top = m - t;
             alpha = [T::ZERO; P];
             // B_{k-1}(n-t-1), read from the slot before this time step overwrites it.
             let mut b_prev = [T::ZERO; P];
-            for k in 1..=top {
-                let saved = if k < P { slots[k] } else { [T::ZERO; P] };
-                let b_full_prev = |i: usize| if i + 1 == k { T::ONE } else { b_prev[i] };
-                if t > 0 {
-                    // B_k(n-t), needed by the next newer time step (k <= top <= P - 1 here).
-                    for i in 0..k {
+            let stages = kf.iter().zip(kb).take(m - t);
+            for (k, (&kf_k, &kb_k)) in (1..).zip(stages) {
+                let saved = slots.get(k).copied().unwrap_or([T::ZERO; P]);
+                let b_full_prev = |i: usize| match i + 1 == k {
+                    true => T::ONE,
+                    false => b_prev.get(i).copied().unwrap_or(T::ZERO),
+                };
+                if let (true, Some(dst)) = (t > 0, slots.get_mut(k)) {
+                    // B_k(n-t), needed by the next newer time step.
+                    for (i, d) in dst.iter_mut().enumerate().take(k) {
                         let shifted = if i == 0 { T::ZERO } else { b_full_prev(i - 1) };
-                        let a_full = if i == 0 { T::ONE } else { alpha[i - 1] };
-                        slots[k][i] = shifted - kb[k - 1] * a_full;
+                        let a_full = match i.checked_sub(1) {
+                            None => T::ONE,
+                            Some(j) => alpha.get(j).copied().unwrap_or(T::ZERO),
+                        };
+                        *d = shifted - kb_k * a_full;
                     }
                 }
-                for (j, aj) in alpha[..k].iter_mut().enumerate() {
-                    *aj -= kf[k - 1] * b_full_prev(j);
+                for (j, aj) in alpha.iter_mut().enumerate().take(k) {
+                    *aj -= kf_k * b_full_prev(j);
                 }
                 b_prev = saved;
             }

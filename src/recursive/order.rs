@@ -70,7 +70,7 @@ impl<T: Scalar, const P: usize> OrderSelector<T, P> {
         for (pi, &f) in self.pls.iter_mut().zip(lattice.errors()) {
             *pi = lambda * *pi + f * f;
         }
-        self.countdown -= 1;
+        self.countdown = self.countdown.saturating_sub(1);
         if self.countdown > 0 {
             return self.selected;
         }
