@@ -32,8 +32,7 @@ mod firmware {
 
     #[exception]
     unsafe fn HardFault(_: &ExceptionFrame) -> ! {
-        debug::exit(debug::EXIT_FAILURE);
-        loop {}
+        debug_exit(false)
     }
 
     fn exercise<const P: usize>(config: &Config<f32>, x: &[f32]) -> bool {
@@ -96,7 +95,9 @@ mod firmware {
         } else {
             debug::EXIT_FAILURE
         });
-        loop {}
+        loop {
+            cortex_m::asm::bkpt();
+        }
     }
 }
 
