@@ -1,10 +1,12 @@
 //! `imu-ar`: characterise a recorded sensor log with the library's estimators.
 //!
 //! ```text
-//! imu-ar fit FILE.. --column C --method ls|yule-walker|burg --order P [--no-demean] [--rate HZ] [--json]
+//! imu-ar fit FILE.. --column C --method ls|yule-walker|burg|rls|lattice --order P
+//!     [--scalar f64|f32] [--lambda L] [--delta D] [--no-demean] [--rate HZ] [--json]
+//! imu-ar compare FILE.. --column C --order P [--lambda L] [--delta D] [--train F] [--json]
 //! imu-ar order FILE.. --column C --max-order P --method ls|yule-walker|burg [--no-demean] [--json]
 //! imu-ar adev FILE.. --column C --rate HZ [--json]
-//! imu-ar simulate --a A1,A2,.. --sigma S --n N --seed K [--rate HZ] [--burn-in B]
+//! imu-ar simulate --a A1,A2,.. [--a-end B1,B2,..] --sigma S --n N --seed K [--rate HZ] [--burn-in B]
 //! ```
 //!
 //! Several files are read as one record, in order. Bad input exits with status 2 and one line
@@ -18,7 +20,8 @@ use clap::{Parser, Subcommand, ValueEnum};
 use imu_ar::allan::overlapping_avar;
 use imu_ar::batch::criteria::Criterion;
 use imu_ar::batch::{BatchConfig, BatchError, Fit, burg, covariance, yule_walker};
-use imu_ar::sim::ArSimulator;
+use imu_ar::recursive::{Config, Lattice, Rls, RlsInit};
+use imu_ar::sim::StandardNormal;
 use imu_ar::{ArModel, Scalar};
 use imu_ar_host::data::read_column;
 use rand_chacha::ChaCha8Rng;
@@ -30,6 +33,16 @@ const MAX_ORDER: usize = 32;
 
 /// Calls `$f::<P>($args..)` with the const `P` equal to the runtime order `$p` (1..=32).
 macro_rules! with_order {
+    ($p:expr, $f:ident :: < $t:ty > $args:tt) => {
+        with_order!(@typed $p, $f, $t, $args;
+            1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31 32)
+    };
+    (@typed $p:expr, $f:ident, $t:ty, $args:tt; $($n:literal)*) => {
+        match $p {
+            $($n => $f::<$t, $n> $args,)*
+            p => unreachable!("order {p} was checked against MAX_ORDER"),
+        }
+    };
     ($p:expr, $f:ident $args:tt) => {
         with_order!(@arms $p, $f $args;
             1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31 32)
@@ -61,6 +74,10 @@ enum Method {
     YuleWalker,
     /// Burg.
     Burg,
+    /// Conventional RLS (Bierman U-D), model after the last sample.
+    Rls,
+    /// EF-LSL lattice, model after the last sample.
+    Lattice,
 }
 
 impl Method {
@@ -69,9 +86,33 @@ impl Method {
             Method::Ls => "ls",
             Method::YuleWalker => "yule-walker",
             Method::Burg => "burg",
+            Method::Rls => "rls",
+            Method::Lattice => "lattice",
+        }
+    }
+
+    fn recursive(self) -> bool {
+        matches!(self, Method::Rls | Method::Lattice)
+    }
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum ScalarKind {
+    F64,
+    F32,
+}
+
+impl ScalarKind {
+    fn name(self) -> &'static str {
+        match self {
+            ScalarKind::F64 => "f64",
+            ScalarKind::F32 => "f32",
         }
     }
 }
+
+/// The default forgetting factor of the recursive methods.
+const DEFAULT_LAMBDA: f64 = 0.999;
 
 #[derive(Subcommand)]
 enum Command {
@@ -89,12 +130,47 @@ enum Command {
         /// Model order, 1 to 32.
         #[arg(long)]
         order: usize,
-        /// Fit the data as they are, without removing the sample mean.
+        /// Arithmetic of the recursive methods (the batch fits compute in f64).
+        #[arg(long, value_enum, default_value = "f64")]
+        scalar: ScalarKind,
+        /// Forgetting factor of the recursive methods, in (0, 1].
+        #[arg(long, default_value_t = DEFAULT_LAMBDA, allow_negative_numbers = true)]
+        lambda: f64,
+        /// Initial regularisation of the recursive methods [default: 0.1 x the variance of the
+        /// first 1000 samples, or 1 when that is 0].
+        #[arg(long, allow_negative_numbers = true)]
+        delta: Option<f64>,
+        /// Fit the data as they are, without removing the (sample or running) mean.
         #[arg(long)]
         no_demean: bool,
         /// Sample rate in Hz; gives the model its time scale.
         #[arg(long, allow_negative_numbers = true)]
         rate: Option<f64>,
+        /// Print one JSON object.
+        #[arg(long)]
+        json: bool,
+    },
+    /// One-step prediction error of a batch LS fit on the training part against RLS and the
+    /// lattice running over the whole record, on the evaluation part.
+    Compare {
+        /// CSV files with a header row, read as one record.
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// Column name.
+        #[arg(long)]
+        column: String,
+        /// Model order, 1 to 32.
+        #[arg(long)]
+        order: usize,
+        /// Forgetting factor, in (0, 1].
+        #[arg(long, default_value_t = DEFAULT_LAMBDA, allow_negative_numbers = true)]
+        lambda: f64,
+        /// Initial regularisation [default: as for `fit`].
+        #[arg(long, allow_negative_numbers = true)]
+        delta: Option<f64>,
+        /// Fraction of the record the batch model is fitted on, in (0, 1).
+        #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
+        train: f64,
         /// Print one JSON object.
         #[arg(long)]
         json: bool,
@@ -160,6 +236,10 @@ enum Command {
         /// Samples drawn and discarded first.
         #[arg(long, default_value_t = 1000)]
         burn_in: usize,
+        /// Coefficients at the last sample: they move linearly from `--a` to these over the
+        /// record (a drifting process; burn-in uses `--a`).
+        #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+        a_end: Option<Vec<f64>>,
     },
 }
 
@@ -213,6 +293,9 @@ fn run(command: Command) -> Result<String, Fail> {
             column,
             method,
             order,
+            scalar,
+            lambda,
+            delta,
             no_demean,
             rate,
             json,
@@ -222,14 +305,73 @@ fn run(command: Command) -> Result<String, Fail> {
                 Some(r) => 1.0 / check_rate(r)?,
                 None => 1.0,
             };
+            check_lambda(lambda)?;
+            if let Some(d) = delta {
+                check_delta(d)?;
+            }
             let x = read_column(&files, &column)?;
-            let config = BatchConfig::new(dt)?.with_demean(!no_demean);
-            let fit = with_order!(order, fit_json(method, &x, &config, rate))
-                .map_err(|e| with_file(&files, e))?;
+            let fit = if method.recursive() {
+                let delta = delta.unwrap_or_else(|| default_delta(&x));
+                let r = Recursive {
+                    method,
+                    scalar,
+                    lambda,
+                    delta,
+                    demean: !no_demean,
+                    dt,
+                    rate,
+                };
+                match scalar {
+                    ScalarKind::F64 => with_order!(order, recursive_fit::<f64>(&x, &r)),
+                    ScalarKind::F32 => with_order!(order, recursive_fit::<f32>(&x, &r)),
+                }
+                .map_err(|Fail(e)| with_file(&files, e))?
+            } else {
+                let config = BatchConfig::new(dt)?.with_demean(!no_demean);
+                with_order!(order, fit_json(method, &x, &config, rate))
+                    .map_err(|e| with_file(&files, e))?
+            };
             Ok(if json {
                 format!("{fit}\n")
             } else {
                 fit_text(&fit)
+            })
+        }
+        Command::Compare {
+            files,
+            column,
+            order,
+            lambda,
+            delta,
+            train,
+            json,
+        } => {
+            check_order("--order", order)?;
+            check_lambda(lambda)?;
+            if let Some(d) = delta {
+                check_delta(d)?;
+            }
+            if !(train > 0.0 && train < 1.0) {
+                return Err(Fail(format!("--train {train}: must be in (0, 1)")));
+            }
+            let x = read_column(&files, &column)?;
+            let delta = delta.unwrap_or_else(|| default_delta(&x));
+            let v = with_order!(order, compare(&x, lambda, delta, train))
+                .map_err(|Fail(e)| with_file(&files, e))?;
+            Ok(if json {
+                format!("{v}\n")
+            } else {
+                format!(
+                    "AR({order}), lambda {lambda}: training {} samples, evaluation {}\n\
+                     one-step prediction MSE: batch LS {}, RLS {}, lattice {}\n\
+                     lattice against batch: {:.1} % lower\n",
+                    v["n_train"],
+                    v["n_eval"],
+                    v["batch_mse"],
+                    v["rls_mse"],
+                    v["lattice_mse"],
+                    v["reduction_percent"].as_f64().unwrap_or(f64::NAN)
+                )
             })
         }
         Command::Order {
@@ -241,6 +383,12 @@ fn run(command: Command) -> Result<String, Fail> {
             json,
         } => {
             check_order("--max-order", max_order)?;
+            if method.recursive() {
+                return Err(Fail(format!(
+                    "--method {}: order criteria need a batch method (ls, yule-walker, burg)",
+                    method.name()
+                )));
+            }
             let x = read_column(&files, &column)?;
             let config = BatchConfig::new(1.0)?.with_demean(!no_demean);
             let report = with_order!(max_order, order_json(method, &x, &config))
@@ -291,13 +439,31 @@ fn run(command: Command) -> Result<String, Fail> {
             seed,
             rate,
             burn_in,
+            a_end,
         } => {
             check_order("--a (number of coefficients)", a.len())?;
             let rate = check_rate(rate)?;
             if !(sigma.is_finite() && sigma >= 0.0) {
                 return Err(Fail(format!("--sigma {sigma}: must be finite and >= 0")));
             }
-            with_order!(a.len(), simulate(&a, sigma, n, seed, rate, burn_in))
+            let a_end = a_end.unwrap_or_else(|| a.clone());
+            if a_end.len() != a.len() {
+                return Err(Fail(format!(
+                    "--a-end has {} coefficients, --a has {}",
+                    a_end.len(),
+                    a.len()
+                )));
+            }
+            let sim = Simulation {
+                a: &a,
+                a_end: &a_end,
+                sigma,
+                n,
+                seed,
+                rate,
+                burn_in,
+            };
+            with_order!(a.len(), simulate(&sim))
         }
     }
 }
@@ -320,6 +486,31 @@ fn check_rate(rate: f64) -> Result<f64, Fail> {
     Ok(rate)
 }
 
+fn check_lambda(lambda: f64) -> Result<(), Fail> {
+    if !(lambda > 0.0 && lambda <= 1.0) {
+        return Err(Fail(format!("--lambda {lambda}: must be in (0, 1]")));
+    }
+    Ok(())
+}
+
+fn check_delta(delta: f64) -> Result<(), Fail> {
+    if !(delta.is_finite() && delta > 0.0) {
+        return Err(Fail(format!(
+            "--delta {delta}: must be positive and finite"
+        )));
+    }
+    Ok(())
+}
+
+/// 0.1 x the variance of the first 1000 samples (what firmware sees at start-up), or 1 when
+/// that is 0.
+fn default_delta(x: &[f64]) -> f64 {
+    let head = &x[..x.len().min(1000)];
+    let mean = head.iter().sum::<f64>() / head.len() as f64;
+    let var = head.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / head.len() as f64;
+    if var > 0.0 { 0.1 * var } else { 1.0 }
+}
+
 fn with_file(files: &[PathBuf], e: impl std::fmt::Display) -> Fail {
     let names: Vec<String> = files.iter().map(|f| f.display().to_string()).collect();
     Fail(format!("{}: {e}", names.join("+")))
@@ -334,7 +525,122 @@ fn batch_fit<const P: usize>(
         Method::Ls => covariance::<f64, P>(x, config),
         Method::YuleWalker => yule_walker::<f64, P>(x, config),
         Method::Burg => burg::<f64, P>(x, config),
+        Method::Rls | Method::Lattice => unreachable!("recursive methods go to recursive_fit"),
     }
+}
+
+/// The settings of a recursive fit.
+struct Recursive {
+    method: Method,
+    scalar: ScalarKind,
+    lambda: f64,
+    delta: f64,
+    demean: bool,
+    dt: f64,
+    rate: Option<f64>,
+}
+
+/// Runs RLS or the lattice in `T` over `x` and reports the model after the last sample.
+fn recursive_fit<T: Scalar, const P: usize>(x: &[f64], r: &Recursive) -> Result<Value, Fail> {
+    let config = Config::new(
+        T::from_f64(r.lambda),
+        T::from_f64(r.delta),
+        T::from_f64(r.dt),
+    )?
+    .with_demean(r.demean);
+    let (model, health, reflection) = match r.method {
+        Method::Rls => {
+            let mut rls = Rls::<T, P>::new(&config, RlsInit::ShiftConsistent);
+            for &v in x {
+                rls.update(&config, T::from_f64(v));
+            }
+            (rls.model(&config), rls.health(), None)
+        }
+        _ => {
+            let mut lattice = Lattice::<T, P>::new(&config);
+            for &v in x {
+                lattice.update(&config, T::from_f64(v));
+            }
+            let model = lattice.model(&config);
+            let k = model.and_then(|m| m.reflection().ok());
+            (model, lattice.health(), k)
+        }
+    };
+    let model = model.ok_or_else(|| Fail("no finite model".into()))?;
+    let a: Vec<f64> = model.a().iter().map(|v| v.to_f64()).collect();
+    let mut v = json!({
+        "method": r.method.name(),
+        "scalar": r.scalar.name(),
+        "order": P,
+        "n": x.len(),
+        "mean": model.mean().to_f64(),
+        "a": a,
+        "noise_variance": model.noise_variance().to_f64(),
+        "lambda": r.lambda,
+        "delta": r.delta,
+        "restarts": health.restarts,
+    });
+    if let Some(k) = reflection {
+        v["reflection"] = json!(k.iter().map(|v| v.to_f64()).collect::<Vec<_>>());
+    }
+    if let Some(rate) = r.rate {
+        v["rate_hz"] = json!(rate);
+        gauss_markov_json(&mut v, &a, model.noise_variance().to_f64(), r.dt);
+    }
+    Ok(v)
+}
+
+/// Adds `gauss_markov` to a fit's JSON for an AR(1) with `0 < a_1 < 1`.
+fn gauss_markov_json(v: &mut Value, a: &[f64], noise_variance: f64, dt: f64) {
+    let [a1] = a else { return };
+    let Ok(ar1) = ArModel::new([*a1], noise_variance, 0.0, dt) else {
+        return;
+    };
+    if let Ok(gm) = ar1.to_gauss_markov() {
+        v["gauss_markov"] = json!({
+            "correlation_time_s": gm.correlation_time(),
+            "sigma": gm.sigma(),
+        });
+    }
+}
+
+/// One-step prediction MSE on the evaluation part `x[n_train..]`: batch LS fitted on
+/// `x[..n_train]`, RLS and lattice (f64) running over the whole record.
+fn compare<const P: usize>(x: &[f64], lambda: f64, delta: f64, train: f64) -> Result<Value, Fail> {
+    let n_train = (train * x.len() as f64) as usize;
+    let n_eval = x.len() - n_train;
+    if n_eval == 0 {
+        return Err(Fail("the evaluation part is empty".into()));
+    }
+    let batch = covariance::<f64, P>(&x[..n_train], &BatchConfig::new(1.0)?)?.model;
+    let config = Config::new(lambda, delta, 1.0)?;
+    let mut rls = Rls::<f64, P>::new(&config, RlsInit::ShiftConsistent);
+    let mut lattice = Lattice::<f64, P>::new(&config);
+    let (mut batch_se, mut rls_se, mut lattice_se) = (0.0, 0.0, 0.0);
+    for (n, &v) in x.iter().enumerate() {
+        let e_rls = rls.update(&config, v).unwrap_or(f64::NAN);
+        let e_lattice = lattice.update(&config, v).unwrap_or(f64::NAN);
+        if n < n_train {
+            continue;
+        }
+        let past: [f64; P] = core::array::from_fn(|k| x[n - 1 - k]);
+        let e_batch = v - batch.predict(&past);
+        batch_se += e_batch * e_batch;
+        rls_se += e_rls * e_rls;
+        lattice_se += e_lattice * e_lattice;
+    }
+    let m = n_eval as f64;
+    let (batch_mse, rls_mse, lattice_mse) = (batch_se / m, rls_se / m, lattice_se / m);
+    Ok(json!({
+        "order": P,
+        "lambda": lambda,
+        "n_train": n_train,
+        "n_eval": n_eval,
+        "batch_mse": batch_mse,
+        "rls_mse": rls_mse,
+        "lattice_mse": lattice_mse,
+        "reduction_percent": 100.0 * (batch_mse - lattice_mse) / batch_mse,
+    }))
 }
 
 fn fit_json<const P: usize>(
@@ -359,21 +665,8 @@ fn fit_json<const P: usize>(
     }
     if let Some(rate) = rate {
         v["rate_hz"] = json!(rate);
-        if P == 1 {
-            let ar1 = ArModel::new(
-                [model.a()[0]],
-                model.noise_variance(),
-                model.mean(),
-                model.dt(),
-            )
-            .expect("a fitted model is valid");
-            if let Ok(gm) = ar1.to_gauss_markov() {
-                v["gauss_markov"] = json!({
-                    "correlation_time_s": gm.correlation_time(),
-                    "sigma": gm.sigma(),
-                });
-            }
-        }
+        let a: Vec<f64> = model.a().to_vec();
+        gauss_markov_json(&mut v, &a, model.noise_variance(), model.dt());
     }
     Ok(v)
 }
@@ -464,29 +757,53 @@ fn order_text(v: &Value) -> String {
     s
 }
 
-fn simulate<const P: usize>(
-    a: &[f64],
+/// The settings of `imu-ar simulate`.
+struct Simulation<'a> {
+    a: &'a [f64],
+    a_end: &'a [f64],
     sigma: f64,
     n: usize,
     seed: u64,
     rate: f64,
     burn_in: usize,
-) -> Result<String, Fail> {
-    let coeffs: [f64; P] = core::array::from_fn(|k| a[k]);
-    let model = ArModel::new(coeffs, sigma * sigma, 0.0, 1.0 / rate)?;
-    if !model.is_stable() {
-        return Err(Fail(format!(
-            "--a {a:?}: the model is not stationary (a pole on or outside the unit circle)"
-        )));
+}
+
+/// Draws the record: coefficients move linearly from `a` (sample 0) to `a_end` (last sample).
+fn simulate<const P: usize>(sim: &Simulation) -> Result<String, Fail> {
+    let at =
+        |f: f64| -> [f64; P] { core::array::from_fn(|k| sim.a[k] + f * (sim.a_end[k] - sim.a[k])) };
+    // Stationary along the path (checked at 101 points).
+    for i in 0..=100 {
+        let model = ArModel::new(at(i as f64 / 100.0), 1.0, 0.0, 1.0)?;
+        if !model.is_stable() {
+            return Err(Fail(format!(
+                "--a {:?} / --a-end {:?}: the model is not stationary (a pole on or outside the unit circle)",
+                sim.a, sim.a_end
+            )));
+        }
     }
-    let mut sim = ArSimulator::new(model);
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    sim.burn_in(&mut rng, burn_in);
-    let mut s = String::with_capacity(24 * n + 8);
+    let mut rng = ChaCha8Rng::seed_from_u64(sim.seed);
+    let mut normal = StandardNormal::new();
+    let mut past = [0.0f64; P];
+    let mut step = |a: &[f64; P], rng: &mut ChaCha8Rng| -> f64 {
+        let x = a
+            .iter()
+            .zip(&past)
+            .fold(sim.sigma * normal.sample(rng), |x, (a, p)| x + a * p);
+        past.rotate_right(1);
+        past[0] = x;
+        x
+    };
+    let start = at(0.0);
+    for _ in 0..sim.burn_in {
+        step(&start, &mut rng);
+    }
+    let mut s = String::with_capacity(24 * sim.n + 8);
     s += "t_s,x\n";
-    for i in 0..n {
-        let x: f64 = sim.next(&mut rng);
-        s += &format!("{},{}\n", i as f64 / rate, Scalar::to_f64(x));
+    let span = sim.n.saturating_sub(1).max(1) as f64;
+    for i in 0..sim.n {
+        let x = step(&at(i as f64 / span), &mut rng);
+        s += &format!("{},{}\n", i as f64 / sim.rate, x);
     }
     Ok(s)
 }

@@ -366,3 +366,75 @@ fn fits_equal_statsmodels() {
     }
     std::fs::remove_file(file).unwrap();
 }
+
+#[test]
+fn recursive_fits_and_the_drifting_ar2_comparison() {
+    // AR(2) whose a_1 drifts linearly from 1.5 to 1.0 over 100,000 samples (a_2 = -0.7, unit
+    // innovation variance): a batch model fitted on the first half is stale on the second.
+    let out = imu_ar(&[
+        "simulate", "--a", "1.5,-0.7", "--a-end", "1.0,-0.7", "--sigma", "1", "--n", "100000",
+        "--seed", "4", "--rate", "100",
+    ]);
+    assert!(out.status.success());
+    let file = temp_file("drift.csv", &String::from_utf8(out.stdout).unwrap());
+    let f = file.to_str().unwrap();
+    for lambda in ["0.99", "0.999"] {
+        let v = json(&imu_ar(&[
+            "compare", f, "--column", "x", "--order", "2", "--lambda", lambda, "--json",
+        ]));
+        let (batch, rls, lattice) = (
+            v["batch_mse"].as_f64().unwrap(),
+            v["rls_mse"].as_f64().unwrap(),
+            v["lattice_mse"].as_f64().unwrap(),
+        );
+        println!(
+            "lambda {lambda}: batch {batch:.4}, RLS {rls:.4}, lattice {lattice:.4}, {:.1} % lower",
+            v["reduction_percent"]
+        );
+        assert!(lattice < batch && rls < batch, "lambda {lambda}: {v}");
+        assert!(
+            (rls - lattice).abs() < 1e-9 * lattice,
+            "RLS and lattice solve the same problem"
+        );
+        assert_eq!(
+            (v["n_train"].as_u64(), v["n_eval"].as_u64()),
+            (Some(50_000), Some(50_000))
+        );
+    }
+    // The recursive fits report the documented keys; f32 and f64 agree closely.
+    let f64_fit = fit_json(
+        &file,
+        "lattice",
+        "2",
+        &["--lambda", "0.999", "--delta", "0.5"],
+    );
+    let f32_fit = fit_json(
+        &file,
+        "lattice",
+        "2",
+        &["--lambda", "0.999", "--delta", "0.5", "--scalar", "f32"],
+    );
+    let rls_fit = fit_json(&file, "rls", "2", &["--lambda", "0.999", "--delta", "0.5"]);
+    assert_eq!(f32_fit["scalar"], "f32");
+    assert_eq!(
+        (f64_fit["lambda"].as_f64(), f64_fit["delta"].as_f64()),
+        (Some(0.999), Some(0.5))
+    );
+    assert_eq!(f64_fit["restarts"], 0);
+    for k in 0..2 {
+        let (a, b, c) = (
+            f64_fit["a"][k].as_f64().unwrap(),
+            f32_fit["a"][k].as_f64().unwrap(),
+            rls_fit["a"][k].as_f64().unwrap(),
+        );
+        assert!(
+            (a - b).abs() < 1e-4 && (a - c).abs() < 1e-9,
+            "a_{}: {a} {b} {c}",
+            k + 1
+        );
+    }
+    // At the end of the record a_1 is near 1.0, not the 1.25 of a whole-record batch fit.
+    let a1 = f64_fit["a"][0].as_f64().unwrap();
+    assert!((a1 - 1.0).abs() < 0.05, "a_1 = {a1}");
+    std::fs::remove_file(file).unwrap();
+}
