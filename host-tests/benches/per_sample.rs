@@ -19,7 +19,9 @@ fn record<T: Scalar>() -> Vec<T> {
     let model = ArModel::new([1.2f64, -0.5], 1.0, 0.0, 0.01).unwrap();
     let mut sim = ArSimulator::new(model);
     let mut rng = ChaCha8Rng::seed_from_u64(1);
-    (0..BLOCK).map(|_| T::from_f64(sim.next(&mut rng))).collect()
+    (0..BLOCK)
+        .map(|_| T::from_f64(sim.next(&mut rng)))
+        .collect()
 }
 
 fn lattice<T: Scalar, const P: usize>(c: &mut Criterion, name: &str) {

@@ -3,6 +3,11 @@
 use super::{Config, Health, RunningMean, WeightSum};
 use crate::{ArModel, Scalar};
 
+/// Ceiling of the entries of `D`: without excitation (a stuck sensor) `P` grows as
+/// `lambda^-n` and would overflow ("covariance wind-up"); held below this the estimator stays
+/// finite and recovers as soon as the input moves again. Far above any value of a healthy run.
+const D_MAX: f64 = 1e30;
+
 /// The initial inverse correlation matrix `P_0` of [`Rls`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -37,9 +42,10 @@ pub enum RlsInit {
 /// The innovation variance is `E_n / W_n` with `E_n = lambda E_{n-1} + e_n eps_n` (a-priori
 /// times a-posteriori error, `E_0 = delta lambda^P`) and `W_n = sum lambda^(n-i)`.
 ///
-/// Safeguards: a non-finite or non-positive factor re-initialises the state (counted in
-/// [`Health::restarts`]) while [`Rls::model`] returns the last good model for `3/(1-lambda)`
-/// samples.
+/// Safeguards: the entries of `D` are capped at 1e30, so that a stuck sensor (no excitation,
+/// `P` growing as `lambda^-n`) cannot overflow it; a non-finite or non-positive factor
+/// re-initialises the state (counted in [`Health::restarts`]) while [`Rls::model`] returns the
+/// last good model for `3/(1-lambda)` samples.
 #[derive(Clone, Copy, Debug)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Rls<T, const P: usize> {
@@ -148,9 +154,12 @@ impl<T: Scalar, const P: usize> Rls<T, P> {
             }
         }
         let mut check = T::ZERO;
+        let d_max = T::from_f64(D_MAX);
         for k in 0..P {
             self.a[k] += gain[k] / alpha * e;
-            self.d[k] = self.d[k] / lambda;
+            // Without excitation (a stuck sensor) D grows as lambda^-n: cap it.
+            let d = self.d[k] / lambda;
+            self.d[k] = if d > d_max { d_max } else { d };
             healthy &= self.d[k] > T::ZERO;
             check += self.a[k] + self.d[k];
         }
