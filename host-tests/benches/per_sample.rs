@@ -24,7 +24,7 @@ fn record<T: Scalar>() -> Vec<T> {
         .collect()
 }
 
-fn lattice<T: Scalar, const P: usize>(c: &mut Criterion, name: &str) {
+fn lattice<T: imu_ar::recursive::FloatArith, const P: usize>(c: &mut Criterion, name: &str) {
     let x = record::<T>();
     let config = Config::new(T::from_f64(0.999), T::from_f64(0.1), T::from_f64(0.01)).unwrap();
     let mut state = Lattice::<T, P>::new(&config);

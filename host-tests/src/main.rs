@@ -20,7 +20,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use imu_ar::allan::overlapping_avar;
 use imu_ar::batch::criteria::Criterion;
 use imu_ar::batch::{BatchConfig, BatchError, Fit, burg, covariance, yule_walker};
-use imu_ar::recursive::{Config, Lattice, Rls, RlsInit};
+use imu_ar::recursive::{Config, FloatArith, Lattice, Rls, RlsInit};
 use imu_ar::sim::StandardNormal;
 use imu_ar::{ArModel, Scalar};
 use imu_ar_host::data::read_column;
@@ -541,7 +541,7 @@ struct Recursive {
 }
 
 /// Runs RLS or the lattice in `T` over `x` and reports the model after the last sample.
-fn recursive_fit<T: Scalar, const P: usize>(x: &[f64], r: &Recursive) -> Result<Value, Fail> {
+fn recursive_fit<T: FloatArith, const P: usize>(x: &[f64], r: &Recursive) -> Result<Value, Fail> {
     let config = Config::new(
         T::from_f64(r.lambda),
         T::from_f64(r.delta),

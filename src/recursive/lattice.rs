@@ -1,7 +1,158 @@
 //! The a-priori least-squares lattice with error feedback (EF-LSL), `O(P)` per sample.
 
+use super::arith::{Arith, FloatArith, float_params};
 use super::{Config, Health, RunningMean, WeightSum};
 use crate::{ArModel, Scalar};
+
+/// The lattice recursion of numerics.md section 2.1, written once over the typed steps of
+/// [`Arith`]: the state of all stages, the last sample's errors, and the reflection
+/// coefficients of the last `P` samples for the exact transversal coefficients.
+///
+/// [`Lattice`] (floats) and [`FixedLattice`](crate::fixed_point::FixedLattice) wrap it with
+/// their input handling (screening, mean removal, scaling) and outputs.
+#[derive(Clone, Copy, Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Core<A: Arith, const P: usize> {
+    /// Forward energies `F_0..F_{P-1}`.
+    pub(crate) f_energy: [A::Energy; P],
+    /// `F_P`.
+    pub(crate) f_energy_p: A::Energy,
+    /// Backward energies `B_0..B_{P-1}`, holding `B_i(n-1)` between samples.
+    pub(crate) b_energy: [A::Energy; P],
+    /// `kf_1..kf_P` (index `m - 1` for order `m`).
+    pub(crate) kf: [A::Coef; P],
+    /// `kb_1..kb_P`.
+    pub(crate) kb: [A::Coef; P],
+    /// `psi_i(n-1)`, i = 0..P-1.
+    bp: [A::Err; P],
+    /// `gamma_i(n-1)`, i = 0..P-1.
+    gp: [A::Gamma; P],
+    /// `gamma_P(n-1)`.
+    gp_p: A::Gamma,
+    /// A-priori forward errors `f_1..f_P` of the last sample; `f_0` is `input`.
+    pub(crate) errors: [A::Err; P],
+    /// `y_n` of the last sample, the order-0 error.
+    pub(crate) input: A::Err,
+    /// Reflection coefficients of the last `P` samples, newest at `head`.
+    ring_kf: [[A::Coef; P]; P],
+    ring_kb: [[A::Coef; P]; P],
+    head: usize,
+}
+
+impl<A: Arith, const P: usize> Core<A, P> {
+    /// The initial state: `F_i = f0`, `B_i = b[i]`, zero reflection coefficients and errors,
+    /// unit conversion factors.
+    pub(crate) fn new(f0: A::Energy, b: [A::Energy; P]) -> Self {
+        Self {
+            f_energy: [f0; P],
+            f_energy_p: f0,
+            b_energy: b,
+            kf: [A::COEF_ZERO; P],
+            kb: [A::COEF_ZERO; P],
+            bp: [A::ERR_ZERO; P],
+            gp: [A::GAMMA_ONE; P],
+            gp_p: A::GAMMA_ONE,
+            errors: [A::ERR_ZERO; P],
+            input: A::ERR_ZERO,
+            ring_kf: [[A::COEF_ZERO; P]; P],
+            ring_kb: [[A::COEF_ZERO; P]; P],
+            head: 0,
+        }
+    }
+
+    /// One sample `y` through all stages; returns `f_P(n)`.
+    #[inline]
+    pub(crate) fn step(&mut self, params: &A::Params, y: A::Err, clip: &mut u32) -> A::Err {
+        let (mut f, mut psi, mut g) = (y, y, A::GAMMA_ONE);
+        for i in 0..P {
+            let gf = A::gain(self.gp[i], f, clip);
+            let fe = A::energy(params, self.f_energy[i], gf, f, clip);
+            let f_next = A::predict(f, self.kf[i], self.bp[i], clip);
+            let psi_next = A::predict(self.bp[i], self.kb[i], f, clip);
+            let gbp = A::gain(self.gp[i], self.bp[i], clip);
+            self.kf[i] = A::adapt(self.kf[i], gbp, f_next, self.b_energy[i], clip);
+            self.kb[i] = A::adapt(self.kb[i], gf, psi_next, fe, clip);
+            let gpsi = A::gain(g, psi, clip);
+            let be = A::energy(params, self.b_energy[i], gpsi, psi, clip);
+            let g_next = A::convert(g, gpsi, be);
+            self.f_energy[i] = fe;
+            self.b_energy[i] = be;
+            self.bp[i] = psi;
+            self.gp[i] = g;
+            self.errors[i] = f_next;
+            f = f_next;
+            psi = psi_next;
+            g = g_next;
+        }
+        let gf = A::gain(self.gp_p, f, clip);
+        self.f_energy_p = A::energy(params, self.f_energy_p, gf, f, clip);
+        self.gp_p = g;
+        self.input = y;
+        // `% P` keeps the index provably in range: no bounds check on the per-sample path.
+        self.head = (self.head + P - 1) % P;
+        self.ring_kf[self.head] = self.kf;
+        self.ring_kb[self.head] = self.kb;
+        f
+    }
+
+    /// Forward energy of order `m` in `0..=P`.
+    pub(crate) fn energy(&self, m: usize) -> Option<A::Energy> {
+        if m == P {
+            Some(self.f_energy_p)
+        } else {
+            self.f_energy.get(m).copied()
+        }
+    }
+
+    /// The exact least-squares coefficients of order `m <= P`, computed in `T` from the
+    /// reflection coefficients of the last `m` samples (converted by `to_t`); see
+    /// [`Lattice::coefficients`].
+    pub(crate) fn coefficients<T: Scalar>(
+        &self,
+        m: usize,
+        to_t: impl Fn(A::Coef) -> T,
+    ) -> Option<[T; P]> {
+        if m > P {
+            return None;
+        }
+        // slots[j][..j]: the leading j coefficients of B_j (its last one is 1) at the time
+        // being built; alpha: the tail of A_k (its first one is 1).
+        let mut slots = [[T::ZERO; P]; P];
+        let mut alpha = [T::ZERO; P];
+        for t in (0..m).rev() {
+            let slot = (self.head + t) % P;
+            let (kf, kb) = (&self.ring_kf[slot], &self.ring_kb[slot]);
+            alpha = [T::ZERO; P];
+            // B_{k-1}(n-t-1), read from the slot before this time step overwrites it.
+            let mut b_prev = [T::ZERO; P];
+            let stages = kf.iter().zip(kb).take(m - t);
+            for (k, (&kf_k, &kb_k)) in (1..).zip(stages) {
+                let (kf_k, kb_k) = (to_t(kf_k), to_t(kb_k));
+                let saved = slots.get(k).copied().unwrap_or([T::ZERO; P]);
+                let b_full_prev = |i: usize| match i + 1 == k {
+                    true => T::ONE,
+                    false => b_prev.get(i).copied().unwrap_or(T::ZERO),
+                };
+                if let (true, Some(dst)) = (t > 0, slots.get_mut(k)) {
+                    // B_k(n-t), needed by the next newer time step.
+                    for (i, d) in dst.iter_mut().enumerate().take(k) {
+                        let shifted = if i == 0 { T::ZERO } else { b_full_prev(i - 1) };
+                        let a_full = match i.checked_sub(1) {
+                            None => T::ONE,
+                            Some(j) => alpha.get(j).copied().unwrap_or(T::ZERO),
+                        };
+                        *d = shifted - kb_k * a_full;
+                    }
+                }
+                for (j, aj) in alpha.iter_mut().enumerate().take(k) {
+                    *aj -= kf_k * b_full_prev(j);
+                }
+                b_prev = saved;
+            }
+        }
+        Some(alpha.map(|v| -v))
+    }
+}
 
 /// Exponentially weighted least-squares AR estimator of all orders `0..=P` at `O(P)` cost: the
 /// a-priori lattice with error feedback of Ling, Manolakis & Proakis (1986, IEEE Trans. ASSP
@@ -60,31 +211,8 @@ use crate::{ArModel, Scalar};
 /// ```
 #[derive(Clone, Copy, Debug)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Lattice<T, const P: usize> {
-    /// Forward energies `F_0..F_{P-1}`.
-    f_energy: [T; P],
-    /// `F_P`.
-    f_energy_p: T,
-    /// Backward energies `B_0..B_{P-1}`, holding `B_i(n-1)` between samples.
-    b_energy: [T; P],
-    /// `kf_1..kf_P` (index `m - 1` for order `m`).
-    kf: [T; P],
-    /// `kb_1..kb_P`.
-    kb: [T; P],
-    /// `psi_i(n-1)`, i = 0..P-1.
-    bp: [T; P],
-    /// `gamma_i(n-1)`, i = 0..P-1.
-    gp: [T; P],
-    /// `gamma_P(n-1)`.
-    gp_p: T,
-    /// A-priori forward errors `f_1..f_P` of the last sample; `f_0` is `input`.
-    errors: [T; P],
-    /// `y_n` of the last sample, the order-0 error.
-    input: T,
-    /// Reflection coefficients of the last `P` samples, newest at `head`.
-    ring_kf: [[T; P]; P],
-    ring_kb: [[T; P]; P],
-    head: usize,
+pub struct Lattice<T: FloatArith, const P: usize> {
+    core: Core<T, P>,
     weight: WeightSum<T>,
     mean: RunningMean<T>,
     health: Health,
@@ -94,54 +222,26 @@ pub struct Lattice<T, const P: usize> {
     hold: u32,
 }
 
-impl<T: Scalar, const P: usize> Lattice<T, P> {
+impl<T: FloatArith, const P: usize> Lattice<T, P> {
     /// A lattice at the initial state of the problem: `F_i = delta lambda^P`,
     /// `B_i = delta lambda^(P-i)`, zero reflection coefficients, unit conversion factors.
     pub fn new(config: &Config<T>) -> Self {
         const { assert!(P > 0, "the model order P must be at least 1") };
-        let mut s = Self {
-            f_energy: [T::ZERO; P],
-            f_energy_p: T::ZERO,
-            b_energy: [T::ZERO; P],
-            kf: [T::ZERO; P],
-            kb: [T::ZERO; P],
-            bp: [T::ZERO; P],
-            gp: [T::ONE; P],
-            gp_p: T::ONE,
-            errors: [T::ZERO; P],
-            input: T::ZERO,
-            ring_kf: [[T::ZERO; P]; P],
-            ring_kb: [[T::ZERO; P]; P],
-            head: 0,
+        Self {
+            core: Self::initial_core(config),
             weight: WeightSum(T::ZERO),
             mean: RunningMean::new(),
             health: Health::default(),
             published: None,
             hold: 0,
-        };
-        s.initialise(config);
-        s
+        }
     }
 
-    fn initialise(&mut self, config: &Config<T>) {
-        let f0 = config.delta_lambda_pow(P);
-        self.f_energy = [f0; P];
-        self.f_energy_p = f0;
-        for (i, b) in self.b_energy.iter_mut().enumerate() {
-            *b = config.delta_lambda_pow(P - i);
-        }
-        self.kf = [T::ZERO; P];
-        self.kb = [T::ZERO; P];
-        self.bp = [T::ZERO; P];
-        self.gp = [T::ONE; P];
-        self.gp_p = T::ONE;
-        self.errors = [T::ZERO; P];
-        self.input = T::ZERO;
-        self.ring_kf = [[T::ZERO; P]; P];
-        self.ring_kb = [[T::ZERO; P]; P];
-        self.head = 0;
-        self.weight = WeightSum(T::ZERO);
-        self.mean = RunningMean::new();
+    fn initial_core(config: &Config<T>) -> Core<T, P> {
+        Core::new(
+            config.delta_lambda_pow(P),
+            core::array::from_fn(|i| config.delta_lambda_pow(P - i)),
+        )
     }
 
     /// Takes one sample and returns the a-priori order-`P` prediction error `x_n - xhat_n`.
@@ -163,81 +263,44 @@ impl<T: Scalar, const P: usize> Lattice<T, P> {
             x
         };
         self.weight.push(lambda);
-
-        let tiny = T::from_f64(1e-30);
-        let (mut f, mut psi, mut g) = (y, y, T::ONE);
-        let mut check = T::ZERO;
-        for i in 0..P {
-            let gf = self.gp[i] * f;
-            let fe = floor(lambda * self.f_energy[i] + gf * f, tiny);
-            let f_next = f - self.kf[i] * self.bp[i];
-            let psi_next = self.bp[i] - self.kb[i] * f;
-            self.kf[i] += self.gp[i] * self.bp[i] * f_next / self.b_energy[i];
-            self.kb[i] += gf * psi_next / fe;
-            let gpsi = g * psi;
-            let be = floor(lambda * self.b_energy[i] + gpsi * psi, tiny);
-            let g_next = clamp_unit(g - gpsi * gpsi / be);
-            self.f_energy[i] = fe;
-            self.b_energy[i] = be;
-            self.bp[i] = psi;
-            self.gp[i] = g;
-            self.errors[i] = f_next;
-            check += self.kf[i] + self.kb[i] + fe + be;
-            f = f_next;
-            psi = psi_next;
-            g = g_next;
-        }
-        self.f_energy_p = floor(lambda * self.f_energy_p + self.gp_p * f * f, tiny);
-        self.gp_p = g;
-        self.input = y;
-        check += self.f_energy_p;
-
+        let mut clip = 0;
+        let f = self.core.step(&float_params(lambda), y, &mut clip);
+        let c = &self.core;
+        let check =
+            c.kf.iter()
+                .chain(&c.kb)
+                .chain(&c.errors)
+                .fold(c.f_energy_p, |s, &v| s + v);
         if !check.is_finite() {
             self.restart(config);
             return None;
         }
-        // `% P` keeps the index provably in range: no bounds check on the per-sample path.
-        self.head = (self.head + P - 1) % P;
-        self.ring_kf[self.head] = self.kf;
-        self.ring_kb[self.head] = self.kb;
         Some(f)
     }
 
     fn restart(&mut self, config: &Config<T>) {
         self.health.restarts += 1;
-        self.initialise(config);
-        let lambda = config.lambda().to_f64();
-        let memory = if lambda < 1.0 {
-            3.0 / (1.0 - lambda)
-        } else {
-            3.0e6
-        };
-        self.hold = if memory < u32::MAX as f64 {
-            memory as u32
-        } else {
-            u32::MAX
-        };
+        self.core = Self::initial_core(config);
+        self.weight = WeightSum(T::ZERO);
+        self.mean = RunningMean::new();
+        self.hold = hold_after_restart(config.lambda().to_f64());
     }
 
     /// A-priori forward prediction errors `f_1(n)..f_P(n)` of the last accepted sample
     /// (`f_m(n) = y_n - a^(m)_{n-1}^T phi_n`); `f_0(n) = y_n` is [`Lattice::input`].
     pub fn errors(&self) -> &[T; P] {
-        &self.errors
+        &self.core.errors
     }
 
     /// The last accepted sample after mean removal, `y_n` (the order-0 prediction error).
     pub fn input(&self) -> T {
-        self.input
+        self.core.input
     }
 
     /// Forward energy `F_m(n) = min J^(m)_n + delta lambda^(n+P)` of order `m` in `0..=P`;
     /// `None` above `P`.
     pub fn energy(&self, m: usize) -> Option<T> {
-        if m == P {
-            Some(self.f_energy_p)
-        } else {
-            self.f_energy.get(m).copied()
-        }
+        self.core.energy(m)
     }
 
     /// Innovation variance of order `m`: `F_m(n) / W_n`, `W_n = sum_{i<=n} lambda^(n-i)`
@@ -251,12 +314,12 @@ impl<T: Scalar, const P: usize> Lattice<T, P> {
     /// Forward reflection coefficients `kf_1..kf_P` (lattice sign: `kf_1 = a_1` of the
     /// order-1 model, minus the error-filter reflection coefficient).
     pub fn forward_reflection(&self) -> &[T; P] {
-        &self.kf
+        &self.core.kf
     }
 
     /// Backward reflection coefficients `kb_1..kb_P`.
     pub fn backward_reflection(&self) -> &[T; P] {
-        &self.kb
+        &self.core.kb
     }
 
     /// The weighted running mean removed from the input (0 without mean removal).
@@ -280,44 +343,7 @@ impl<T: Scalar, const P: usize> Lattice<T, P> {
     ///
     /// with `A_m = [1, -a^(m)]`. `O(m^3/3)` operations, no allocation; `None` for `m > P`.
     pub fn coefficients(&self, m: usize) -> Option<[T; P]> {
-        if m > P {
-            return None;
-        }
-        // slots[j][..j]: the leading j coefficients of B_j (its last one is 1) at the time
-        // being built; alpha: the tail of A_k (its first one is 1).
-        let mut slots = [[T::ZERO; P]; P];
-        let mut alpha = [T::ZERO; P];
-        for t in (0..m).rev() {
-            let slot = (self.head + t) % P;
-            let (kf, kb) = (&self.ring_kf[slot], &self.ring_kb[slot]);
-            alpha = [T::ZERO; P];
-            // B_{k-1}(n-t-1), read from the slot before this time step overwrites it.
-            let mut b_prev = [T::ZERO; P];
-            let stages = kf.iter().zip(kb).take(m - t);
-            for (k, (&kf_k, &kb_k)) in (1..).zip(stages) {
-                let saved = slots.get(k).copied().unwrap_or([T::ZERO; P]);
-                let b_full_prev = |i: usize| match i + 1 == k {
-                    true => T::ONE,
-                    false => b_prev.get(i).copied().unwrap_or(T::ZERO),
-                };
-                if let (true, Some(dst)) = (t > 0, slots.get_mut(k)) {
-                    // B_k(n-t), needed by the next newer time step.
-                    for (i, d) in dst.iter_mut().enumerate().take(k) {
-                        let shifted = if i == 0 { T::ZERO } else { b_full_prev(i - 1) };
-                        let a_full = match i.checked_sub(1) {
-                            None => T::ONE,
-                            Some(j) => alpha.get(j).copied().unwrap_or(T::ZERO),
-                        };
-                        *d = shifted - kb_k * a_full;
-                    }
-                }
-                for (j, aj) in alpha.iter_mut().enumerate().take(k) {
-                    *aj -= kf_k * b_full_prev(j);
-                }
-                b_prev = saved;
-            }
-        }
-        Some(alpha.map(|v| -v))
+        self.core.coefficients(m, |k| k)
     }
 
     /// The order-`P` model after the last sample: coefficients, innovation variance
@@ -335,18 +361,17 @@ impl<T: Scalar, const P: usize> Lattice<T, P> {
     }
 }
 
-#[inline]
-fn floor<T: Scalar>(x: T, min: T) -> T {
-    if x > min { x } else { min }
-}
-
-#[inline]
-fn clamp_unit<T: Scalar>(g: T) -> T {
-    if g > T::ONE {
-        T::ONE
-    } else if g > T::ZERO {
-        g
+/// Samples for which a restarted estimator keeps publishing its last good model:
+/// `3/(1 - lambda)`, or three million for `lambda = 1`.
+pub(crate) fn hold_after_restart(lambda: f64) -> u32 {
+    let memory = if lambda < 1.0 {
+        3.0 / (1.0 - lambda)
     } else {
-        T::ZERO
+        3.0e6
+    };
+    if memory < u32::MAX as f64 {
+        memory as u32
+    } else {
+        u32::MAX
     }
 }

@@ -24,7 +24,8 @@
 //! breakdown re-initialises the state while the last good model stays published
 //! ([`Health`] counts all three).
 
-mod lattice;
+mod arith;
+pub(crate) mod lattice;
 mod mean;
 mod order;
 mod rls;
@@ -33,7 +34,8 @@ use core::fmt;
 
 use crate::Scalar;
 
-pub use lattice::Lattice;
+pub use arith::{Arith, FloatArith, FloatParams};
+pub use lattice::{Core, Lattice};
 pub use mean::RunningMean;
 pub use order::{OrderRule, OrderSelector};
 pub use rls::{Rls, RlsInit};

@@ -1,6 +1,6 @@
 //! Online order selection from the lattice's errors and energies of every order.
 
-use super::{Config, Lattice};
+use super::{Config, FloatArith, Lattice};
 use crate::Scalar;
 
 /// How [`OrderSelector`] scores the orders `0..=P`.
@@ -40,7 +40,7 @@ pub struct OrderSelector<T, const P: usize> {
     streak: u32,
 }
 
-impl<T: Scalar, const P: usize> OrderSelector<T, P> {
+impl<T: FloatArith, const P: usize> OrderSelector<T, P> {
     /// A selector starting at order `P`; `interval` and `patience` are at least 1.
     pub fn new(rule: OrderRule, interval: u32, patience: u32) -> Self {
         let interval = interval.max(1);
