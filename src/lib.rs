@@ -5,6 +5,7 @@
 
 pub mod allan;
 pub mod batch;
+pub mod fixed_point;
 pub mod model;
 pub mod recursive;
 pub mod scalar;

@@ -17,12 +17,12 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
+use imu_ar::ArModel;
 use imu_ar::allan::overlapping_avar;
 use imu_ar::batch::criteria::Criterion;
 use imu_ar::batch::{BatchConfig, BatchError, Fit, burg, covariance, yule_walker};
 use imu_ar::recursive::{Config, FloatArith, Lattice, Rls, RlsInit};
 use imu_ar::sim::StandardNormal;
-use imu_ar::ArModel;
 use imu_ar_host::data::read_column;
 use rand_chacha::ChaCha8Rng;
 use rand_core::SeedableRng;

@@ -52,6 +52,9 @@ pub enum ConfigError {
     Interval,
     /// The saturation limit is not positive.
     Saturation,
+    /// The fixed-point scale is not positive and finite, or makes `delta` vanish in the
+    /// energy format.
+    Scale,
 }
 
 impl fmt::Display for ConfigError {
@@ -61,6 +64,7 @@ impl fmt::Display for ConfigError {
             Self::Delta => "regularisation delta must be positive and finite",
             Self::Interval => "sample interval must be positive and finite",
             Self::Saturation => "saturation limit must be positive",
+            Self::Scale => "fixed-point scale must be positive and keep delta representable",
         })
     }
 }
@@ -206,6 +210,8 @@ pub struct Health {
     pub saturated: u64,
     /// Re-initialisations after a numerical breakdown.
     pub restarts: u64,
+    /// Internal values saturated to their number format (fixed point only; 0 for floats).
+    pub clipped: u64,
 }
 
 impl Health {

@@ -1,0 +1,220 @@
+//! The fixed-point lattice against the f64 direct solve of numerics.md section 0, on the
+//! section-8 processes and on both real records as raw counts; and at the edges of its formats.
+//! Prints the table that `tools/readme-tables.sh` puts into README.md.
+
+use std::path::Path;
+
+use imu_ar::ArModel;
+use imu_ar::fixed_point::{FixedConfig, FixedLattice};
+use imu_ar::recursive::Config;
+use imu_ar::sim::ArSimulator;
+use imu_ar_host::data::read_column;
+use imu_ar_host::reference::{Regularisation, Section0, running_mean_removed};
+use rand_chacha::ChaCha8Rng;
+use rand_core::SeedableRng;
+
+fn ar<const P: usize>(a: [f64; P], sigma: f64, n: usize, seed: u64) -> Vec<f64> {
+    let mut sim = ArSimulator::new(ArModel::new(a, sigma * sigma, 0.0, 0.01).unwrap());
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    sim.burn_in(&mut rng, 20_000);
+    (0..n).map(|_| sim.next(&mut rng)).collect()
+}
+
+fn add(x: &[f64], y: &[f64]) -> Vec<f64> {
+    x.iter().zip(y).map(|(a, b)| a + b).collect()
+}
+
+/// Max coefficient error of an order-`P` fixed lattice after `x` (scaled to unit RMS, no mean
+/// removal) against the direct solve with the lattice's own rounded `lambda`.
+fn fixed_error<const P: usize>(x: &[f64], lambda: f64) -> f64 {
+    let rms = (x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64).sqrt();
+    let delta = 0.1 * rms * rms;
+    let config = Config::new(lambda as f32, delta as f32, 0.01)
+        .unwrap()
+        .with_demean(false);
+    let fixed = FixedConfig::new(&config, (1.0 / rms) as f32).unwrap();
+    let mut lattice = FixedLattice::<P>::new(&fixed);
+    let mut reference = Section0::new(P, fixed.lambda(), f64::from(delta as f32));
+    for &v in x {
+        reference.push(v);
+        lattice.update(&fixed, v as f32).expect("sample accepted");
+    }
+    let h = lattice.health();
+    assert_eq!((h.saturated, h.clipped, h.restarts), (0, 0, 0), "{h:?}");
+    let (a_ref, _) = reference.solve(P, Regularisation::ShiftConsistent);
+    let a = lattice.coefficients(P).unwrap();
+    a.iter()
+        .zip(&a_ref)
+        .fold(0.0, |m, (a, b)| m.max((f64::from(*a) - b).abs()))
+}
+
+#[test]
+fn section_8_processes_after_a_million_samples() {
+    const N: usize = 1_000_000;
+    let white = ar([0.0], 1.0, N, 20);
+    let gm_white = add(&ar([0.999], 0.05, N, 21), &white);
+    let sine: Vec<f64> = (0..N)
+        .map(|n| (2.0 * std::f64::consts::PI * 0.1 * n as f64).sin())
+        .collect();
+    let gm_white_sine = add(&gm_white, &sine);
+    let pw = ar([2.7607, -3.8106, 2.6535, -0.9238], 1.0, N, 22);
+    let r = 0.89f64;
+    let resonant = ar(
+        [2.0 * r * std::f64::consts::FRAC_PI_4.cos(), -r * r],
+        1.0,
+        N,
+        23,
+    );
+    let processes: [(&str, &[f64]); 4] = [
+        ("GM(0.999) + white", &gm_white),
+        ("Percival-Walden AR(4)", &pw),
+        ("AR(2), poles 0.89", &resonant),
+        ("GM + white + sinusoid", &gm_white_sine),
+    ];
+    println!("| process | lambda | p = 1 | p = 2 | p = 4 | p = 8 |");
+    println!("|---|---|---|---|---|---|");
+    for (name, x) in processes {
+        for lambda in [0.99, 0.999, 0.9999] {
+            let errors = [
+                fixed_error::<1>(x, lambda),
+                fixed_error::<2>(x, lambda),
+                fixed_error::<4>(x, lambda),
+                fixed_error::<8>(x, lambda),
+            ];
+            let cells: Vec<String> = errors.iter().map(|e| format!("{e:.1e}")).collect();
+            println!("| {name} | {lambda} | {} |", cells.join(" | "));
+            for (p, e) in [1, 2, 4, 8].iter().zip(errors) {
+                assert!(e <= 1e-5, "{name}, lambda {lambda}, p = {p}: error {e:e}");
+            }
+        }
+    }
+}
+
+#[test]
+fn real_records_as_raw_counts() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/imu");
+    if !dir.is_dir() {
+        println!("skipped: {} is absent", dir.display());
+        return;
+    }
+    // Sensor units per count (SOURCES.md): the values are exact multiples of these.
+    let records = [
+        (
+            "ADIS16405",
+            vec![
+                dir.join("adis16405_imu1_part1.csv"),
+                dir.join("adis16405_imu1_part2.csv"),
+            ],
+            0.05,
+            0.00333,
+        ),
+        (
+            "MPU-6050",
+            vec![dir.join("mpu6050_static_10min.csv")],
+            1.0 / 131.0,
+            1.0 / 4096.0,
+        ),
+    ];
+    println!("| record | axis | counts per unit | lambda | fixed, p = 1..8 | clipped |");
+    println!("|---|---|---|---|---|---|");
+    for (name, files, gyro_lsb, accel_lsb) in &records {
+        for axis in ["gx", "gy", "gz", "ax", "ay", "az"] {
+            let lsb: f64 = if axis.starts_with('g') {
+                *gyro_lsb
+            } else {
+                *accel_lsb
+            };
+            let x = read_column(files, axis).unwrap();
+            let counts: Vec<i16> = x.iter().map(|v| (v / lsb).round() as i16).collect();
+            let mean = x.iter().sum::<f64>() / x.len() as f64;
+            let var = x.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / x.len() as f64;
+            for lambda in [0.99, 0.999, 0.9999] {
+                // delta = the record's variance: smaller values let the order-1 reflection
+                // coefficient of the first few samples pass the +-4 of its format (the LS value
+                // there is y_2 y_3 / (y_2^2 + delta)); that would be clipped and counted.
+                let config = Config::new(lambda as f32, var as f32, 0.01).unwrap();
+                let fixed = FixedConfig::for_counts(&config, lsb as f32).unwrap();
+                let mut lattice = FixedLattice::<8>::new(&fixed);
+                let delta = f64::from(config.delta());
+                let mut reference = Section0::new(8, fixed.lambda(), delta);
+                let exact: Vec<f64> = counts.iter().map(|&c| f64::from(c) * lsb).collect();
+                for (&c, y) in counts
+                    .iter()
+                    .zip(running_mean_removed(&exact, fixed.lambda()))
+                {
+                    reference.push(y);
+                    lattice
+                        .update_counts(&fixed, c)
+                        .expect("no reading at the rails");
+                }
+                let h = lattice.health();
+                assert_eq!((h.saturated, h.restarts), (0, 0), "{name} {axis}: {h:?}");
+                let mut worst = 0.0f64;
+                for m in 1..=8 {
+                    let (a_ref, _) = reference.solve(m, Regularisation::ShiftConsistent);
+                    let a = lattice.coefficients(m).unwrap();
+                    for k in 0..m {
+                        worst = worst.max((f64::from(a[k]) - a_ref[k]).abs());
+                    }
+                }
+                println!(
+                    "| {name} | {axis} | {:.0} | {lambda} | {worst:.1e} | {} |",
+                    1.0 / lsb,
+                    h.clipped
+                );
+                assert_eq!(
+                    h.clipped, 0,
+                    "{name} {axis} lambda {lambda}: internal saturation"
+                );
+                assert!(
+                    worst <= 1e-3,
+                    "{name} {axis} lambda {lambda}: error {worst:e}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn full_scale_constant_and_alternating_inputs() {
+    let config = Config::new(0.99f32, 1.0, 0.01).unwrap();
+    let fixed = FixedConfig::for_counts(&config, 1.0).unwrap();
+    // Readings at the rails are rejected and counted, never wrapped.
+    let mut lattice = FixedLattice::<4>::new(&fixed);
+    for c in [i16::MAX, i16::MIN, -32767] {
+        assert_eq!(lattice.update_counts(&fixed, c), None);
+    }
+    assert_eq!(lattice.health().saturated, 3);
+    // Constant input, then alternating full scale just inside the rails, then the top of the
+    // range held: every output is in range, the model stays finite, saturations are counted.
+    let inputs = (0..20_000)
+        .map(|_| 12_345i16)
+        .chain((0..20_000).map(|n| if n % 2 == 0 { 32_766 } else { -32_766 }))
+        .chain((0..20_000).map(|_| 32_766));
+    let mut clipped_after = [0; 3];
+    for (n, c) in inputs.enumerate() {
+        lattice.update_counts(&fixed, c).expect("inside the rails");
+        clipped_after[n / 20_000] = lattice.health().clipped;
+    }
+    let h = lattice.health();
+    assert_eq!((h.samples, h.saturated, h.restarts), (60_000, 3, 0));
+    // Alternating full scale drives errors past +-16 internal units: saturated and counted.
+    assert!(clipped_after[1] > clipped_after[0], "{clipped_after:?}");
+    let model = lattice.model(&fixed).unwrap();
+    assert!(
+        model.a().iter().all(|a| a.is_finite() && a.abs() < 100.0),
+        "{:?}",
+        model.a()
+    );
+    assert!(model.noise_variance().is_finite());
+    println!("after the edge cases: {h:?}, a = {:?}", model.a());
+    // The float input: beyond +-16 internal units is saturated, NaN is non-finite.
+    let fixed = FixedConfig::new(&config, 1.0).unwrap();
+    let mut lattice = FixedLattice::<2>::new(&fixed);
+    assert_eq!(lattice.update(&fixed, 16.0), None);
+    assert_eq!(lattice.update(&fixed, -1e30), None);
+    assert_eq!(lattice.update(&fixed, f32::NAN), None);
+    assert!(lattice.update(&fixed, 15.9).is_some());
+    let h = lattice.health();
+    assert_eq!((h.saturated, h.non_finite, h.samples), (2, 1, 1));
+}

@@ -1,0 +1,456 @@
+//! The lattice in fixed point, for MCUs and DSPs without an FPU and for bit-reproducible
+//! firmware.
+//!
+//! [`FixedLattice`] runs the same recursion as the float [`Lattice`](crate::recursive::Lattice)
+//! ([`Core`] over the typed steps of [`Arith`]), with one Q format per quantity
+//! (numerics.md section 2.2), all in "internal units" (`scale` times the sensor's units):
+//!
+//! | quantity | type | range | resolution |
+//! |---|---|---|---|
+//! | errors `f`, `psi`, input `y` | [`I5F27`] | +-16 | 7.5e-9 |
+//! | conversion factors `gamma` | [`I2F30`] | +-2 (kept in [0, 1]) | 9.3e-10 |
+//! | reflection coefficients `kf`, `kb` | [`I3F29`] | +-4 | 1.9e-9 |
+//! | energies `F`, `B`, weight `W` | [`I24F40`] | +-8.4e6 | 9.1e-13 |
+//! | forgetting factor `lambda` | [`U0F32`] | [0, 1) | 2.3e-10 |
+//!
+//! Every product is formed exactly in `i64` (or `i128` where an energy is involved) and rounded
+//! to nearest once; the `fixed` crate's own `*` rounds toward minus infinity, a bias that the
+//! `lambda` recursions would accumulate over `1/(1 - lambda)` samples. Divisions by an energy
+//! use a reciprocal: the energy is normalised by its leading zeros (CLZ) to a 32-bit mantissa
+//! `m` in `[2^31, 2^32)`, `r = round(2^63 / m)` is one 64/32-bit division, and the quotient is
+//! `x r` shifted back by the exponent (relative error below 2^-31). Every result is saturated
+//! to its format, and each saturation is counted in [`Health::clipped`].
+//!
+//! Scaling. The energies must hold `Var(y) / (1 - lambda)`, so `y` should stay well inside
+//! +-16: choose `scale` so that the sensor's full range, offset included, maps inside +-16.
+//! [`FixedConfig::for_counts`] does this for raw `i16` counts: one count is `2^-11` internal
+//! units, so the whole `i16` range fits and no input can overflow; counts at the rails
+//! (`-32768`, `-32767` and `32767`) are taken as a saturated sensor and rejected. The float input
+//! [`FixedLattice::update`] rejects (and counts as saturated) any `x` with `|x scale| >= 16`.
+//!
+//! Host and target compute the same bits: integer arithmetic only on the per-sample path.
+
+use fixed::types::{I2F30, I3F29, I5F27, I24F40, U0F32};
+
+use crate::ArModel;
+use crate::recursive::lattice::hold_after_restart;
+use crate::recursive::{Arith, Config, ConfigError, Core, Health};
+
+/// The fixed-point number formats of the lattice, as an [`Arith`] implementation.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Q;
+
+/// [`Arith::Params`] of [`Q`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct QParams {
+    lambda: U0F32,
+    floor: I24F40,
+}
+
+const ERR_FRAC: u32 = 27;
+const GAMMA_FRAC: u32 = 30;
+const COEF_FRAC: u32 = 29;
+const ENERGY_FRAC: u32 = 40;
+/// Energies are floored at 16 LSB (1.5e-11 internal units^2).
+const ENERGY_FLOOR: i64 = 16;
+
+/// `x / 2^s` rounded to nearest (ties up), `s >= 1`.
+#[inline(always)]
+fn round_shift(x: i128, s: u32) -> i128 {
+    (x + (1i128 << (s - 1))) >> s
+}
+
+/// `x` saturated to `[lo, hi]`, counting a saturation in `clip`.
+#[inline(always)]
+fn saturate(x: i128, lo: i64, hi: i64, clip: &mut u32) -> i64 {
+    if x > hi as i128 {
+        *clip += 1;
+        hi
+    } else if x < lo as i128 {
+        *clip += 1;
+        lo
+    } else {
+        x as i64
+    }
+}
+
+#[inline(always)]
+fn sat_i32(x: i128, clip: &mut u32) -> i32 {
+    saturate(x, i32::MIN as i64, i32::MAX as i64, clip) as i32
+}
+
+/// `1 / e` for a positive Q40 energy, as `(r, shift)` with `1/e_real = r 2^(shift - 55)`.
+#[inline(always)]
+fn reciprocal(e: i64) -> (u64, u32) {
+    let e = e.max(1) as u64;
+    let lz = e.leading_zeros();
+    let m = ((e << lz) >> 32) as u32 as u64; // in [2^31, 2^32)
+    let r = ((1u64 << 63) + m / 2) / m; // round(2^63 / m), in (2^31, 2^32]
+    (r, lz)
+}
+
+/// `x / e` for `x` in `Q(x_frac)` and a Q40 energy `e`, in `Q(out_frac)`, before rounding
+/// shifts: returns the exact product `x r` and the right shift that lands it in `out_frac`.
+#[inline(always)]
+fn divide(x: i128, x_frac: u32, e: i64, out_frac: u32) -> i128 {
+    let (r, lz) = reciprocal(e);
+    // x_real r 2^(lz - 55) = X r 2^(lz - 55 - x_frac); in Q(out_frac): shift right by
+    // 55 + x_frac - out_frac - lz.
+    let shift = 55 + x_frac - out_frac;
+    let p = x * r as i128;
+    if shift > lz {
+        round_shift(p, shift - lz)
+    } else {
+        p << (lz - shift)
+    }
+}
+
+impl Arith for Q {
+    type Err = I5F27;
+    type Gamma = I2F30;
+    type Coef = I3F29;
+    type Energy = I24F40;
+    type Params = QParams;
+
+    const ERR_ZERO: I5F27 = I5F27::ZERO;
+    const GAMMA_ONE: I2F30 = I2F30::ONE;
+    const COEF_ZERO: I3F29 = I3F29::ZERO;
+
+    #[inline(always)]
+    fn gain(g: I2F30, x: I5F27, clip: &mut u32) -> I5F27 {
+        let p = g.to_bits() as i128 * x.to_bits() as i128;
+        I5F27::from_bits(sat_i32(round_shift(p, GAMMA_FRAC), clip))
+    }
+
+    #[inline(always)]
+    fn energy(p: &QParams, e: I24F40, gx: I5F27, x: I5F27, clip: &mut u32) -> I24F40 {
+        let decayed = round_shift(e.to_bits() as i128 * p.lambda.to_bits() as i128, 32);
+        let add = round_shift(
+            gx.to_bits() as i128 * x.to_bits() as i128,
+            2 * ERR_FRAC - ENERGY_FRAC,
+        );
+        let e = saturate(decayed + add, i64::MIN, i64::MAX, clip);
+        I24F40::from_bits(e.max(p.floor.to_bits()))
+    }
+
+    #[inline(always)]
+    fn predict(x: I5F27, k: I3F29, y: I5F27, clip: &mut u32) -> I5F27 {
+        let ky = round_shift(k.to_bits() as i128 * y.to_bits() as i128, COEF_FRAC);
+        I5F27::from_bits(sat_i32(x.to_bits() as i128 - ky, clip))
+    }
+
+    #[inline(always)]
+    fn adapt(k: I3F29, gx: I5F27, e: I5F27, energy: I24F40, clip: &mut u32) -> I3F29 {
+        let num = gx.to_bits() as i128 * e.to_bits() as i128; // Q54
+        let delta = divide(num, 2 * ERR_FRAC, energy.to_bits(), COEF_FRAC);
+        I3F29::from_bits(sat_i32(k.to_bits() as i128 + delta, clip))
+    }
+
+    #[inline(always)]
+    fn convert(g: I2F30, gx: I5F27, energy: I24F40) -> I2F30 {
+        let num = gx.to_bits() as i128 * gx.to_bits() as i128; // Q54
+        let delta = divide(num, 2 * ERR_FRAC, energy.to_bits(), GAMMA_FRAC);
+        let g = (g.to_bits() as i128 - delta).clamp(0, 1 << GAMMA_FRAC);
+        I2F30::from_bits(g as i32)
+    }
+}
+
+/// Settings of [`FixedLattice`], shared by many channels: a validated [`Config`] and the
+/// scale from sensor units to internal units, converted to the fixed formats once.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct FixedConfig {
+    params: QParams,
+    /// `delta lambda^k` in Q40, `k = 0..=P` is computed from these at construction.
+    delta: f64,
+    lambda: f64,
+    scale: f32,
+    dt: f32,
+    demean: bool,
+    /// `|x scale|` at or above this (Q27 bits) is saturated.
+    limit: i64,
+    /// Counts at or beyond these are taken as a saturated sensor.
+    count_limit: (i16, i16),
+}
+
+impl FixedConfig {
+    /// From a float configuration and `scale`, the internal units per sensor unit (see the
+    /// [module docs](self) for how to choose it). `lambda` is rounded to 32 fractional bits
+    /// (`lambda = 1` becomes `1 - 2^-32`); `delta` is taken in sensor units^2; a saturation
+    /// limit of `config` applies in sensor units, and `|x scale| >= 16` is always saturated.
+    ///
+    /// # Errors
+    ///
+    /// [`ConfigError::Scale`] unless `scale` is positive and finite and `delta scale^2` is at
+    /// least 1e-9 internal units^2 (far above the energy format's resolution).
+    ///
+    /// ```
+    /// use imu_ar::fixed_point::FixedConfig;
+    /// use imu_ar::recursive::Config;
+    ///
+    /// // A gyro of +-250 deg/s: map the full range to +-12.5 internal units.
+    /// let config = Config::new(0.999f32, 0.01, 0.01).unwrap();
+    /// let fixed = FixedConfig::new(&config, 0.05).unwrap();
+    /// assert!((fixed.lambda() - 0.999).abs() < 1e-7);
+    /// ```
+    pub fn new(config: &Config<f32>, scale: f32) -> Result<Self, ConfigError> {
+        if !(scale.is_finite() && scale > 0.0) {
+            return Err(ConfigError::Scale);
+        }
+        let s = f64::from(scale);
+        let delta = f64::from(config.delta()) * s * s;
+        if !(1e-9..1e6).contains(&delta) {
+            return Err(ConfigError::Scale);
+        }
+        let lambda = U0F32::saturating_from_num(f64::from(config.lambda()));
+        let user_limit = config.saturation().map_or(f64::INFINITY, |l| {
+            f64::from(l) * s * (1u64 << ERR_FRAC) as f64
+        });
+        let format_limit = (16i64 << ERR_FRAC) as f64;
+        Ok(Self {
+            params: QParams {
+                lambda,
+                floor: I24F40::from_bits(ENERGY_FLOOR),
+            },
+            delta,
+            lambda: lambda.to_num::<f64>(),
+            scale,
+            dt: config.dt(),
+            demean: config.demean(),
+            limit: user_limit.min(format_limit) as i64,
+            count_limit: (-32767, 32767),
+        })
+    }
+
+    /// For raw `i16` counts of `lsb` sensor units each: `scale = 2^-11 / lsb`, so one count is
+    /// `2^-11` internal units and the whole `i16` range fits. Use
+    /// [`FixedLattice::update_counts`]; counts at the rails (`<= -32767` or `>= 32767`) are
+    /// rejected as saturated.
+    ///
+    /// # Errors
+    ///
+    /// As [`FixedConfig::new`].
+    pub fn for_counts(config: &Config<f32>, lsb: f32) -> Result<Self, ConfigError> {
+        if !(lsb.is_finite() && lsb > 0.0) {
+            return Err(ConfigError::Scale);
+        }
+        Self::new(config, 1.0 / (2048.0 * lsb))
+    }
+
+    /// The forgetting factor actually used (rounded to 32 fractional bits).
+    pub fn lambda(&self) -> f64 {
+        self.lambda
+    }
+
+    /// Internal units per sensor unit.
+    pub fn scale(&self) -> f32 {
+        self.scale
+    }
+
+    fn delta_lambda_pow(&self, k: usize) -> I24F40 {
+        let v = (0..k).fold(self.delta, |acc, _| acc * self.lambda);
+        I24F40::saturating_from_num(v)
+    }
+}
+
+/// The EF-LSL lattice of [`Lattice`](crate::recursive::Lattice) in fixed point: the same
+/// recursion ([`Core`]), the same outputs, the Q formats of the [module docs](self).
+///
+/// ```
+/// use imu_ar::fixed_point::{FixedConfig, FixedLattice};
+/// use imu_ar::recursive::Config;
+///
+/// // An MPU-6050 gyro at +-250 deg/s: 1/131 deg/s per count.
+/// let config = Config::new(0.999f32, 0.01, 0.01).unwrap();
+/// let fixed = FixedConfig::for_counts(&config, 1.0 / 131.0).unwrap();
+/// let mut lattice = FixedLattice::<2>::new(&fixed);
+/// for n in 0..1000i32 {
+///     let counts = (590 + (n * 37 % 11) - 5) as i16; // an offset of 4.5 deg/s and some noise
+///     lattice.update_counts(&fixed, counts);
+/// }
+/// assert_eq!(lattice.update_counts(&fixed, i16::MAX), None); // at the rail: saturated
+/// assert_eq!(lattice.health().saturated, 1);
+/// let model = lattice.model(&fixed).unwrap();
+/// assert!((model.mean() - 4.5).abs() < 0.05);
+/// ```
+#[derive(Clone, Copy, Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct FixedLattice<const P: usize> {
+    core: Core<Q, P>,
+    /// The first sample, Q27.
+    origin: i32,
+    /// Weighted mean of `x - origin`, Q59.
+    offset: i64,
+    /// `W_n = lambda W_{n-1} + 1`, Q40.
+    weight: i64,
+    started: bool,
+    health: Health,
+    published: Option<ArModel<f32, P>>,
+    hold: u32,
+}
+
+impl<const P: usize> FixedLattice<P> {
+    /// A lattice at the initial state: `F_i = delta lambda^P`, `B_i = delta lambda^(P-i)`.
+    pub fn new(config: &FixedConfig) -> Self {
+        const { assert!(P > 0, "the model order P must be at least 1") };
+        Self {
+            core: Self::initial_core(config),
+            origin: 0,
+            offset: 0,
+            weight: 0,
+            started: false,
+            health: Health::default(),
+            published: None,
+            hold: 0,
+        }
+    }
+
+    fn initial_core(config: &FixedConfig) -> Core<Q, P> {
+        Core::new(
+            config.delta_lambda_pow(P),
+            core::array::from_fn(|i| config.delta_lambda_pow(P - i)),
+        )
+    }
+
+    /// Takes one sample in sensor units; returns the a-priori order-`P` prediction error in
+    /// internal units (divide by [`FixedConfig::scale`] for sensor units), or `None` when the
+    /// sample was rejected: NaN or infinite, beyond the configured saturation limit, or
+    /// `|x scale| >= 16` (counted in [`FixedLattice::health`]; the state is unchanged).
+    pub fn update(&mut self, config: &FixedConfig, x: f32) -> Option<I5F27> {
+        if !x.is_finite() {
+            self.health.non_finite += 1;
+            return None;
+        }
+        let bits = f64::from(x) * f64::from(config.scale) * (1u64 << ERR_FRAC) as f64;
+        if bits.abs() >= config.limit as f64 {
+            self.health.saturated += 1;
+            return None;
+        }
+        Some(self.accept(config, libm::round(bits) as i32))
+    }
+
+    /// Takes one raw sensor reading, for a configuration made by [`FixedConfig::for_counts`]:
+    /// the count is exactly `count << 16` in Q27. Readings at the rails are rejected as
+    /// saturated and counted.
+    pub fn update_counts(&mut self, config: &FixedConfig, count: i16) -> Option<I5F27> {
+        let (lo, hi) = config.count_limit;
+        let bits = i32::from(count) << 16;
+        if count <= lo || count >= hi || i64::from(bits).abs() >= config.limit {
+            self.health.saturated += 1;
+            return None;
+        }
+        Some(self.accept(config, bits))
+    }
+
+    fn accept(&mut self, config: &FixedConfig, x: i32) -> I5F27 {
+        self.health.samples += 1;
+        self.hold = self.hold.saturating_sub(1);
+        let mut clip = 0u32;
+        let lambda = config.params.lambda.to_bits() as i128;
+        let weight = round_shift(self.weight as i128 * lambda, 32) + (1i128 << ENERGY_FRAC);
+        self.weight = saturate(weight, 0, i64::MAX, &mut clip);
+        let y = if config.demean {
+            if !self.started {
+                self.origin = x;
+                self.started = true;
+            }
+            let mean = round_shift(self.offset as i128, 32);
+            let y = sat_i32(x as i128 - self.origin as i128 - mean, &mut clip);
+            // offset += y / W, in Q59.
+            let step = divide(y as i128, ERR_FRAC, self.weight, ERR_FRAC + 32);
+            self.offset = saturate(self.offset as i128 + step, i64::MIN, i64::MAX, &mut clip);
+            y
+        } else {
+            x
+        };
+        let f = self
+            .core
+            .step(&config.params, I5F27::from_bits(y), &mut clip);
+        self.health.clipped += u64::from(clip);
+        f
+    }
+
+    /// A-priori forward prediction errors `f_1(n)..f_P(n)` of the last accepted sample, in
+    /// internal units.
+    pub fn errors(&self) -> &[I5F27; P] {
+        &self.core.errors
+    }
+
+    /// The last accepted sample after mean removal, in internal units.
+    pub fn input(&self) -> I5F27 {
+        self.core.input
+    }
+
+    /// Forward energy of order `m` in `0..=P`, in internal units^2; `None` above `P`.
+    pub fn energy(&self, m: usize) -> Option<I24F40> {
+        self.core.energy(m)
+    }
+
+    /// Innovation variance of order `m` in sensor units^2: `F_m / W_n / scale^2`.
+    pub fn innovation_variance(&self, config: &FixedConfig, m: usize) -> Option<f32> {
+        if self.weight <= 0 {
+            return None;
+        }
+        let e = self.energy(m)?.to_num::<f64>();
+        let w = I24F40::from_bits(self.weight).to_num::<f64>();
+        let s = f64::from(config.scale);
+        Some((e / w / (s * s)) as f32)
+    }
+
+    /// Forward reflection coefficients `kf_1..kf_P`.
+    pub fn forward_reflection(&self) -> &[I3F29; P] {
+        &self.core.kf
+    }
+
+    /// Backward reflection coefficients `kb_1..kb_P`.
+    pub fn backward_reflection(&self) -> &[I3F29; P] {
+        &self.core.kb
+    }
+
+    /// The weighted running mean, in sensor units.
+    pub fn mean(&self, config: &FixedConfig) -> f32 {
+        let origin = f64::from(self.origin) / (1u64 << ERR_FRAC) as f64;
+        let offset = self.offset as f64 / (1u64 << (ERR_FRAC + 32)) as f64;
+        ((origin + offset) / f64::from(config.scale)) as f32
+    }
+
+    /// What happened to the samples so far, including internal saturations (`clipped`).
+    pub fn health(&self) -> Health {
+        self.health
+    }
+
+    /// The exact least-squares coefficients of order `m <= P`, as for the float lattice,
+    /// evaluated in `f32` from the fixed-point reflection coefficients.
+    pub fn coefficients(&self, m: usize) -> Option<[f32; P]> {
+        self.core.coefficients(m, |k| k.to_num::<f32>())
+    }
+
+    /// The order-`P` model in sensor units after the last sample (see
+    /// [`Lattice::model`](crate::recursive::Lattice::model)).
+    pub fn model(&mut self, config: &FixedConfig) -> Option<ArModel<f32, P>> {
+        if self.hold == 0 {
+            let a = self.coefficients(P)?;
+            let variance = self.innovation_variance(config, P)?;
+            let dt = config.dt;
+            if let Ok(m) = ArModel::new(a, variance, self.mean(config), dt) {
+                self.published = Some(m);
+            }
+        }
+        self.published
+    }
+
+    /// Re-initialises the state (counted as a restart); the last model stays published for
+    /// `3/(1 - lambda)` samples. Fixed-point arithmetic cannot produce a non-finite value, so
+    /// the lattice never does this by itself.
+    pub fn restart(&mut self, config: &FixedConfig) {
+        self.health.restarts += 1;
+        self.core = Self::initial_core(config);
+        self.origin = 0;
+        self.offset = 0;
+        self.weight = 0;
+        self.started = false;
+        self.hold = hold_after_restart(config.lambda);
+    }
+}
