@@ -18,6 +18,7 @@ mod firmware {
     use cortex_m_rt::{ExceptionFrame, entry, exception};
     use cortex_m_semihosting::debug;
     use imu_ar::allan::AllanStream;
+    use imu_ar::fixed_point::{FixedConfig, FixedLattice};
     use imu_ar::recursive::{Config, Lattice, OrderRule, OrderSelector, Rls, RlsInit};
 
     unsafe extern "C" {
@@ -40,6 +41,10 @@ mod firmware {
         let mut rls = Rls::<f32, P>::new(config, RlsInit::ShiftConsistent);
         let mut selector = OrderSelector::<f32, P>::new(OrderRule::Pls, 100, 3);
         let mut allan = AllanStream::<12>::new();
+        let mut fixed = match FixedConfig::new(config, black_box(2.0)) {
+            Ok(f) => (f, FixedLattice::<P>::new(&f)),
+            Err(_) => return false,
+        };
         let mut finite = true;
         for &v in x {
             let v = black_box(v);
@@ -51,7 +56,10 @@ mod firmware {
                 finite &= e.is_finite();
             }
             allan.push(v);
+            black_box(fixed.1.update(&fixed.0, v));
+            black_box(fixed.1.update_counts(&fixed.0, black_box(v as i16)));
         }
+        finite &= fixed.1.model(&fixed.0).is_some();
         let order = black_box(selector.order());
         finite &= order <= P;
         match (lattice.model(config), rls.model(config)) {

@@ -55,55 +55,91 @@ const COEF_FRAC: u32 = 29;
 const ENERGY_FRAC: u32 = 40;
 /// Energies are floored at 16 LSB (1.5e-11 internal units^2).
 const ENERGY_FLOOR: i64 = 16;
+const TWO_32: f64 = 4_294_967_296.0;
 
-/// `x / 2^s` rounded to nearest (ties up), `s >= 1`.
+/// `x / 2^s` rounded to nearest (ties up); any `s`.
 #[inline(always)]
-fn round_shift(x: i128, s: u32) -> i128 {
-    (x + (1i128 << (s - 1))) >> s
-}
-
-/// `x` saturated to `[lo, hi]`, counting a saturation in `clip`.
-#[inline(always)]
-fn saturate(x: i128, lo: i64, hi: i64, clip: &mut u32) -> i64 {
-    if x > hi as i128 {
-        *clip += 1;
-        hi
-    } else if x < lo as i128 {
-        *clip += 1;
-        lo
-    } else {
-        x as i64
+fn round_shift(x: i64, s: u32) -> i64 {
+    match s {
+        0 => x,
+        1..=63 => (x >> s) + ((x >> (s - 1)) & 1),
+        _ => 0,
     }
 }
 
+/// `x` saturated to `i32`, counting a saturation in `clip`.
 #[inline(always)]
-fn sat_i32(x: i128, clip: &mut u32) -> i32 {
-    saturate(x, i32::MIN as i64, i32::MAX as i64, clip) as i32
+fn sat_i32(x: i64, clip: &mut u32) -> i32 {
+    match i32::try_from(x) {
+        Ok(v) => v,
+        Err(_) => {
+            *clip += 1;
+            if x < 0 { i32::MIN } else { i32::MAX }
+        }
+    }
 }
 
-/// `1 / e` for a positive Q40 energy, as `(r, shift)` with `1/e_real = r 2^(shift - 55)`.
+/// `x + y` saturated, counting a saturation in `clip`.
+#[inline(always)]
+fn sat_add(x: i64, y: i64, clip: &mut u32) -> i64 {
+    x.checked_add(y).unwrap_or_else(|| {
+        *clip += 1;
+        if y < 0 { i64::MIN } else { i64::MAX }
+    })
+}
+
+/// `e lambda` for a Q40 energy and a Q0.32 `lambda`, rounded to nearest: the 96-bit product
+/// split into `hi lambda + (lo lambda) / 2^32`, both exact in 64 bits.
+#[inline(always)]
+fn decay(e: i64, lambda: u32) -> i64 {
+    let hi = e >> 32;
+    let lo = e as u32;
+    let low = (u64::from(lo) * u64::from(lambda) + (1 << 31)) >> 32;
+    hi * i64::from(lambda) + low as i64
+}
+
+/// The reciprocal of a positive Q40 value `e`: `(r, lz)` with `1/e_real = r 2^(lz - 55)`,
+/// `r` in about `(2^31, 2^32]`, accurate to about 2^-31 relative.
+///
+/// `e` is normalised by its leading zeros (CLZ) to a mantissa `m` in `[2^31, 2^32)`; a 32/32
+/// hardware division gives `2^48 / m` to 16 bits, and one Newton-Raphson step
+/// `r <- r + r (2^63 - m r) / 2^63` doubles that to 32 bits.
 #[inline(always)]
 fn reciprocal(e: i64) -> (u64, u32) {
     let e = e.max(1) as u64;
     let lz = e.leading_zeros();
-    let m = ((e << lz) >> 32) as u32 as u64; // in [2^31, 2^32)
-    let r = ((1u64 << 63) + m / 2) / m; // round(2^63 / m), in (2^31, 2^32]
-    (r, lz)
+    let m = ((e << lz) >> 32) as u32; // in [2^31, 2^32)
+    // `| 0x8000` changes nothing (the top bit is set) but proves the divisor non-zero.
+    let r0 = u64::from(u32::MAX / ((m >> 16) | 0x8000)) << 15; // about 2^63 / m, to 2^-16
+    let residual = (1u64 << 63).wrapping_sub(u64::from(m) * r0) as i64; // 2^63 - m r0
+    let r = r0 as i64 + ((r0 as i64 * (residual >> 32)) >> 31);
+    (r as u64, lz)
 }
 
-/// `x / e` for `x` in `Q(x_frac)` and a Q40 energy `e`, in `Q(out_frac)`, before rounding
-/// shifts: returns the exact product `x r` and the right shift that lands it in `out_frac`.
+/// `x / e` for `x` in `Q(x_frac)` and a positive Q40 `e`, in `Q(out_frac)`: `x` rounded to 30
+/// significant bits times the reciprocal of `e`, shifted back (relative error below 2^-29).
 #[inline(always)]
-fn divide(x: i128, x_frac: u32, e: i64, out_frac: u32) -> i128 {
+fn divide(x: i64, x_frac: u32, e: i64, out_frac: u32, clip: &mut u32) -> i64 {
     let (r, lz) = reciprocal(e);
-    // x_real r 2^(lz - 55) = X r 2^(lz - 55 - x_frac); in Q(out_frac): shift right by
-    // 55 + x_frac - out_frac - lz.
-    let shift = 55 + x_frac - out_frac;
-    let p = x * r as i128;
-    if shift > lz {
-        round_shift(p, shift - lz)
+    // Keep 30 significant bits of x, so that x r (r <= 2^32) fits in 64 bits.
+    let bits = 64 - x.unsigned_abs().leading_zeros();
+    let t = bits.saturating_sub(30);
+    let xs = round_shift(x, t);
+    let p = xs * r as i64;
+    // x_real / e_real = X r 2^(lz - 55 - x_frac); in Q(out_frac) that is X r shifted right by
+    // 55 + x_frac - out_frac - lz, of which t is already done.
+    let shift = i64::from(55 + x_frac) - i64::from(out_frac + lz + t);
+    if shift >= 0 {
+        round_shift(p, shift as u32)
     } else {
-        p << (lz - shift)
+        let left = shift.unsigned_abs() as u32;
+        match p.checked_shl(left).filter(|v| v >> left == p) {
+            Some(v) => v,
+            None => {
+                *clip += 1;
+                if p < 0 { i64::MIN } else { i64::MAX }
+            }
+        }
     }
 }
 
@@ -120,39 +156,48 @@ impl Arith for Q {
 
     #[inline(always)]
     fn gain(g: I2F30, x: I5F27, clip: &mut u32) -> I5F27 {
-        let p = g.to_bits() as i128 * x.to_bits() as i128;
+        let p = i64::from(g.to_bits()) * i64::from(x.to_bits()); // Q57, exact
         I5F27::from_bits(sat_i32(round_shift(p, GAMMA_FRAC), clip))
     }
 
     #[inline(always)]
     fn energy(p: &QParams, e: I24F40, gx: I5F27, x: I5F27, clip: &mut u32) -> I24F40 {
-        let decayed = round_shift(e.to_bits() as i128 * p.lambda.to_bits() as i128, 32);
+        let decayed = decay(e.to_bits(), p.lambda.to_bits());
         let add = round_shift(
-            gx.to_bits() as i128 * x.to_bits() as i128,
+            i64::from(gx.to_bits()) * i64::from(x.to_bits()), // Q54, exact
             2 * ERR_FRAC - ENERGY_FRAC,
         );
-        let e = saturate(decayed + add, i64::MIN, i64::MAX, clip);
+        let e = sat_add(decayed, add, clip);
         I24F40::from_bits(e.max(p.floor.to_bits()))
     }
 
     #[inline(always)]
     fn predict(x: I5F27, k: I3F29, y: I5F27, clip: &mut u32) -> I5F27 {
-        let ky = round_shift(k.to_bits() as i128 * y.to_bits() as i128, COEF_FRAC);
-        I5F27::from_bits(sat_i32(x.to_bits() as i128 - ky, clip))
+        let ky = round_shift(i64::from(k.to_bits()) * i64::from(y.to_bits()), COEF_FRAC);
+        I5F27::from_bits(sat_i32(i64::from(x.to_bits()) - ky, clip))
     }
 
     #[inline(always)]
     fn adapt(k: I3F29, gx: I5F27, e: I5F27, energy: I24F40, clip: &mut u32) -> I3F29 {
-        let num = gx.to_bits() as i128 * e.to_bits() as i128; // Q54
-        let delta = divide(num, 2 * ERR_FRAC, energy.to_bits(), COEF_FRAC);
-        I3F29::from_bits(sat_i32(k.to_bits() as i128 + delta, clip))
+        let num = i64::from(gx.to_bits()) * i64::from(e.to_bits()); // Q54, exact
+        let delta = divide(num, 2 * ERR_FRAC, energy.to_bits(), COEF_FRAC, clip);
+        I3F29::from_bits(sat_i32(sat_add(i64::from(k.to_bits()), delta, clip), clip))
     }
 
     #[inline(always)]
     fn convert(g: I2F30, gx: I5F27, energy: I24F40) -> I2F30 {
-        let num = gx.to_bits() as i128 * gx.to_bits() as i128; // Q54
-        let delta = divide(num, 2 * ERR_FRAC, energy.to_bits(), GAMMA_FRAC);
-        let g = (g.to_bits() as i128 - delta).clamp(0, 1 << GAMMA_FRAC);
+        let num = i64::from(gx.to_bits()) * i64::from(gx.to_bits()); // Q54, exact
+        let mut ignored = 0;
+        let delta = divide(
+            num,
+            2 * ERR_FRAC,
+            energy.to_bits(),
+            GAMMA_FRAC,
+            &mut ignored,
+        );
+        let g = i64::from(g.to_bits())
+            .saturating_sub(delta)
+            .clamp(0, 1 << GAMMA_FRAC);
         I2F30::from_bits(g as i32)
     }
 }
@@ -204,7 +249,8 @@ impl FixedConfig {
         if !(1e-9..1e6).contains(&delta) {
             return Err(ConfigError::Scale);
         }
-        let lambda = U0F32::saturating_from_num(f64::from(config.lambda()));
+        // By hand rather than `saturating_from_num`, which has a panic path (for NaN).
+        let lambda = U0F32::from_bits(libm::round(f64::from(config.lambda()) * TWO_32) as u32);
         let user_limit = config.saturation().map_or(f64::INFINITY, |l| {
             f64::from(l) * s * (1u64 << ERR_FRAC) as f64
         });
@@ -215,7 +261,7 @@ impl FixedConfig {
                 floor: I24F40::from_bits(ENERGY_FLOOR),
             },
             delta,
-            lambda: lambda.to_num::<f64>(),
+            lambda: f64::from(lambda.to_bits()) / TWO_32,
             scale,
             dt: config.dt(),
             demean: config.demean(),
@@ -251,7 +297,8 @@ impl FixedConfig {
 
     fn delta_lambda_pow(&self, k: usize) -> I24F40 {
         let v = (0..k).fold(self.delta, |acc, _| acc * self.lambda);
-        I24F40::saturating_from_num(v)
+        // `as` saturates (and maps NaN to 0): no panic path.
+        I24F40::from_bits(libm::round(v * (1u64 << ENERGY_FRAC) as f64) as i64)
     }
 }
 
@@ -348,19 +395,24 @@ impl<const P: usize> FixedLattice<P> {
         self.health.samples += 1;
         self.hold = self.hold.saturating_sub(1);
         let mut clip = 0u32;
-        let lambda = config.params.lambda.to_bits() as i128;
-        let weight = round_shift(self.weight as i128 * lambda, 32) + (1i128 << ENERGY_FRAC);
-        self.weight = saturate(weight, 0, i64::MAX, &mut clip);
+        let weight = decay(self.weight, config.params.lambda.to_bits());
+        self.weight = sat_add(weight, 1 << ENERGY_FRAC, &mut clip);
         let y = if config.demean {
             if !self.started {
                 self.origin = x;
                 self.started = true;
             }
-            let mean = round_shift(self.offset as i128, 32);
-            let y = sat_i32(x as i128 - self.origin as i128 - mean, &mut clip);
+            let mean = round_shift(self.offset, 32);
+            let y = sat_i32(i64::from(x) - i64::from(self.origin) - mean, &mut clip);
             // offset += y / W, in Q59.
-            let step = divide(y as i128, ERR_FRAC, self.weight, ERR_FRAC + 32);
-            self.offset = saturate(self.offset as i128 + step, i64::MIN, i64::MAX, &mut clip);
+            let step = divide(
+                i64::from(y),
+                ERR_FRAC,
+                self.weight,
+                ERR_FRAC + 32,
+                &mut clip,
+            );
+            self.offset = sat_add(self.offset, step, &mut clip);
             y
         } else {
             x
@@ -393,8 +445,8 @@ impl<const P: usize> FixedLattice<P> {
         if self.weight <= 0 {
             return None;
         }
-        let e = self.energy(m)?.to_num::<f64>();
-        let w = I24F40::from_bits(self.weight).to_num::<f64>();
+        let e = self.energy(m)?.to_bits() as f64;
+        let w = self.weight as f64;
         let s = f64::from(config.scale);
         Some((e / w / (s * s)) as f32)
     }
@@ -424,7 +476,8 @@ impl<const P: usize> FixedLattice<P> {
     /// The exact least-squares coefficients of order `m <= P`, as for the float lattice,
     /// evaluated in `f32` from the fixed-point reflection coefficients.
     pub fn coefficients(&self, m: usize) -> Option<[f32; P]> {
-        self.core.coefficients(m, |k| k.to_num::<f32>())
+        let lsb = 1.0 / (1u32 << COEF_FRAC) as f32;
+        self.core.coefficients(m, |k| k.to_bits() as f32 * lsb)
     }
 
     /// The order-`P` model in sensor units after the last sample (see

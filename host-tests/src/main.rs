@@ -6,6 +6,7 @@
 //! imu-ar compare FILE.. --column C --order P [--lambda L] [--delta D] [--train F] [--json]
 //! imu-ar order FILE.. --column C --max-order P --method ls|yule-walker|burg [--no-demean] [--json]
 //! imu-ar adev FILE.. --column C --rate HZ [--json]
+//! imu-ar parity
 //! imu-ar simulate --a A1,A2,.. [--a-end B1,B2,..] --sigma S --n N --seed K [--rate HZ] [--burn-in B]
 //! ```
 //!
@@ -27,6 +28,10 @@ use imu_ar_host::data::read_column;
 use rand_chacha::ChaCha8Rng;
 use rand_core::SeedableRng;
 use serde_json::{Value, json};
+
+/// The parity run shared with the `parity` firmware (same file, compiled for the host).
+#[path = "../../examples/common/parity.rs"]
+mod parity;
 
 /// The highest model order the tool accepts.
 const MAX_ORDER: usize = 32;
@@ -211,6 +216,9 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Checksums of the f32 and fixed-point lattices on the seeded parity sequence, to compare
+    /// with `cargo qemu parity` (bit-identical results on host and target).
+    Parity,
     /// Simulate an AR process; CSV `t_s,x` on stdout.
     Simulate {
         /// Coefficients a_1,..,a_P of `x[n] = sum a_k x[n-k] + w[n]`.
@@ -431,6 +439,10 @@ fn run(command: Command) -> Result<String, Fail> {
                 }
                 s
             })
+        }
+        Command::Parity => {
+            let (f, q) = parity::checksums().ok_or_else(|| Fail("parity run refused".into()))?;
+            Ok(format!("parity f32 {f:016x} fixed {q:016x}\n"))
         }
         Command::Simulate {
             a,

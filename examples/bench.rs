@@ -1,0 +1,169 @@
+//! Cost per sample on the emulated Cortex-M4F, in executed instructions.
+//!
+//! ```text
+//! cargo qemu bench
+//! ```
+//!
+//! QEMU runs with `-icount shift=0` (one instruction per virtual nanosecond), so SysTick on the
+//! MPS2 processor clock (25 MHz) decrements once per 40 executed instructions.
+//! The firmware checks that figure against a loop of known length (two instructions per
+//! iteration), times batches of 1000 `update` calls on a prepared record (inputs through
+//! `black_box`), subtracts the cost of the same loop without the call, and prints one line per
+//! row: `<estimator> <scalar> p=<P> insns/sample=<N>`. These are instruction counts, not cycles.
+#![cfg_attr(target_os = "none", no_std, no_main)]
+
+#[cfg(target_os = "none")]
+#[path = "common/mod.rs"]
+mod common;
+
+#[cfg(target_os = "none")]
+mod firmware {
+    use core::hint::black_box;
+
+    use cortex_m::peripheral::{SYST, syst::SystClkSource};
+    use imu_ar::fixed_point::{FixedConfig, FixedLattice};
+    use imu_ar::recursive::{Config, Lattice, Rls, RlsInit};
+
+    use super::common;
+
+    const BATCH: usize = 1000;
+    const RELOAD: u32 = 0x00FF_FFFF;
+
+    /// SysTick ticks spent in `f` (less than 2^24 ticks, 671 million instructions).
+    fn ticks(syst: &mut SYST, f: impl FnOnce()) -> u32 {
+        syst.clear_current();
+        let start = SYST::get_current();
+        f();
+        let end = SYST::get_current();
+        start.wrapping_sub(end) & RELOAD
+    }
+
+    /// Instructions per SysTick tick, from `subs; bne` loops of known length.
+    fn calibrate(syst: &mut SYST) -> u32 {
+        let spin = |n: u32| {
+            // SAFETY: a register-only countdown loop, two instructions per iteration.
+            unsafe {
+                core::arch::asm!("1:", "subs {0}, {0}, #1", "bne 1b", inout(reg) n => _,
+                    options(nomem, nostack));
+            }
+        };
+        let long = ticks(syst, || spin(black_box(2_000_000)));
+        let short = ticks(syst, || spin(black_box(1_000_000)));
+        // 2,000,000 instructions more in the long run; the fixed overhead cancels.
+        (2_000_000 + (long - short) / 2) / (long - short)
+    }
+
+    pub struct Bench {
+        syst: SYST,
+        per_tick: u32,
+        x: [f32; BATCH],
+        counts: [i16; BATCH],
+    }
+
+    impl Bench {
+        fn insns_per_sample(&mut self, body: impl Fn(usize)) -> u32 {
+            let empty = ticks(&mut self.syst, || {
+                for i in 0..BATCH {
+                    black_box(i);
+                }
+            });
+            let full = ticks(&mut self.syst, || {
+                for i in 0..BATCH {
+                    body(black_box(i));
+                }
+            });
+            (full.saturating_sub(empty) * self.per_tick + BATCH as u32 / 2) / BATCH as u32
+        }
+
+        fn lattice_f32<const P: usize>(&mut self) {
+            let config = Config::new(0.999f32, 0.1, 0.01).unwrap_or_else(|_| common::exit(false));
+            let mut state = Lattice::<f32, P>::new(&config);
+            let x = self.x;
+            let cell = core::cell::RefCell::new(&mut state);
+            let n = self.insns_per_sample(|i| {
+                black_box(cell.borrow_mut().update(&config, black_box(x[i])));
+            });
+            defmt::info!("lattice f32 p={=usize} insns/sample={=u32}", P, n);
+        }
+
+        fn lattice_fixed<const P: usize>(&mut self) {
+            let config = Config::new(0.999f32, 1e-3, 0.01).unwrap_or_else(|_| common::exit(false));
+            let fixed =
+                FixedConfig::for_counts(&config, 0.05).unwrap_or_else(|_| common::exit(false));
+            let mut state = FixedLattice::<P>::new(&fixed);
+            let counts = self.counts;
+            let cell = core::cell::RefCell::new(&mut state);
+            let n = self.insns_per_sample(|i| {
+                black_box(
+                    cell.borrow_mut()
+                        .update_counts(&fixed, black_box(counts[i])),
+                );
+            });
+            defmt::info!("lattice fixed p={=usize} insns/sample={=u32}", P, n);
+        }
+
+        fn rls_f32<const P: usize>(&mut self) {
+            let config = Config::new(0.999f32, 0.1, 0.01).unwrap_or_else(|_| common::exit(false));
+            let mut state = Rls::<f32, P>::new(&config, RlsInit::ShiftConsistent);
+            let x = self.x;
+            let cell = core::cell::RefCell::new(&mut state);
+            let n = self.insns_per_sample(|i| {
+                black_box(cell.borrow_mut().update(&config, black_box(x[i])));
+            });
+            defmt::info!("rls f32 p={=usize} insns/sample={=u32}", P, n);
+        }
+    }
+
+    pub fn run() -> ! {
+        let Some(mut cp) = cortex_m::Peripherals::take() else {
+            common::exit(false)
+        };
+        cp.SYST.set_clock_source(SystClkSource::Core);
+        cp.SYST.set_reload(RELOAD);
+        cp.SYST.enable_counter();
+        let per_tick = calibrate(&mut cp.SYST);
+        defmt::info!(
+            "calibration: {=u32} instructions per SysTick tick",
+            per_tick
+        );
+
+        // An AR(1) record with a gyro-like offset: 0.9 memory, uniform innovations.
+        let mut x = [0.0f32; BATCH];
+        let mut counts = [0i16; BATCH];
+        let (mut state, mut seed) = (0.0f32, 12345u32);
+        for (v, c) in x.iter_mut().zip(counts.iter_mut()) {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            state = 0.9 * state + ((seed >> 8) as f32 / 16_777_216.0 - 0.5);
+            *v = 0.4 + state;
+            *c = (*v * 20.0) as i16;
+        }
+        let mut bench = Bench {
+            syst: cp.SYST,
+            per_tick,
+            x,
+            counts,
+        };
+        bench.lattice_f32::<1>();
+        bench.lattice_f32::<2>();
+        bench.lattice_f32::<4>();
+        bench.lattice_f32::<8>();
+        bench.lattice_fixed::<1>();
+        bench.lattice_fixed::<2>();
+        bench.lattice_fixed::<4>();
+        bench.lattice_fixed::<8>();
+        bench.rls_f32::<4>();
+        bench.rls_f32::<8>();
+        common::exit(per_tick > 0)
+    }
+}
+
+#[cfg(target_os = "none")]
+#[cortex_m_rt::entry]
+fn main() -> ! {
+    firmware::run()
+}
+
+#[cfg(not(target_os = "none"))]
+fn main() {
+    eprintln!("bench is firmware for the Cortex-M4F: run it with `cargo qemu bench`");
+}

@@ -1,0 +1,99 @@
+//! The parity run: one documented input sequence through the f32 lattice and the fixed-point
+//! lattice, hashed to two checksums. The `parity` firmware and `imu-ar parity` on the host run
+//! this same code; equal checksums mean bit-identical results on both.
+//!
+//! Input: `SAMPLES` samples of `x[n] = 3 + 1.2 (x[n-1] - 3) - 0.5 (x[n-2] - 3) + w[n]`,
+//! `w ~ N(0, 0.25)` from `imu_ar::sim::ArSimulator` on `ChaCha8Rng::seed_from_u64(SEED)`
+//! (1000 samples burn-in), as `f32`; every 997th sample is replaced by NaN (rejected by both).
+//! Both lattices: order `P = 4`, `lambda = 0.999`, `delta = 0.1`, `dt = 0.01`, running mean
+//! removed; the fixed one with `scale = 2` (internal units per sensor unit).
+//!
+//! Checksum: 64-bit FNV-1a over the little-endian bit patterns of, per accepted sample, the
+//! returned error, the errors `f_1..f_P`, the energies `F_0..F_P` and the reflection
+//! coefficients `kf`, `kb`; then the final coefficients `a_1..a_P` and innovation variance.
+
+use imu_ar::ArModel;
+use imu_ar::fixed_point::{FixedConfig, FixedLattice};
+use imu_ar::recursive::{Config, Lattice};
+use imu_ar::sim::ArSimulator;
+use rand_chacha::ChaCha8Rng;
+use rand_core::SeedableRng;
+
+/// Seed of the input sequence.
+pub const SEED: u64 = 2010;
+/// Samples in the run.
+pub const SAMPLES: usize = 20_000;
+const P: usize = 4;
+
+/// 64-bit FNV-1a.
+struct Fnv(u64);
+
+impl Fnv {
+    fn new() -> Self {
+        Fnv(0xcbf2_9ce4_8422_2325)
+    }
+
+    fn bytes(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 ^= u64::from(b);
+            self.0 = self.0.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    }
+}
+
+/// `(f32 checksum, fixed-point checksum)`, or `None` if a configuration is refused.
+pub fn checksums() -> Option<(u64, u64)> {
+    let truth = ArModel::new([1.2f32, -0.5], 0.25, 3.0, 0.01).ok()?;
+    let mut sim = ArSimulator::new(truth);
+    let mut rng = ChaCha8Rng::seed_from_u64(SEED);
+    sim.burn_in(&mut rng, 1000);
+
+    let config = Config::new(0.999f32, 0.1, 0.01).ok()?;
+    let fixed_config = FixedConfig::new(&config, 2.0).ok()?;
+    let mut float = Lattice::<f32, P>::new(&config);
+    let mut fixed = FixedLattice::<P>::new(&fixed_config);
+    let (mut hf, mut hq) = (Fnv::new(), Fnv::new());
+    for n in 0..SAMPLES {
+        let x: f32 = sim.next(&mut rng);
+        let x = if n % 997 == 996 { f32::NAN } else { x };
+        if let Some(e) = float.update(&config, x) {
+            hf.bytes(&e.to_bits().to_le_bytes());
+            for v in float
+                .errors()
+                .iter()
+                .chain(float.forward_reflection())
+                .chain(float.backward_reflection())
+            {
+                hf.bytes(&v.to_bits().to_le_bytes());
+            }
+            for m in 0..=P {
+                hf.bytes(&float.energy(m)?.to_bits().to_le_bytes());
+            }
+        }
+        if let Some(e) = fixed.update(&fixed_config, x) {
+            hq.bytes(&e.to_bits().to_le_bytes());
+            for v in fixed.errors() {
+                hq.bytes(&v.to_bits().to_le_bytes());
+            }
+            for k in fixed
+                .forward_reflection()
+                .iter()
+                .chain(fixed.backward_reflection())
+            {
+                hq.bytes(&k.to_bits().to_le_bytes());
+            }
+            for m in 0..=P {
+                hq.bytes(&fixed.energy(m)?.to_bits().to_le_bytes());
+            }
+        }
+    }
+    let mf = float.model(&config)?;
+    for v in mf.a().iter().chain([&mf.noise_variance()]) {
+        hf.bytes(&v.to_bits().to_le_bytes());
+    }
+    let mq = fixed.model(&fixed_config)?;
+    for v in mq.a().iter().chain([&mq.noise_variance()]) {
+        hq.bytes(&v.to_bits().to_le_bytes());
+    }
+    Some((hf.0, hq.0))
+}
