@@ -116,11 +116,11 @@ fn reciprocal(e: i64) -> (u64, u32) {
     (r as u64, lz)
 }
 
-/// `x / e` for `x` in `Q(x_frac)` and a positive Q40 `e`, in `Q(out_frac)`: `x` rounded to 30
-/// significant bits times the reciprocal of `e`, shifted back (relative error below 2^-29).
+/// `x / e` for `x` in `Q(x_frac)` and the reciprocal `(r, lz)` of a positive Q40 `e`, in
+/// `Q(out_frac)`: `x` rounded to 30 significant bits times `r`, shifted back (relative error
+/// below 2^-29).
 #[inline(always)]
-fn divide(x: i64, x_frac: u32, e: i64, out_frac: u32, clip: &mut u32) -> i64 {
-    let (r, lz) = reciprocal(e);
+fn divide(x: i64, x_frac: u32, (r, lz): (u64, u32), out_frac: u32, clip: &mut u32) -> i64 {
     // Keep 30 significant bits of x, so that x r (r <= 2^32) fits in 64 bits.
     let bits = 64 - x.unsigned_abs().leading_zeros();
     let t = bits.saturating_sub(30);
@@ -148,6 +148,7 @@ impl Arith for Q {
     type Gamma = I2F30;
     type Coef = I3F29;
     type Energy = I24F40;
+    type Recip = (u64, u32);
     type Params = QParams;
 
     const ERR_ZERO: I5F27 = I5F27::ZERO;
@@ -178,23 +179,22 @@ impl Arith for Q {
     }
 
     #[inline(always)]
-    fn adapt(k: I3F29, gx: I5F27, e: I5F27, energy: I24F40, clip: &mut u32) -> I3F29 {
+    fn recip(energy: I24F40) -> (u64, u32) {
+        reciprocal(energy.to_bits())
+    }
+
+    #[inline(always)]
+    fn adapt(k: I3F29, gx: I5F27, e: I5F27, energy: &(u64, u32), clip: &mut u32) -> I3F29 {
         let num = i64::from(gx.to_bits()) * i64::from(e.to_bits()); // Q54, exact
-        let delta = divide(num, 2 * ERR_FRAC, energy.to_bits(), COEF_FRAC, clip);
+        let delta = divide(num, 2 * ERR_FRAC, *energy, COEF_FRAC, clip);
         I3F29::from_bits(sat_i32(sat_add(i64::from(k.to_bits()), delta, clip), clip))
     }
 
     #[inline(always)]
-    fn convert(g: I2F30, gx: I5F27, energy: I24F40) -> I2F30 {
+    fn convert(g: I2F30, gx: I5F27, energy: &(u64, u32)) -> I2F30 {
         let num = i64::from(gx.to_bits()) * i64::from(gx.to_bits()); // Q54, exact
         let mut ignored = 0;
-        let delta = divide(
-            num,
-            2 * ERR_FRAC,
-            energy.to_bits(),
-            GAMMA_FRAC,
-            &mut ignored,
-        );
+        let delta = divide(num, 2 * ERR_FRAC, *energy, GAMMA_FRAC, &mut ignored);
         let g = i64::from(g.to_bits())
             .saturating_sub(delta)
             .clamp(0, 1 << GAMMA_FRAC);
@@ -405,13 +405,8 @@ impl<const P: usize> FixedLattice<P> {
             let mean = round_shift(self.offset, 32);
             let y = sat_i32(i64::from(x) - i64::from(self.origin) - mean, &mut clip);
             // offset += y / W, in Q59.
-            let step = divide(
-                i64::from(y),
-                ERR_FRAC,
-                self.weight,
-                ERR_FRAC + 32,
-                &mut clip,
-            );
+            let w = reciprocal(self.weight);
+            let step = divide(i64::from(y), ERR_FRAC, w, ERR_FRAC + 32, &mut clip);
             self.offset = sat_add(self.offset, step, &mut clip);
             y
         } else {

@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
 # Regenerates the measured tables of README.md (between the BEGIN/END markers) from runs:
-#   - f32 accuracy of the recursive cores (host-tests/tests/recursive_f32.rs),
+#   - f32 and fixed-point accuracy of the lattice (host-tests/tests/recursive_f32.rs, fixed.rs),
+#   - instructions per sample on the emulated Cortex-M4F (`cargo qemu bench`),
 #   - `imu-ar compare` on a drifting AR(2),
 #   - host cost per sample (criterion, host-tests/benches/per_sample.rs).
 #
 #   tools/readme-tables.sh            all of them (about 4 minutes)
-#   tools/readme-tables.sh accuracy   one section: accuracy | compare | host-cost
+#   tools/readme-tables.sh accuracy   one group: accuracy | target-cost | compare | host-cost
 set -euo pipefail
 cd "$(dirname "$0")/.."
 only=${1:-all}
@@ -29,28 +30,58 @@ PY
     echo "README.md: section $1 updated"
 }
 
+# tables OUTPUT HEADER=SECTION...: the markdown tables of a test's output, by header cell, into
+# $tmp/SECTION.md (libtest may print "test name ... " on the line where a table starts).
+tables() {
+    python3 - "$tmp" "$@" <<'PY'
+import sys
+tmp, output, pairs = sys.argv[1], sys.argv[2], sys.argv[3:]
+headers = dict(p.split("=", 1) for p in pairs)
+tables, current = {}, None
+for line in open(output):
+    for header, name in headers.items():
+        if header in line:
+            current, line = name, line[line.index(header):]
+            break
+    else:
+        if not line.startswith("|"):
+            current = None
+    if current:
+        tables.setdefault(current, []).append(line)
+for name in headers.values():
+    open(f"{tmp}/{name}.md", "w").write("".join(tables[name]))
+PY
+}
+
 if [ "$only" = all ] || [ "$only" = accuracy ]; then
     cargo test --release -p imu-ar-host --test recursive_f32 -- --nocapture --test-threads 1 \
         > "$tmp/accuracy.txt" 2>/dev/null
-    python3 - "$tmp" <<'PY'
-import sys
-tmp = sys.argv[1]
-tables, current = {}, None
-for line in open(f"{tmp}/accuracy.txt"):
-    # libtest may print "test name ... " on the line where a table starts.
-    if "| process |" in line:
-        current, line = "f32-accuracy", line[line.index("| process |"):]
-    elif "| record |" in line:
-        current, line = "real-accuracy", line[line.index("| record |"):]
-    elif not line.startswith("|"):
-        current = None
-    if current:
-        tables.setdefault(current, []).append(line)
-for name, lines in tables.items():
-    open(f"{tmp}/{name}.md", "w").write("".join(lines))
-PY
+    tables "$tmp/accuracy.txt" "| process |=f32-accuracy" "| record |=real-accuracy"
     replace f32-accuracy "$tmp/f32-accuracy.md"
     replace real-accuracy "$tmp/real-accuracy.md"
+    cargo test --release -p imu-ar-host --test fixed -- --nocapture --test-threads 1 \
+        > "$tmp/fixed.txt" 2>/dev/null
+    tables "$tmp/fixed.txt" "| process |=fixed-accuracy" "| record |=fixed-real"
+    replace fixed-accuracy "$tmp/fixed-accuracy.md"
+    replace fixed-real "$tmp/fixed-real.md"
+fi
+
+if [ "$only" = all ] || [ "$only" = target-cost ]; then
+    cargo qemu bench 2>/dev/null > "$tmp/bench.txt"
+    python3 - "$tmp/bench.txt" > "$tmp/target-cost.md" <<'PY'
+import re, sys
+rows = {}
+for line in open(sys.argv[1]):
+    m = re.search(r"(\w+) (\w+) p=(\d+) insns/sample=(\d+)", line)
+    if m:
+        rows.setdefault((m[1], m[2]), {})[int(m[3])] = int(m[4])
+orders = sorted({p for r in rows.values() for p in r})
+print("| estimator | scalar | " + " | ".join(f"p = {p}" for p in orders) + " |")
+print("|---|---|" + "---|" * len(orders))
+for (est, scalar), r in rows.items():
+    print(f"| {est} | {scalar} | " + " | ".join(str(r.get(p, "")) for p in orders) + " |")
+PY
+    replace target-cost "$tmp/target-cost.md"
 fi
 
 if [ "$only" = all ] || [ "$only" = compare ]; then

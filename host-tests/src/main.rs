@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! imu-ar fit FILE.. --column C --method ls|yule-walker|burg|rls|lattice --order P
-//!     [--scalar f64|f32] [--lambda L] [--delta D] [--no-demean] [--rate HZ] [--json]
+//!     [--scalar f64|f32|fixed] [--lambda L] [--delta D] [--scale S] [--no-demean] [--rate HZ] [--json]
 //! imu-ar compare FILE.. --column C --order P [--lambda L] [--delta D] [--train F] [--json]
 //! imu-ar order FILE.. --column C --max-order P --method ls|yule-walker|burg [--no-demean] [--json]
 //! imu-ar adev FILE.. --column C --rate HZ [--json]
@@ -22,6 +22,7 @@ use imu_ar::ArModel;
 use imu_ar::allan::overlapping_avar;
 use imu_ar::batch::criteria::Criterion;
 use imu_ar::batch::{BatchConfig, BatchError, Fit, burg, covariance, yule_walker};
+use imu_ar::fixed_point::{FixedConfig, FixedLattice};
 use imu_ar::recursive::{Config, FloatArith, Lattice, Rls, RlsInit};
 use imu_ar::sim::StandardNormal;
 use imu_ar_host::data::read_column;
@@ -105,6 +106,8 @@ impl Method {
 enum ScalarKind {
     F64,
     F32,
+    /// The fixed-point lattice (`--method lattice` only).
+    Fixed,
 }
 
 impl ScalarKind {
@@ -112,6 +115,7 @@ impl ScalarKind {
         match self {
             ScalarKind::F64 => "f64",
             ScalarKind::F32 => "f32",
+            ScalarKind::Fixed => "fixed",
         }
     }
 }
@@ -145,6 +149,10 @@ enum Command {
         /// first 1000 samples, or 1 when that is 0].
         #[arg(long, allow_negative_numbers = true)]
         delta: Option<f64>,
+        /// Internal units per sensor unit of `--scalar fixed` [default: 8 / max |x|, so that the
+        /// record, offset included, uses half of the +-16 range].
+        #[arg(long, allow_negative_numbers = true)]
+        scale: Option<f64>,
         /// Fit the data as they are, without removing the (sample or running) mean.
         #[arg(long)]
         no_demean: bool,
@@ -304,11 +312,23 @@ fn run(command: Command) -> Result<String, Fail> {
             scalar,
             lambda,
             delta,
+            scale,
             no_demean,
             rate,
             json,
         } => {
             check_order("--order", order)?;
+            if matches!(scalar, ScalarKind::Fixed) && !matches!(method, Method::Lattice) {
+                return Err(Fail(format!(
+                    "--scalar fixed: only --method lattice runs in fixed point, not {}",
+                    method.name()
+                )));
+            }
+            if let Some(s) = scale {
+                if !(s.is_finite() && s > 0.0) {
+                    return Err(Fail(format!("--scale {s}: must be positive and finite")));
+                }
+            }
             let dt = match rate {
                 Some(r) => 1.0 / check_rate(r)?,
                 None => 1.0,
@@ -332,6 +352,11 @@ fn run(command: Command) -> Result<String, Fail> {
                 match scalar {
                     ScalarKind::F64 => with_order!(order, recursive_fit::<f64>(&x, &r)),
                     ScalarKind::F32 => with_order!(order, recursive_fit::<f32>(&x, &r)),
+                    ScalarKind::Fixed => {
+                        let peak = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                        let scale = scale.unwrap_or(if peak > 0.0 { 8.0 / peak } else { 1.0 });
+                        with_order!(order, fixed_fit(&x, &r, scale))
+                    }
                 }
                 .map_err(|Fail(e)| with_file(&files, e))?
             } else {
@@ -598,6 +623,44 @@ fn recursive_fit<T: FloatArith, const P: usize>(x: &[f64], r: &Recursive) -> Res
     if let Some(rate) = r.rate {
         v["rate_hz"] = json!(rate);
         gauss_markov_json(&mut v, &a, model.noise_variance().to_f64(), r.dt);
+    }
+    Ok(v)
+}
+
+/// Runs the fixed-point lattice over `x` (in sensor units, scaled by `scale`).
+fn fixed_fit<const P: usize>(x: &[f64], r: &Recursive, scale: f64) -> Result<Value, Fail> {
+    let config = Config::new(r.lambda as f32, r.delta as f32, r.dt as f32)?.with_demean(r.demean);
+    let fixed = FixedConfig::new(&config, scale as f32)?;
+    let mut lattice = FixedLattice::<P>::new(&fixed);
+    for &v in x {
+        lattice.update(&fixed, v as f32);
+    }
+    let health = lattice.health();
+    let model = lattice
+        .model(&fixed)
+        .ok_or_else(|| Fail("no finite model".into()))?;
+    let a: Vec<f64> = model.a().iter().map(|&v| f64::from(v)).collect();
+    let mut v = json!({
+        "method": "lattice",
+        "scalar": "fixed",
+        "order": P,
+        "n": x.len(),
+        "mean": f64::from(model.mean()),
+        "a": a,
+        "noise_variance": f64::from(model.noise_variance()),
+        "lambda": fixed.lambda(),
+        "delta": r.delta,
+        "scale": f64::from(fixed.scale()),
+        "restarts": health.restarts,
+        "saturated": health.saturated,
+        "clipped": health.clipped,
+    });
+    if let Ok(k) = model.reflection() {
+        v["reflection"] = json!(k.iter().map(|&v| f64::from(v)).collect::<Vec<_>>());
+    }
+    if let Some(rate) = r.rate {
+        v["rate_hz"] = json!(rate);
+        gauss_markov_json(&mut v, &a, f64::from(model.noise_variance()), r.dt);
     }
     Ok(v)
 }

@@ -416,6 +416,23 @@ fn recursive_fits_and_the_drifting_ar2_comparison() {
     );
     let rls_fit = fit_json(&file, "rls", "2", &["--lambda", "0.999", "--delta", "0.5"]);
     assert_eq!(f32_fit["scalar"], "f32");
+    let fixed_fit = fit_json(
+        &file,
+        "lattice",
+        "2",
+        &["--lambda", "0.999", "--delta", "0.5", "--scalar", "fixed"],
+    );
+    assert_eq!(
+        (fixed_fit["scalar"].as_str(), fixed_fit["clipped"].as_u64()),
+        (Some("fixed"), Some(0))
+    );
+    for k in 0..2 {
+        let (a, q) = (
+            f64_fit["a"][k].as_f64().unwrap(),
+            fixed_fit["a"][k].as_f64().unwrap(),
+        );
+        assert!((a - q).abs() < 1e-4, "fixed a_{}: {q} vs f64 {a}", k + 1);
+    }
     assert_eq!(
         (f64_fit["lambda"].as_f64(), f64_fit["delta"].as_f64()),
         (Some(0.999), Some(0.5))

@@ -22,6 +22,9 @@ pub trait Arith: Copy + Debug {
     type Coef: Copy + Debug + PartialEq;
     /// Weighted energies `F`, `B`, positive.
     type Energy: Copy + Debug + PartialEq;
+    /// A divisor prepared once for several divisions by the same energy (for floats the energy
+    /// itself; for fixed point its normalised reciprocal).
+    type Recip: Copy + Debug;
     /// What the steps need from the configuration (the forgetting factor in its format).
     type Params: Copy + Debug;
 
@@ -47,17 +50,20 @@ pub trait Arith: Copy + Debug {
     /// `x - k y`: an order update of an error.
     fn predict(x: Self::Err, k: Self::Coef, y: Self::Err, clip: &mut u32) -> Self::Err;
 
+    /// Prepares divisions by `energy`.
+    fn recip(energy: Self::Energy) -> Self::Recip;
+
     /// `k + gx e / energy`: the error-feedback update of a reflection coefficient.
     fn adapt(
         k: Self::Coef,
         gx: Self::Err,
         e: Self::Err,
-        energy: Self::Energy,
+        energy: &Self::Recip,
         clip: &mut u32,
     ) -> Self::Coef;
 
     /// `g - gx^2 / energy`, kept in `[0, 1]`: the next order's conversion factor.
-    fn convert(g: Self::Gamma, gx: Self::Err, energy: Self::Energy) -> Self::Gamma;
+    fn convert(g: Self::Gamma, gx: Self::Err, energy: &Self::Recip) -> Self::Gamma;
 }
 
 /// [`Arith::Params`] of the float formats.
@@ -77,6 +83,7 @@ macro_rules! impl_arith_float {
             type Gamma = $t;
             type Coef = $t;
             type Energy = $t;
+            type Recip = $t;
             type Params = FloatParams<$t>;
 
             const ERR_ZERO: $t = 0.0;
@@ -100,13 +107,18 @@ macro_rules! impl_arith_float {
             }
 
             #[inline(always)]
-            fn adapt(k: $t, gx: $t, e: $t, energy: $t, _: &mut u32) -> $t {
-                k + gx * e / energy
+            fn recip(energy: $t) -> $t {
+                energy
             }
 
             #[inline(always)]
-            fn convert(g: $t, gx: $t, energy: $t) -> $t {
-                let g = g - gx * gx / energy;
+            fn adapt(k: $t, gx: $t, e: $t, energy: &$t, _: &mut u32) -> $t {
+                k + gx * e / *energy
+            }
+
+            #[inline(always)]
+            fn convert(g: $t, gx: $t, energy: &$t) -> $t {
+                let g = g - gx * gx / *energy;
                 if g > 1.0 {
                     1.0
                 } else if g > 0.0 {

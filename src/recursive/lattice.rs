@@ -19,6 +19,9 @@ pub struct Core<A: Arith, const P: usize> {
     pub(crate) f_energy_p: A::Energy,
     /// Backward energies `B_0..B_{P-1}`, holding `B_i(n-1)` between samples.
     pub(crate) b_energy: [A::Energy; P],
+    /// `B_i` prepared for division: computed for step 7 and reused by step 4 of the next
+    /// sample.
+    b_recip: [A::Recip; P],
     /// `kf_1..kf_P` (index `m - 1` for order `m`).
     pub(crate) kf: [A::Coef; P],
     /// `kb_1..kb_P`.
@@ -47,6 +50,7 @@ impl<A: Arith, const P: usize> Core<A, P> {
             f_energy: [f0; P],
             f_energy_p: f0,
             b_energy: b,
+            b_recip: b.map(A::recip),
             kf: [A::COEF_ZERO; P],
             kb: [A::COEF_ZERO; P],
             bp: [A::ERR_ZERO; P],
@@ -70,13 +74,15 @@ impl<A: Arith, const P: usize> Core<A, P> {
             let f_next = A::predict(f, self.kf[i], self.bp[i], clip);
             let psi_next = A::predict(self.bp[i], self.kb[i], f, clip);
             let gbp = A::gain(self.gp[i], self.bp[i], clip);
-            self.kf[i] = A::adapt(self.kf[i], gbp, f_next, self.b_energy[i], clip);
-            self.kb[i] = A::adapt(self.kb[i], gf, psi_next, fe, clip);
+            self.kf[i] = A::adapt(self.kf[i], gbp, f_next, &self.b_recip[i], clip);
+            self.kb[i] = A::adapt(self.kb[i], gf, psi_next, &A::recip(fe), clip);
             let gpsi = A::gain(g, psi, clip);
             let be = A::energy(params, self.b_energy[i], gpsi, psi, clip);
-            let g_next = A::convert(g, gpsi, be);
+            let be_recip = A::recip(be);
+            let g_next = A::convert(g, gpsi, &be_recip);
             self.f_energy[i] = fe;
             self.b_energy[i] = be;
+            self.b_recip[i] = be_recip;
             self.bp[i] = psi;
             self.gp[i] = g;
             self.errors[i] = f_next;
