@@ -324,10 +324,8 @@ fn run(command: Command) -> Result<String, Fail> {
                     method.name()
                 )));
             }
-            if let Some(s) = scale {
-                if !(s.is_finite() && s > 0.0) {
-                    return Err(Fail(format!("--scale {s}: must be positive and finite")));
-                }
+            if let Some(s) = scale.filter(|s| !(s.is_finite() && *s > 0.0)) {
+                return Err(Fail(format!("--scale {s}: must be positive and finite")));
             }
             let dt = match rate {
                 Some(r) => 1.0 / check_rate(r)?,
