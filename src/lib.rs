@@ -9,6 +9,7 @@ pub mod fixed_point;
 pub mod model;
 pub mod recursive;
 pub mod scalar;
+pub mod sensor;
 pub mod sim;
 
 pub use model::{ArModel, GaussMarkov, ModelError};

@@ -1,0 +1,391 @@
+//! TDK InvenSense ICM-42688-P over SPI.
+//!
+//! Registers (user bank 0), bits, FIFO packet layout and scale factors from the "ICM-42688-P
+//! Datasheet", DS-000347 revision 1.2: section 3.1 (gyro sensitivity), 3.2 (accelerometer
+//! sensitivity), section 6 (FIFO packet structure, packet 3) and the bank 0 register
+//! descriptions (register addresses below). SPI: bit 7 of the address byte set for a read.
+
+use embedded_hal::delay::DelayNs;
+use embedded_hal::spi::{Operation, SpiDevice};
+
+use super::{Error, FifoStats, ImuReader, RawSample, Scale, be_i16, be_i16x3};
+
+/// DEVICE_CONFIG: SOFT_RESET_CONFIG in bit 0 (1 ms to complete).
+const DEVICE_CONFIG: u8 = 0x11;
+/// FIFO_CONFIG: FIFO_MODE in bits 7:6 (01 stream-to-FIFO).
+const FIFO_CONFIG: u8 = 0x16;
+/// TEMP_DATA1: temperature, then ACCEL_DATA_X1 (0x1F) .. GYRO_DATA_Z0 (0x2A), big-endian.
+const TEMP_DATA1: u8 = 0x1D;
+/// INT_STATUS: FIFO_FULL_INT in bit 1, cleared by reading.
+const INT_STATUS: u8 = 0x2D;
+/// FIFO_COUNTH/L: bytes in the FIFO, big-endian (reset value of INTF_CONFIG0).
+const FIFO_COUNTH: u8 = 0x2E;
+/// FIFO_DATA.
+const FIFO_DATA: u8 = 0x30;
+/// SIGNAL_PATH_RESET: FIFO_FLUSH in bit 1.
+const SIGNAL_PATH_RESET: u8 = 0x4B;
+/// PWR_MGMT0: GYRO_MODE bits 3:2, ACCEL_MODE bits 1:0 (11 = low noise).
+const PWR_MGMT0: u8 = 0x4E;
+/// GYRO_CONFIG0: GYRO_FS_SEL bits 7:5, GYRO_ODR bits 3:0.
+const GYRO_CONFIG0: u8 = 0x4F;
+/// ACCEL_CONFIG0: ACCEL_FS_SEL bits 7:5, ACCEL_ODR bits 3:0.
+const ACCEL_CONFIG0: u8 = 0x50;
+/// FIFO_CONFIG1: FIFO_TEMP_EN (2), FIFO_GYRO_EN (1), FIFO_ACCEL_EN (0).
+const FIFO_CONFIG1: u8 = 0x5F;
+/// WHO_AM_I, 0x47.
+const WHO_AM_I: u8 = 0x75;
+
+const ID: u8 = 0x47;
+const READ: u8 = 0x80;
+const FIFO_FULL: u8 = 1 << 1;
+const FIFO_FLUSH: u8 = 1 << 1;
+/// Packet 3: header, accel x/y/z, gyro x/y/z (big-endian), temperature (1 byte), timestamp (2).
+const PACKET: usize = 16;
+/// Header bits: HEADER_MSG (7, FIFO empty), HEADER_ACCEL (6), HEADER_GYRO (5).
+const HEADER_EMPTY: u8 = 1 << 7;
+const HEADER_ACCEL_GYRO: u8 = 0b0110_0000;
+/// Packets read per SPI transaction.
+const CHUNK: usize = 8;
+
+/// Gyro full-scale range (GYRO_FS_SEL).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum IcmGyroRange {
+    /// +-2000 deg/s, 16.4 counts per deg/s.
+    #[default]
+    Dps2000 = 0,
+    /// +-1000 deg/s, 32.8 counts per deg/s.
+    Dps1000 = 1,
+    /// +-500 deg/s, 65.5 counts per deg/s.
+    Dps500 = 2,
+    /// +-250 deg/s, 131 counts per deg/s.
+    Dps250 = 3,
+    /// +-125 deg/s, 262 counts per deg/s.
+    Dps125 = 4,
+    /// +-62.5 deg/s, 524.3 counts per deg/s.
+    Dps62_5 = 5,
+    /// +-31.25 deg/s, 1048.6 counts per deg/s.
+    Dps31_25 = 6,
+    /// +-15.625 deg/s, 2097.2 counts per deg/s.
+    Dps15_625 = 7,
+}
+
+impl IcmGyroRange {
+    /// Counts per deg/s (DS-000347 rev 1.2, section 3.1).
+    pub fn counts_per_dps(self) -> f32 {
+        match self {
+            Self::Dps2000 => 16.4,
+            Self::Dps1000 => 32.8,
+            Self::Dps500 => 65.5,
+            Self::Dps250 => 131.0,
+            Self::Dps125 => 262.0,
+            Self::Dps62_5 => 524.3,
+            Self::Dps31_25 => 1048.6,
+            Self::Dps15_625 => 2097.2,
+        }
+    }
+}
+
+/// Accelerometer full-scale range (ACCEL_FS_SEL).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum IcmAccelRange {
+    /// +-16 g, 2048 counts per g.
+    #[default]
+    G16 = 0,
+    /// +-8 g, 4096 counts per g.
+    G8 = 1,
+    /// +-4 g, 8192 counts per g.
+    G4 = 2,
+    /// +-2 g, 16384 counts per g.
+    G2 = 3,
+}
+
+impl IcmAccelRange {
+    /// Counts per g (DS-000347 rev 1.2, section 3.2).
+    pub fn counts_per_g(self) -> f32 {
+        match self {
+            Self::G16 => 2048.0,
+            Self::G8 => 4096.0,
+            Self::G4 => 8192.0,
+            Self::G2 => 16384.0,
+        }
+    }
+}
+
+/// Output data rate (GYRO_ODR / ACCEL_ODR codes).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Odr {
+    /// 8 kHz.
+    Hz8000 = 3,
+    /// 4 kHz.
+    Hz4000 = 4,
+    /// 2 kHz.
+    Hz2000 = 5,
+    /// 1 kHz.
+    Hz1000 = 6,
+    /// 500 Hz.
+    Hz500 = 15,
+    /// 200 Hz.
+    Hz200 = 7,
+    /// 100 Hz.
+    #[default]
+    Hz100 = 8,
+    /// 50 Hz.
+    Hz50 = 9,
+    /// 25 Hz.
+    Hz25 = 10,
+}
+
+/// Configuration written by [`Icm42688::init`] (gyro and accelerometer at the same rate).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Icm42688Config {
+    /// Gyro range.
+    pub gyro_range: IcmGyroRange,
+    /// Accelerometer range.
+    pub accel_range: IcmAccelRange,
+    /// Output data rate of both.
+    pub odr: Odr,
+}
+
+impl Icm42688Config {
+    /// The sensitivities of this configuration.
+    pub fn scale(&self) -> Scale {
+        Scale {
+            gyro_counts_per_dps: self.gyro_range.counts_per_dps(),
+            accel_counts_per_g: self.accel_range.counts_per_g(),
+        }
+    }
+}
+
+/// An ICM-42688-P on an SPI device.
+///
+/// ```
+/// # use embedded_hal::spi::{ErrorType, Operation, SpiDevice};
+/// # struct Bus;
+/// # impl ErrorType for Bus { type Error = core::convert::Infallible; }
+/// # impl SpiDevice for Bus {
+/// #     fn transaction(&mut self, ops: &mut [Operation<'_, u8>]) -> Result<(), Self::Error> {
+/// #         let mut reg = 0;
+/// #         for op in ops {
+/// #             match op {
+/// #                 Operation::Write(w) => reg = w[0],
+/// #                 Operation::Read(b) => { b.fill(0); if reg == 0xF5 { b[0] = 0x47; } }
+/// #                 _ => {}
+/// #             }
+/// #         }
+/// #         Ok(())
+/// #     }
+/// # }
+/// # struct Delay;
+/// # impl embedded_hal::delay::DelayNs for Delay { fn delay_ns(&mut self, _: u32) {} }
+/// use imu_ar::recursive::{Config, Lattice};
+/// use imu_ar::sensor::{AccelUnit, GyroUnit, Icm42688, Icm42688Config, ImuReader, RawSample};
+///
+/// let mut imu = Icm42688::new(Bus);
+/// imu.init(&mut Delay, Icm42688Config::default())?;
+/// imu.enable_fifo()?;
+/// let config = Config::new(0.999f32, 1e-4, 0.01).unwrap();
+/// let mut axes = [Lattice::<f32, 4>::new(&config); 6];
+/// let mut batch = [RawSample::default(); 16];
+/// let n = imu.read_fifo(&mut batch)?;
+/// let scale = imu.scale();
+/// for s in &batch[..n] {
+///     let gyro = scale.gyro(s.gyro, GyroUnit::RadPerSec);
+///     let accel = scale.accel(s.accel, AccelUnit::MetersPerSec2);
+///     for (lattice, x) in axes.iter_mut().zip(gyro.into_iter().chain(accel)) {
+///         lattice.update(&config, x);
+///     }
+/// }
+/// let bus: Bus = imu.destroy();
+/// # Ok::<(), imu_ar::sensor::Error<core::convert::Infallible>>(())
+/// ```
+#[derive(Debug)]
+pub struct Icm42688<SPI> {
+    spi: SPI,
+    config: Icm42688Config,
+    fifo: bool,
+    stats: FifoStats,
+}
+
+impl<SPI: SpiDevice> Icm42688<SPI> {
+    /// A reader on `spi` (mode 0 or 3); no bus traffic until `init`.
+    pub fn new(spi: SPI) -> Self {
+        Self {
+            spi,
+            config: Icm42688Config::default(),
+            fifo: false,
+            stats: FifoStats::default(),
+        }
+    }
+
+    /// Gives the bus back.
+    pub fn destroy(self) -> SPI {
+        self.spi
+    }
+
+    fn write(&mut self, reg: u8, value: u8) -> Result<(), Error<SPI::Error>> {
+        self.spi.write(&[reg, value])?;
+        Ok(())
+    }
+
+    fn read_regs(&mut self, reg: u8, buf: &mut [u8]) -> Result<(), Error<SPI::Error>> {
+        self.spi
+            .transaction(&mut [Operation::Write(&[reg | READ]), Operation::Read(buf)])?;
+        Ok(())
+    }
+
+    /// WHO_AM_I.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::Bus`].
+    pub fn who_am_i(&mut self) -> Result<u8, Error<SPI::Error>> {
+        let mut id = [0];
+        self.read_regs(WHO_AM_I, &mut id)?;
+        Ok(id[0])
+    }
+
+    /// Probes WHO_AM_I (0x47), soft-resets the chip (1 ms), writes ranges and rates and puts
+    /// gyro and accelerometer in low-noise mode (then 1 ms; the gyro needs about 30 ms more
+    /// before its data are valid). The FIFO is off afterwards.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::WrongDevice`] or [`Error::Bus`]; after a bus error `init` can be called again.
+    pub fn init(
+        &mut self,
+        delay: &mut impl DelayNs,
+        config: Icm42688Config,
+    ) -> Result<(), Error<SPI::Error>> {
+        let id = self.who_am_i()?;
+        if id != ID {
+            return Err(Error::WrongDevice { found: id });
+        }
+        self.write(DEVICE_CONFIG, 0x01)?;
+        delay.delay_ms(1);
+        self.write(
+            GYRO_CONFIG0,
+            (config.gyro_range as u8) << 5 | config.odr as u8,
+        )?;
+        self.write(
+            ACCEL_CONFIG0,
+            (config.accel_range as u8) << 5 | config.odr as u8,
+        )?;
+        self.write(PWR_MGMT0, 0x0F)?;
+        delay.delay_ms(1);
+        self.config = config;
+        self.fifo = false;
+        Ok(())
+    }
+
+    /// The configuration written by the last `init`.
+    pub fn config(&self) -> &Icm42688Config {
+        &self.config
+    }
+
+    /// Enables the FIFO in stream mode with packet 3 (accelerometer, gyro, temperature,
+    /// timestamp: 16 bytes) and flushes it.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::Bus`].
+    pub fn enable_fifo(&mut self) -> Result<(), Error<SPI::Error>> {
+        self.write(FIFO_CONFIG1, 0b0000_0111)?;
+        self.write(FIFO_CONFIG, 0b0100_0000)?;
+        self.write(SIGNAL_PATH_RESET, FIFO_FLUSH)?;
+        self.fifo = true;
+        Ok(())
+    }
+
+    /// Temperature in deg C from a raw register value: `raw / 132.48 + 25`. FIFO samples carry
+    /// the 8-bit FIFO temperature (`t / 2.07 + 25`) scaled by 64 into the same 16-bit form.
+    pub fn temperature_celsius(raw: i16) -> f32 {
+        f32::from(raw) / 132.48 + 25.0
+    }
+
+    fn fifo_count(&mut self) -> Result<u16, Error<SPI::Error>> {
+        let mut b = [0; 2];
+        self.read_regs(FIFO_COUNTH, &mut b)?;
+        Ok(u16::from_be_bytes(b))
+    }
+}
+
+impl<SPI: SpiDevice> ImuReader for Icm42688<SPI> {
+    type BusError = SPI::Error;
+
+    fn scale(&self) -> Scale {
+        self.config.scale()
+    }
+
+    /// One burst read of TEMP_DATA1 .. GYRO_DATA_Z0.
+    fn read(&mut self) -> Result<RawSample, Error<SPI::Error>> {
+        let mut b = [0u8; 14];
+        self.read_regs(TEMP_DATA1, &mut b)?;
+        Ok(RawSample {
+            temperature: Some(be_i16(&b, 0)),
+            accel: be_i16x3(&b, 2),
+            gyro: be_i16x3(&b, 8),
+        })
+    }
+
+    /// Reads INT_STATUS first: on FIFO_FULL_INT the FIFO is flushed (its complete packets are
+    /// counted as discarded) and [`Error::FifoOverflow`] is returned. Otherwise whole packets
+    /// (up to `out.len()`) are read, 8 per SPI transaction; a packet whose header does not
+    /// announce accelerometer and gyro data is skipped and counted as malformed, and a header
+    /// with HEADER_MSG set (FIFO empty) ends the batch. A bus error after some packets were read
+    /// loses them: they are counted in [`FifoStats::discarded`].
+    fn read_fifo(&mut self, out: &mut [RawSample]) -> Result<usize, Error<SPI::Error>> {
+        if !self.fifo {
+            return Err(Error::FifoDisabled);
+        }
+        let mut status = [0];
+        self.read_regs(INT_STATUS, &mut status)?;
+        if status[0] & FIFO_FULL != 0 {
+            let discarded = self.fifo_count()? / PACKET as u16;
+            self.write(SIGNAL_PATH_RESET, FIFO_FLUSH)?;
+            self.stats.overflows += 1;
+            self.stats.discarded += u64::from(discarded);
+            return Err(Error::FifoOverflow { discarded });
+        }
+        let available = usize::from(self.fifo_count()?) / PACKET;
+        let mut remaining = available;
+        let mut delivered = 0;
+        let mut buf = [0u8; PACKET * CHUNK];
+        while remaining > 0 && delivered < out.len() {
+            let n = remaining.min(CHUNK).min(out.len() - delivered);
+            if let Err(e) = self.read_regs(FIFO_DATA, &mut buf[..n * PACKET]) {
+                self.stats.discarded += delivered as u64;
+                return Err(e);
+            }
+            remaining -= n;
+            for packet in buf[..n * PACKET].chunks_exact(PACKET) {
+                let header = packet[0];
+                if header & HEADER_EMPTY != 0 {
+                    remaining = 0;
+                    break;
+                }
+                if header & HEADER_ACCEL_GYRO != HEADER_ACCEL_GYRO {
+                    self.stats.malformed += 1;
+                    continue;
+                }
+                if let Some(slot) = out.get_mut(delivered) {
+                    *slot = RawSample {
+                        accel: be_i16x3(packet, 1),
+                        gyro: be_i16x3(packet, 7),
+                        temperature: Some(i16::from(packet[13] as i8) * 64),
+                    };
+                    delivered += 1;
+                }
+            }
+        }
+        self.stats.samples += delivered as u64;
+        Ok(delivered)
+    }
+
+    fn fifo_stats(&self) -> FifoStats {
+        self.stats
+    }
+}
