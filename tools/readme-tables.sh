@@ -2,11 +2,12 @@
 # Regenerates the measured tables of README.md (between the BEGIN/END markers) from runs:
 #   - f32 and fixed-point accuracy of the lattice (host-tests/tests/recursive_f32.rs, fixed.rs),
 #   - instructions per sample on the emulated Cortex-M4F (`cargo qemu bench`),
+#   - the demo's output and footprint (`cargo qemu demo`, tools/footprint.sh),
 #   - `imu-ar compare` on a drifting AR(2),
 #   - host cost per sample (criterion, host-tests/benches/per_sample.rs).
 #
 #   tools/readme-tables.sh            all of them (about 4 minutes)
-#   tools/readme-tables.sh accuracy   one group: accuracy | target-cost | compare | host-cost
+#   tools/readme-tables.sh accuracy   one group: accuracy | target-cost | demo | compare | host-cost
 set -euo pipefail
 cd "$(dirname "$0")/.."
 only=${1:-all}
@@ -82,6 +83,17 @@ for (est, scalar), r in rows.items():
     print(f"| {est} | {scalar} | " + " | ".join(str(r.get(p, "")) for p in orders) + " |")
 PY
     replace target-cost "$tmp/target-cost.md"
+fi
+
+if [ "$only" = all ] || [ "$only" = demo ]; then
+    {
+        echo '```text'
+        cargo qemu demo 2>/dev/null | grep -E 't=120\.0s|^INFO  check|demo:'
+        echo '```'
+    } > "$tmp/demo-output.md"
+    replace demo-output "$tmp/demo-output.md"
+    tools/footprint.sh demo > "$tmp/footprint.md"
+    replace footprint "$tmp/footprint.md"
 fi
 
 if [ "$only" = all ] || [ "$only" = compare ]; then

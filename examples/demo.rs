@@ -1,0 +1,296 @@
+//! The main job on the emulated Cortex-M4F: learn the error model of every axis of an IMU.
+//!
+//! ```text
+//! cargo qemu demo
+//! ```
+//!
+//! Inside the firmware, a simulated MPU-6050 answers the register protocol on a simulated I2C
+//! bus (`examples/common/sim_imu.rs`) and produces six axes at 100 Hz, each with a constant
+//! bias, a first-order Gauss-Markov drift whose sigma and correlation time change with a
+//! simulated temperature ramp (25 to 45 deg C), white noise, and quantisation to counts. The
+//! firmware reads it through `imu_ar::sensor::Mpu6050` (FIFO batches of 100 ms) and estimates
+//! each axis with an f32 lattice of order 4 (`lambda = 0.9995`, a 20 s memory) plus a BIC order
+//! selector. Every 10 s of sensor time it logs, per axis: `a_1..a_4`, the innovation sigma, the
+//! selected order, the Gauss-Markov correlation time and sigma of the order-1 model, and the
+//! one-step prediction MSE of the lattice and of a batch LS model fitted on the previous 10 s.
+//!
+//! After 120 s it checks each axis against the simulated truth and exits 0 when all hold. The
+//! truth of an AR(4) fit to `bias + Gauss-Markov + white` (an ARMA(1,1)) is its best AR(4)
+//! approximation: Levinson-Durbin on the exact autocovariances, at the temperature of the
+//! centre of mass of the estimator's memory (`lambda / (1 - lambda)` samples before the end).
+//! - the running mean is within 4 standard deviations (of an exponentially weighted mean of
+//!   this process) of the true mean;
+//! - every coefficient is within 0.1 of the true AR(4) coefficients (about 6 standard
+//!   deviations with 4000 effective samples);
+//! - the innovation variance is within 10 % of the true AR(4) innovation variance;
+//! - the lattice's prediction MSE over the last 10 s is within 25 % of that same variance.
+//!
+//! The Gauss-Markov correlation time and sigma (from the order-1 model) are logged where an
+//! AR(1) fits, i.e. where the selector chose order 1; `NaN` elsewhere.
+//!
+//! Build with `IMU_AR_DEMO_FAULT=lambda` (forgetting factor 0.5: a 3-sample memory) or
+//! `IMU_AR_DEMO_FAULT=corrupt` (every 20th sample spiked by 2000 counts) to see the checks
+//! fail and the firmware exit 1.
+#![cfg_attr(target_os = "none", no_std, no_main)]
+
+#[cfg(target_os = "none")]
+#[path = "common/mod.rs"]
+mod common;
+
+#[cfg(target_os = "none")]
+#[path = "common/sim_imu.rs"]
+mod sim_imu;
+
+#[cfg(target_os = "none")]
+mod firmware {
+    use embedded_hal::delay::DelayNs;
+    use imu_ar::batch::{BatchConfig, covariance};
+    use imu_ar::recursive::{Config, Lattice, OrderRule, OrderSelector};
+    use imu_ar::sensor::{AccelUnit, GyroUnit, ImuReader, Mpu6050, Mpu6050Config, RawSample};
+    use imu_ar::{ArModel, Scalar};
+
+    use super::common;
+    use super::sim_imu::{AXES, SimImu};
+
+    const P: usize = 4;
+    const RATE: f32 = 100.0;
+    const WINDOW: usize = 1000; // 10 s
+    const DURATION_S: u32 = 120;
+    const NAMES: [&str; 6] = ["gx", "gy", "gz", "ax", "ay", "az"];
+    /// Largest accepted coefficient error: about 6 standard deviations of an estimate with
+    /// `(1 + lambda)/(1 - lambda) = 4000` effective samples.
+    const A_TOLERANCE: f64 = 0.1;
+
+    struct NoDelay;
+    impl DelayNs for NoDelay {
+        fn delay_ns(&mut self, _: u32) {}
+    }
+
+    /// Per-axis bookkeeping of one 10 s window.
+    struct Window {
+        samples: [f32; WINDOW],
+        len: usize,
+        lattice_se: f64,
+        batch_se: f64,
+        counted: usize,
+    }
+
+    pub fn run() -> ! {
+        let lambda = match option_env!("IMU_AR_DEMO_FAULT") {
+            Some("lambda") => 0.5f32,
+            _ => 0.9995,
+        };
+        let corrupt = option_env!("IMU_AR_DEMO_FAULT") == Some("corrupt");
+        let mut imu = Mpu6050::new(SimImu::new(2010, corrupt), 0x68);
+        if imu.init(&mut NoDelay, Mpu6050Config::default()).is_err() || imu.enable_fifo().is_err() {
+            defmt::error!("demo: the simulated MPU-6050 did not initialise");
+            common::exit(false)
+        }
+        let scale = imu.scale();
+        // Gyro in deg/s, accel in g; delta about 0.1 x each axis's variance.
+        let deltas = [2.5e-4f32, 2.5e-4, 2.5e-4, 1e-6, 1e-6, 1e-6];
+        let configs = deltas
+            .map(|d| Config::new(lambda, d, 1.0 / RATE).unwrap_or_else(|_| common::exit(false)));
+        let mut lattices: [Lattice<f32, P>; 6] =
+            core::array::from_fn(|i| Lattice::new(&configs[i]));
+        let mut selectors: [OrderSelector<f32, P>; 6] =
+            core::array::from_fn(|_| OrderSelector::new(OrderRule::Bic, 500, 3));
+        let mut windows: [Window; 6] = core::array::from_fn(|_| Window {
+            samples: [0.0; WINDOW],
+            len: 0,
+            lattice_se: 0.0,
+            batch_se: 0.0,
+            counted: 0,
+        });
+        let mut batch_models: [Option<ArModel<f32, P>>; 6] = [None; 6];
+        let batch_config = BatchConfig::new(1.0 / RATE).unwrap_or_else(|_| common::exit(false));
+        let mut last_mse = [(0.0f64, 0.0f64); 6];
+
+        let mut batch = [RawSample::default(); 32];
+        let mut n = 0usize;
+        while n < DURATION_S as usize * RATE as usize {
+            let got = match imu.read_fifo(&mut batch) {
+                Ok(k) => k,
+                Err(e) => {
+                    defmt::warn!("demo: FIFO: {}", defmt::Debug2Format(&e));
+                    continue;
+                }
+            };
+            for s in &batch[..got] {
+                let gyro = scale.gyro(s.gyro, GyroUnit::DegPerSec);
+                let accel = scale.accel(s.accel, AccelUnit::G);
+                for (axis, x) in gyro.into_iter().chain(accel).enumerate() {
+                    let config = &configs[axis];
+                    let w = &mut windows[axis];
+                    // Batch prediction from the previous window's model, on in-window history.
+                    if let (Some(m), true) = (&batch_models[axis], w.len >= P) {
+                        let past: [f32; P] = core::array::from_fn(|k| w.samples[w.len - 1 - k]);
+                        let e = f64::from(x - m.predict(&past));
+                        w.batch_se += e * e;
+                    }
+                    if let Some(e) = lattices[axis].update(config, x) {
+                        selectors[axis].update(config, &lattices[axis]);
+                        if w.len >= P && batch_models[axis].is_some() {
+                            w.lattice_se += f64::from(e) * f64::from(e);
+                            w.counted += 1;
+                        }
+                    }
+                    w.samples[w.len] = x;
+                    w.len += 1;
+                }
+                n += 1;
+                if n.is_multiple_of(WINDOW) {
+                    let t = n as f32 / RATE;
+                    for axis in 0..AXES {
+                        let w = &mut windows[axis];
+                        let counted = w.counted.max(1) as f64;
+                        let (lat_mse, batch_mse) = (w.lattice_se / counted, w.batch_se / counted);
+                        if w.counted > 0 {
+                            last_mse[axis] = (lat_mse, batch_mse);
+                        }
+                        batch_models[axis] = covariance::<f32, P>(&w.samples, &batch_config)
+                            .ok()
+                            .map(|f| f.model);
+                        report(
+                            t,
+                            axis,
+                            &mut lattices[axis],
+                            &configs[axis],
+                            &selectors[axis],
+                            w.counted > 0,
+                            lat_mse,
+                            batch_mse,
+                        );
+                        w.len = 0;
+                        w.lattice_se = 0.0;
+                        w.batch_se = 0.0;
+                        w.counted = 0;
+                    }
+                }
+            }
+        }
+
+        // The truth check. An estimator with forgetting factor lambda sees the process averaged
+        // over its memory, whose centre of mass lies lambda/(1 - lambda) samples back: compare
+        // with the truth there (the parameters drift with the temperature ramp).
+        let back = f64::from(lambda) / (1.0 - f64::from(lambda)) / f64::from(RATE);
+        let truth = imu.destroy().truth_at(f64::from(DURATION_S) - back);
+        let mut ok = true;
+        for axis in 0..AXES {
+            let t = &truth[axis];
+            let (Some(model), Some((a_true, e_true))) =
+                (lattices[axis].model(&configs[axis]), t.ar_projection::<P>())
+            else {
+                defmt::error!("{=str}: no model", NAMES[axis]);
+                ok = false;
+                continue;
+            };
+            let mean_sd = t.ew_mean_sd(f64::from(lambda));
+            let mean_err = (f64::from(model.mean()) - t.mean).abs();
+            let a_err = model
+                .a()
+                .iter()
+                .zip(&a_true)
+                .fold(0.0f64, |m, (a, b)| m.max((f64::from(*a) - b).abs()));
+            let var_ratio = f64::from(model.noise_variance()) / e_true;
+            let mse_ratio = last_mse[axis].0 / e_true;
+            let pass_mean = mean_err <= 4.0 * mean_sd;
+            let pass_a = a_err <= A_TOLERANCE;
+            let pass_var = (0.9..=1.1).contains(&var_ratio);
+            let pass_mse = (0.75..=1.25).contains(&mse_ratio);
+            ok &= pass_mean && pass_a && pass_var && pass_mse;
+            defmt::info!(
+                "check {=str}: mean {=f32} vs {=f32} (|err| {=f32} <= {=f32}) {=bool}; max|a - a_true| {=f32} <= {=f32} {=bool}; innovation variance / truth {=f32} in [0.9, 1.1] {=bool}; lattice MSE / truth {=f32} in [0.75, 1.25] {=bool}",
+                NAMES[axis],
+                model.mean(),
+                t.mean as f32,
+                mean_err as f32,
+                (4.0 * mean_sd) as f32,
+                pass_mean,
+                a_err as f32,
+                A_TOLERANCE as f32,
+                pass_a,
+                var_ratio as f32,
+                pass_var,
+                mse_ratio as f32,
+                pass_mse
+            );
+        }
+        if ok {
+            defmt::info!(
+                "demo: {=u32} s of six-axis data, every estimate within its tolerance of the simulated truth",
+                DURATION_S
+            );
+        } else {
+            defmt::error!("demo: estimates far from the simulated truth");
+        }
+        common::exit(ok)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn report(
+        t: f32,
+        axis: usize,
+        lattice: &mut Lattice<f32, P>,
+        config: &Config<f32>,
+        selector: &OrderSelector<f32, P>,
+        have_batch: bool,
+        lattice_mse: f64,
+        batch_mse: f64,
+    ) {
+        let Some(model) = lattice.model(config) else {
+            return;
+        };
+        let sigma = libm::sqrtf(model.noise_variance());
+        let gm = lattice
+            .coefficients(1)
+            .zip(lattice.innovation_variance(1))
+            .and_then(|(a, v)| ArModel::new([a[0]], v, model.mean(), config.dt()).ok())
+            .and_then(|m| m.to_gauss_markov().ok());
+        // Only where an AR(1) fits: the selected order is 1.
+        let (tc, gm_sigma) = match (gm, selector.order()) {
+            (Some(g), 1) => (g.correlation_time(), g.sigma()),
+            _ => (f32::NAN, f32::NAN),
+        };
+        let unit = if axis < 3 { "deg/s" } else { "g" };
+        if have_batch {
+            defmt::info!(
+                "t={=f32}s {=str}: a={=[?]} sigma={=f32} {=str} order={=usize} gm(tc={=f32}s sigma={=f32}) mse lattice={=f32} batch={=f32}",
+                t,
+                NAMES[axis],
+                model.a().as_slice(),
+                sigma,
+                unit,
+                selector.order(),
+                tc,
+                gm_sigma,
+                lattice_mse as f32,
+                batch_mse as f32
+            );
+        } else {
+            defmt::info!(
+                "t={=f32}s {=str}: a={=[?]} sigma={=f32} {=str} order={=usize} gm(tc={=f32}s sigma={=f32})",
+                t,
+                NAMES[axis],
+                model.a().as_slice(),
+                sigma,
+                unit,
+                selector.order(),
+                tc,
+                gm_sigma
+            );
+        }
+        let _ = Scalar::to_f64(sigma);
+    }
+}
+
+#[cfg(target_os = "none")]
+#[cortex_m_rt::entry]
+fn main() -> ! {
+    firmware::run()
+}
+
+#[cfg(not(target_os = "none"))]
+fn main() {
+    eprintln!("demo is firmware for the Cortex-M4F: run it with `cargo qemu demo`");
+}
