@@ -184,17 +184,24 @@ impl Arith for Q {
     }
 
     #[inline(always)]
-    fn adapt(k: I3F29, gx: I5F27, e: I5F27, energy: &(u64, u32), clip: &mut u32) -> I3F29 {
+    fn adapt(
+        k: I3F29,
+        gx: I5F27,
+        e: I5F27,
+        _: I24F40,
+        recip: &(u64, u32),
+        clip: &mut u32,
+    ) -> I3F29 {
         let num = i64::from(gx.to_bits()) * i64::from(e.to_bits()); // Q54, exact
-        let delta = divide(num, 2 * ERR_FRAC, *energy, COEF_FRAC, clip);
+        let delta = divide(num, 2 * ERR_FRAC, *recip, COEF_FRAC, clip);
         I3F29::from_bits(sat_i32(sat_add(i64::from(k.to_bits()), delta, clip), clip))
     }
 
     #[inline(always)]
-    fn convert(g: I2F30, gx: I5F27, energy: &(u64, u32)) -> I2F30 {
+    fn convert(g: I2F30, gx: I5F27, _: I24F40, recip: &(u64, u32)) -> I2F30 {
         let num = i64::from(gx.to_bits()) * i64::from(gx.to_bits()); // Q54, exact
         let mut ignored = 0;
-        let delta = divide(num, 2 * ERR_FRAC, *energy, GAMMA_FRAC, &mut ignored);
+        let delta = divide(num, 2 * ERR_FRAC, *recip, GAMMA_FRAC, &mut ignored);
         let g = i64::from(g.to_bits())
             .saturating_sub(delta)
             .clamp(0, 1 << GAMMA_FRAC);
@@ -448,12 +455,12 @@ impl<const P: usize> FixedLattice<P> {
 
     /// Forward reflection coefficients `kf_1..kf_P`.
     pub fn forward_reflection(&self) -> &[I3F29; P] {
-        &self.core.kf
+        self.core.forward_reflection()
     }
 
     /// Backward reflection coefficients `kb_1..kb_P`.
     pub fn backward_reflection(&self) -> &[I3F29; P] {
-        &self.core.kb
+        self.core.backward_reflection()
     }
 
     /// The weighted running mean, in sensor units.

@@ -22,8 +22,8 @@ pub trait Arith: Copy + Debug {
     type Coef: Copy + Debug + PartialEq;
     /// Weighted energies `F`, `B`, positive.
     type Energy: Copy + Debug + PartialEq;
-    /// A divisor prepared once for several divisions by the same energy (for floats the energy
-    /// itself; for fixed point its normalised reciprocal).
+    /// A divisor prepared once for several divisions by the same energy: nothing for floats
+    /// (they divide by the energy), the normalised reciprocal for fixed point.
     type Recip: Copy + Debug;
     /// What the steps need from the configuration (the forgetting factor in its format).
     type Params: Copy + Debug;
@@ -53,17 +53,25 @@ pub trait Arith: Copy + Debug {
     /// Prepares divisions by `energy`.
     fn recip(energy: Self::Energy) -> Self::Recip;
 
-    /// `k + gx e / energy`: the error-feedback update of a reflection coefficient.
+    /// `k + gx e / energy`: the error-feedback update of a reflection coefficient; `recip` is
+    /// `recip(energy)`.
     fn adapt(
         k: Self::Coef,
         gx: Self::Err,
         e: Self::Err,
-        energy: &Self::Recip,
+        energy: Self::Energy,
+        recip: &Self::Recip,
         clip: &mut u32,
     ) -> Self::Coef;
 
-    /// `g - gx^2 / energy`, kept in `[0, 1]`: the next order's conversion factor.
-    fn convert(g: Self::Gamma, gx: Self::Err, energy: &Self::Recip) -> Self::Gamma;
+    /// `g - gx^2 / energy`, not below 0: the next order's conversion factor (never above `g`,
+    /// since `energy >= gx^2 / g`).
+    fn convert(
+        g: Self::Gamma,
+        gx: Self::Err,
+        energy: Self::Energy,
+        recip: &Self::Recip,
+    ) -> Self::Gamma;
 }
 
 /// [`Arith::Params`] of the float formats.
@@ -83,7 +91,7 @@ macro_rules! impl_arith_float {
             type Gamma = $t;
             type Coef = $t;
             type Energy = $t;
-            type Recip = $t;
+            type Recip = ();
             type Params = FloatParams<$t>;
 
             const ERR_ZERO: $t = 0.0;
@@ -107,25 +115,18 @@ macro_rules! impl_arith_float {
             }
 
             #[inline(always)]
-            fn recip(energy: $t) -> $t {
-                energy
+            fn recip(_: $t) {}
+
+            #[inline(always)]
+            fn adapt(k: $t, gx: $t, e: $t, energy: $t, _: &(), _: &mut u32) -> $t {
+                k + gx * e / energy
             }
 
             #[inline(always)]
-            fn adapt(k: $t, gx: $t, e: $t, energy: &$t, _: &mut u32) -> $t {
-                k + gx * e / *energy
-            }
-
-            #[inline(always)]
-            fn convert(g: $t, gx: $t, energy: &$t) -> $t {
-                let g = g - gx * gx / *energy;
-                if g > 1.0 {
-                    1.0
-                } else if g > 0.0 {
-                    g
-                } else {
-                    0.0
-                }
+            fn convert(g: $t, gx: $t, energy: $t, _: &()) -> $t {
+                // Subtracting a non-negative number: only rounding can take it below 0.
+                let g = g - gx * gx / energy;
+                if g > 0.0 { g } else { 0.0 }
             }
         }
     )*};

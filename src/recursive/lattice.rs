@@ -22,10 +22,6 @@ pub struct Core<A: Arith, const P: usize> {
     /// `B_i` prepared for division: computed for step 7 and reused by step 4 of the next
     /// sample.
     b_recip: [A::Recip; P],
-    /// `kf_1..kf_P` (index `m - 1` for order `m`).
-    pub(crate) kf: [A::Coef; P],
-    /// `kb_1..kb_P`.
-    pub(crate) kb: [A::Coef; P],
     /// `psi_i(n-1)`, i = 0..P-1.
     bp: [A::Err; P],
     /// `gamma_i(n-1)`, i = 0..P-1.
@@ -36,7 +32,9 @@ pub struct Core<A: Arith, const P: usize> {
     pub(crate) errors: [A::Err; P],
     /// `y_n` of the last sample, the order-0 error.
     pub(crate) input: A::Err,
-    /// Reflection coefficients of the last `P` samples, newest at `head`.
+    /// `kf_1..kf_P` (index `m - 1` for order `m`) of the last `P` samples, newest at `head`:
+    /// the current coefficients are updated from one slot into the next, so that keeping the
+    /// history costs no copy.
     ring_kf: [[A::Coef; P]; P],
     ring_kb: [[A::Coef; P]; P],
     head: usize,
@@ -51,8 +49,6 @@ impl<A: Arith, const P: usize> Core<A, P> {
             f_energy_p: f0,
             b_energy: b,
             b_recip: b.map(A::recip),
-            kf: [A::COEF_ZERO; P],
-            kb: [A::COEF_ZERO; P],
             bp: [A::ERR_ZERO; P],
             gp: [A::GAMMA_ONE; P],
             gp_p: A::GAMMA_ONE,
@@ -67,19 +63,24 @@ impl<A: Arith, const P: usize> Core<A, P> {
     /// One sample `y` through all stages; returns `f_P(n)`.
     #[inline]
     pub(crate) fn step(&mut self, params: &A::Params, y: A::Err, clip: &mut u32) -> A::Err {
+        // `% P` keeps the indices provably in range: no bounds check on the per-sample path.
+        let old = self.head % P;
+        let new = (old + P - 1) % P;
         let (mut f, mut psi, mut g) = (y, y, A::GAMMA_ONE);
         for i in 0..P {
+            let (kf, kb) = (self.ring_kf[old][i], self.ring_kb[old][i]);
             let gf = A::gain(self.gp[i], f, clip);
             let fe = A::energy(params, self.f_energy[i], gf, f, clip);
-            let f_next = A::predict(f, self.kf[i], self.bp[i], clip);
-            let psi_next = A::predict(self.bp[i], self.kb[i], f, clip);
+            let f_next = A::predict(f, kf, self.bp[i], clip);
+            let psi_next = A::predict(self.bp[i], kb, f, clip);
             let gbp = A::gain(self.gp[i], self.bp[i], clip);
-            self.kf[i] = A::adapt(self.kf[i], gbp, f_next, &self.b_recip[i], clip);
-            self.kb[i] = A::adapt(self.kb[i], gf, psi_next, &A::recip(fe), clip);
+            let b = self.b_energy[i];
+            self.ring_kf[new][i] = A::adapt(kf, gbp, f_next, b, &self.b_recip[i], clip);
+            self.ring_kb[new][i] = A::adapt(kb, gf, psi_next, fe, &A::recip(fe), clip);
             let gpsi = A::gain(g, psi, clip);
-            let be = A::energy(params, self.b_energy[i], gpsi, psi, clip);
+            let be = A::energy(params, b, gpsi, psi, clip);
             let be_recip = A::recip(be);
-            let g_next = A::convert(g, gpsi, &be_recip);
+            let g_next = A::convert(g, gpsi, be, &be_recip);
             self.f_energy[i] = fe;
             self.b_energy[i] = be;
             self.b_recip[i] = be_recip;
@@ -94,11 +95,18 @@ impl<A: Arith, const P: usize> Core<A, P> {
         self.f_energy_p = A::energy(params, self.f_energy_p, gf, f, clip);
         self.gp_p = g;
         self.input = y;
-        // `% P` keeps the index provably in range: no bounds check on the per-sample path.
-        self.head = (self.head + P - 1) % P;
-        self.ring_kf[self.head] = self.kf;
-        self.ring_kb[self.head] = self.kb;
+        self.head = new;
         f
+    }
+
+    /// `kf_1..kf_P` after the last sample.
+    pub(crate) fn forward_reflection(&self) -> &[A::Coef; P] {
+        &self.ring_kf[self.head % P]
+    }
+
+    /// `kb_1..kb_P` after the last sample.
+    pub(crate) fn backward_reflection(&self) -> &[A::Coef; P] {
+        &self.ring_kb[self.head % P]
     }
 
     /// Forward energy of order `m` in `0..=P`.
@@ -271,12 +279,10 @@ impl<T: FloatArith, const P: usize> Lattice<T, P> {
         self.weight.push(lambda);
         let mut clip = 0;
         let f = self.core.step(&float_params(lambda), y, &mut clip);
+        // A non-finite value anywhere reaches f_P within a sample or two (the reflection
+        // coefficients feed the errors), and an overflowing input reaches F_0 and F_P at once.
         let c = &self.core;
-        let check =
-            c.kf.iter()
-                .chain(&c.kb)
-                .chain(&c.errors)
-                .fold(c.f_energy_p, |s, &v| s + v);
+        let check = f + c.f_energy_p + c.f_energy[0];
         if !check.is_finite() {
             self.restart(config);
             return None;
@@ -320,12 +326,12 @@ impl<T: FloatArith, const P: usize> Lattice<T, P> {
     /// Forward reflection coefficients `kf_1..kf_P` (lattice sign: `kf_1 = a_1` of the
     /// order-1 model, minus the error-filter reflection coefficient).
     pub fn forward_reflection(&self) -> &[T; P] {
-        &self.core.kf
+        self.core.forward_reflection()
     }
 
     /// Backward reflection coefficients `kb_1..kb_P`.
     pub fn backward_reflection(&self) -> &[T; P] {
-        &self.core.kb
+        self.core.backward_reflection()
     }
 
     /// The weighted running mean removed from the input (0 without mean removal).
