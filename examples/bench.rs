@@ -10,6 +10,10 @@
 //! iteration), times batches of 1000 `update` calls on a prepared record (inputs through
 //! `black_box`), subtracts the cost of the same loop without the call, and prints one line per
 //! row: `<estimator> <scalar> p=<P> insns/sample=<N>`. These are instruction counts, not cycles.
+//!
+//! Rows: `lattice` (f32 and fixed), `rls` (f32) per sample at p = 1, 2, 4, 8, 16, 32;
+//! `extract` per request of the exact coefficients of order p; `frame6` per six-axis frame of
+//! order-4 lattices.
 #![cfg_attr(target_os = "none", no_std, no_main)]
 
 #[cfg(target_os = "none")]
@@ -102,6 +106,33 @@ mod firmware {
             defmt::info!("lattice fixed p={=usize} insns/sample={=u32}", P, n);
         }
 
+        /// The exact transversal coefficients on request, after 1000 samples.
+        fn extract_f32<const P: usize>(&mut self) {
+            let config = Config::new(0.999f32, 0.1, 0.01).unwrap_or_else(|_| common::exit(false));
+            let mut state = Lattice::<f32, P>::new(&config);
+            for &v in &self.x {
+                state.update(&config, v);
+            }
+            let n = self.insns_per_sample(|_| {
+                black_box(black_box(&state).coefficients(P));
+            });
+            defmt::info!("extract f32 p={=usize} insns/sample={=u32}", P, n);
+        }
+
+        /// One six-axis frame: six order-4 lattices, one sample each.
+        fn frame6_f32(&mut self) {
+            let config = Config::new(0.999f32, 0.1, 0.01).unwrap_or_else(|_| common::exit(false));
+            let mut axes = [Lattice::<f32, 4>::new(&config); 6];
+            let x = self.x;
+            let cell = core::cell::RefCell::new(&mut axes);
+            let n = self.insns_per_sample(|i| {
+                for (k, lattice) in cell.borrow_mut().iter_mut().enumerate() {
+                    black_box(lattice.update(&config, black_box(x[(i + k) % BATCH])));
+                }
+            });
+            defmt::info!("frame6 f32 p=4 insns/sample={=u32}", n);
+        }
+
         fn rls_f32<const P: usize>(&mut self) {
             let config = Config::new(0.999f32, 0.1, 0.01).unwrap_or_else(|_| common::exit(false));
             let mut state = Rls::<f32, P>::new(&config, RlsInit::ShiftConsistent);
@@ -143,16 +174,21 @@ mod firmware {
             x,
             counts,
         };
-        bench.lattice_f32::<1>();
-        bench.lattice_f32::<2>();
-        bench.lattice_f32::<4>();
-        bench.lattice_f32::<8>();
-        bench.lattice_fixed::<1>();
-        bench.lattice_fixed::<2>();
-        bench.lattice_fixed::<4>();
-        bench.lattice_fixed::<8>();
-        bench.rls_f32::<4>();
-        bench.rls_f32::<8>();
+        macro_rules! orders {
+            ($f:ident) => {
+                bench.$f::<1>();
+                bench.$f::<2>();
+                bench.$f::<4>();
+                bench.$f::<8>();
+                bench.$f::<16>();
+                bench.$f::<32>();
+            };
+        }
+        orders!(lattice_f32);
+        orders!(lattice_fixed);
+        orders!(rls_f32);
+        orders!(extract_f32);
+        bench.frame6_f32();
         common::exit(per_tick > 0)
     }
 }

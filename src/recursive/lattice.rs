@@ -129,25 +129,32 @@ impl<A: Arith, const P: usize> Core<A, P> {
         if m > P {
             return None;
         }
-        // slots[j][..j]: the leading j coefficients of B_j (its last one is 1) at the time
-        // being built; alpha: the tail of A_k (its first one is 1).
-        let mut slots = [[T::ZERO; P]; P];
+        // rows[parity][j][..j]: the leading j coefficients of B_j (its last one is 1), for
+        // the time being built (written) and the one after it in age (read), alternating.
+        // alpha: the tail of A_k (its first one is 1).
+        let mut rows = [[[T::ZERO; P]; P]; 2];
         let mut alpha = [T::ZERO; P];
         for t in (0..m).rev() {
             let slot = (self.head + t) % P;
             let (kf, kb) = (&self.ring_kf[slot], &self.ring_kb[slot]);
             alpha = [T::ZERO; P];
-            // B_{k-1}(n-t-1), read from the slot before this time step overwrites it.
-            let mut b_prev = [T::ZERO; P];
+            let (first, second) = rows.split_at_mut(1);
+            let (older, newer) = if t % 2 == 0 {
+                (&second[0], &mut first[0])
+            } else {
+                (&first[0], &mut second[0])
+            };
             let stages = kf.iter().zip(kb).take(m - t);
             for (k, (&kf_k, &kb_k)) in (1..).zip(stages) {
                 let (kf_k, kb_k) = (to_t(kf_k), to_t(kb_k));
-                let saved = slots.get(k).copied().unwrap_or([T::ZERO; P]);
-                let b_full_prev = |i: usize| match i + 1 == k {
-                    true => T::ONE,
-                    false => b_prev.get(i).copied().unwrap_or(T::ZERO),
+                // B_{k-1}(n-t-1), with its trailing 1.
+                let b_prev = older.get(k - 1);
+                let b_full_prev = |i: usize| match (i + 1 == k, b_prev) {
+                    (true, _) => T::ONE,
+                    (false, Some(row)) => row.get(i).copied().unwrap_or(T::ZERO),
+                    (false, None) => T::ZERO,
                 };
-                if let (true, Some(dst)) = (t > 0, slots.get_mut(k)) {
+                if let (true, Some(dst)) = (t > 0, newer.get_mut(k)) {
                     // B_k(n-t), needed by the next newer time step.
                     for (i, d) in dst.iter_mut().enumerate().take(k) {
                         let shifted = if i == 0 { T::ZERO } else { b_full_prev(i - 1) };
@@ -161,7 +168,6 @@ impl<A: Arith, const P: usize> Core<A, P> {
                 for (j, aj) in alpha.iter_mut().enumerate().take(k) {
                     *aj -= kf_k * b_full_prev(j);
                 }
-                b_prev = saved;
             }
         }
         Some(alpha.map(|v| -v))
