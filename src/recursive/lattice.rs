@@ -1,7 +1,7 @@
 //! The a-priori least-squares lattice with error feedback (EF-LSL), `O(P)` per sample.
 
 use super::arith::{Arith, FloatArith, float_params};
-use super::{Config, Health, RunningMean, WeightSum};
+use super::{Config, Health, Shell};
 use crate::{ArModel, Scalar};
 
 /// The lattice recursion of numerics.md section 2.1, written once over the typed steps of
@@ -233,13 +233,7 @@ impl<A: Arith, const P: usize> Core<A, P> {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Lattice<T: FloatArith, const P: usize> {
     core: Core<T, P>,
-    weight: WeightSum<T>,
-    mean: RunningMean<T>,
-    health: Health,
-    /// The last model handed out, held through a restart.
-    published: Option<ArModel<T, P>>,
-    /// Samples to go before a restarted lattice publishes again.
-    hold: u32,
+    shell: Shell<T, P>,
 }
 
 impl<T: FloatArith, const P: usize> Lattice<T, P> {
@@ -249,11 +243,7 @@ impl<T: FloatArith, const P: usize> Lattice<T, P> {
         const { assert!(P > 0, "the model order P must be at least 1") };
         Self {
             core: Self::initial_core(config),
-            weight: WeightSum(T::ZERO),
-            mean: RunningMean::new(),
-            health: Health::default(),
-            published: None,
-            hold: 0,
+            shell: Shell::new(),
         }
     }
 
@@ -270,38 +260,19 @@ impl<T: FloatArith, const P: usize> Lattice<T, P> {
     /// [`Lattice::health`], the state is unchanged) or when it broke the recursion down, which
     /// re-initialises the lattice (counted as a restart).
     pub fn update(&mut self, config: &Config<T>, x: T) -> Option<T> {
-        if let Err(why) = config.screen(x) {
-            self.health.reject(why);
-            return None;
-        }
-        self.health.samples += 1;
-        self.hold = self.hold.saturating_sub(1);
-        let lambda = config.lambda();
-        let y = if config.demean() {
-            self.mean.center(lambda, x)
-        } else {
-            x
-        };
-        self.weight.push(lambda);
+        let y = self.shell.intake(config, x)?;
         let mut clip = 0;
-        let f = self.core.step(&float_params(lambda), y, &mut clip);
+        let f = self.core.step(&float_params(config.lambda()), y, &mut clip);
         // A non-finite value anywhere reaches f_P within a sample or two (the reflection
         // coefficients feed the errors), and an overflowing input reaches F_0 and F_P at once.
         let c = &self.core;
         let check = f + c.f_energy_p + c.f_energy[0];
         if !check.is_finite() {
-            self.restart(config);
+            self.shell.restart(config);
+            self.core = Self::initial_core(config);
             return None;
         }
         Some(f)
-    }
-
-    fn restart(&mut self, config: &Config<T>) {
-        self.health.restarts += 1;
-        self.core = Self::initial_core(config);
-        self.weight = WeightSum(T::ZERO);
-        self.mean = RunningMean::new();
-        self.hold = hold_after_restart(config.lambda().to_f64());
     }
 
     /// A-priori forward prediction errors `f_1(n)..f_P(n)` of the last accepted sample
@@ -324,9 +295,7 @@ impl<T: FloatArith, const P: usize> Lattice<T, P> {
     /// Innovation variance of order `m`: `F_m(n) / W_n`, `W_n = sum_{i<=n} lambda^(n-i)`
     /// (`= F_m (1 - lambda)/(1 - lambda^n)`); `None` above `P` or before the first sample.
     pub fn innovation_variance(&self, m: usize) -> Option<T> {
-        let w = self.weight.0;
-        (w > T::ZERO).then_some(())?;
-        self.energy(m).map(|e| e / w)
+        self.shell.per_sample(self.energy(m)?)
     }
 
     /// Forward reflection coefficients `kf_1..kf_P` (lattice sign: `kf_1 = a_1` of the
@@ -342,12 +311,12 @@ impl<T: FloatArith, const P: usize> Lattice<T, P> {
 
     /// The weighted running mean removed from the input (0 without mean removal).
     pub fn mean(&self) -> T {
-        self.mean.mean()
+        self.shell.mean.mean()
     }
 
     /// What happened to the samples so far.
     pub fn health(&self) -> Health {
-        self.health
+        self.shell.health
     }
 
     /// The exact least-squares coefficients `a_1..a_m` of order `m <= P` after the last
@@ -368,14 +337,11 @@ impl<T: FloatArith, const P: usize> Lattice<T, P> {
     /// `F_P / W_n`, the running mean and `dt`. Returns the last good model while a restarted
     /// lattice settles, and `None` before the first sample or if no finite model exists yet.
     pub fn model(&mut self, config: &Config<T>) -> Option<ArModel<T, P>> {
-        if self.hold == 0 {
-            let a = self.coefficients(P)?;
-            let variance = self.innovation_variance(P)?;
-            if let Ok(m) = ArModel::new(a, variance, self.mean(), config.dt()) {
-                self.published = Some(m);
-            }
-        }
-        self.published
+        let a = self.coefficients(P);
+        let variance = self.innovation_variance(P);
+        let mean = self.mean();
+        self.shell
+            .publish(|| ArModel::new(a?, variance?, mean, config.dt()).ok())
     }
 }
 

@@ -240,3 +240,76 @@ impl<T: Scalar> WeightSum<T> {
         self.0 = lambda * self.0 + T::ONE;
     }
 }
+
+/// What every float estimator keeps around its recursion: the running mean, the weight sum,
+/// the health counters, and the published model held through a restart.
+#[derive(Clone, Copy, Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub(crate) struct Shell<T, const P: usize> {
+    pub(crate) mean: RunningMean<T>,
+    pub(crate) weight: WeightSum<T>,
+    pub(crate) health: Health,
+    published: Option<crate::ArModel<T, P>>,
+    /// Samples to go before a restarted estimator publishes again.
+    hold: u32,
+}
+
+impl<T: Scalar, const P: usize> Shell<T, P> {
+    pub(crate) fn new() -> Self {
+        Self {
+            mean: RunningMean::new(),
+            weight: WeightSum(T::ZERO),
+            health: Health::default(),
+            published: None,
+            hold: 0,
+        }
+    }
+
+    /// Screens `x` (a rejection is counted and changes nothing else) and returns the sample
+    /// the recursion takes: `x` less the running mean, or `x`.
+    #[inline]
+    pub(crate) fn intake(&mut self, config: &Config<T>, x: T) -> Option<T> {
+        if let Err(why) = config.screen(x) {
+            self.health.reject(why);
+            return None;
+        }
+        self.health.samples += 1;
+        self.hold = self.hold.saturating_sub(1);
+        let lambda = config.lambda();
+        let y = if config.demean() {
+            self.mean.center(lambda, x)
+        } else {
+            x
+        };
+        self.weight.push(lambda);
+        Some(y)
+    }
+
+    /// Counts a restart, forgets the mean and the weight, and holds the published model for
+    /// `3/(1 - lambda)` samples.
+    pub(crate) fn restart(&mut self, config: &Config<T>) {
+        self.health.restarts += 1;
+        self.mean = RunningMean::new();
+        self.weight = WeightSum(T::ZERO);
+        self.hold = lattice::hold_after_restart(config.lambda().to_f64());
+    }
+
+    /// `E / W_n`, the innovation variance of an energy; `None` before the first sample.
+    pub(crate) fn per_sample(&self, energy: T) -> Option<T> {
+        (self.weight.0 > T::ZERO).then(|| energy / self.weight.0)
+    }
+
+    /// The model `make` builds, unless a restarted estimator is still settling: then (and when
+    /// `make` finds no valid model) the last one published.
+    pub(crate) fn publish(
+        &mut self,
+        make: impl FnOnce() -> Option<crate::ArModel<T, P>>,
+    ) -> Option<crate::ArModel<T, P>> {
+        if self.hold == 0
+            && let Some(m) = make()
+        {
+            self.published = Some(m);
+        }
+        self.published
+    }
+}

@@ -1,6 +1,6 @@
 //! Conventional recursive least squares, `O(P^2)` per sample, in Bierman's U-D form.
 
-use super::{Config, Health, RunningMean, WeightSum};
+use super::{Config, Health, Shell};
 use crate::{ArModel, Scalar};
 
 /// Ceiling of the entries of `D`: without excitation (a stuck sensor) `P` grows as
@@ -57,12 +57,8 @@ pub struct Rls<T, const P: usize> {
     phi: [T; P],
     energy: T,
     error: T,
-    weight: WeightSum<T>,
-    mean: RunningMean<T>,
     init: RlsInit,
-    health: Health,
-    published: Option<ArModel<T, P>>,
-    hold: u32,
+    shell: Shell<T, P>,
 }
 
 impl<T: Scalar, const P: usize> Rls<T, P> {
@@ -76,12 +72,8 @@ impl<T: Scalar, const P: usize> Rls<T, P> {
             phi: [T::ZERO; P],
             energy: T::ZERO,
             error: T::ZERO,
-            weight: WeightSum(T::ZERO),
-            mean: RunningMean::new(),
             init,
-            health: Health::default(),
-            published: None,
-            hold: 0,
+            shell: Shell::new(),
         };
         s.initialise(config);
         s
@@ -99,8 +91,6 @@ impl<T: Scalar, const P: usize> Rls<T, P> {
         self.phi = [T::ZERO; P];
         self.energy = config.delta_lambda_pow(P);
         self.error = T::ZERO;
-        self.weight = WeightSum(T::ZERO);
-        self.mean = RunningMean::new();
     }
 
     /// Takes one sample and returns the a-priori prediction error `x_n - xhat_n`.
@@ -110,18 +100,8 @@ impl<T: Scalar, const P: usize> Rls<T, P> {
     // Bierman's algorithm reads best with the indices of its published form.
     #[allow(clippy::needless_range_loop)]
     pub fn update(&mut self, config: &Config<T>, x: T) -> Option<T> {
-        if let Err(why) = config.screen(x) {
-            self.health.reject(why);
-            return None;
-        }
-        self.health.samples += 1;
-        self.hold = self.hold.saturating_sub(1);
+        let y = self.shell.intake(config, x)?;
         let lambda = config.lambda();
-        let y = if config.demean() {
-            self.mean.center(lambda, x)
-        } else {
-            x
-        };
         let e = self
             .a
             .iter()
@@ -167,18 +147,10 @@ impl<T: Scalar, const P: usize> Rls<T, P> {
         self.energy = lambda * self.energy + e * (e * lambda / alpha);
         check += self.energy;
         if !(healthy && check.is_finite()) {
-            self.health.restarts += 1;
+            self.shell.restart(config);
             self.initialise(config);
-            let lam = lambda.to_f64();
-            let memory = if lam < 1.0 { 3.0 / (1.0 - lam) } else { 3.0e6 };
-            self.hold = if memory < u32::MAX as f64 {
-                memory as u32
-            } else {
-                u32::MAX
-            };
             return None;
         }
-        self.weight.push(lambda);
         self.phi.copy_within(0..P - 1, 1);
         self.phi[0] = y;
         self.error = e;
@@ -197,27 +169,23 @@ impl<T: Scalar, const P: usize> Rls<T, P> {
 
     /// Innovation variance `E_n / W_n`; `None` before the first sample.
     pub fn innovation_variance(&self) -> Option<T> {
-        (self.weight.0 > T::ZERO).then(|| self.energy / self.weight.0)
+        self.shell.per_sample(self.energy)
     }
 
     /// The weighted running mean removed from the input (0 without mean removal).
     pub fn mean(&self) -> T {
-        self.mean.mean()
+        self.shell.mean.mean()
     }
 
     /// What happened to the samples so far.
     pub fn health(&self) -> Health {
-        self.health
+        self.shell.health
     }
 
     /// The model after the last sample; the last good one while a restarted state settles.
     pub fn model(&mut self, config: &Config<T>) -> Option<ArModel<T, P>> {
-        if self.hold == 0 {
-            let variance = self.innovation_variance()?;
-            if let Ok(m) = ArModel::new(self.a, variance, self.mean(), config.dt()) {
-                self.published = Some(m);
-            }
-        }
-        self.published
+        let (a, variance, mean) = (self.a, self.innovation_variance(), self.mean());
+        self.shell
+            .publish(|| ArModel::new(a, variance?, mean, config.dt()).ok())
     }
 }
