@@ -8,7 +8,7 @@
 use embedded_hal::delay::DelayNs;
 use embedded_hal::spi::{Operation, SpiDevice};
 
-use super::{Error, FifoStats, ImuReader, RawSample, Scale, be_i16, be_i16x3};
+use super::{Error, FifoStats, ImuReader, Packet, RawSample, Scale, be_i16, be_i16x3};
 
 /// DEVICE_CONFIG: SOFT_RESET_CONFIG in bit 0 (1 ms to complete).
 const DEVICE_CONFIG: u8 = 0x11;
@@ -44,8 +44,6 @@ const PACKET: usize = 16;
 /// Header bits: HEADER_MSG (7, FIFO empty), HEADER_ACCEL (6), HEADER_GYRO (5).
 const HEADER_EMPTY: u8 = 1 << 7;
 const HEADER_ACCEL_GYRO: u8 = 0b0110_0000;
-/// Packets read per SPI transaction.
-const CHUNK: usize = 8;
 
 /// Gyro full-scale range (GYRO_FS_SEL).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -344,45 +342,30 @@ impl<SPI: SpiDevice> ImuReader for Icm42688<SPI> {
         let mut status = [0];
         self.read_regs(INT_STATUS, &mut status)?;
         if status[0] & FIFO_FULL != 0 {
-            let discarded = self.fifo_count()? / PACKET as u16;
+            let bytes = self.fifo_count()?;
             self.write(SIGNAL_PATH_RESET, FIFO_FLUSH)?;
-            self.stats.overflows += 1;
-            self.stats.discarded += u64::from(discarded);
-            return Err(Error::FifoOverflow { discarded });
+            return Err(self.stats.overflow(bytes, PACKET));
         }
         let available = usize::from(self.fifo_count()?) / PACKET;
-        let mut remaining = available;
-        let mut delivered = 0;
-        let mut buf = [0u8; PACKET * CHUNK];
-        while remaining > 0 && delivered < out.len() {
-            let n = remaining.min(CHUNK).min(out.len() - delivered);
-            if let Err(e) = self.read_regs(FIFO_DATA, &mut buf[..n * PACKET]) {
-                self.stats.discarded += delivered as u64;
-                return Err(e);
+        let spi = &mut self.spi;
+        let read = |buf: &mut [u8]| {
+            spi.transaction(&mut [Operation::Write(&[FIFO_DATA | READ]), Operation::Read(buf)])
+                .map_err(Error::Bus)
+        };
+        self.stats.drain(available, PACKET, out, read, |p| {
+            let header = p.first().copied().unwrap_or(HEADER_EMPTY);
+            if header & HEADER_EMPTY != 0 {
+                Packet::End
+            } else if header & HEADER_ACCEL_GYRO != HEADER_ACCEL_GYRO {
+                Packet::Malformed
+            } else {
+                Packet::Sample(RawSample {
+                    accel: be_i16x3(p, 1),
+                    gyro: be_i16x3(p, 7),
+                    temperature: p.get(13).map(|&t| i16::from(t as i8) * 64),
+                })
             }
-            remaining -= n;
-            for packet in buf[..n * PACKET].chunks_exact(PACKET) {
-                let header = packet[0];
-                if header & HEADER_EMPTY != 0 {
-                    remaining = 0;
-                    break;
-                }
-                if header & HEADER_ACCEL_GYRO != HEADER_ACCEL_GYRO {
-                    self.stats.malformed += 1;
-                    continue;
-                }
-                if let Some(slot) = out.get_mut(delivered) {
-                    *slot = RawSample {
-                        accel: be_i16x3(packet, 1),
-                        gyro: be_i16x3(packet, 7),
-                        temperature: Some(i16::from(packet[13] as i8) * 64),
-                    };
-                    delivered += 1;
-                }
-            }
-        }
-        self.stats.samples += delivered as u64;
-        Ok(delivered)
+        })
     }
 
     fn fifo_stats(&self) -> FifoStats {

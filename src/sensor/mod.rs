@@ -207,3 +207,70 @@ fn be_i16(b: &[u8], i: usize) -> i16 {
 fn be_i16x3(b: &[u8], i: usize) -> [i16; 3] {
     [be_i16(b, i), be_i16(b, i + 2), be_i16(b, i + 4)]
 }
+
+/// What a FIFO packet turned out to be.
+pub(crate) enum Packet {
+    /// A sample.
+    Sample(RawSample),
+    /// A packet of the wrong layout: skipped and counted.
+    Malformed,
+    /// The chip's "FIFO empty" marker: the batch ends.
+    End,
+}
+
+/// Packets read per bus transfer.
+const CHUNK: usize = 8;
+/// The longest FIFO packet of the supported chips.
+const MAX_PACKET: usize = 16;
+
+impl FifoStats {
+    /// Counts an overflow whose reset lost the complete packets in `bytes` bytes of FIFO.
+    pub(crate) fn overflow<E>(&mut self, bytes: u16, packet: usize) -> Error<E> {
+        let discarded = bytes / packet as u16;
+        self.overflows += 1;
+        self.discarded += u64::from(discarded);
+        Error::FifoOverflow { discarded }
+    }
+
+    /// Reads `available` whole packets of `packet` bytes (at most `out.len()` samples), 8 per
+    /// transfer through `read`, and parses them into `out`. A failed transfer loses the
+    /// packets read before it: they are counted as discarded.
+    pub(crate) fn drain<E>(
+        &mut self,
+        available: usize,
+        packet: usize,
+        out: &mut [RawSample],
+        mut read: impl FnMut(&mut [u8]) -> Result<(), Error<E>>,
+        parse: impl Fn(&[u8]) -> Packet,
+    ) -> Result<usize, Error<E>> {
+        let packet = packet.clamp(1, MAX_PACKET);
+        let mut buf = [0u8; MAX_PACKET * CHUNK];
+        let (mut remaining, mut delivered) = (available, 0);
+        while remaining > 0 && delivered < out.len() {
+            let n = remaining.min(CHUNK).min(out.len() - delivered);
+            let bytes = &mut buf[..n * packet];
+            if let Err(e) = read(bytes) {
+                self.discarded += delivered as u64;
+                return Err(e);
+            }
+            remaining -= n;
+            for p in bytes.chunks_exact(packet) {
+                match parse(p) {
+                    Packet::Sample(s) => {
+                        if let Some(slot) = out.get_mut(delivered) {
+                            *slot = s;
+                            delivered += 1;
+                        }
+                    }
+                    Packet::Malformed => self.malformed += 1,
+                    Packet::End => {
+                        remaining = 0;
+                        break;
+                    }
+                }
+            }
+        }
+        self.samples += delivered as u64;
+        Ok(delivered)
+    }
+}

@@ -8,7 +8,7 @@
 use embedded_hal::delay::DelayNs;
 use embedded_hal::i2c::I2c;
 
-use super::{Error, FifoStats, ImuReader, RawSample, Scale, be_i16, be_i16x3};
+use super::{Error, FifoStats, ImuReader, Packet, RawSample, Scale, be_i16, be_i16x3};
 
 /// Register 25, SMPLRT_DIV: sample rate = gyro output rate / (1 + SMPLRT_DIV).
 const SMPLRT_DIV: u8 = 0x19;
@@ -44,8 +44,6 @@ const USER_CTRL_FIFO_RESET: u8 = 1 << 2;
 const FIFO_EN_ACCEL_GYRO: u8 = 0b0111_1000;
 /// Bytes per FIFO packet with accelerometer and gyro enabled.
 const PACKET: usize = 12;
-/// Packets read per I2C transfer.
-const CHUNK: usize = 8;
 
 /// WHO_AM_I of the MPU-6050, MPU-6500 and MPU-9250.
 const KNOWN_IDS: [u8; 3] = [0x68, 0x70, 0x71];
@@ -340,37 +338,24 @@ impl<I2C: I2c> ImuReader for Mpu6050<I2C> {
         let mut status = [0];
         self.read_regs(INT_STATUS, &mut status)?;
         if status[0] & FIFO_OFLOW != 0 {
-            let discarded = self.fifo_count()? / PACKET as u16;
+            let bytes = self.fifo_count()?;
             self.write(USER_CTRL, USER_CTRL_FIFO_RESET)?;
             self.write(USER_CTRL, USER_CTRL_FIFO_EN)?;
-            self.stats.overflows += 1;
-            self.stats.discarded += u64::from(discarded);
-            return Err(Error::FifoOverflow { discarded });
+            return Err(self.stats.overflow(bytes, PACKET));
         }
         let available = usize::from(self.fifo_count()?) / PACKET;
-        let wanted = available.min(out.len());
-        let mut done = 0;
-        let mut buf = [0u8; PACKET * CHUNK];
-        while done < wanted {
-            let n = (wanted - done).min(CHUNK);
-            if let Err(e) = self.read_regs(FIFO_R_W, &mut buf[..n * PACKET]) {
-                self.stats.discarded += done as u64;
-                return Err(e);
-            }
-            for (slot, packet) in out[done..]
-                .iter_mut()
-                .zip(buf[..n * PACKET].chunks_exact(PACKET))
-            {
-                *slot = RawSample {
-                    accel: be_i16x3(packet, 0),
-                    gyro: be_i16x3(packet, 6),
-                    temperature: None,
-                };
-            }
-            done += n;
-        }
-        self.stats.samples += done as u64;
-        Ok(done)
+        let (i2c, address) = (&mut self.i2c, self.address);
+        let read = |buf: &mut [u8]| {
+            i2c.write_read(address, &[FIFO_R_W], buf)
+                .map_err(Error::Bus)
+        };
+        self.stats.drain(available, PACKET, out, read, |p| {
+            Packet::Sample(RawSample {
+                accel: be_i16x3(p, 0),
+                gyro: be_i16x3(p, 6),
+                temperature: None,
+            })
+        })
     }
 
     fn fifo_stats(&self) -> FifoStats {
