@@ -6,4 +6,5 @@
 #![deny(missing_docs)]
 
 pub mod data;
+pub mod fixtures;
 pub mod reference;

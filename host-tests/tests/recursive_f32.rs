@@ -4,24 +4,10 @@
 
 use std::path::Path;
 
-use imu_ar::ArModel;
 use imu_ar::recursive::{Config, Lattice, Rls, RlsInit};
-use imu_ar::sim::ArSimulator;
 use imu_ar_host::data::read_column;
+use imu_ar_host::fixtures::{add, ar};
 use imu_ar_host::reference::{Regularisation, Section0, running_mean_removed};
-use rand_chacha::ChaCha8Rng;
-use rand_core::SeedableRng;
-
-fn ar<const P: usize>(a: [f64; P], sigma: f64, n: usize, seed: u64) -> Vec<f64> {
-    let mut sim = ArSimulator::new(ArModel::new(a, sigma * sigma, 0.0, 0.01).unwrap());
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    sim.burn_in(&mut rng, 20_000);
-    (0..n).map(|_| sim.next(&mut rng)).collect()
-}
-
-fn add(x: &[f64], y: &[f64]) -> Vec<f64> {
-    x.iter().zip(y).map(|(a, b)| a + b).collect()
-}
 
 /// Max |a_f32 - a_ref| after the whole record, over the listed orders of an order-`P` lattice
 /// and for an order-`P` RLS; `run` panics on a restart or a non-finite output.
