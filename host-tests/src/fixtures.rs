@@ -19,3 +19,62 @@ pub fn ar<const P: usize>(a: [f64; P], sigma: f64, n: usize, seed: u64) -> Vec<f
 pub fn add(x: &[f64], y: &[f64]) -> Vec<f64> {
     x.iter().zip(y).map(|(a, b)| a + b).collect()
 }
+
+/// One real recording of `../shared/data/imu` (see its SOURCES.md).
+pub struct Record {
+    /// The sensor.
+    pub name: &'static str,
+    /// Its CSV files, read as one record.
+    pub files: Vec<std::path::PathBuf>,
+    /// Gyro units (deg/s) per count: the values are exact multiples of it.
+    pub gyro_lsb: f64,
+    /// Accelerometer units (g) per count.
+    pub accel_lsb: f64,
+}
+
+impl Record {
+    /// Units per count of `axis` (`gx`..`gz` or `ax`..`az`).
+    pub fn lsb(&self, axis: &str) -> f64 {
+        if axis.starts_with('g') {
+            self.gyro_lsb
+        } else {
+            self.accel_lsb
+        }
+    }
+}
+
+/// The six axes of every record.
+pub const AXES: [&str; 6] = ["gx", "gy", "gz", "ax", "ay", "az"];
+
+/// `../shared/data/imu` beside the repository, or `None` (saying so) when it is absent.
+pub fn data_dir() -> Option<std::path::PathBuf> {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/imu");
+    if dir.is_dir() {
+        Some(dir)
+    } else {
+        println!("skipped: {} is absent", dir.display());
+        None
+    }
+}
+
+/// The ADIS16405 record (both parts) and the MPU-6050 record, or `None` without the data.
+pub fn real_records() -> Option<[Record; 2]> {
+    let dir = data_dir()?;
+    Some([
+        Record {
+            name: "ADIS16405",
+            files: vec![
+                dir.join("adis16405_imu1_part1.csv"),
+                dir.join("adis16405_imu1_part2.csv"),
+            ],
+            gyro_lsb: 0.05,
+            accel_lsb: 0.00333,
+        },
+        Record {
+            name: "MPU-6050",
+            files: vec![dir.join("mpu6050_static_10min.csv")],
+            gyro_lsb: 1.0 / 131.0,
+            accel_lsb: 1.0 / 4096.0,
+        },
+    ])
+}

@@ -1,6 +1,8 @@
 //! The `imu-ar` tool: outputs, the published ADIS16405 Allan table, and every bad input.
 
 use std::path::{Path, PathBuf};
+
+use imu_ar_host::fixtures::data_dir;
 use std::process::{Command, Output};
 
 fn imu_ar(args: &[&str]) -> Output {
@@ -8,16 +10,6 @@ fn imu_ar(args: &[&str]) -> Output {
         .args(args)
         .output()
         .expect("run imu-ar")
-}
-
-fn data_dir() -> Option<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/imu");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        println!("skipped: {} is absent", dir.display());
-        None
-    }
 }
 
 /// A file in the temp directory with the given contents.

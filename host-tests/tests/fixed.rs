@@ -2,12 +2,10 @@
 //! section-8 processes and on both real records as raw counts; and at the edges of its formats.
 //! Prints the table that `tools/readme-tables.sh` puts into README.md.
 
-use std::path::Path;
-
 use imu_ar::fixed_point::{FixedConfig, FixedLattice};
 use imu_ar::recursive::Config;
 use imu_ar_host::data::read_column;
-use imu_ar_host::fixtures::{add, ar};
+use imu_ar_host::fixtures::{AXES, add, ar, real_records};
 use imu_ar_host::reference::{Regularisation, Section0, running_mean_removed};
 
 /// Max coefficient error of an order-`P` fixed lattice after `x` (scaled to unit RMS, no mean
@@ -78,39 +76,16 @@ fn section_8_processes_after_a_million_samples() {
 
 #[test]
 fn real_records_as_raw_counts() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/imu");
-    if !dir.is_dir() {
-        println!("skipped: {} is absent", dir.display());
+    let Some(records) = real_records() else {
         return;
-    }
-    // Sensor units per count (SOURCES.md): the values are exact multiples of these.
-    let records = [
-        (
-            "ADIS16405",
-            vec![
-                dir.join("adis16405_imu1_part1.csv"),
-                dir.join("adis16405_imu1_part2.csv"),
-            ],
-            0.05,
-            0.00333,
-        ),
-        (
-            "MPU-6050",
-            vec![dir.join("mpu6050_static_10min.csv")],
-            1.0 / 131.0,
-            1.0 / 4096.0,
-        ),
-    ];
+    };
     println!("| record | axis | counts per unit | lambda | fixed, p = 1..8 | clipped |");
     println!("|---|---|---|---|---|---|");
-    for (name, files, gyro_lsb, accel_lsb) in &records {
-        for axis in ["gx", "gy", "gz", "ax", "ay", "az"] {
-            let lsb: f64 = if axis.starts_with('g') {
-                *gyro_lsb
-            } else {
-                *accel_lsb
-            };
-            let x = read_column(files, axis).unwrap();
+    for record in &records {
+        let name = record.name;
+        for axis in AXES {
+            let lsb = record.lsb(axis);
+            let x = read_column(&record.files, axis).unwrap();
             let counts: Vec<i16> = x.iter().map(|v| (v / lsb).round() as i16).collect();
             let mean = x.iter().sum::<f64>() / x.len() as f64;
             let var = x.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / x.len() as f64;

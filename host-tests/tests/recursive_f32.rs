@@ -2,11 +2,9 @@
 //! processes of section 8 and both real records. The test prints the table that
 //! `tools/accuracy-table.sh` puts into README.md.
 
-use std::path::Path;
-
 use imu_ar::recursive::{Config, Lattice, Rls, RlsInit};
 use imu_ar_host::data::read_column;
-use imu_ar_host::fixtures::{add, ar};
+use imu_ar_host::fixtures::{AXES, add, ar, real_records};
 use imu_ar_host::reference::{Regularisation, Section0, running_mean_removed};
 
 /// Max |a_f32 - a_ref| after the whole record, over the listed orders of an order-`P` lattice
@@ -148,26 +146,15 @@ fn rls_error<const P: usize>(x: &[f64], config: &Config<f32>, reference: &Sectio
 
 #[test]
 fn real_records_every_axis() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/imu");
-    if !dir.is_dir() {
-        println!("skipped: {} is absent", dir.display());
+    let Some(records) = real_records() else {
         return;
-    }
-    let records = [
-        (
-            "ADIS16405",
-            vec![
-                dir.join("adis16405_imu1_part1.csv"),
-                dir.join("adis16405_imu1_part2.csv"),
-            ],
-        ),
-        ("MPU-6050", vec![dir.join("mpu6050_static_10min.csv")]),
-    ];
+    };
     println!("| record | axis | lambda | lattice f32, p = 1..8 | RLS f32, p = 1..8 |");
     println!("|---|---|---|---|---|");
-    for (name, files) in &records {
-        for axis in ["gx", "gy", "gz", "ax", "ay", "az"] {
-            let x = read_column(files, axis).unwrap();
+    for record in &records {
+        let name = record.name;
+        for axis in AXES {
+            let x = read_column(&record.files, axis).unwrap();
             let mean = x.iter().sum::<f64>() / x.len() as f64;
             let var = x.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / x.len() as f64;
             // delta = 0.1 x the record's variance (any 0.01..1 x works; it only shapes the start).
