@@ -44,10 +44,10 @@ mod sim_imu;
 #[cfg(target_os = "none")]
 mod firmware {
     use embedded_hal::delay::DelayNs;
+    use imu_ar::ArModel;
     use imu_ar::batch::{BatchConfig, covariance};
     use imu_ar::recursive::{Config, Lattice, OrderRule, OrderSelector};
     use imu_ar::sensor::{AccelUnit, GyroUnit, ImuReader, Mpu6050, Mpu6050Config, RawSample};
-    use imu_ar::{ArModel, Scalar};
 
     use super::common;
     use super::sim_imu::{AXES, SimImu};
@@ -280,7 +280,6 @@ mod firmware {
                 gm_sigma
             );
         }
-        let _ = Scalar::to_f64(sigma);
     }
 }
 

@@ -24,36 +24,39 @@ fn record<T: Scalar>() -> Vec<T> {
         .collect()
 }
 
-fn lattice<T: imu_ar::recursive::FloatArith, const P: usize>(c: &mut Criterion, name: &str) {
+/// Criterion group `name`, id `p`: `update` over one block of the record.
+fn bench_block<T: Scalar>(c: &mut Criterion, name: &str, p: usize, mut update: impl FnMut(T)) {
     let x = record::<T>();
-    let config = Config::new(T::from_f64(0.999), T::from_f64(0.1), T::from_f64(0.01)).unwrap();
-    let mut state = Lattice::<T, P>::new(&config);
     let mut group = c.benchmark_group(name);
     group.throughput(Throughput::Elements(BLOCK as u64));
-    group.bench_function(BenchmarkId::from_parameter(P), |b| {
+    group.bench_function(BenchmarkId::from_parameter(p), |b| {
         b.iter(|| {
             for &v in &x {
-                black_box(state.update(&config, black_box(v)));
+                update(black_box(v));
             }
         })
     });
     group.finish();
 }
 
-fn rls<T: Scalar, const P: usize>(c: &mut Criterion, name: &str) {
-    let x = record::<T>();
-    let config = Config::new(T::from_f64(0.999), T::from_f64(0.1), T::from_f64(0.01)).unwrap();
-    let mut state = Rls::<T, P>::new(&config, RlsInit::ShiftConsistent);
-    let mut group = c.benchmark_group(name);
-    group.throughput(Throughput::Elements(BLOCK as u64));
-    group.bench_function(BenchmarkId::from_parameter(P), |b| {
-        b.iter(|| {
-            for &v in &x {
-                black_box(state.update(&config, black_box(v)));
-            }
-        })
+fn config<T: Scalar>() -> Config<T> {
+    Config::new(T::from_f64(0.999), T::from_f64(0.1), T::from_f64(0.01)).unwrap()
+}
+
+fn lattice<T: imu_ar::recursive::FloatArith, const P: usize>(c: &mut Criterion, name: &str) {
+    let config = config::<T>();
+    let mut state = Lattice::<T, P>::new(&config);
+    bench_block(c, name, P, |v| {
+        black_box(state.update(&config, v));
     });
-    group.finish();
+}
+
+fn rls<T: Scalar, const P: usize>(c: &mut Criterion, name: &str) {
+    let config = config::<T>();
+    let mut state = Rls::<T, P>::new(&config, RlsInit::ShiftConsistent);
+    bench_block(c, name, P, |v| {
+        black_box(state.update(&config, v));
+    });
 }
 
 fn per_sample(c: &mut Criterion) {
