@@ -198,7 +198,14 @@ impl Arith for Q {
     }
 
     #[inline(always)]
-    fn convert(g: I2F30, gx: I5F27, _: I24F40, recip: &(u64, u32)) -> I2F30 {
+    fn convert(
+        _: &QParams,
+        g: I2F30,
+        gx: I5F27,
+        _: I24F40,
+        _: I24F40,
+        recip: &(u64, u32),
+    ) -> I2F30 {
         let num = i64::from(gx.to_bits()) * i64::from(gx.to_bits()); // Q54, exact
         let mut ignored = 0;
         let delta = divide(num, 2 * ERR_FRAC, *recip, GAMMA_FRAC, &mut ignored);

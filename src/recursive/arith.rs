@@ -22,8 +22,8 @@ pub trait Arith: Copy + Debug {
     type Coef: Copy + Debug + PartialEq;
     /// Weighted energies `F`, `B`, positive.
     type Energy: Copy + Debug + PartialEq;
-    /// A divisor prepared once for several divisions by the same energy: nothing for floats
-    /// (they divide by the energy), the normalised reciprocal for fixed point.
+    /// A divisor prepared once for several divisions by the same energy: the reciprocal for
+    /// floats, the normalised reciprocal for fixed point.
     type Recip: Copy + Debug;
     /// What the steps need from the configuration (the forgetting factor in its format).
     type Params: Copy + Debug;
@@ -38,7 +38,7 @@ pub trait Arith: Copy + Debug {
     /// `g x`, the shared product of the energy and coefficient updates.
     fn gain(g: Self::Gamma, x: Self::Err, clip: &mut u32) -> Self::Err;
 
-    /// `lambda e + gx x`, floored at a tiny positive value.
+    /// `lambda e + gx x`, kept above a tiny positive value.
     fn energy(
         p: &Self::Params,
         e: Self::Energy,
@@ -64,11 +64,14 @@ pub trait Arith: Copy + Debug {
         clip: &mut u32,
     ) -> Self::Coef;
 
-    /// `g - gx^2 / energy`, not below 0: the next order's conversion factor (never above `g`,
-    /// since `energy >= gx^2 / g`).
+    /// The next order's conversion factor `g - gx^2 / energy = g lambda old / energy`, where
+    /// `energy = lambda old + gx^2 / g` is the energy made from `old` by [`Arith::energy`]:
+    /// in `[0, g]`.
     fn convert(
+        p: &Self::Params,
         g: Self::Gamma,
         gx: Self::Err,
+        old: Self::Energy,
         energy: Self::Energy,
         recip: &Self::Recip,
     ) -> Self::Gamma;
@@ -80,7 +83,8 @@ pub trait Arith: Copy + Debug {
 pub struct FloatParams<T> {
     /// Forgetting factor.
     pub lambda: T,
-    /// Floor of the energies.
+    /// Added to every energy update, so that the energies stay positive (and divisible)
+    /// however long the input is exactly zero.
     pub floor: T,
 }
 
@@ -91,7 +95,7 @@ macro_rules! impl_arith_float {
             type Gamma = $t;
             type Coef = $t;
             type Energy = $t;
-            type Recip = ();
+            type Recip = $t;
             type Params = FloatParams<$t>;
 
             const ERR_ZERO: $t = 0.0;
@@ -105,8 +109,7 @@ macro_rules! impl_arith_float {
 
             #[inline(always)]
             fn energy(p: &FloatParams<$t>, e: $t, gx: $t, x: $t, _: &mut u32) -> $t {
-                let e = p.lambda * e + gx * x;
-                if e > p.floor { e } else { p.floor }
+                p.lambda * e + gx * x + p.floor
             }
 
             #[inline(always)]
@@ -115,18 +118,19 @@ macro_rules! impl_arith_float {
             }
 
             #[inline(always)]
-            fn recip(_: $t) {}
-
-            #[inline(always)]
-            fn adapt(k: $t, gx: $t, e: $t, energy: $t, _: &(), _: &mut u32) -> $t {
-                k + gx * e / energy
+            fn recip(energy: $t) -> $t {
+                1.0 / energy
             }
 
             #[inline(always)]
-            fn convert(g: $t, gx: $t, energy: $t, _: &()) -> $t {
-                // Subtracting a non-negative number: only rounding can take it below 0.
-                let g = g - gx * gx / energy;
-                if g > 0.0 { g } else { 0.0 }
+            fn adapt(k: $t, gx: $t, e: $t, _: $t, recip: &$t, _: &mut u32) -> $t {
+                k + gx * e * recip
+            }
+
+            #[inline(always)]
+            fn convert(p: &FloatParams<$t>, g: $t, _: $t, old: $t, _: $t, recip: &$t) -> $t {
+                // The ratio form needs no clamp: `energy >= lambda old` holds after rounding.
+                g * (p.lambda * old) * recip
             }
         }
     )*};

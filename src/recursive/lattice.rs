@@ -80,7 +80,7 @@ impl<A: Arith, const P: usize> Core<A, P> {
             let gpsi = A::gain(g, psi, clip);
             let be = A::energy(params, b, gpsi, psi, clip);
             let be_recip = A::recip(be);
-            let g_next = A::convert(g, gpsi, be, &be_recip);
+            let g_next = A::convert(params, g, gpsi, b, be, &be_recip);
             self.f_energy[i] = fe;
             self.b_energy[i] = be;
             self.b_recip[i] = be_recip;
@@ -201,8 +201,9 @@ impl<A: Arith, const P: usize> Core<A, P> {
 /// [`Lattice::model`]) exactly, from the reflection coefficients of the last `P` samples
 /// (numerics.md section 1, option 1): `O(P^3/3)` operations per request, `O(P)` per sample.
 ///
-/// Safeguards: the energies are floored at a tiny positive value and the conversion factor
-/// is kept in `[0, 1]`; a non-finite state re-initialises the lattice (counted in
+/// Safeguards: every energy update adds a tiny positive value (`1e-30`, so that `F_m` exceeds
+/// the exact energy by `1e-30 W_n`), which keeps the energies divisible however long the input
+/// is exactly zero, and the conversion factor is formed as a ratio that stays in `[0, 1]`; a non-finite state re-initialises the lattice (counted in
 /// [`Health::restarts`]) and [`Lattice::model`] keeps returning the last good model for
 /// `3/(1 - lambda)` samples.
 ///
