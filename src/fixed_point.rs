@@ -53,18 +53,32 @@ const ERR_FRAC: u32 = 27;
 const GAMMA_FRAC: u32 = 30;
 const COEF_FRAC: u32 = 29;
 const ENERGY_FRAC: u32 = 40;
+/// The running mean's offset from the first sample.
+const OFFSET_FRAC: u32 = 56;
 /// Energies are floored at 16 LSB (1.5e-11 internal units^2).
 const ENERGY_FLOOR: i64 = 16;
 const TWO_32: f64 = 4_294_967_296.0;
 
-/// `x / 2^s` rounded to nearest (ties up); any `s`.
+/// `x y / 2^s` rounded to nearest (ties up), for a constant `s` in `1..=62`: one `SMULL` and
+/// a rounding shift.
 #[inline(always)]
-fn round_shift(x: i64, s: u32) -> i64 {
-    match s {
-        0 => x,
-        1..=63 => (x >> s) + ((x >> (s - 1)) & 1),
-        _ => 0,
-    }
+fn mul_shift(x: i32, y: i32, s: u32) -> i64 {
+    (i64::from(x) * i64::from(y) + (1 << (s - 1))) >> s
+}
+
+/// `x y / 2^32` rounded to nearest: the high word of the product (`SMMULR`).
+#[inline(always)]
+fn mul_hi(x: i32, y: i32) -> i32 {
+    // |x y| <= 2^62: the sum cannot overflow and the result fits in an i32.
+    ((i64::from(x) * i64::from(y) + (1 << 31)) >> 32) as i32
+}
+
+/// `(x 2^n, n)` with `n` the redundant sign bits of `x`: `|x 2^n|` in `[2^30, 2^31]` unless
+/// `x` is 0 (`n = 31`).
+#[inline(always)]
+fn normalise(x: i32) -> (i32, u32) {
+    let n = (x ^ (x >> 31)).leading_zeros() - 1;
+    (x.wrapping_shl(n), n)
 }
 
 /// `x` saturated to `i32`, counting a saturation in `clip`.
@@ -88,58 +102,69 @@ fn sat_add(x: i64, y: i64, clip: &mut u32) -> i64 {
     })
 }
 
-/// `e lambda` for a Q40 energy and a Q0.32 `lambda`, rounded to nearest: the 96-bit product
-/// split into `hi lambda + (lo lambda) / 2^32`, both exact in 64 bits.
+/// `e lambda` for a non-negative Q40 energy and a Q0.32 `lambda`, rounded to nearest: the
+/// 96-bit product split into `hi lambda + (lo lambda) / 2^32`, both exact in 64 bits.
 #[inline(always)]
 fn decay(e: i64, lambda: u32) -> i64 {
-    let hi = e >> 32;
-    let lo = e as u32;
-    let low = (u64::from(lo) * u64::from(lambda) + (1 << 31)) >> 32;
-    hi * i64::from(lambda) + low as i64
+    let e = e as u64;
+    let low = ((e & 0xFFFF_FFFF) * u64::from(lambda) + (1 << 31)) >> 32;
+    ((e >> 32) * u64::from(lambda) + low) as i64
 }
 
-/// The reciprocal of a positive Q40 value `e`: `(r, lz)` with `1/e_real = r 2^(lz - 55)`,
-/// `r` in about `(2^31, 2^32]`, accurate to about 2^-31 relative.
+/// A positive Q40 energy prepared for division: `(r, lz)` with `1/e_real = r 2^(lz - 54)`,
+/// `r` in `(2^30, 2^31)` accurate to about 2^-30 relative.
 ///
 /// `e` is normalised by its leading zeros (CLZ) to a mantissa `m` in `[2^31, 2^32)`; a 32/32
 /// hardware division gives `2^48 / m` to 16 bits, and one Newton-Raphson step
-/// `r <- r + r (2^63 - m r) / 2^63` doubles that to 32 bits.
+/// `r <- r + r (2^62 - m r) / 2^62` doubles that.
 #[inline(always)]
-fn reciprocal(e: i64) -> (u64, u32) {
+fn reciprocal(e: i64) -> (i32, u32) {
     let e = e.max(1) as u64;
-    let lz = e.leading_zeros();
-    let m = ((e << lz) >> 32) as u32; // in [2^31, 2^32)
+    let (hi, lo) = ((e >> 32) as u32, e as u32);
+    let (m, lz) = if hi != 0 {
+        let z = hi.leading_zeros();
+        // `(lo >> 1) >> (31 - z)` is `lo >> (32 - z)` without a shift by 32.
+        ((hi << z) | ((lo >> 1) >> (31 - z)), z)
+    } else {
+        let z = lo.leading_zeros();
+        (lo << z, 32 + z)
+    };
     // `| 0x8000` changes nothing (the top bit is set) but proves the divisor non-zero.
-    let r0 = u64::from(u32::MAX / ((m >> 16) | 0x8000)) << 15; // about 2^63 / m, to 2^-16
-    let residual = (1u64 << 63).wrapping_sub(u64::from(m) * r0) as i64; // 2^63 - m r0
-    let r = r0 as i64 + ((r0 as i64 * (residual >> 32)) >> 31);
-    (r as u64, lz)
+    let r0 = (u32::MAX / ((m >> 16) | 0x8000)) << 14; // in (2^30, 2^31)
+    let residual = (1u64 << 62).wrapping_sub(u64::from(m) * u64::from(r0)) as i64;
+    let correction = (i64::from((residual >> 31) as i32) * i64::from(r0 as i32)) >> 31;
+    (((r0 as i32) + correction as i32).min(i32::MAX), lz)
 }
 
-/// `x / e` for `x` in `Q(x_frac)` and the reciprocal `(r, lz)` of a positive Q40 `e`, in
-/// `Q(out_frac)`: `x` rounded to 30 significant bits times `r`, shifted back (relative error
-/// below 2^-29).
+/// `a b / e` in `Q(out_frac)`, for `a b` in `Q(ab_frac)` and the [`reciprocal`] of a positive
+/// Q40 `e`: both factors normalised, two high-word products, one shift back (relative error
+/// about 2^-28). Saturates (and counts) only beyond 2^61 LSB.
 #[inline(always)]
-fn divide(x: i64, x_frac: u32, (r, lz): (u64, u32), out_frac: u32, clip: &mut u32) -> i64 {
-    // Keep 30 significant bits of x, so that x r (r <= 2^32) fits in 64 bits.
-    let bits = 64 - x.unsigned_abs().leading_zeros();
-    let t = bits.saturating_sub(30);
-    let xs = round_shift(x, t);
-    let p = xs * r as i64;
-    // x_real / e_real = X r 2^(lz - 55 - x_frac); in Q(out_frac) that is X r shifted right by
-    // 55 + x_frac - out_frac - lz, of which t is already done.
-    let shift = i64::from(55 + x_frac) - i64::from(out_frac + lz + t);
-    if shift >= 0 {
-        round_shift(p, shift as u32)
+fn quotient(
+    a: i32,
+    b: i32,
+    ab_frac: u32,
+    (r, lz): (i32, u32),
+    out_frac: u32,
+    clip: &mut u32,
+) -> i64 {
+    let (an, na) = normalise(a);
+    let (bn, nb) = normalise(b);
+    // q = a b r 2^(na + nb - 64), |q| <= 2^29.
+    let q = mul_hi(mul_hi(an, bn), r);
+    // a b / e in Q(out) = a b r 2^(lz - 54 - ab_frac + out) = q 2^shift.
+    let shift = (10 + lz + out_frac) as i32 - (ab_frac + na + nb) as i32;
+    if shift < 0 {
+        // |q| < 2^29, so anything past 30 gives 0 and the rounded sum fits in 32 bits.
+        let t = shift.unsigned_abs().min(30);
+        i64::from((q + (1 << (t - 1))) >> t)
+    } else if shift <= 32 {
+        i64::from(q) << shift
     } else {
-        let left = shift.unsigned_abs() as u32;
-        match p.checked_shl(left).filter(|v| v >> left == p) {
-            Some(v) => v,
-            None => {
-                *clip += 1;
-                if p < 0 { i64::MIN } else { i64::MAX }
-            }
+        if q != 0 {
+            *clip += 1;
         }
+        i64::from(q.signum()) * i64::MAX
     }
 }
 
@@ -148,7 +173,7 @@ impl Arith for Q {
     type Gamma = I2F30;
     type Coef = I3F29;
     type Energy = I24F40;
-    type Recip = (u64, u32);
+    type Recip = (i32, u32);
     type Params = QParams;
 
     const ERR_ZERO: I5F27 = I5F27::ZERO;
@@ -156,30 +181,27 @@ impl Arith for Q {
     const COEF_ZERO: I3F29 = I3F29::ZERO;
 
     #[inline(always)]
-    fn gain(g: I2F30, x: I5F27, clip: &mut u32) -> I5F27 {
-        let p = i64::from(g.to_bits()) * i64::from(x.to_bits()); // Q57, exact
-        I5F27::from_bits(sat_i32(round_shift(p, GAMMA_FRAC), clip))
+    fn gain(g: I2F30, x: I5F27, _: &mut u32) -> I5F27 {
+        // |g x| <= |x|, since g is in [0, 1].
+        I5F27::from_bits(mul_shift(g.to_bits(), x.to_bits(), GAMMA_FRAC) as i32)
     }
 
     #[inline(always)]
     fn energy(p: &QParams, e: I24F40, gx: I5F27, x: I5F27, clip: &mut u32) -> I24F40 {
-        let decayed = decay(e.to_bits(), p.lambda.to_bits());
-        let add = round_shift(
-            i64::from(gx.to_bits()) * i64::from(x.to_bits()), // Q54, exact
-            2 * ERR_FRAC - ENERGY_FRAC,
-        );
-        let e = sat_add(decayed, add, clip);
+        // gx x >= 0 (gx has the sign of x), and so is the sum.
+        let add = mul_shift(gx.to_bits(), x.to_bits(), 2 * ERR_FRAC - ENERGY_FRAC);
+        let e = sat_add(decay(e.to_bits(), p.lambda.to_bits()), add, clip);
         I24F40::from_bits(e.max(p.floor.to_bits()))
     }
 
     #[inline(always)]
     fn predict(x: I5F27, k: I3F29, y: I5F27, clip: &mut u32) -> I5F27 {
-        let ky = round_shift(i64::from(k.to_bits()) * i64::from(y.to_bits()), COEF_FRAC);
+        let ky = mul_shift(k.to_bits(), y.to_bits(), COEF_FRAC);
         I5F27::from_bits(sat_i32(i64::from(x.to_bits()) - ky, clip))
     }
 
     #[inline(always)]
-    fn recip(energy: I24F40) -> (u64, u32) {
+    fn recip(energy: I24F40) -> (i32, u32) {
         reciprocal(energy.to_bits())
     }
 
@@ -189,11 +211,17 @@ impl Arith for Q {
         gx: I5F27,
         e: I5F27,
         _: I24F40,
-        recip: &(u64, u32),
+        recip: &(i32, u32),
         clip: &mut u32,
     ) -> I3F29 {
-        let num = i64::from(gx.to_bits()) * i64::from(e.to_bits()); // Q54, exact
-        let delta = divide(num, 2 * ERR_FRAC, *recip, COEF_FRAC, clip);
+        let delta = quotient(
+            gx.to_bits(),
+            e.to_bits(),
+            2 * ERR_FRAC,
+            *recip,
+            COEF_FRAC,
+            clip,
+        );
         I3F29::from_bits(sat_i32(sat_add(i64::from(k.to_bits()), delta, clip), clip))
     }
 
@@ -204,11 +232,17 @@ impl Arith for Q {
         gx: I5F27,
         _: I24F40,
         _: I24F40,
-        recip: &(u64, u32),
+        recip: &(i32, u32),
     ) -> I2F30 {
-        let num = i64::from(gx.to_bits()) * i64::from(gx.to_bits()); // Q54, exact
         let mut ignored = 0;
-        let delta = divide(num, 2 * ERR_FRAC, *recip, GAMMA_FRAC, &mut ignored);
+        let delta = quotient(
+            gx.to_bits(),
+            gx.to_bits(),
+            2 * ERR_FRAC,
+            *recip,
+            GAMMA_FRAC,
+            &mut ignored,
+        );
         let g = i64::from(g.to_bits())
             .saturating_sub(delta)
             .clamp(0, 1 << GAMMA_FRAC);
@@ -342,7 +376,7 @@ pub struct FixedLattice<const P: usize> {
     core: Core<Q, P>,
     /// The first sample, Q27.
     origin: i32,
-    /// Weighted mean of `x - origin`, Q59.
+    /// Weighted mean of `x - origin`, Q56.
     offset: i64,
     /// `W_n = lambda W_{n-1} + 1`, Q40.
     weight: i64,
@@ -416,11 +450,12 @@ impl<const P: usize> FixedLattice<P> {
                 self.origin = x;
                 self.started = true;
             }
-            let mean = round_shift(self.offset, 32);
+            let mean =
+                (self.offset + (1 << (OFFSET_FRAC - ERR_FRAC - 1))) >> (OFFSET_FRAC - ERR_FRAC);
             let y = sat_i32(i64::from(x) - i64::from(self.origin) - mean, &mut clip);
-            // offset += y / W, in Q59.
+            // offset += y / W: y times 1 (Q30) over W.
             let w = reciprocal(self.weight);
-            let step = divide(i64::from(y), ERR_FRAC, w, ERR_FRAC + 32, &mut clip);
+            let step = quotient(y, 1 << 30, ERR_FRAC + 30, w, OFFSET_FRAC, &mut clip);
             self.offset = sat_add(self.offset, step, &mut clip);
             y
         } else {
@@ -473,7 +508,7 @@ impl<const P: usize> FixedLattice<P> {
     /// The weighted running mean, in sensor units.
     pub fn mean(&self, config: &FixedConfig) -> f32 {
         let origin = f64::from(self.origin) / (1u64 << ERR_FRAC) as f64;
-        let offset = self.offset as f64 / (1u64 << (ERR_FRAC + 32)) as f64;
+        let offset = self.offset as f64 / (1u64 << OFFSET_FRAC) as f64;
         ((origin + offset) / f64::from(config.scale)) as f32
     }
 
