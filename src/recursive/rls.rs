@@ -50,8 +50,9 @@ pub enum RlsInit {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Rls<T, const P: usize> {
     a: [T; P],
-    /// Strictly upper part of `U`.
-    u: [[T; P]; P],
+    /// Strictly upper part of `U`, by columns: `ut[j][i] = U[i][j]` for `i < j`, so that the
+    /// inner loops run over contiguous memory.
+    ut: [[T; P]; P],
     d: [T; P],
     /// `y_{n-1} .. y_{n-P}` for the next sample.
     phi: [T; P],
@@ -67,7 +68,7 @@ impl<T: Scalar, const P: usize> Rls<T, P> {
         const { assert!(P > 0, "the model order P must be at least 1") };
         let mut s = Self {
             a: [T::ZERO; P],
-            u: [[T::ZERO; P]; P],
+            ut: [[T::ZERO; P]; P],
             d: [T::ZERO; P],
             phi: [T::ZERO; P],
             energy: T::ZERO,
@@ -81,7 +82,7 @@ impl<T: Scalar, const P: usize> Rls<T, P> {
 
     fn initialise(&mut self, config: &Config<T>) {
         self.a = [T::ZERO; P];
-        self.u = [[T::ZERO; P]; P];
+        self.ut = [[T::ZERO; P]; P];
         for (k, d) in self.d.iter_mut().enumerate() {
             *d = match self.init {
                 RlsInit::ShiftConsistent => T::ONE / config.delta_lambda_pow(P - 1 - k),
@@ -97,8 +98,6 @@ impl<T: Scalar, const P: usize> Rls<T, P> {
     ///
     /// Returns `None` when the sample was rejected (NaN, infinite or saturated: counted, the
     /// state is unchanged) or broke the recursion down (re-initialised, counted as a restart).
-    // Bierman's algorithm reads best with the indices of its published form.
-    #[allow(clippy::needless_range_loop)]
     pub fn update(&mut self, config: &Config<T>, x: T) -> Option<T> {
         let y = self.shell.intake(config, x)?;
         let lambda = config.lambda();
@@ -108,43 +107,47 @@ impl<T: Scalar, const P: usize> Rls<T, P> {
             .zip(&self.phi)
             .fold(y, |e, (&a, &p)| e - a * p);
 
-        // Bierman's update of U D U^T with measurement variance lambda, then D /= lambda.
+        // Bierman's update of U D U^T with measurement variance lambda, then D /= lambda:
+        // f = U^T phi, v = D f.
         let mut f = self.phi;
-        for j in 1..P {
-            for i in 0..j {
-                f[j] += self.u[i][j] * self.phi[i];
-            }
+        for (j, fj) in f.iter_mut().enumerate().skip(1) {
+            *fj += dot(&self.ut[j][..j], &self.phi[..j]);
         }
         let v: [T; P] = core::array::from_fn(|j| self.d[j] * f[j]);
-        let mut gain = [T::ZERO; P];
+        let mut gain = v;
         let mut alpha = lambda + v[0] * f[0];
         let mut healthy = alpha > T::ZERO;
-        self.d[0] = self.d[0] * lambda / alpha;
-        gain[0] = v[0];
+        // One division per column: 1/alpha_j also gives mu of column j + 1.
+        let mut alpha_recip = T::ONE / alpha;
+        self.d[0] = self.d[0] * lambda * alpha_recip;
         for j in 1..P {
+            let beta_recip = alpha_recip;
             let beta = alpha;
             alpha += v[j] * f[j];
-            let mu = -f[j] / beta;
-            self.d[j] = self.d[j] * beta / alpha;
-            gain[j] = v[j];
-            for i in 0..j {
-                let t = self.u[i][j];
-                self.u[i][j] = t + gain[i] * mu;
-                gain[i] += v[j] * t;
+            alpha_recip = T::ONE / alpha;
+            let mu = -f[j] * beta_recip;
+            self.d[j] = self.d[j] * (beta * alpha_recip);
+            let (column, gains) = (&mut self.ut[j][..j], &mut gain[..j]);
+            for (u, g) in column.iter_mut().zip(gains) {
+                let t = *u;
+                *u = t + *g * mu;
+                *g += v[j] * t;
             }
         }
         let mut check = T::ZERO;
         let d_max = T::from_f64(D_MAX);
-        for k in 0..P {
-            self.a[k] += gain[k] / alpha * e;
+        let lambda_recip = T::ONE / lambda;
+        let step = e * alpha_recip;
+        for ((a, d), g) in self.a.iter_mut().zip(&mut self.d).zip(&gain) {
+            *a += *g * step;
             // Without excitation (a stuck sensor) D grows as lambda^-n: cap it.
-            let d = self.d[k] / lambda;
-            self.d[k] = if d > d_max { d_max } else { d };
-            healthy &= self.d[k] > T::ZERO;
-            check += self.a[k] + self.d[k];
+            let scaled = *d * lambda_recip;
+            *d = if scaled > d_max { d_max } else { scaled };
+            healthy &= *d > T::ZERO;
+            check += *a + *d;
         }
         // a-posteriori error eps = e lambda / alpha
-        self.energy = lambda * self.energy + e * (e * lambda / alpha);
+        self.energy = lambda * self.energy + e * (e * lambda * alpha_recip);
         check += self.energy;
         if !(healthy && check.is_finite()) {
             self.shell.restart(config);
@@ -188,4 +191,10 @@ impl<T: Scalar, const P: usize> Rls<T, P> {
         self.shell
             .publish(|| ArModel::new(a, variance?, mean, config.dt()).ok())
     }
+}
+
+/// `sum x_i y_i`.
+#[inline(always)]
+fn dot<T: Scalar>(x: &[T], y: &[T]) -> T {
+    x.iter().zip(y).fold(T::ZERO, |s, (&a, &b)| s + a * b)
 }
