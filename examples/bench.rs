@@ -11,9 +11,11 @@
 //! `black_box`), subtracts the cost of the same loop without the call, and prints one line per
 //! row: `<estimator> <scalar> p=<P> insns/sample=<N>`. These are instruction counts, not cycles.
 //!
-//! Rows: `lattice` (f32 and fixed), `rls` (f32) per sample at p = 1, 2, 4, 8, 16, 32;
-//! `extract` per request of the exact coefficients of order p; `frame6` per six-axis frame of
-//! order-4 lattices.
+//! Rows: `lattice` (f32 and fixed), `rls` (f32) per sample at p = 1, 2, 4, 8, 16, 32, and at
+//! p = 3, 5, 6, 7 for the f32 lattice and RLS (where one overtakes the other); `extract` per
+//! request of the exact coefficients of order p; `frame6` per six-axis frame of order-4
+//! lattices. Then the state of one channel, `<estimator> <scalar> p=<P> bytes=<N>`
+//! (`size_of` on the target).
 #![cfg_attr(target_os = "none", no_std, no_main)]
 
 #[cfg(target_os = "none")]
@@ -88,6 +90,8 @@ mod firmware {
                 black_box(cell.borrow_mut().update(&config, black_box(x[i])));
             });
             defmt::info!("lattice f32 p={=usize} insns/sample={=u32}", P, n);
+            let bytes = core::mem::size_of::<Lattice<f32, P>>();
+            defmt::info!("lattice f32 p={=usize} bytes={=usize}", P, bytes);
         }
 
         fn lattice_fixed<const P: usize>(&mut self) {
@@ -104,6 +108,8 @@ mod firmware {
                 );
             });
             defmt::info!("lattice fixed p={=usize} insns/sample={=u32}", P, n);
+            let bytes = core::mem::size_of::<FixedLattice<P>>();
+            defmt::info!("lattice fixed p={=usize} bytes={=usize}", P, bytes);
         }
 
         /// The exact transversal coefficients on request, after 1000 samples.
@@ -142,6 +148,8 @@ mod firmware {
                 black_box(cell.borrow_mut().update(&config, black_box(x[i])));
             });
             defmt::info!("rls f32 p={=usize} insns/sample={=u32}", P, n);
+            let bytes = core::mem::size_of::<Rls<f32, P>>();
+            defmt::info!("rls f32 p={=usize} bytes={=usize}", P, bytes);
         }
     }
 
@@ -187,6 +195,16 @@ mod firmware {
         orders!(lattice_f32);
         orders!(lattice_fixed);
         orders!(rls_f32);
+        macro_rules! between {
+            ($f:ident) => {
+                bench.$f::<3>();
+                bench.$f::<5>();
+                bench.$f::<6>();
+                bench.$f::<7>();
+            };
+        }
+        between!(lattice_f32);
+        between!(rls_f32);
         orders!(extract_f32);
         bench.frame6_f32();
         common::exit(per_tick > 0)
