@@ -470,8 +470,8 @@ impl<const P: usize> FixedLattice<P> {
 
     /// A-priori forward prediction errors `f_1(n)..f_P(n)` of the last accepted sample, in
     /// internal units.
-    pub fn errors(&self) -> [I5F27; P] {
-        self.core.errors()
+    pub fn errors(&self) -> &[I5F27; P] {
+        &self.core.errors
     }
 
     /// The last accepted sample after mean removal, in internal units.
@@ -496,12 +496,12 @@ impl<const P: usize> FixedLattice<P> {
     }
 
     /// Forward reflection coefficients `kf_1..kf_P`.
-    pub fn forward_reflection(&self) -> [I3F29; P] {
+    pub fn forward_reflection(&self) -> &[I3F29; P] {
         self.core.forward_reflection()
     }
 
     /// Backward reflection coefficients `kb_1..kb_P`.
-    pub fn backward_reflection(&self) -> [I3F29; P] {
+    pub fn backward_reflection(&self) -> &[I3F29; P] {
         self.core.backward_reflection()
     }
 

@@ -60,7 +60,7 @@ pub fn checksums() -> Option<(u64, u64)> {
             hf.bytes(&e.to_bits().to_le_bytes());
             for v in float
                 .errors()
-                .into_iter()
+                .iter()
                 .chain(float.forward_reflection())
                 .chain(float.backward_reflection())
             {
@@ -77,7 +77,7 @@ pub fn checksums() -> Option<(u64, u64)> {
             }
             for k in fixed
                 .forward_reflection()
-                .into_iter()
+                .iter()
                 .chain(fixed.backward_reflection())
             {
                 hq.bytes(&k.to_bits().to_le_bytes());

@@ -1,12 +1,16 @@
 //! Host cost per sample of the recursive cores: `cargo bench -p imu-ar-host --bench per_sample`.
 //!
-//! Each iteration feeds a block of 1000 samples of an AR(2) record; criterion reports the time
-//! per block and, through the throughput, per sample. `tools/perf-table.sh` reads the results.
+//! The rows of the target's `cargo qemu bench`, and the f64 cores: each iteration feeds a block
+//! of 1000 samples of an AR(2) record (as raw counts for the fixed-point lattice); criterion
+//! reports the time per block and, through the throughput, per sample. `extract` times one
+//! request of the exact coefficients, `frame6` one six-axis frame of order-4 lattices.
+//! `tools/bench-report.sh` reads the results.
 
 use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use imu_ar::fixed_point::{FixedConfig, FixedLattice};
 use imu_ar::recursive::{Config, Lattice, Rls, RlsInit};
 use imu_ar::sim::ArSimulator;
 use imu_ar::{ArModel, Scalar};
@@ -24,14 +28,19 @@ fn record<T: Scalar>() -> Vec<T> {
         .collect()
 }
 
-/// Criterion group `name`, id `p`: `update` over one block of the record.
-fn bench_block<T: Scalar>(c: &mut Criterion, name: &str, p: usize, mut update: impl FnMut(T)) {
-    let x = record::<T>();
+/// Criterion group `name`, id `p`: `update` over one block of `x`.
+fn bench_block<T: Copy>(
+    c: &mut Criterion,
+    name: &str,
+    p: usize,
+    x: &[T],
+    mut update: impl FnMut(T),
+) {
     let mut group = c.benchmark_group(name);
-    group.throughput(Throughput::Elements(BLOCK as u64));
+    group.throughput(Throughput::Elements(x.len() as u64));
     group.bench_function(BenchmarkId::from_parameter(p), |b| {
         b.iter(|| {
-            for &v in &x {
+            for &v in x {
                 update(black_box(v));
             }
         })
@@ -46,15 +55,51 @@ fn config<T: Scalar>() -> Config<T> {
 fn lattice<T: imu_ar::recursive::FloatArith, const P: usize>(c: &mut Criterion, name: &str) {
     let config = config::<T>();
     let mut state = Lattice::<T, P>::new(&config);
-    bench_block(c, name, P, |v| {
+    bench_block(c, name, P, &record::<T>(), |v| {
         black_box(state.update(&config, v));
+    });
+}
+
+fn lattice_fixed<const P: usize>(c: &mut Criterion) {
+    let config = Config::new(0.999f32, 1e-3, 0.01).unwrap();
+    let fixed = FixedConfig::for_counts(&config, 0.05).unwrap();
+    let mut state = FixedLattice::<P>::new(&fixed);
+    let counts: Vec<i16> = record::<f32>().iter().map(|&v| (v * 20.0) as i16).collect();
+    bench_block(c, "lattice_fixed", P, &counts, |v| {
+        black_box(state.update_counts(&fixed, v));
+    });
+}
+
+/// The exact coefficients on request, after one block.
+fn extract<const P: usize>(c: &mut Criterion) {
+    let config = config::<f32>();
+    let mut state = Lattice::<f32, P>::new(&config);
+    for v in record::<f32>() {
+        state.update(&config, v);
+    }
+    bench_block(c, "extract_f32", P, &[()], |()| {
+        black_box(black_box(&state).coefficients(P));
+    });
+}
+
+fn frame6(c: &mut Criterion) {
+    let config = config::<f32>();
+    let mut axes = [Lattice::<f32, 4>::new(&config); 6];
+    let x = record::<f32>();
+    let frames: Vec<[f32; 6]> = (0..BLOCK)
+        .map(|i| core::array::from_fn(|k| x[(i + k) % BLOCK]))
+        .collect();
+    bench_block(c, "frame6_f32", 4, &frames, |frame| {
+        for (lattice, v) in axes.iter_mut().zip(frame) {
+            black_box(lattice.update(&config, v));
+        }
     });
 }
 
 fn rls<T: Scalar, const P: usize>(c: &mut Criterion, name: &str) {
     let config = config::<T>();
     let mut state = Rls::<T, P>::new(&config, RlsInit::ShiftConsistent);
-    bench_block(c, name, P, |v| {
+    bench_block(c, name, P, &record::<T>(), |v| {
         black_box(state.update(&config, v));
     });
 }
@@ -62,6 +107,7 @@ fn rls<T: Scalar, const P: usize>(c: &mut Criterion, name: &str) {
 fn per_sample(c: &mut Criterion) {
     macro_rules! orders {
         ($f:ident, $t:ty, $name:expr) => {
+            $f::<$t, 1>(c, $name);
             $f::<$t, 2>(c, $name);
             $f::<$t, 4>(c, $name);
             $f::<$t, 8>(c, $name);
@@ -73,6 +119,19 @@ fn per_sample(c: &mut Criterion) {
     orders!(lattice, f64, "lattice_f64");
     orders!(rls, f32, "rls_f32");
     orders!(rls, f64, "rls_f64");
+    lattice_fixed::<1>(c);
+    lattice_fixed::<2>(c);
+    lattice_fixed::<4>(c);
+    lattice_fixed::<8>(c);
+    lattice_fixed::<16>(c);
+    lattice_fixed::<32>(c);
+    extract::<1>(c);
+    extract::<2>(c);
+    extract::<4>(c);
+    extract::<8>(c);
+    extract::<16>(c);
+    extract::<32>(c);
+    frame6(c);
 }
 
 criterion_group! {

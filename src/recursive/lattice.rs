@@ -4,26 +4,6 @@ use super::arith::{Arith, FloatArith, float_params};
 use super::{Config, Health, Shell};
 use crate::{ArModel, Scalar};
 
-/// The state of one lattice stage `i` (order `i` to `i + 1`), kept together so that the
-/// per-sample loop walks one array.
-#[derive(Clone, Copy, Debug)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-struct Stage<A: Arith> {
-    /// Forward energy `F_i`.
-    f_energy: A::Energy,
-    /// Backward energy `B_i`, holding `B_i(n-1)` between samples.
-    b_energy: A::Energy,
-    /// `B_i` prepared for division: computed for step 7 and reused by step 4 of the next
-    /// sample.
-    b_recip: A::Recip,
-    /// `psi_i(n-1)`.
-    bp: A::Err,
-    /// `gamma_i(n-1)`.
-    gp: A::Gamma,
-    /// The a-priori forward error `f_{i+1}` of the last sample.
-    error: A::Err,
-}
-
 /// The lattice recursion of numerics.md section 2.1, written once over the typed steps of
 /// [`Arith`]: the state of all stages, the last sample's errors, and the reflection
 /// coefficients of the last `P` samples for the exact transversal coefficients.
@@ -33,17 +13,30 @@ struct Stage<A: Arith> {
 #[derive(Clone, Copy, Debug)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Core<A: Arith, const P: usize> {
-    stages: [Stage<A>; P],
+    /// Forward energies `F_0..F_{P-1}`.
+    pub(crate) f_energy: [A::Energy; P],
     /// `F_P`.
-    f_energy_p: A::Energy,
+    pub(crate) f_energy_p: A::Energy,
+    /// Backward energies `B_0..B_{P-1}`, holding `B_i(n-1)` between samples.
+    pub(crate) b_energy: [A::Energy; P],
+    /// `B_i` prepared for division: computed for step 7 and reused by step 4 of the next
+    /// sample.
+    b_recip: [A::Recip; P],
+    /// `psi_i(n-1)`, i = 0..P-1.
+    bp: [A::Err; P],
+    /// `gamma_i(n-1)`, i = 0..P-1.
+    gp: [A::Gamma; P],
     /// `gamma_P(n-1)`.
     gp_p: A::Gamma,
+    /// A-priori forward errors `f_1..f_P` of the last sample; `f_0` is `input`.
+    pub(crate) errors: [A::Err; P],
     /// `y_n` of the last sample, the order-0 error.
     pub(crate) input: A::Err,
-    /// `[kf_m, kb_m]` (index `m - 1` for order `m`) of the last `P` samples, newest at
-    /// `head`: the current coefficients are updated from one slot into the next, so that
-    /// keeping the history costs no copy.
-    ring: [[[A::Coef; 2]; P]; P],
+    /// `kf_1..kf_P` (index `m - 1` for order `m`) of the last `P` samples, newest at `head`:
+    /// the current coefficients are updated from one slot into the next, so that keeping the
+    /// history costs no copy.
+    ring_kf: [[A::Coef; P]; P],
+    ring_kb: [[A::Coef; P]; P],
     head: usize,
 }
 
@@ -52,18 +45,17 @@ impl<A: Arith, const P: usize> Core<A, P> {
     /// unit conversion factors.
     pub(crate) fn new(f0: A::Energy, b: [A::Energy; P]) -> Self {
         Self {
-            stages: b.map(|b| Stage {
-                f_energy: f0,
-                b_energy: b,
-                b_recip: A::recip(b),
-                bp: A::ERR_ZERO,
-                gp: A::GAMMA_ONE,
-                error: A::ERR_ZERO,
-            }),
+            f_energy: [f0; P],
             f_energy_p: f0,
+            b_energy: b,
+            b_recip: b.map(A::recip),
+            bp: [A::ERR_ZERO; P],
+            gp: [A::GAMMA_ONE; P],
             gp_p: A::GAMMA_ONE,
+            errors: [A::ERR_ZERO; P],
             input: A::ERR_ZERO,
-            ring: [[[A::COEF_ZERO; 2]; P]; P],
+            ring_kf: [[A::COEF_ZERO; P]; P],
+            ring_kb: [[A::COEF_ZERO; P]; P],
             head: 0,
         }
     }
@@ -75,30 +67,26 @@ impl<A: Arith, const P: usize> Core<A, P> {
         let old = self.head % P;
         let new = (old + P - 1) % P;
         let (mut f, mut psi, mut g) = (y, y, A::GAMMA_ONE);
-        for (i, s) in self.stages.iter_mut().enumerate() {
-            let [kf, kb] = self.ring[old][i];
-            let gf = A::gain(s.gp, f, clip);
-            let fe = A::energy(params, s.f_energy, gf, f, clip);
-            let f_next = A::predict(f, kf, s.bp, clip);
-            let psi_next = A::predict(s.bp, kb, f, clip);
-            let gbp = A::gain(s.gp, s.bp, clip);
-            let b = s.b_energy;
-            self.ring[new][i] = [
-                A::adapt(kf, gbp, f_next, b, &s.b_recip, clip),
-                A::adapt(kb, gf, psi_next, fe, &A::recip(fe), clip),
-            ];
+        for i in 0..P {
+            let (kf, kb) = (self.ring_kf[old][i], self.ring_kb[old][i]);
+            let gf = A::gain(self.gp[i], f, clip);
+            let fe = A::energy(params, self.f_energy[i], gf, f, clip);
+            let f_next = A::predict(f, kf, self.bp[i], clip);
+            let psi_next = A::predict(self.bp[i], kb, f, clip);
+            let gbp = A::gain(self.gp[i], self.bp[i], clip);
+            let b = self.b_energy[i];
+            self.ring_kf[new][i] = A::adapt(kf, gbp, f_next, b, &self.b_recip[i], clip);
+            self.ring_kb[new][i] = A::adapt(kb, gf, psi_next, fe, &A::recip(fe), clip);
             let gpsi = A::gain(g, psi, clip);
             let be = A::energy(params, b, gpsi, psi, clip);
             let be_recip = A::recip(be);
             let g_next = A::convert(params, g, gpsi, b, be, &be_recip);
-            *s = Stage {
-                f_energy: fe,
-                b_energy: be,
-                b_recip: be_recip,
-                bp: psi,
-                gp: g,
-                error: f_next,
-            };
+            self.f_energy[i] = fe;
+            self.b_energy[i] = be;
+            self.b_recip[i] = be_recip;
+            self.bp[i] = psi;
+            self.gp[i] = g;
+            self.errors[i] = f_next;
             f = f_next;
             psi = psi_next;
             g = g_next;
@@ -111,19 +99,14 @@ impl<A: Arith, const P: usize> Core<A, P> {
         f
     }
 
-    /// `f_1..f_P` of the last sample.
-    pub(crate) fn errors(&self) -> [A::Err; P] {
-        self.stages.map(|s| s.error)
-    }
-
     /// `kf_1..kf_P` after the last sample.
-    pub(crate) fn forward_reflection(&self) -> [A::Coef; P] {
-        self.ring[self.head % P].map(|[kf, _]| kf)
+    pub(crate) fn forward_reflection(&self) -> &[A::Coef; P] {
+        &self.ring_kf[self.head % P]
     }
 
     /// `kb_1..kb_P` after the last sample.
-    pub(crate) fn backward_reflection(&self) -> [A::Coef; P] {
-        self.ring[self.head % P].map(|[_, kb]| kb)
+    pub(crate) fn backward_reflection(&self) -> &[A::Coef; P] {
+        &self.ring_kb[self.head % P]
     }
 
     /// Forward energy of order `m` in `0..=P`.
@@ -131,7 +114,7 @@ impl<A: Arith, const P: usize> Core<A, P> {
         if m == P {
             Some(self.f_energy_p)
         } else {
-            self.stages.get(m).map(|s| s.f_energy)
+            self.f_energy.get(m).copied()
         }
     }
 
@@ -152,7 +135,8 @@ impl<A: Arith, const P: usize> Core<A, P> {
         let mut rows = [[[T::ZERO; P]; P]; 2];
         let mut alpha = [T::ZERO; P];
         for t in (0..m).rev() {
-            let slot = &self.ring[(self.head + t) % P];
+            let slot = (self.head + t) % P;
+            let (kf, kb) = (&self.ring_kf[slot], &self.ring_kb[slot]);
             alpha = [T::ZERO; P];
             let (first, second) = rows.split_at_mut(1);
             let (older, newer) = if t % 2 == 0 {
@@ -160,7 +144,8 @@ impl<A: Arith, const P: usize> Core<A, P> {
             } else {
                 (&first[0], &mut second[0])
             };
-            for (k, &[kf_k, kb_k]) in (1..).zip(slot.iter().take(m - t)) {
+            let stages = kf.iter().zip(kb).take(m - t);
+            for (k, (&kf_k, &kb_k)) in (1..).zip(stages) {
                 let (kf_k, kb_k) = (to_t(kf_k), to_t(kb_k));
                 // B_{k-1}(n-t-1), with its trailing 1.
                 let b_prev = older.get(k - 1);
@@ -282,7 +267,7 @@ impl<T: FloatArith, const P: usize> Lattice<T, P> {
         // A non-finite value anywhere reaches f_P within a sample or two (the reflection
         // coefficients feed the errors), and an overflowing input reaches F_0 and F_P at once.
         let c = &self.core;
-        let check = f + c.f_energy_p + c.energy(0).unwrap_or(T::ZERO);
+        let check = f + c.f_energy_p + c.f_energy[0];
         if !check.is_finite() {
             self.shell.restart(config);
             self.core = Self::initial_core(config);
@@ -293,8 +278,8 @@ impl<T: FloatArith, const P: usize> Lattice<T, P> {
 
     /// A-priori forward prediction errors `f_1(n)..f_P(n)` of the last accepted sample
     /// (`f_m(n) = y_n - a^(m)_{n-1}^T phi_n`); `f_0(n) = y_n` is [`Lattice::input`].
-    pub fn errors(&self) -> [T; P] {
-        self.core.errors()
+    pub fn errors(&self) -> &[T; P] {
+        &self.core.errors
     }
 
     /// The last accepted sample after mean removal, `y_n` (the order-0 prediction error).
@@ -316,12 +301,12 @@ impl<T: FloatArith, const P: usize> Lattice<T, P> {
 
     /// Forward reflection coefficients `kf_1..kf_P` (lattice sign: `kf_1 = a_1` of the
     /// order-1 model, minus the error-filter reflection coefficient).
-    pub fn forward_reflection(&self) -> [T; P] {
+    pub fn forward_reflection(&self) -> &[T; P] {
         self.core.forward_reflection()
     }
 
     /// Backward reflection coefficients `kb_1..kb_P`.
-    pub fn backward_reflection(&self) -> [T; P] {
+    pub fn backward_reflection(&self) -> &[T; P] {
         self.core.backward_reflection()
     }
 
