@@ -133,7 +133,9 @@ fn reciprocal(e: i64) -> (i32, u32) {
     let r0 = (u32::MAX / ((m >> 16) | 0x8000)) << 14; // in (2^30, 2^31)
     let residual = (1u64 << 62).wrapping_sub(u64::from(m) * u64::from(r0)) as i64;
     let correction = (i64::from((residual >> 31) as i32) * i64::from(r0 as i32)) >> 31;
-    (((r0 as i32) + correction as i32).min(i32::MAX), lz)
+    // 2^62 / m reaches 2^31 only for m = 2^31.
+    let r = (i64::from(r0) + correction).min(i64::from(i32::MAX));
+    (r as i32, lz)
 }
 
 /// `a b / e` in `Q(out_frac)`, for `a b` in `Q(ab_frac)` and the [`reciprocal`] of a positive

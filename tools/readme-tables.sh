@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
 # Regenerates the measured tables of README.md (between the BEGIN/END markers) from runs:
 #   - f32 and fixed-point accuracy of the lattice (host-tests/tests/recursive_f32.rs, fixed.rs),
-#   - instructions per sample on the emulated Cortex-M4F (`cargo qemu bench`),
 #   - the demo's output and footprint (`cargo qemu demo`, tools/footprint.sh),
-#   - `imu-ar compare` on a drifting AR(2),
-#   - host cost per sample (criterion, host-tests/benches/per_sample.rs).
+#   - `imu-ar compare` on a drifting AR(2).
 #
-#   tools/readme-tables.sh            all of them (about 4 minutes)
-#   tools/readme-tables.sh accuracy   one group: accuracy | target-cost | demo | compare | host-cost
+# The performance tables are written by tools/bench-report.sh.
+#
+#   tools/readme-tables.sh            all of them (about 3 minutes)
+#   tools/readme-tables.sh accuracy   one group: accuracy | demo | compare
 set -euo pipefail
 cd "$(dirname "$0")/.."
 only=${1:-all}
@@ -67,24 +67,6 @@ if [ "$only" = all ] || [ "$only" = accuracy ]; then
     replace fixed-real "$tmp/fixed-real.md"
 fi
 
-if [ "$only" = all ] || [ "$only" = target-cost ]; then
-    cargo qemu bench 2>/dev/null > "$tmp/bench.txt"
-    python3 - "$tmp/bench.txt" > "$tmp/target-cost.md" <<'PY'
-import re, sys
-rows = {}
-for line in open(sys.argv[1]):
-    m = re.search(r"(\w+) (\w+) p=(\d+) insns/sample=(\d+)", line)
-    if m:
-        rows.setdefault((m[1], m[2]), {})[int(m[3])] = int(m[4])
-orders = sorted({p for r in rows.values() for p in r})
-print("| estimator | scalar | " + " | ".join(f"p = {p}" for p in orders) + " |")
-print("|---|---|" + "---|" * len(orders))
-for (est, scalar), r in rows.items():
-    print(f"| {est} | {scalar} | " + " | ".join(str(r.get(p, "")) for p in orders) + " |")
-PY
-    replace target-cost "$tmp/target-cost.md"
-fi
-
 if [ "$only" = all ] || [ "$only" = demo ]; then
     {
         echo '```text'
@@ -113,22 +95,4 @@ print("| " + " | ".join(cells) + " | %.1f %% lower |" % v["reduction_percent"])'
         done
     } > "$tmp/compare.md"
     replace compare "$tmp/compare.md"
-fi
-
-if [ "$only" = all ] || [ "$only" = host-cost ]; then
-    cargo bench -q -p imu-ar-host --bench per_sample > /dev/null
-    python3 - > "$tmp/host-cost.md" <<'PY'
-import json
-orders = [2, 4, 8, 16, 32]
-rows = [("lattice", "f32"), ("lattice", "f64"), ("rls", "f32"), ("rls", "f64")]
-print("| estimator | scalar | " + " | ".join(f"p = {p}" for p in orders) + " |")
-print("|---|---|" + "---|" * len(orders))
-for est, scalar in rows:
-    cells = []
-    for p in orders:
-        e = json.load(open(f"target/criterion/{est}_{scalar}/{p}/new/estimates.json"))
-        cells.append(f"{e['mean']['point_estimate'] / 1000:.0f}")
-    print(f"| {est} | {scalar} | " + " | ".join(cells) + " |")
-PY
-    replace host-cost "$tmp/host-cost.md"
 fi

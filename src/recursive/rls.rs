@@ -126,7 +126,7 @@ impl<T: Scalar, const P: usize> Rls<T, P> {
             alpha += v[j] * f[j];
             alpha_recip = T::ONE / alpha;
             let mu = -f[j] * beta_recip;
-            self.d[j] = self.d[j] * (beta * alpha_recip);
+            self.d[j] *= beta * alpha_recip;
             let (column, gains) = (&mut self.ut[j][..j], &mut gain[..j]);
             for (u, g) in column.iter_mut().zip(gains) {
                 let t = *u;

@@ -1,0 +1,40 @@
+//! Flash of the fixed-point lattice: `update` and `model` of a `FixedLattice<8>`
+//! (`tools/bench-report.sh` subtracts `size_base`).
+//!
+//! ```text
+//! cargo qemu size_lattice_fixed
+//! ```
+#![cfg_attr(target_os = "none", no_std, no_main)]
+
+#[cfg(target_os = "none")]
+#[path = "common/mod.rs"]
+mod common;
+#[cfg(target_os = "none")]
+#[path = "common/size.rs"]
+mod size;
+
+#[cfg(target_os = "none")]
+#[cortex_m_rt::entry]
+fn main() -> ! {
+    use imu_ar::fixed_point::{FixedConfig, FixedLattice};
+    use imu_ar::recursive::Config;
+
+    let Ok(config) = Config::new(0.999f32, 0.1, 0.01) else {
+        common::exit(false)
+    };
+    let Ok(fixed) = FixedConfig::new(&config, 4.0) else {
+        common::exit(false)
+    };
+    size::run(
+        FixedLattice::<8>::new(&fixed),
+        |lattice, x| {
+            lattice.update(&fixed, x);
+        },
+        |mut lattice| lattice.model(&fixed).map_or(f32::NAN, |m| m.a()[0]),
+    )
+}
+
+#[cfg(not(target_os = "none"))]
+fn main() {
+    eprintln!("size_lattice_fixed is firmware for the Cortex-M4F: run it with `cargo qemu size_lattice_fixed`");
+}

@@ -1,0 +1,36 @@
+//! Flash of RLS: `update` and `model` of an `Rls<f32, 8>` (`tools/bench-report.sh` subtracts
+//! `size_base`).
+//!
+//! ```text
+//! cargo qemu size_rls_f32
+//! ```
+#![cfg_attr(target_os = "none", no_std, no_main)]
+
+#[cfg(target_os = "none")]
+#[path = "common/mod.rs"]
+mod common;
+#[cfg(target_os = "none")]
+#[path = "common/size.rs"]
+mod size;
+
+#[cfg(target_os = "none")]
+#[cortex_m_rt::entry]
+fn main() -> ! {
+    use imu_ar::recursive::{Config, Rls, RlsInit};
+
+    let Ok(config) = Config::new(0.999f32, 0.1, 0.01) else {
+        common::exit(false)
+    };
+    size::run(
+        Rls::<f32, 8>::new(&config, RlsInit::ShiftConsistent),
+        |rls, x| {
+            rls.update(&config, x);
+        },
+        |mut rls| rls.model(&config).map_or(f32::NAN, |m| m.a()[0]),
+    )
+}
+
+#[cfg(not(target_os = "none"))]
+fn main() {
+    eprintln!("size_rls_f32 is firmware for the Cortex-M4F: run it with `cargo qemu size_rls_f32`");
+}

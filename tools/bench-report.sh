@@ -1,0 +1,151 @@
+#!/usr/bin/env bash
+# Regenerates the "Performance" section of README.md (between the BEGIN/END perf-* markers)
+# from these runs, about 6 minutes:
+#   - instructions per sample and state bytes per channel on the emulated Cortex-M4F
+#     (`cargo qemu bench`), with the per-stage slope and the order where the lattice overtakes
+#     RLS,
+#   - nanoseconds per sample on the host (criterion, host-tests/benches/per_sample.rs),
+#   - flash per estimator: each `size_*` firmware minus `size_base` (tools/footprint.sh),
+#   - wall time of the `imu-ar` tool on the 1,000,000-row ADIS16405 record (best of 3).
+#
+#   tools/bench-report.sh            all of it
+#   tools/bench-report.sh target     one part: target | host | flash | wall
+set -euo pipefail
+cd "$(dirname "$0")/.."
+only=${1:-all}
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+data=${IMU_AR_DATA:-../shared/data/imu}
+
+# replace SECTION FILE: put FILE's contents between the section's markers in README.md.
+replace() {
+    python3 - "$1" "$2" <<'PY'
+import sys
+name, path = sys.argv[1], sys.argv[2]
+body = open(path).read().rstrip("\n")
+readme = open("README.md").read()
+begin, end = f"<!-- BEGIN {name} -->", f"<!-- END {name} -->"
+if begin not in readme or end not in readme:
+    sys.exit(f"README.md has no {begin} ... {end} section")
+pre, rest = readme.split(begin, 1)
+_, post = rest.split(end, 1)
+open("README.md", "w").write(f"{pre}{begin}\n{body}\n{end}{post}")
+PY
+    echo "README.md: section $1 updated"
+}
+
+if [ "$only" = all ] || [ "$only" = target ]; then
+    cargo qemu bench 2>/dev/null > "$tmp/bench.txt"
+    python3 - "$tmp/bench.txt" "$tmp" <<'PY'
+import re, sys
+text, tmp = open(sys.argv[1]).read(), sys.argv[2]
+insns, size = {}, {}
+for est, scalar, p, key, n in re.findall(r"(\w+) (\w+) p=(\d+) (insns/sample|bytes)=(\d+)", text):
+    table = insns if key == "insns/sample" else size
+    table.setdefault((est, scalar), {})[int(p)] = int(n)
+orders = [1, 2, 4, 8, 16, 32]
+
+def table(rows, unit):
+    lines = ["| estimator | scalar | " + " | ".join(f"p = {p}" for p in orders) + " |",
+             "|---|---|" + "---|" * len(orders)]
+    for (est, scalar), r in rows.items():
+        lines.append(f"| {est} | {scalar} | " + " | ".join(str(r.get(p, "")) for p in orders) + " |")
+    return "\n".join(lines) + "\n"
+
+def slope(r):
+    ps = [p for p in orders if p in r]
+    mp, my = sum(ps) / len(ps), sum(r[p] for p in ps) / len(ps)
+    return sum((p - mp) * (r[p] - my) for p in ps) / sum((p - mp) ** 2 for p in ps)
+
+lat, fix, rls = insns[("lattice", "f32")], insns[("lattice", "fixed")], insns[("rls", "f32")]
+s_f32, s_fixed = slope(lat), slope(fix)
+common = sorted(set(lat) & set(rls))
+cheaper = [p for p in common if all(lat[q] < rls[q] for q in common if q >= p)]
+cross = cheaper[0] if cheaper else None
+below = max((p for p in common if cross and p < cross), default=None)
+with open(f"{tmp}/perf-target.md", "w") as out:
+    out.write(table(insns, "insns"))
+    out.write(f"\nPer lattice stage (least-squares slope over p = 1..32): **{s_f32:.1f}** instructions "
+              f"in f32, **{s_fixed:.0f}** in fixed point ({s_fixed / s_f32:.1f} times the f32 figure).")
+    if cross:
+        out.write(f" The f32 lattice is cheaper than RLS from **p = {cross}** on "
+                  f"(p = {below}: lattice {lat[below]}, RLS {rls[below]}; p = {cross}: lattice "
+                  f"{lat[cross]}, RLS {rls[cross]}).\n")
+    else:
+        out.write(" RLS is cheaper at every measured order.\n")
+with open(f"{tmp}/perf-state.md", "w") as out:
+    out.write(table(size, "bytes"))
+PY
+    replace perf-target "$tmp/perf-target.md"
+    replace perf-state "$tmp/perf-state.md"
+fi
+
+if [ "$only" = all ] || [ "$only" = host ]; then
+    cargo bench -q -p imu-ar-host --bench per_sample > /dev/null
+    python3 - > "$tmp/perf-host.md" <<'PY'
+import json, os
+orders = [1, 2, 4, 8, 16, 32]
+rows = [("lattice", "f32"), ("lattice", "f64"), ("lattice", "fixed"), ("rls", "f32"),
+        ("rls", "f64"), ("extract", "f32"), ("frame6", "f32")]
+print("| estimator | scalar | " + " | ".join(f"p = {p}" for p in orders) + " |")
+print("|---|---|" + "---|" * len(orders))
+for est, scalar in rows:
+    cells = []
+    for p in orders:
+        path = f"target/criterion/{est}_{scalar}/{p}/new/estimates.json"
+        if not os.path.exists(path):
+            cells.append("")
+            continue
+        ns = json.load(open(path))["mean"]["point_estimate"]
+        # A block of 1000 samples (frames) per iteration; extract times one request.
+        per = ns if est == "extract" else ns / 1000
+        cells.append(f"{per:.0f}" if per >= 10 else f"{per:.1f}")
+    print(f"| {est} | {scalar} | " + " | ".join(cells) + " |")
+PY
+    replace perf-host "$tmp/perf-host.md"
+fi
+
+if [ "$only" = all ] || [ "$only" = flash ]; then
+    tools/footprint.sh size_base size_lattice_f32 size_lattice_fixed size_rls_f32 > "$tmp/sizes.md"
+    python3 - "$tmp/sizes.md" > "$tmp/perf-flash.md" <<'PY'
+import re, sys
+flash = dict(re.findall(r"\| `(\w+)` \| (\d+) \|", open(sys.argv[1]).read()))
+base = int(flash.pop("size_base"))
+names = {"size_lattice_f32": ("lattice", "f32"), "size_lattice_fixed": ("lattice", "fixed"),
+         "size_rls_f32": ("rls", "f32")}
+print("| estimator | scalar | flash (bytes), p = 8 | firmware |")
+print("|---|---|---|---|")
+for name, total in flash.items():
+    est, scalar = names[name]
+    print(f"| {est} | {scalar} | {int(total) - base} | `{name}`: {total} - `size_base`: {base} |")
+PY
+    replace perf-flash "$tmp/perf-flash.md"
+fi
+
+if [ "$only" = all ] || [ "$only" = wall ]; then
+    cargo build --release -q -p imu-ar-host
+    python3 - "$data" > "$tmp/perf-wall.md" <<'PY'
+import subprocess, sys, time
+data = sys.argv[1]
+files = [f"{data}/adis16405_imu1_part1.csv", f"{data}/adis16405_imu1_part2.csv"]
+runs = [
+    ("fit --method lattice --order 4", ["fit", "--method", "lattice", "--order", "4"]),
+    ("fit --method lattice --order 32", ["fit", "--method", "lattice", "--order", "32"]),
+    ("fit --method lattice --order 4 --scalar fixed",
+     ["fit", "--method", "lattice", "--order", "4", "--scalar", "fixed"]),
+    ("fit --method yule-walker --order 1", ["fit", "--method", "yule-walker", "--order", "1"]),
+    ("adev --rate 100", ["adev", "--rate", "100"]),
+]
+print("| `imu-ar ... --column gx` on both ADIS16405 files (1,000,000 rows) | wall (s) |")
+print("|---|---|")
+for label, args in runs:
+    best = float("inf")
+    for _ in range(3):
+        start = time.perf_counter()
+        subprocess.run(["target/release/imu-ar", *args, "--column", "gx", *files],
+                       check=True, stdout=subprocess.DEVNULL)
+        best = min(best, time.perf_counter() - start)
+    print(f"| `{label}` | {best:.2f} |")
+PY
+    replace perf-wall "$tmp/perf-wall.md"
+fi
