@@ -13,13 +13,15 @@
 //! | energies `F`, `B`, weight `W` | [`I24F40`] | +-8.4e6 | 9.1e-13 |
 //! | forgetting factor `lambda` | [`U0F32`] | [0, 1) | 2.3e-10 |
 //!
-//! Every product is formed exactly in `i64` (or `i128` where an energy is involved) and rounded
-//! to nearest once; the `fixed` crate's own `*` rounds toward minus infinity, a bias that the
-//! `lambda` recursions would accumulate over `1/(1 - lambda)` samples. Divisions by an energy
-//! use a reciprocal: the energy is normalised by its leading zeros (CLZ) to a 32-bit mantissa
-//! `m` in `[2^31, 2^32)`, `r = round(2^63 / m)` is one 64/32-bit division, and the quotient is
-//! `x r` shifted back by the exponent (relative error below 2^-31). Every result is saturated
-//! to its format, and each saturation is counted in [`Health::clipped`].
+//! Every product is formed exactly in `i64` (one `SMULL`) and rounded to nearest once; the
+//! `fixed` crate's own `*` rounds toward minus infinity, a bias that the `lambda` recursions
+//! would accumulate over `1/(1 - lambda)` samples. Divisions by an energy use its reciprocal,
+//! computed once per energy and sample: the energy is normalised by its leading zeros (CLZ) to
+//! a 32-bit mantissa `m`, and `r = 2^61 / m` comes from one 32/32-bit `UDIV` and one
+//! Newton-Raphson step. A quotient `a b / e` normalises `a` and `b` (CLZ), takes the high words
+//! of `a b` and of that times `r` (`SMMULR`), and shifts back by the exponents (relative error
+//! about 2^-28). Every result that can leave its format is saturated, and each saturation is
+//! counted in [`Health::clipped`].
 //!
 //! Scaling. The energies must hold `Var(y) / (1 - lambda)`, so `y` should stay well inside
 //! +-16: choose `scale` so that the sensor's full range, offset included, maps inside +-16.
@@ -111,12 +113,12 @@ fn decay(e: i64, lambda: u32) -> i64 {
     ((e >> 32) * u64::from(lambda) + low) as i64
 }
 
-/// A positive Q40 energy prepared for division: `(r, lz)` with `1/e_real = r 2^(lz - 54)`,
-/// `r` in `(2^30, 2^31)` accurate to about 2^-30 relative.
+/// A positive Q40 energy prepared for division: `(r, lz)` with `1/e_real = r 2^(lz - 53)`,
+/// `r` in `(2^29, 2^30]` accurate to about 2^-29 relative.
 ///
 /// `e` is normalised by its leading zeros (CLZ) to a mantissa `m` in `[2^31, 2^32)`; a 32/32
 /// hardware division gives `2^48 / m` to 16 bits, and one Newton-Raphson step
-/// `r <- r + r (2^62 - m r) / 2^62` doubles that.
+/// `r <- r + r (2^61 - m r) / 2^61` doubles that.
 #[inline(always)]
 fn reciprocal(e: i64) -> (i32, u32) {
     let e = e.max(1) as u64;
@@ -130,12 +132,10 @@ fn reciprocal(e: i64) -> (i32, u32) {
         (lo << z, 32 + z)
     };
     // `| 0x8000` changes nothing (the top bit is set) but proves the divisor non-zero.
-    let r0 = (u32::MAX / ((m >> 16) | 0x8000)) << 14; // in (2^30, 2^31)
-    let residual = (1u64 << 62).wrapping_sub(u64::from(m) * u64::from(r0)) as i64;
-    let correction = (i64::from((residual >> 31) as i32) * i64::from(r0 as i32)) >> 31;
-    // 2^62 / m reaches 2^31 only for m = 2^31.
-    let r = (i64::from(r0) + correction).min(i64::from(i32::MAX));
-    (r as i32, lz)
+    let r0 = (u32::MAX / ((m >> 16) | 0x8000)) << 13; // in (2^29, 2^30]
+    let residual = (1u64 << 61).wrapping_sub(u64::from(m) * u64::from(r0)) as i64;
+    let correction = (i64::from((residual >> 30) as i32) * i64::from(r0 as i32)) >> 31;
+    ((r0 as i32).wrapping_add(correction as i32), lz)
 }
 
 /// `a b / e` in `Q(out_frac)`, for `a b` in `Q(ab_frac)` and the [`reciprocal`] of a positive
@@ -152,12 +152,12 @@ fn quotient(
 ) -> i64 {
     let (an, na) = normalise(a);
     let (bn, nb) = normalise(b);
-    // q = a b r 2^(na + nb - 64), |q| <= 2^29.
+    // q = a b r 2^(na + nb - 64), |q| <= 2^28.
     let q = mul_hi(mul_hi(an, bn), r);
-    // a b / e in Q(out) = a b r 2^(lz - 54 - ab_frac + out) = q 2^shift.
-    let shift = (10 + lz + out_frac) as i32 - (ab_frac + na + nb) as i32;
+    // a b / e in Q(out) = a b r 2^(lz - 53 - ab_frac + out) = q 2^shift.
+    let shift = (11 + lz + out_frac) as i32 - (ab_frac + na + nb) as i32;
     if shift < 0 {
-        // |q| < 2^29, so anything past 30 gives 0 and the rounded sum fits in 32 bits.
+        // |q| <= 2^28, so anything past 30 gives 0 and the rounded sum fits in 32 bits.
         let t = shift.unsigned_abs().min(30);
         i64::from((q + (1 << (t - 1))) >> t)
     } else if shift <= 32 {
