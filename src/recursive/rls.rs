@@ -111,22 +111,18 @@ impl<T: Scalar, const P: usize> Rls<T, P> {
         // f = U^T phi, v = D f.
         let mut f = self.phi;
         for (j, fj) in f.iter_mut().enumerate().skip(1) {
-            *fj += dot(&self.ut[j][..j], &self.phi[..j]);
+            *fj = dot(*fj, &self.ut[j][..j], &self.phi[..j]);
         }
         let v: [T; P] = core::array::from_fn(|j| self.d[j] * f[j]);
         let mut gain = v;
         let mut alpha = lambda + v[0] * f[0];
         let mut healthy = alpha > T::ZERO;
-        // One division per column: 1/alpha_j also gives mu of column j + 1.
-        let mut alpha_recip = T::ONE / alpha;
-        self.d[0] = self.d[0] * lambda * alpha_recip;
+        self.d[0] = self.d[0] * lambda / alpha;
         for j in 1..P {
-            let beta_recip = alpha_recip;
             let beta = alpha;
             alpha += v[j] * f[j];
-            alpha_recip = T::ONE / alpha;
-            let mu = -f[j] * beta_recip;
-            self.d[j] *= beta * alpha_recip;
+            let mu = -f[j] / beta;
+            self.d[j] = self.d[j] * beta / alpha;
             let (column, gains) = (&mut self.ut[j][..j], &mut gain[..j]);
             for (u, g) in column.iter_mut().zip(gains) {
                 let t = *u;
@@ -136,18 +132,16 @@ impl<T: Scalar, const P: usize> Rls<T, P> {
         }
         let mut check = T::ZERO;
         let d_max = T::from_f64(D_MAX);
-        let lambda_recip = T::ONE / lambda;
-        let step = e * alpha_recip;
         for ((a, d), g) in self.a.iter_mut().zip(&mut self.d).zip(&gain) {
-            *a += *g * step;
+            *a += *g / alpha * e;
             // Without excitation (a stuck sensor) D grows as lambda^-n: cap it.
-            let scaled = *d * lambda_recip;
+            let scaled = *d / lambda;
             *d = if scaled > d_max { d_max } else { scaled };
             healthy &= *d > T::ZERO;
             check += *a + *d;
         }
         // a-posteriori error eps = e lambda / alpha
-        self.energy = lambda * self.energy + e * (e * lambda * alpha_recip);
+        self.energy = lambda * self.energy + e * (e * lambda / alpha);
         check += self.energy;
         if !(healthy && check.is_finite()) {
             self.shell.restart(config);
@@ -193,8 +187,8 @@ impl<T: Scalar, const P: usize> Rls<T, P> {
     }
 }
 
-/// `sum x_i y_i`.
+/// `init + sum x_i y_i`, summed in order.
 #[inline(always)]
-fn dot<T: Scalar>(x: &[T], y: &[T]) -> T {
-    x.iter().zip(y).fold(T::ZERO, |s, (&a, &b)| s + a * b)
+fn dot<T: Scalar>(init: T, x: &[T], y: &[T]) -> T {
+    x.iter().zip(y).fold(init, |s, (&a, &b)| s + a * b)
 }
