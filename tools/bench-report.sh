@@ -6,10 +6,12 @@
 #     RLS,
 #   - nanoseconds per sample on the host (criterion, host-tests/benches/per_sample.rs),
 #   - flash per estimator: each `size_*` firmware minus `size_base` (tools/footprint.sh),
-#   - wall time of the `imu-ar` tool on the 1,000,000-row ADIS16405 record (best of 3).
+#   - wall time of the `imu-ar` tool on the 1,000,000-row ADIS16405 record (best of 3),
+#   - the same bench built for ARMv7-M without an FPU (thumbv7m-none-eabi, soft-float f32),
+#     run on the same emulated core.
 #
 #   tools/bench-report.sh            all of it
-#   tools/bench-report.sh target     one part: target | host | flash | wall
+#   tools/bench-report.sh target     one part: target | host | flash | wall | nofpu
 set -euo pipefail
 cd "$(dirname "$0")/.."
 only=${1:-all}
@@ -148,4 +150,30 @@ for label, args in runs:
     print(f"| `{label}` | {best:.2f} |")
 PY
     replace perf-wall "$tmp/perf-wall.md"
+fi
+
+if [ "$only" = all ] || [ "$only" = nofpu ]; then
+    rustup target list --installed | grep -qx thumbv7m-none-eabi ||
+        rustup target add thumbv7m-none-eabi
+    cargo run -q --release --target thumbv7m-none-eabi --example bench 2>/dev/null \
+        > "$tmp/nofpu.txt"
+    python3 - "$tmp/nofpu.txt" > "$tmp/perf-nofpu.md" <<'PY'
+import re, sys
+rows = {}
+for est, scalar, p, n in re.findall(r"(lattice|rls) (\w+) p=(\d+) insns/sample=(\d+)", open(sys.argv[1]).read()):
+    rows.setdefault((est, scalar), {})[int(p)] = int(n)
+orders = [1, 2, 4, 8, 16, 32]
+print("| estimator | scalar | " + " | ".join(f"p = {p}" for p in orders) + " |")
+print("|---|---|" + "---|" * len(orders))
+for (est, scalar), r in rows.items():
+    print(f"| {est} | {scalar} | " + " | ".join(str(r.get(p, "")) for p in orders) + " |")
+def slope(r):
+    ps = [p for p in orders if p in r]
+    mp, my = sum(ps) / len(ps), sum(r[p] for p in ps) / len(ps)
+    return sum((p - mp) * (r[p] - my) for p in ps) / sum((p - mp) ** 2 for p in ps)
+f32, fixed = slope(rows[("lattice", "f32")]), slope(rows[("lattice", "fixed")])
+print(f"\nPer lattice stage: **{f32:.0f}** instructions in soft-float f32, **{fixed:.0f}** in fixed "
+      f"point ({f32 / fixed:.1f} times cheaper).")
+PY
+    replace perf-nofpu "$tmp/perf-nofpu.md"
 fi
