@@ -32,5 +32,7 @@ fn main() -> ! {
 
 #[cfg(not(target_os = "none"))]
 fn main() {
-    eprintln!("size_lattice_f32 is firmware for the Cortex-M4F: run it with `cargo qemu size_lattice_f32`");
+    eprintln!(
+        "size_lattice_f32 is firmware for the Cortex-M4F: run it with `cargo qemu size_lattice_f32`"
+    );
 }

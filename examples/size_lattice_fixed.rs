@@ -36,5 +36,7 @@ fn main() -> ! {
 
 #[cfg(not(target_os = "none"))]
 fn main() {
-    eprintln!("size_lattice_fixed is firmware for the Cortex-M4F: run it with `cargo qemu size_lattice_fixed`");
+    eprintln!(
+        "size_lattice_fixed is firmware for the Cortex-M4F: run it with `cargo qemu size_lattice_fixed`"
+    );
 }
