@@ -111,3 +111,19 @@ pub fn read_column(files: &[PathBuf], column: &str) -> Result<Vec<f64>, DataErro
     }
     Ok(out)
 }
+
+/// Averages of consecutive blocks of `m` samples (a last, incomplete block is dropped): the
+/// record at `1/m` of its rate, as sensor drift is usually modelled. `m = 1` returns `x`.
+///
+/// Block averaging is a low-pass filter: it keeps the slow (correlated) part of the error and
+/// divides the white part's variance by `m`, so a model fitted to averaged data describes the
+/// averaged sensor, not the raw one (numerics.md section 6).
+pub fn block_average(x: &[f64], m: usize) -> Vec<f64> {
+    match m {
+        0 | 1 => x.to_vec(),
+        _ => x
+            .chunks_exact(m)
+            .map(|block| block.iter().sum::<f64>() / m as f64)
+            .collect(),
+    }
+}

@@ -25,7 +25,7 @@ use imu_ar::batch::{BatchConfig, BatchError, Fit, burg, covariance, yule_walker}
 use imu_ar::fixed_point::{FixedConfig, FixedLattice};
 use imu_ar::recursive::{Config, FloatArith, Lattice, Rls, RlsInit};
 use imu_ar::sim::StandardNormal;
-use imu_ar_host::data::read_column;
+use imu_ar_host::data::{block_average, read_column};
 use rand_chacha::ChaCha8Rng;
 use rand_core::SeedableRng;
 use serde_json::{Value, json};
@@ -156,6 +156,9 @@ enum Command {
         /// Fit the data as they are, without removing the (sample or running) mean.
         #[arg(long)]
         no_demean: bool,
+        /// Average blocks of M samples first (the rate, if given, becomes rate / M).
+        #[arg(long, default_value_t = 1)]
+        decimate: usize,
         /// Sample rate in Hz; gives the model its time scale.
         #[arg(long, allow_negative_numbers = true)]
         rate: Option<f64>,
@@ -181,6 +184,9 @@ enum Command {
         /// Initial regularisation [default: as for `fit`].
         #[arg(long, allow_negative_numbers = true)]
         delta: Option<f64>,
+        /// Average blocks of M samples first (the rate, if given, becomes rate / M).
+        #[arg(long, default_value_t = 1)]
+        decimate: usize,
         /// Fraction of the record the batch model is fitted on, in (0, 1).
         #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
         train: f64,
@@ -314,10 +320,13 @@ fn run(command: Command) -> Result<String, Fail> {
             delta,
             scale,
             no_demean,
+            decimate,
             rate,
             json,
         } => {
             check_order("--order", order)?;
+            check_decimate(decimate)?;
+            let rate = rate.map(|r| r / decimate as f64);
             if matches!(scalar, ScalarKind::Fixed) && !matches!(method, Method::Lattice) {
                 return Err(Fail(format!(
                     "--scalar fixed: only --method lattice runs in fixed point, not {}",
@@ -335,7 +344,7 @@ fn run(command: Command) -> Result<String, Fail> {
             if let Some(d) = delta {
                 check_delta(d)?;
             }
-            let x = read_column(&files, &column)?;
+            let x = block_average(&read_column(&files, &column)?, decimate);
             let fit = if method.recursive() {
                 let delta = delta.unwrap_or_else(|| default_delta(&x));
                 let r = Recursive {
@@ -374,10 +383,12 @@ fn run(command: Command) -> Result<String, Fail> {
             order,
             lambda,
             delta,
+            decimate,
             train,
             json,
         } => {
             check_order("--order", order)?;
+            check_decimate(decimate)?;
             check_lambda(lambda)?;
             if let Some(d) = delta {
                 check_delta(d)?;
@@ -385,10 +396,11 @@ fn run(command: Command) -> Result<String, Fail> {
             if !(train > 0.0 && train < 1.0) {
                 return Err(Fail(format!("--train {train}: must be in (0, 1)")));
             }
-            let x = read_column(&files, &column)?;
+            let x = block_average(&read_column(&files, &column)?, decimate);
             let delta = delta.unwrap_or_else(|| default_delta(&x));
-            let v = with_order!(order, compare(&x, lambda, delta, train))
+            let mut v = with_order!(order, compare(&x, lambda, delta, train))
                 .map_err(|Fail(e)| with_file(&files, e))?;
+            v["decimate"] = json!(decimate);
             Ok(if json {
                 format!("{v}\n")
             } else {
@@ -508,6 +520,13 @@ fn check_order(flag: &str, p: usize) -> Result<(), Fail> {
         return Err(Fail(format!(
             "{flag} {p}: the order must be 1 to {MAX_ORDER} (the supported maximum)"
         )));
+    }
+    Ok(())
+}
+
+fn check_decimate(m: usize) -> Result<(), Fail> {
+    if m == 0 {
+        return Err(Fail("--decimate 0: must be at least 1".into()));
     }
     Ok(())
 }

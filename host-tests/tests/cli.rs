@@ -447,3 +447,76 @@ fn recursive_fits_and_the_drifting_ar2_comparison() {
     assert!((a1 - 1.0).abs() < 0.05, "a_1 = {a1}");
     std::fs::remove_file(file).unwrap();
 }
+
+#[test]
+fn decimate_fits_the_block_averages() {
+    // 1003 samples: 100 blocks of 10, and 3 left over that must be dropped.
+    let raw: Vec<f64> = (0..1003)
+        .map(|n| (n as f64 * 0.37).sin() + 0.1 * (n % 7) as f64)
+        .collect();
+    let averaged: Vec<f64> = (0..100)
+        .map(|b| raw[10 * b..10 * b + 10].iter().sum::<f64>() / 10.0)
+        .collect();
+    let csv = |x: &[f64]| {
+        x.iter()
+            .fold("x\n".to_string(), |s, v| s + &format!("{v:e}\n"))
+    };
+    let raw_file = temp_file("decimate-raw.csv", &csv(&raw));
+    let averaged_file = temp_file("decimate-averaged.csv", &csv(&averaged));
+    for method in ["ls", "burg", "lattice"] {
+        let decimated = fit_json(
+            &raw_file,
+            method,
+            "2",
+            &["--decimate", "10", "--rate", "50"],
+        );
+        let direct = fit_json(&averaged_file, method, "2", &["--rate", "5"]);
+        assert_eq!(decimated["n"], 100, "{method}");
+        assert_eq!(decimated["rate_hz"], 5.0, "{method}");
+        for (d, a) in decimated["a"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .zip(direct["a"].as_array().unwrap())
+        {
+            let (d, a) = (d.as_f64().unwrap(), a.as_f64().unwrap());
+            assert!(
+                (d - a).abs() <= 1e-12 * (1.0 + a.abs()),
+                "{method}: {d} against {a}"
+            );
+        }
+    }
+    let compare = json(&imu_ar(&[
+        "compare",
+        raw_file.to_str().unwrap(),
+        "--column",
+        "x",
+        "--order",
+        "2",
+        "--decimate",
+        "10",
+        "--json",
+    ]));
+    assert_eq!(
+        (compare["n_train"].as_u64(), compare["n_eval"].as_u64()),
+        (Some(50), Some(50))
+    );
+    assert_eq!(compare["decimate"], 10);
+    let zero = imu_ar(&[
+        "fit",
+        raw_file.to_str().unwrap(),
+        "--column",
+        "x",
+        "--method",
+        "ls",
+        "--order",
+        "2",
+        "--decimate",
+        "0",
+    ]);
+    assert_eq!(zero.status.code(), Some(2));
+    assert_eq!(
+        String::from_utf8_lossy(&zero.stderr),
+        "imu-ar: --decimate 0: must be at least 1\n"
+    );
+}
