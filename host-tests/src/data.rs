@@ -43,6 +43,26 @@ fn error(file: &Path, line: Option<u64>, problem: impl Into<String>) -> DataErro
 /// Every cell must be a finite number: a missing column, an empty or non-numeric cell, NaN or
 /// infinity is an error naming the file and line, and so is a file without data rows.
 pub fn read_column(files: &[PathBuf], column: &str) -> Result<Vec<f64>, DataError> {
+    read_cells(files, column, |cell| match cell.parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(_) => Err(format!(
+            "column '{column}': '{cell}' is not a finite number"
+        )),
+        Err(_) => Err(format!("column '{column}': '{cell}' is not a number")),
+    })
+}
+
+/// Reads column `column` of each file as text, as [`read_column`] reads numbers.
+pub fn read_text_column(files: &[PathBuf], column: &str) -> Result<Vec<String>, DataError> {
+    read_cells(files, column, |cell| Ok(cell.to_string()))
+}
+
+/// The cells of `column`, each converted by `parse` (whose error names the problem).
+fn read_cells<T>(
+    files: &[PathBuf],
+    column: &str,
+    parse: impl Fn(&str) -> Result<T, String>,
+) -> Result<Vec<T>, DataError> {
     let progress = std::io::stderr().is_terminal();
     let mut out = Vec::new();
     for path in files {
@@ -82,21 +102,7 @@ pub fn read_column(files: &[PathBuf], column: &str) -> Result<Vec<f64>, DataErro
             let cell = record.get(index).ok_or_else(|| {
                 error(path, line, format!("column '{column}' missing in this row"))
             })?;
-            let value: f64 = cell.parse().map_err(|_| {
-                error(
-                    path,
-                    line,
-                    format!("column '{column}': '{cell}' is not a number"),
-                )
-            })?;
-            if !value.is_finite() {
-                return Err(error(
-                    path,
-                    line,
-                    format!("column '{column}': '{cell}' is not a finite number"),
-                ));
-            }
-            out.push(value);
+            out.push(parse(cell).map_err(|problem| error(path, line, problem))?);
             if progress && out.len() % 100_000 == 0 {
                 eprint!("\rread {} rows", out.len());
                 let _ = std::io::stderr().flush();

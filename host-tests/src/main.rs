@@ -28,11 +28,13 @@ use imu_ar::sim::StandardNormal;
 use imu_ar_host::data::{block_average, read_column};
 use rand_chacha::ChaCha8Rng;
 use rand_core::SeedableRng;
+use report::report;
 use serde_json::{Value, json};
 
 /// The parity run shared with the `parity` firmware (same file, compiled for the host).
 #[path = "../../examples/common/parity.rs"]
 mod parity;
+mod report;
 
 /// The highest model order the tool accepts.
 const MAX_ORDER: usize = 32;
@@ -193,6 +195,43 @@ enum Command {
         /// Print one JSON object.
         #[arg(long)]
         json: bool,
+    },
+    /// The paper's comparison on one record, in PNG plots: coefficient convergence of RLS and
+    /// the lattice against the batch fit, one-step prediction error over time, the fitted PSD
+    /// against a Welch periodogram, and Allan deviations of the data and the model. Prints a
+    /// JSON summary.
+    Report {
+        /// CSV files with a header row, read as one record.
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// Column name.
+        #[arg(long)]
+        column: String,
+        /// Model order, 1 to 32.
+        #[arg(long)]
+        order: usize,
+        /// Forgetting factor, in (0, 1].
+        #[arg(long, default_value_t = DEFAULT_LAMBDA, allow_negative_numbers = true)]
+        lambda: f64,
+        /// Sample rate in Hz of the raw record.
+        #[arg(long, allow_negative_numbers = true)]
+        rate: f64,
+        /// Average blocks of M samples first (the rate becomes rate / M).
+        #[arg(long, default_value_t = 1)]
+        decimate: usize,
+        /// Fraction of the record the batch model is fitted on, in (0, 1).
+        #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
+        train: f64,
+        /// The column's unit, for the axis labels.
+        #[arg(long, default_value = "units")]
+        unit: String,
+        /// A published Allan table to draw too: CSV with `channel`, `tau_s` and `adev`
+        /// columns; the rows of channel `--column` are used.
+        #[arg(long)]
+        reference: Option<PathBuf>,
+        /// Directory for the PNG files (created if needed).
+        #[arg(long)]
+        out: PathBuf,
     },
     /// Order criteria (AIC, AICc, BIC, FPE) of orders 0..=P.
     Order {
@@ -417,6 +456,43 @@ fn run(command: Command) -> Result<String, Fail> {
                 )
             })
         }
+        Command::Report {
+            files,
+            column,
+            order,
+            lambda,
+            rate,
+            decimate,
+            train,
+            unit,
+            reference,
+            out,
+        } => {
+            check_order("--order", order)?;
+            check_lambda(lambda)?;
+            check_decimate(decimate)?;
+            let rate = check_rate(rate)? / decimate as f64;
+            if !(train > 0.0 && train < 1.0) {
+                return Err(Fail(format!("--train {train}: must be in (0, 1)")));
+            }
+            let reference = match reference {
+                Some(path) => Some(read_reference(&path, &column)?),
+                None => None,
+            };
+            let x = block_average(&read_column(&files, &column)?, decimate);
+            let r = report::Report {
+                x: &x,
+                rate,
+                lambda,
+                delta: default_delta(&x),
+                train,
+                unit: &unit,
+                reference,
+                out: &out,
+            };
+            let v = with_order!(order, report(&r)).map_err(|Fail(e)| with_file(&files, e))?;
+            Ok(format!("{v}\n"))
+        }
         Command::Order {
             files,
             column,
@@ -522,6 +598,27 @@ fn check_order(flag: &str, p: usize) -> Result<(), Fail> {
         )));
     }
     Ok(())
+}
+
+/// `(tau_s, adev)` of `channel` from a published Allan table.
+fn read_reference(path: &std::path::Path, channel: &str) -> Result<Vec<(f64, f64)>, Fail> {
+    let files = [path.to_path_buf()];
+    let channels = imu_ar_host::data::read_text_column(&files, "channel")?;
+    let tau = read_column(&files, "tau_s")?;
+    let adev = read_column(&files, "adev")?;
+    let rows: Vec<(f64, f64)> = channels
+        .iter()
+        .zip(tau.into_iter().zip(adev))
+        .filter(|(c, _)| c.as_str() == channel)
+        .map(|(_, p)| p)
+        .collect();
+    if rows.is_empty() {
+        return Err(Fail(format!(
+            "{}: no rows of channel '{channel}'",
+            path.display()
+        )));
+    }
+    Ok(rows)
 }
 
 fn check_decimate(m: usize) -> Result<(), Fail> {

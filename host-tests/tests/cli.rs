@@ -520,3 +520,57 @@ fn decimate_fits_the_block_averages() {
         "imu-ar: --decimate 0: must be at least 1\n"
     );
 }
+
+#[test]
+fn report_writes_four_pngs_and_a_summary() {
+    let sim = imu_ar(&[
+        "simulate", "--a", "1.5,-0.7", "--a-end", "1.0,-0.7", "--sigma", "1", "--n", "20000",
+        "--seed", "4", "--rate", "100",
+    ]);
+    assert!(sim.status.success());
+    let file = temp_file("report.csv", &String::from_utf8(sim.stdout).unwrap());
+    let out = std::env::temp_dir().join(format!("imu-ar-cli-{}-report", std::process::id()));
+    let v = json(&imu_ar(&[
+        "report",
+        file.to_str().unwrap(),
+        "--column",
+        "x",
+        "--order",
+        "2",
+        "--lambda",
+        "0.99",
+        "--rate",
+        "100",
+        "--out",
+        out.to_str().unwrap(),
+    ]));
+    for name in ["coefficients", "prediction_error", "psd", "adev"] {
+        let png = std::fs::read(out.join(format!("{name}.png"))).unwrap();
+        assert!(png.len() > 10_000, "{name}.png: {} bytes", png.len());
+        assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n", "{name}.png");
+    }
+    assert_eq!(
+        (v["n"].as_u64(), v["n_train"].as_u64()),
+        (Some(20000), Some(10000))
+    );
+    // The drift makes the batch model fitted on the first half worse on the second.
+    let (batch, lattice) = (
+        v["batch_mse"].as_f64().unwrap(),
+        v["lattice_mse"].as_f64().unwrap(),
+    );
+    assert!(lattice < batch, "lattice {lattice}, batch {batch}");
+    let bad = imu_ar(&[
+        "report",
+        file.to_str().unwrap(),
+        "--column",
+        "x",
+        "--order",
+        "2",
+        "--rate",
+        "0",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(bad.stdout.is_empty());
+}

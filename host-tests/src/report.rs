@@ -1,0 +1,437 @@
+//! `imu-ar report`: the paper's comparison on one record, in four PNG plots.
+
+use std::path::{Path, PathBuf};
+
+use imu_ar::ArModel;
+use imu_ar::allan::overlapping_avar;
+use imu_ar::batch::{BatchConfig, covariance};
+use imu_ar::recursive::{Config, Lattice, Rls, RlsInit};
+use plotters::prelude::*;
+use rustfft::{FftPlanner, num_complex::Complex};
+use serde_json::{Value, json};
+
+use crate::Fail;
+
+/// What the report shows and where it goes.
+pub struct Report<'a> {
+    /// The record (already decimated), in sensor units.
+    pub x: &'a [f64],
+    /// Sample rate of `x` in Hz.
+    pub rate: f64,
+    pub lambda: f64,
+    pub delta: f64,
+    /// Fraction of the record the batch model is fitted on.
+    pub train: f64,
+    /// The sensor unit, for the axis labels.
+    pub unit: &'a str,
+    /// Published Allan deviations `(tau_s, adev)` to draw with the data's.
+    pub reference: Option<Vec<(f64, f64)>>,
+    pub out: &'a Path,
+}
+
+const SIZE: (u32, u32) = (960, 600);
+
+/// Coefficients `a_1..a_P` at sampled times (s).
+type Track<const P: usize> = Vec<(f64, [f64; P])>;
+/// Points per drawn time series: the plots stay small and readable for any record length.
+const POINTS: usize = 400;
+
+/// Registers the embedded DejaVu Sans as the plots' font (no system fonts needed).
+fn font() -> Result<(), Fail> {
+    plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular())
+        .map_err(|_| Fail("cannot load the embedded font".into()))
+}
+
+fn draw_err(e: impl std::fmt::Debug) -> Fail {
+    Fail(format!("drawing failed: {e:?}"))
+}
+
+/// Writes the four PNGs and returns a JSON summary.
+pub fn report<const P: usize>(r: &Report) -> Result<Value, Fail> {
+    std::fs::create_dir_all(r.out)
+        .map_err(|e| Fail(format!("{}: cannot create: {e}", r.out.display())))?;
+    font()?;
+    let x = r.x;
+    let dt = 1.0 / r.rate;
+    let n_train = (r.train * x.len() as f64) as usize;
+    let batch_config = BatchConfig::new(dt)?;
+    let train_fit = covariance::<f64, P>(&x[..n_train], &batch_config)?.model;
+    let whole_fit = covariance::<f64, P>(x, &batch_config)?.model;
+
+    // The recursive estimators over the whole record; their errors and coefficients sampled.
+    let config = Config::new(r.lambda, r.delta, dt)?;
+    let mut rls = Rls::<f64, P>::new(&config, RlsInit::ShiftConsistent);
+    let mut lattice = Lattice::<f64, P>::new(&config);
+    let stride = (x.len() / POINTS).max(1);
+    let mut coef = (Vec::new(), Vec::new());
+    let mut se = [vec![], vec![], vec![]];
+    let mut block = [0.0; 3];
+    let mut eval = [0.0; 3];
+    for (n, &v) in x.iter().enumerate() {
+        let e_rls = rls.update(&config, v).unwrap_or(0.0);
+        let e_lattice = lattice.update(&config, v).unwrap_or(0.0);
+        let e_batch = if n >= P {
+            let past: [f64; P] = core::array::from_fn(|k| x[n - 1 - k]);
+            v - train_fit.predict(&past)
+        } else {
+            0.0
+        };
+        for (k, e) in [e_batch, e_rls, e_lattice].into_iter().enumerate() {
+            block[k] += e * e;
+            if n >= n_train {
+                eval[k] += e * e;
+            }
+        }
+        if (n + 1) % stride == 0 {
+            let t = (n + 1) as f64 * dt;
+            for (k, b) in block.iter_mut().enumerate() {
+                se[k].push((t, *b / stride as f64));
+                *b = 0.0;
+            }
+            let a_lattice = lattice.coefficients(P).unwrap_or([f64::NAN; P]);
+            coef.0.push((t, *rls.coefficients()));
+            coef.1.push((t, a_lattice));
+        }
+    }
+    let m = (x.len() - n_train) as f64;
+    let mse = eval.map(|s| s / m);
+
+    let files = [
+        coefficients_png::<P>(r, &coef, &train_fit)?,
+        error_png(r, &se, n_train as f64 * dt)?,
+        psd_png(r, &whole_fit)?,
+        adev_png(r, &whole_fit)?,
+    ];
+    Ok(json!({
+        "order": P,
+        "lambda": r.lambda,
+        "rate_hz": r.rate,
+        "n": x.len(),
+        "n_train": n_train,
+        "batch_mse": mse[0],
+        "rls_mse": mse[1],
+        "lattice_mse": mse[2],
+        "reduction_percent": 100.0 * (mse[0] - mse[2]) / mse[0],
+        "batch_a": train_fit.a().to_vec(),
+        "lattice_a": lattice.coefficients(P).map(|a| a.to_vec()),
+        "files": files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>(),
+    }))
+}
+
+/// A chart on `root` with the report's caption, margins and label areas.
+fn builder<'a, 'b, DB: DrawingBackend>(
+    root: &'a DrawingArea<DB, plotters::coord::Shift>,
+    caption: String,
+    y_labels: u32,
+) -> ChartBuilder<'a, 'b, DB> {
+    let mut builder = ChartBuilder::on(root);
+    builder
+        .caption(caption, ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(45)
+        .y_label_area_size(y_labels);
+    builder
+}
+
+/// The legend of every series that has a label.
+fn legend<'a, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+) -> Result<(), Fail> {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(draw_err)
+}
+
+fn caption(r: &Report, what: &str) -> String {
+    format!(
+        "{what} (n = {}, {} Hz, lambda = {})",
+        r.x.len(),
+        r.rate,
+        r.lambda
+    )
+}
+
+/// Range of finite values, widened a little.
+fn span(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
+            (l.min(v), h.max(v))
+        });
+    if lo > hi {
+        return (0.0, 1.0);
+    }
+    let pad = 0.05 * (hi - lo).max(1e-12 * hi.abs().max(1.0));
+    (lo - pad, hi + pad)
+}
+
+fn coefficients_png<const P: usize>(
+    r: &Report,
+    coef: &(Track<P>, Track<P>),
+    batch: &ArModel<f64, P>,
+) -> Result<PathBuf, Fail> {
+    let path = r.out.join("coefficients.png");
+    let root = BitMapBackend::new(&path, SIZE).into_drawing_area();
+    root.fill(&WHITE).map_err(draw_err)?;
+    let t_end = coef.0.last().map_or(1.0, |c| c.0);
+    // The first tenth of the record is the transient: leave it out of the y range.
+    let settled = |s: &Track<P>| {
+        s.iter()
+            .filter(|c| c.0 > 0.1 * t_end)
+            .flat_map(|c| c.1)
+            .collect::<Vec<_>>()
+    };
+    let (lo, hi) = span(
+        settled(&coef.0)
+            .into_iter()
+            .chain(settled(&coef.1))
+            .chain(batch.a().iter().copied()),
+    );
+    let mut chart = builder(
+        &root,
+        caption(r, "AR coefficients: RLS and lattice against the batch fit"),
+        70,
+    )
+    .build_cartesian_2d(0.0..t_end, lo..hi)
+    .map_err(draw_err)?;
+    chart
+        .configure_mesh()
+        .x_desc("time (s)")
+        .y_desc("coefficient a_k (1)")
+        .draw()
+        .map_err(draw_err)?;
+    for k in 0..P {
+        let color = Palette99::pick(k).to_rgba();
+        chart
+            .draw_series(LineSeries::new(
+                coef.0.iter().map(|c| (c.0, c.1[k])),
+                color.stroke_width(1),
+            ))
+            .map_err(draw_err)?
+            .label(format!("a_{} RLS", k + 1))
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color.stroke_width(1)));
+        chart
+            .draw_series(
+                coef.1
+                    .iter()
+                    .step_by(4)
+                    .map(|c| Circle::new((c.0, c.1[k]), 2, color.filled())),
+            )
+            .map_err(draw_err)?
+            .label(format!("a_{} lattice", k + 1))
+            .legend(move |(x, y)| Circle::new((x + 10, y), 3, color.filled()));
+        let a = batch.a()[k];
+        chart
+            .draw_series(LineSeries::new(
+                [(0.0, a), (t_end, a)],
+                BLACK.stroke_width(1),
+            ))
+            .map_err(draw_err)?;
+    }
+    legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+    root.present().map_err(draw_err)?;
+    Ok(path.clone())
+}
+
+fn error_png(r: &Report, se: &[Vec<(f64, f64)>; 3], t_train: f64) -> Result<PathBuf, Fail> {
+    let path = r.out.join("prediction_error.png");
+    let root = BitMapBackend::new(&path, SIZE).into_drawing_area();
+    root.fill(&WHITE).map_err(draw_err)?;
+    let t_end = se[0].last().map_or(1.0, |p| p.0);
+    let positive = se.iter().flatten().map(|p| p.1).filter(|v| *v > 0.0);
+    let hi = positive.clone().fold(0.0f64, f64::max);
+    let lo = positive.fold(f64::INFINITY, f64::min).max(hi * 1e-9);
+    let mut chart = builder(
+        &root,
+        caption(r, "One-step prediction error, block means"),
+        80,
+    )
+    .build_cartesian_2d(0.0..t_end, (lo * 0.9..hi * 1.1).log_scale())
+    .map_err(draw_err)?;
+    chart
+        .configure_mesh()
+        .x_desc(format!(
+            "time (s); batch LS fitted on the first {t_train:.0} s"
+        ))
+        .y_desc(format!("mean squared error ({})^2", r.unit))
+        .draw()
+        .map_err(draw_err)?;
+    let names = ["batch LS", "RLS", "lattice"];
+    let colors = [BLACK, BLUE, RED];
+    for ((series, name), color) in se.iter().zip(names).zip(colors) {
+        chart
+            .draw_series(LineSeries::new(
+                series.iter().copied().filter(|p| p.1 > 0.0),
+                color.stroke_width(1),
+            ))
+            .map_err(draw_err)?
+            .label(name)
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color.stroke_width(2)));
+    }
+    chart
+        .draw_series(LineSeries::new(
+            [(t_train, lo), (t_train, hi)],
+            BLACK.mix(0.4),
+        ))
+        .map_err(draw_err)?;
+    legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+    root.present().map_err(draw_err)?;
+    Ok(path.clone())
+}
+
+/// One-sided Welch PSD (Hann window, half-overlapping segments), in units^2/Hz.
+fn welch(x: &[f64], rate: f64) -> Vec<(f64, f64)> {
+    let len = (x.len() / 8).clamp(16, 4096).next_power_of_two() / 2;
+    let window: Vec<f64> = (0..len)
+        .map(|i| 0.5 - 0.5 * (2.0 * std::f64::consts::PI * i as f64 / len as f64).cos())
+        .collect();
+    let norm: f64 = window.iter().map(|w| w * w).sum::<f64>() * rate;
+    let mean = x.iter().sum::<f64>() / x.len() as f64;
+    let fft = FftPlanner::new().plan_fft_forward(len);
+    let mut sum = vec![0.0; len / 2 + 1];
+    let mut count = 0;
+    for start in (0..=x.len().saturating_sub(len)).step_by(len / 2) {
+        let mut buf: Vec<Complex<f64>> = x[start..start + len]
+            .iter()
+            .zip(&window)
+            .map(|(v, w)| Complex::new((v - mean) * w, 0.0))
+            .collect();
+        fft.process(&mut buf);
+        for (s, c) in sum.iter_mut().zip(&buf) {
+            *s += c.norm_sqr();
+        }
+        count += 1;
+    }
+    sum.iter()
+        .enumerate()
+        .skip(1)
+        .map(|(k, s)| {
+            let one_sided = if 2 * k == len { 1.0 } else { 2.0 };
+            (
+                k as f64 * rate / len as f64,
+                one_sided * s / (norm * count as f64),
+            )
+        })
+        .collect()
+}
+
+fn psd_png<const P: usize>(r: &Report, model: &ArModel<f64, P>) -> Result<PathBuf, Fail> {
+    let path = r.out.join("psd.png");
+    let data = welch(r.x, r.rate);
+    let fitted: Vec<(f64, f64)> = data.iter().map(|&(f, _)| (f, 2.0 * model.psd(f))).collect();
+    let root = BitMapBackend::new(&path, SIZE).into_drawing_area();
+    root.fill(&WHITE).map_err(draw_err)?;
+    let (f_lo, f_hi) = (data[0].0, data[data.len() - 1].0);
+    let values = data.iter().chain(&fitted).map(|p| p.1).filter(|v| *v > 0.0);
+    let (lo, hi) = values.fold((f64::INFINITY, 0.0f64), |(l, h), v| (l.min(v), h.max(v)));
+    let mut chart = builder(
+        &root,
+        caption(
+            r,
+            "PSD: Welch periodogram of the data and the fitted AR model",
+        ),
+        80,
+    )
+    .build_cartesian_2d((f_lo..f_hi).log_scale(), (lo * 0.8..hi * 1.25).log_scale())
+    .map_err(draw_err)?;
+    chart
+        .configure_mesh()
+        .x_desc("frequency (Hz)")
+        .y_desc(format!("one-sided PSD ({})^2/Hz", r.unit))
+        .draw()
+        .map_err(draw_err)?;
+    chart
+        .draw_series(LineSeries::new(data, BLUE.mix(0.6).stroke_width(1)))
+        .map_err(draw_err)?
+        .label("data (Welch, Hann)")
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLUE.stroke_width(2)));
+    chart
+        .draw_series(LineSeries::new(fitted, RED.stroke_width(2)))
+        .map_err(draw_err)?
+        .label(format!("AR({P}) batch LS fit"))
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], RED.stroke_width(2)));
+    legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+    root.present().map_err(draw_err)?;
+    Ok(path.clone())
+}
+
+fn adev_png<const P: usize>(r: &Report, model: &ArModel<f64, P>) -> Result<PathBuf, Fail> {
+    let path = r.out.join("adev.png");
+    let dt = 1.0 / r.rate;
+    let ms: Vec<usize> = (0..)
+        .map(|k| 1usize << k)
+        .take_while(|m| 2 * m <= r.x.len())
+        .collect();
+    let data: Vec<(f64, f64)> = ms
+        .iter()
+        .filter_map(|&m| Some((m as f64 * dt, overlapping_avar(r.x, m).ok()?.sqrt())))
+        .collect();
+    let fitted: Vec<(f64, f64)> = ms
+        .iter()
+        .filter_map(|&m| {
+            Some((
+                m as f64 * dt,
+                model.allan_variance(u32::try_from(m).ok()?).ok()?.sqrt(),
+            ))
+        })
+        .collect();
+    let reference = r.reference.clone().unwrap_or_default();
+    let all = data.iter().chain(&fitted).chain(&reference);
+    let (t_lo, t_hi) = all.clone().fold((f64::INFINITY, 0.0f64), |(l, h), p| {
+        (l.min(p.0), h.max(p.0))
+    });
+    let (lo, hi) = all
+        .map(|p| p.1)
+        .filter(|v| *v > 0.0)
+        .fold((f64::INFINITY, 0.0f64), |(l, h), v| (l.min(v), h.max(v)));
+    let root = BitMapBackend::new(&path, SIZE).into_drawing_area();
+    root.fill(&WHITE).map_err(draw_err)?;
+    let mut chart = builder(
+        &root,
+        caption(r, "Allan deviation: data and fitted AR model"),
+        80,
+    )
+    .build_cartesian_2d(
+        (t_lo * 0.8..t_hi * 1.25).log_scale(),
+        (lo * 0.8..hi * 1.25).log_scale(),
+    )
+    .map_err(draw_err)?;
+    chart
+        .configure_mesh()
+        .x_desc("averaging time tau (s)")
+        .y_desc(format!("Allan deviation ({})", r.unit))
+        .draw()
+        .map_err(draw_err)?;
+    chart
+        .draw_series(LineSeries::new(data.clone(), BLUE.stroke_width(2)))
+        .map_err(draw_err)?
+        .label("data (overlapping)")
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLUE.stroke_width(2)));
+    chart
+        .draw_series(data.iter().map(|&p| Circle::new(p, 3, BLUE.filled())))
+        .map_err(draw_err)?;
+    chart
+        .draw_series(LineSeries::new(fitted, RED.stroke_width(2)))
+        .map_err(draw_err)?
+        .label(format!("AR({P}) batch LS fit"))
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], RED.stroke_width(2)));
+    if !reference.is_empty() {
+        chart
+            .draw_series(
+                reference
+                    .iter()
+                    .map(|&p| Cross::new(p, 5, BLACK.stroke_width(2))),
+            )
+            .map_err(draw_err)?
+            .label("published table")
+            .legend(|(x, y)| Cross::new((x + 10, y), 5, BLACK.stroke_width(2)));
+    }
+    legend(&mut chart, SeriesLabelPosition::LowerLeft)?;
+    root.present().map_err(draw_err)?;
+    Ok(path.clone())
+}
