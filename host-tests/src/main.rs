@@ -17,7 +17,7 @@ use std::io::{BufWriter, Write};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand, ValueEnum};
+use clap::{Args, Parser, Subcommand, ValueEnum};
 use imu_ar::ArModel;
 use imu_ar::allan::overlapping_avar;
 use imu_ar::batch::criteria::Criterion;
@@ -171,27 +171,8 @@ enum Command {
     /// One-step prediction error of a batch LS fit on the training part against RLS and the
     /// lattice running over the whole record, on the evaluation part.
     Compare {
-        /// CSV files with a header row, read as one record.
-        #[arg(required = true)]
-        files: Vec<PathBuf>,
-        /// Column name.
-        #[arg(long)]
-        column: String,
-        /// Model order, 1 to 32.
-        #[arg(long)]
-        order: usize,
-        /// Forgetting factor, in (0, 1].
-        #[arg(long, default_value_t = DEFAULT_LAMBDA, allow_negative_numbers = true)]
-        lambda: f64,
-        /// Initial regularisation [default: as for `fit`].
-        #[arg(long, allow_negative_numbers = true)]
-        delta: Option<f64>,
-        /// Average blocks of M samples first (the rate, if given, becomes rate / M).
-        #[arg(long, default_value_t = 1)]
-        decimate: usize,
-        /// Fraction of the record the batch model is fitted on, in (0, 1).
-        #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
-        train: f64,
+        #[command(flatten)]
+        run: Comparison,
         /// Print one JSON object.
         #[arg(long)]
         json: bool,
@@ -201,27 +182,11 @@ enum Command {
     /// against a Welch periodogram, and Allan deviations of the data and the model. Prints a
     /// JSON summary.
     Report {
-        /// CSV files with a header row, read as one record.
-        #[arg(required = true)]
-        files: Vec<PathBuf>,
-        /// Column name.
-        #[arg(long)]
-        column: String,
-        /// Model order, 1 to 32.
-        #[arg(long)]
-        order: usize,
-        /// Forgetting factor, in (0, 1].
-        #[arg(long, default_value_t = DEFAULT_LAMBDA, allow_negative_numbers = true)]
-        lambda: f64,
+        #[command(flatten)]
+        run: Comparison,
         /// Sample rate in Hz of the raw record.
         #[arg(long, allow_negative_numbers = true)]
         rate: f64,
-        /// Average blocks of M samples first (the rate becomes rate / M).
-        #[arg(long, default_value_t = 1)]
-        decimate: usize,
-        /// Fraction of the record the batch model is fitted on, in (0, 1).
-        #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
-        train: f64,
         /// The column's unit, for the axis labels.
         #[arg(long, default_value = "units")]
         unit: String,
@@ -302,6 +267,50 @@ enum Command {
         #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
         a_end: Option<Vec<f64>>,
     },
+}
+
+/// The record and settings of `compare` and `report`.
+#[derive(Args)]
+struct Comparison {
+    /// CSV files with a header row, read as one record.
+    #[arg(required = true)]
+    files: Vec<PathBuf>,
+    /// Column name.
+    #[arg(long)]
+    column: String,
+    /// Model order, 1 to 32.
+    #[arg(long)]
+    order: usize,
+    /// Forgetting factor, in (0, 1].
+    #[arg(long, default_value_t = DEFAULT_LAMBDA, allow_negative_numbers = true)]
+    lambda: f64,
+    /// Initial regularisation [default: as for `fit`].
+    #[arg(long, allow_negative_numbers = true)]
+    delta: Option<f64>,
+    /// Average blocks of M samples first (a rate becomes rate / M).
+    #[arg(long, default_value_t = 1)]
+    decimate: usize,
+    /// Fraction of the record the batch model is fitted on, in (0, 1).
+    #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
+    train: f64,
+}
+
+impl Comparison {
+    /// Checks the settings, then reads (and decimates) the record; returns it with `delta`.
+    fn load(&self) -> Result<(Vec<f64>, f64), Fail> {
+        check_order("--order", self.order)?;
+        check_lambda(self.lambda)?;
+        if let Some(d) = self.delta {
+            check_delta(d)?;
+        }
+        check_decimate(self.decimate)?;
+        if !(self.train > 0.0 && self.train < 1.0) {
+            return Err(Fail(format!("--train {}: must be in (0, 1)", self.train)));
+        }
+        let x = block_average(&read_column(&self.files, &self.column)?, self.decimate);
+        let delta = self.delta.unwrap_or_else(|| default_delta(&x));
+        Ok((x, delta))
+    }
 }
 
 /// A one-line error for stderr; the tool exits with status 2.
@@ -416,30 +425,12 @@ fn run(command: Command) -> Result<String, Fail> {
                 fit_text(&fit)
             })
         }
-        Command::Compare {
-            files,
-            column,
-            order,
-            lambda,
-            delta,
-            decimate,
-            train,
-            json,
-        } => {
-            check_order("--order", order)?;
-            check_decimate(decimate)?;
-            check_lambda(lambda)?;
-            if let Some(d) = delta {
-                check_delta(d)?;
-            }
-            if !(train > 0.0 && train < 1.0) {
-                return Err(Fail(format!("--train {train}: must be in (0, 1)")));
-            }
-            let x = block_average(&read_column(&files, &column)?, decimate);
-            let delta = delta.unwrap_or_else(|| default_delta(&x));
-            let mut v = with_order!(order, compare(&x, lambda, delta, train))
-                .map_err(|Fail(e)| with_file(&files, e))?;
-            v["decimate"] = json!(decimate);
+        Command::Compare { run, json } => {
+            let (x, delta) = run.load()?;
+            let (order, lambda) = (run.order, run.lambda);
+            let mut v = with_order!(order, compare(&x, lambda, delta, run.train))
+                .map_err(|Fail(e)| with_file(&run.files, e))?;
+            v["decimate"] = json!(run.decimate);
             Ok(if json {
                 format!("{v}\n")
             } else {
@@ -457,40 +448,30 @@ fn run(command: Command) -> Result<String, Fail> {
             })
         }
         Command::Report {
-            files,
-            column,
-            order,
-            lambda,
+            run,
             rate,
-            decimate,
-            train,
             unit,
             reference,
             out,
         } => {
-            check_order("--order", order)?;
-            check_lambda(lambda)?;
-            check_decimate(decimate)?;
-            let rate = check_rate(rate)? / decimate as f64;
-            if !(train > 0.0 && train < 1.0) {
-                return Err(Fail(format!("--train {train}: must be in (0, 1)")));
-            }
+            let rate = check_rate(rate)? / run.decimate.max(1) as f64;
             let reference = match reference {
-                Some(path) => Some(read_reference(&path, &column)?),
+                Some(path) => Some(read_reference(&path, &run.column)?),
                 None => None,
             };
-            let x = block_average(&read_column(&files, &column)?, decimate);
+            let (x, delta) = run.load()?;
             let r = report::Report {
                 x: &x,
                 rate,
-                lambda,
-                delta: default_delta(&x),
-                train,
+                lambda: run.lambda,
+                delta,
+                train: run.train,
                 unit: &unit,
                 reference,
                 out: &out,
             };
-            let v = with_order!(order, report(&r)).map_err(|Fail(e)| with_file(&files, e))?;
+            let v =
+                with_order!(run.order, report(&r)).map_err(|Fail(e)| with_file(&run.files, e))?;
             Ok(format!("{v}\n"))
         }
         Command::Order {
