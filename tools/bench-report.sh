@@ -21,44 +21,16 @@ data=${IMU_AR_DATA:-../shared/data/imu}
 
 # replace SECTION FILE: put FILE's contents between the section's markers in README.md.
 replace() {
-    python3 - "$1" "$2" <<'PY'
-import sys
-name, path = sys.argv[1], sys.argv[2]
-body = open(path).read().rstrip("\n")
-readme = open("README.md").read()
-begin, end = f"<!-- BEGIN {name} -->", f"<!-- END {name} -->"
-if begin not in readme or end not in readme:
-    sys.exit(f"README.md has no {begin} ... {end} section")
-pre, rest = readme.split(begin, 1)
-_, post = rest.split(end, 1)
-open("README.md", "w").write(f"{pre}{begin}\n{body}\n{end}{post}")
-PY
-    echo "README.md: section $1 updated"
+    python3 tools/readme.py replace "$1" "$2"
 }
 
 if [ "$only" = all ] || [ "$only" = target ]; then
     cargo qemu bench 2>/dev/null > "$tmp/bench.txt"
-    python3 - "$tmp/bench.txt" "$tmp" <<'PY'
-import re, sys
+    PYTHONPATH=tools python3 - "$tmp/bench.txt" "$tmp" <<'PY'
+import sys
+from readme import bench_rows, slope, table
 text, tmp = open(sys.argv[1]).read(), sys.argv[2]
-insns, size = {}, {}
-for est, scalar, p, key, n in re.findall(r"(\w+) (\w+) p=(\d+) (insns/sample|bytes)=(\d+)", text):
-    table = insns if key == "insns/sample" else size
-    table.setdefault((est, scalar), {})[int(p)] = int(n)
-orders = [1, 2, 4, 8, 16, 32]
-
-def table(rows, unit):
-    lines = ["| estimator | scalar | " + " | ".join(f"p = {p}" for p in orders) + " |",
-             "|---|---|" + "---|" * len(orders)]
-    for (est, scalar), r in rows.items():
-        lines.append(f"| {est} | {scalar} | " + " | ".join(str(r.get(p, "")) for p in orders) + " |")
-    return "\n".join(lines) + "\n"
-
-def slope(r):
-    ps = [p for p in orders if p in r]
-    mp, my = sum(ps) / len(ps), sum(r[p] for p in ps) / len(ps)
-    return sum((p - mp) * (r[p] - my) for p in ps) / sum((p - mp) ** 2 for p in ps)
-
+insns, size = bench_rows(text), bench_rows(text, "bytes")
 lat, fix, rls = insns[("lattice", "f32")], insns[("lattice", "fixed")], insns[("rls", "f32")]
 s_f32, s_fixed = slope(lat), slope(fix)
 common = sorted(set(lat) & set(rls))
@@ -66,7 +38,7 @@ cheaper = [p for p in common if all(lat[q] < rls[q] for q in common if q >= p)]
 cross = cheaper[0] if cheaper else None
 below = max((p for p in common if cross and p < cross), default=None)
 with open(f"{tmp}/perf-target.md", "w") as out:
-    out.write(table(insns, "insns"))
+    out.write(table(insns))
     out.write(f"\nPer lattice stage (least-squares slope over p = 1..32): **{s_f32:.1f}** instructions "
               f"in f32, **{s_fixed:.0f}** in fixed point ({s_fixed / s_f32:.1f} times the f32 figure).")
     if cross:
@@ -76,7 +48,7 @@ with open(f"{tmp}/perf-target.md", "w") as out:
     else:
         out.write(" RLS is cheaper at every measured order.\n")
 with open(f"{tmp}/perf-state.md", "w") as out:
-    out.write(table(size, "bytes"))
+    out.write(table(size))
 PY
     replace perf-target "$tmp/perf-target.md"
     replace perf-state "$tmp/perf-state.md"
@@ -157,20 +129,11 @@ if [ "$only" = all ] || [ "$only" = nofpu ]; then
         rustup target add thumbv7m-none-eabi
     cargo run -q --release --target thumbv7m-none-eabi --example bench 2>/dev/null \
         > "$tmp/nofpu.txt"
-    python3 - "$tmp/nofpu.txt" > "$tmp/perf-nofpu.md" <<'PY'
-import re, sys
-rows = {}
-for est, scalar, p, n in re.findall(r"(lattice|rls) (\w+) p=(\d+) insns/sample=(\d+)", open(sys.argv[1]).read()):
-    rows.setdefault((est, scalar), {})[int(p)] = int(n)
-orders = [1, 2, 4, 8, 16, 32]
-print("| estimator | scalar | " + " | ".join(f"p = {p}" for p in orders) + " |")
-print("|---|---|" + "---|" * len(orders))
-for (est, scalar), r in rows.items():
-    print(f"| {est} | {scalar} | " + " | ".join(str(r.get(p, "")) for p in orders) + " |")
-def slope(r):
-    ps = [p for p in orders if p in r]
-    mp, my = sum(ps) / len(ps), sum(r[p] for p in ps) / len(ps)
-    return sum((p - mp) * (r[p] - my) for p in ps) / sum((p - mp) ** 2 for p in ps)
+    PYTHONPATH=tools python3 - "$tmp/nofpu.txt" > "$tmp/perf-nofpu.md" <<'PY'
+import sys
+from readme import bench_rows, slope, table
+rows = {k: r for k, r in bench_rows(open(sys.argv[1]).read()).items() if k[0] in ("lattice", "rls")}
+print(table(rows), end="")
 f32, fixed = slope(rows[("lattice", "f32")]), slope(rows[("lattice", "fixed")])
 print(f"\nPer lattice stage: **{f32:.0f}** instructions in soft-float f32, **{fixed:.0f}** in fixed "
       f"point ({f32 / fixed:.1f} times cheaper).")

@@ -16,19 +16,7 @@ trap 'rm -rf "$tmp"' EXIT
 
 # replace SECTION FILE: put FILE's contents between the section's markers in README.md.
 replace() {
-    python3 - "$1" "$2" <<'PY'
-import re, sys
-name, path = sys.argv[1], sys.argv[2]
-body = open(path).read().rstrip("\n")
-readme = open("README.md").read()
-begin, end = f"<!-- BEGIN {name} -->", f"<!-- END {name} -->"
-if begin not in readme or end not in readme:
-    sys.exit(f"README.md has no {begin} ... {end} section")
-pre, rest = readme.split(begin, 1)
-_, post = rest.split(end, 1)
-open("README.md", "w").write(f"{pre}{begin}\n{body}\n{end}{post}")
-PY
-    echo "README.md: section $1 updated"
+    python3 tools/readme.py replace "$1" "$2"
 }
 
 # tables OUTPUT HEADER=SECTION...: the markdown tables of a test's output, by header cell, into

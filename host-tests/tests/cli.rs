@@ -28,6 +28,18 @@ fn json(out: &Output) -> serde_json::Value {
     serde_json::from_slice(&out.stdout).expect("one JSON object")
 }
 
+/// A temp file `name` holding `n` samples (column `x`, 100 Hz) of an AR(2) whose a_1 drifts
+/// linearly from 1.5 to 1.0 (a_2 = -0.7, unit innovation variance): a batch model fitted on
+/// the first half is stale on the second.
+fn drift_record(name: &str, n: &str) -> PathBuf {
+    let out = imu_ar(&[
+        "simulate", "--a", "1.5,-0.7", "--a-end", "1.0,-0.7", "--sigma", "1", "--n", n, "--seed",
+        "4", "--rate", "100",
+    ]);
+    assert!(out.status.success());
+    temp_file(name, &String::from_utf8(out.stdout).unwrap())
+}
+
 /// `imu-ar fit FILE --column x --method M --order P --json EXTRA..`, parsed.
 fn fit_json(file: &Path, method: &str, order: &str, extra: &[&str]) -> serde_json::Value {
     let file = file.to_str().unwrap();
@@ -361,14 +373,7 @@ fn fits_equal_statsmodels() {
 
 #[test]
 fn recursive_fits_and_the_drifting_ar2_comparison() {
-    // AR(2) whose a_1 drifts linearly from 1.5 to 1.0 over 100,000 samples (a_2 = -0.7, unit
-    // innovation variance): a batch model fitted on the first half is stale on the second.
-    let out = imu_ar(&[
-        "simulate", "--a", "1.5,-0.7", "--a-end", "1.0,-0.7", "--sigma", "1", "--n", "100000",
-        "--seed", "4", "--rate", "100",
-    ]);
-    assert!(out.status.success());
-    let file = temp_file("drift.csv", &String::from_utf8(out.stdout).unwrap());
+    let file = drift_record("drift.csv", "100000");
     let f = file.to_str().unwrap();
     for lambda in ["0.99", "0.999"] {
         let v = json(&imu_ar(&[
@@ -523,12 +528,7 @@ fn decimate_fits_the_block_averages() {
 
 #[test]
 fn report_writes_four_pngs_and_a_summary() {
-    let sim = imu_ar(&[
-        "simulate", "--a", "1.5,-0.7", "--a-end", "1.0,-0.7", "--sigma", "1", "--n", "20000",
-        "--seed", "4", "--rate", "100",
-    ]);
-    assert!(sim.status.success());
-    let file = temp_file("report.csv", &String::from_utf8(sim.stdout).unwrap());
+    let file = drift_record("report.csv", "20000");
     let out = std::env::temp_dir().join(format!("imu-ar-cli-{}-report", std::process::id()));
     let v = json(&imu_ar(&[
         "report",
