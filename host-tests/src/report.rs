@@ -30,6 +30,8 @@ pub struct Report<'a> {
 }
 
 const SIZE: (u32, u32) = (960, 600);
+/// Fewest samples a report is drawn from: enough for a periodogram of 8-sample segments.
+const MIN_SAMPLES: usize = 64;
 
 /// Coefficients `a_1..a_P` at sampled times (s).
 type Track<const P: usize> = Vec<(f64, [f64; P])>;
@@ -50,8 +52,14 @@ fn draw_err(e: impl std::fmt::Debug) -> Fail {
 pub fn report<const P: usize>(r: &Report) -> Result<Value, Fail> {
     std::fs::create_dir_all(r.out)
         .map_err(|e| Fail(format!("{}: cannot create: {e}", r.out.display())))?;
-    font()?;
     let x = r.x;
+    if x.len() < MIN_SAMPLES {
+        return Err(Fail(format!(
+            "report needs at least {MIN_SAMPLES} samples (after --decimate), not {}",
+            x.len()
+        )));
+    }
+    font()?;
     let dt = 1.0 / r.rate;
     let n_train = (r.train * x.len() as f64) as usize;
     let batch_config = BatchConfig::new(dt)?;

@@ -573,4 +573,25 @@ fn report_writes_four_pngs_and_a_summary() {
     ]);
     assert_eq!(bad.status.code(), Some(2));
     assert!(bad.stdout.is_empty());
+    let short = imu_ar(&[
+        "report",
+        file.to_str().unwrap(),
+        "--column",
+        "x",
+        "--order",
+        "2",
+        "--rate",
+        "100",
+        "--decimate",
+        "1000",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(short.status.code(), Some(2));
+    assert!(
+        String::from_utf8_lossy(&short.stderr)
+            .contains("at least 64 samples (after --decimate), not 20"),
+        "{}",
+        String::from_utf8_lossy(&short.stderr)
+    );
 }
