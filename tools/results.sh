@@ -1,9 +1,12 @@
 #!/usr/bin/env bash
-# Regenerates the README "Results" tables from the `imu-ar` tool's JSON (about 1 minute):
+# Regenerates the README "Results" tables from the `imu-ar` tool's JSON, and the plots README
+# shows (docs/plots), in about 4 minutes:
 #   - results-sim: a stationary AR(4) with known coefficients, every estimator against truth,
 #   - results-real: batch LS against RLS and the lattice, one-step prediction MSE, on every
 #     gyro axis of the ADIS16405 and MPU-6050 records at about 100 Hz and decimated to 10 Hz
-#     and 1 Hz (batch model fitted on the first half, all evaluated on the second).
+#     and 1 Hz (batch model fitted on the first half, all evaluated on the second),
+#   - handoff: the Kalman hand-off of the ADIS16405 gx axis (`imu-ar kalman`),
+#   - docs/plots: `imu-ar report` on the drifting AR(2) and on gx of both records.
 #
 #   tools/results.sh
 set -euo pipefail
@@ -65,3 +68,52 @@ print("| " + " | ".join(cells) + " | %+.1f %% |" % -v["reduction_percent"])' "$r
     done
 } > "$tmp/results-real.md"
 replace results-real "$tmp/results-real.md"
+
+# The Kalman hand-off of the ADIS16405 gx axis: an AR(1) at the full rate and an AR(1) of
+# 10-s averages (a Gauss-Markov drift), both at a 100 Hz filter, with their Allan checks.
+for dec in 1 1000; do
+    "$tool" kalman "${adis[@]}" --column gx --order 1 --rate 100 --decimate "$dec" \
+        --filter-rate 100 --json > "$tmp/kalman-$dec.json"
+done
+python3 - "$tmp/kalman-1.json" "$tmp/kalman-1000.json" > "$tmp/handoff.md" <<'PY'
+import json, sys
+fits = [json.load(open(f)) for f in sys.argv[1:]]
+names = ["100 Hz samples", "10 s averages"]
+print("| AR(1) fitted on | a_1 | sigma_w^2 ((deg/s)^2) | T_c (s) | sigma (deg/s) "
+      "| Phi at 100 Hz | Q at 100 Hz ((deg/s)^2) | Allan check holds up to |")
+print("|---|---|---|---|---|---|---|---|")
+for name, v in zip(names, fits):
+    gm = v["gauss_markov"]
+    print("| %s | %.4g | %.4g | %.4g | %.4g | %.6g | %.4g | %s s |" % (
+        name, v["a"][0], v["noise_variance"], gm["correlation_time_s"], gm["sigma"],
+        v["phi"][0][0], v["q"][0][0], "%.4g" % v["explained_up_to_s"]))
+print()
+print("| tau (s) | data ADEV (deg/s) | model ADEV (deg/s) | data / model | tolerance | fitted on |")
+print("|---|---|---|---|---|---|")
+for name, v in zip(names, fits):
+    for row in v["allan"]:
+        if row["tau_s"] < 5:
+            continue
+        print("| %.4g | %.3g | %.3g | %.2f | %.2f | %s |" % (
+            row["tau_s"], row["data_adev"], row["model_adev"], row["data_over_model"],
+            row["tolerance"], name))
+PY
+replace handoff "$tmp/handoff.md"
+
+# The plots README shows: the drifting AR(2), and gx of each real record at its full rate.
+plots=docs/plots
+mkdir -p "$plots"
+"$tool" simulate --a 1.5,-0.7 --a-end 1.0,-0.7 --sigma 1 --n 100000 --seed 4 > "$tmp/drift.csv"
+"$tool" report "$tmp/drift.csv" --column x --order 2 --lambda 0.999 --rate 1 \
+    --out "$tmp/drift" > /dev/null
+"$tool" report "${adis[@]}" --column gx --order 4 --lambda 0.999 --rate 100 --unit deg/s \
+    --reference "$data/adis16405_imu1_allan_reference.csv" --out "$tmp/adis" > /dev/null
+"$tool" report "${mpu[@]}" --column gx --order 4 --lambda 0.999 --rate 99.3 --unit deg/s \
+    --out "$tmp/mpu" > /dev/null
+cp "$tmp/drift/coefficients.png" "$plots/drift-coefficients.png"
+cp "$tmp/drift/prediction_error.png" "$plots/drift-prediction-error.png"
+for record in adis mpu; do
+    cp "$tmp/$record/psd.png" "$plots/$record-gx-psd.png"
+    cp "$tmp/$record/adev.png" "$plots/$record-gx-adev.png"
+done
+ls -l "$plots"

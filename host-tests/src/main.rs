@@ -2,10 +2,16 @@
 //!
 //! ```text
 //! imu-ar fit FILE.. --column C --method ls|yule-walker|burg|rls|lattice --order P
-//!     [--scalar f64|f32|fixed] [--lambda L] [--delta D] [--scale S] [--no-demean] [--rate HZ] [--json]
-//! imu-ar compare FILE.. --column C --order P [--lambda L] [--delta D] [--train F] [--json]
+//!     [--scalar f64|f32|fixed] [--lambda L] [--delta D] [--scale S] [--no-demean] [--decimate M]
+//!     [--rate HZ] [--json]
+//! imu-ar compare FILE.. --column C --order P [--lambda L] [--delta D] [--decimate M] [--train F]
+//!     [--json]
+//! imu-ar report FILE.. --column C --order P --rate HZ --out DIR [--lambda L] [--delta D]
+//!     [--decimate M] [--train F] [--unit U] [--reference TABLE]
 //! imu-ar order FILE.. --column C --max-order P --method ls|yule-walker|burg [--no-demean] [--json]
 //! imu-ar adev FILE.. --column C --rate HZ [--json]
+//! imu-ar kalman FILE.. --column C --order P --rate HZ [--method ls|yule-walker|burg] [--decimate M]
+//!     [--filter-rate HZ] [--json]
 //! imu-ar parity
 //! imu-ar simulate --a A1,A2,.. [--a-end B1,B2,..] --sigma S --n N --seed K [--rate HZ] [--burn-in B]
 //! ```
@@ -26,11 +32,13 @@ use imu_ar::fixed_point::{FixedConfig, FixedLattice};
 use imu_ar::recursive::{Config, FloatArith, Lattice, Rls, RlsInit};
 use imu_ar::sim::StandardNormal;
 use imu_ar_host::data::{block_average, read_column};
+use kalman::handoff;
 use rand_chacha::ChaCha8Rng;
 use rand_core::SeedableRng;
 use report::report;
 use serde_json::{Value, json};
 
+mod kalman;
 /// The parity run shared with the `parity` firmware (same file, compiled for the host).
 #[path = "../../examples/common/parity.rs"]
 mod parity;
@@ -75,7 +83,7 @@ struct Cli {
 }
 
 #[derive(Clone, Copy, ValueEnum)]
-enum Method {
+pub(crate) enum Method {
     /// Covariance method (conditional least squares).
     Ls,
     /// Yule-Walker (biased autocovariance, Levinson-Durbin).
@@ -198,6 +206,30 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// The Kalman filter hand-off of a batch fit: `Phi`, `Q` and the stationary covariance at
+    /// the filter's rate, the Gauss-Markov form of an AR(1), and the Allan check that the model
+    /// explains the data's Allan deviation.
+    Kalman {
+        #[command(flatten)]
+        record: Record,
+        /// Batch estimator.
+        #[arg(long, value_enum, default_value = "burg")]
+        method: Method,
+        /// Sample rate in Hz of the raw record.
+        #[arg(long, allow_negative_numbers = true)]
+        rate: f64,
+        /// Average blocks of M samples first; the model's rate becomes rate / M.
+        #[arg(long, default_value_t = 1)]
+        decimate: usize,
+        /// The filter's rate in Hz [default: the model's]. The model's rate must be an integer
+        /// multiple of it, except for an AR(1) with a Gauss-Markov equivalent, which samples
+        /// at any rate.
+        #[arg(long, allow_negative_numbers = true)]
+        filter_rate: Option<f64>,
+        /// Print one JSON object.
+        #[arg(long)]
+        json: bool,
+    },
     /// Order criteria (AIC, AICc, BIC, FPE) of orders 0..=P.
     Order {
         /// CSV files with a header row, read as one record.
@@ -269,9 +301,9 @@ enum Command {
     },
 }
 
-/// The record and settings of `compare` and `report`.
+/// One column of a record, and the order of the model to fit to it.
 #[derive(Args)]
-struct Comparison {
+struct Record {
     /// CSV files with a header row, read as one record.
     #[arg(required = true)]
     files: Vec<PathBuf>,
@@ -281,6 +313,25 @@ struct Comparison {
     /// Model order, 1 to 32.
     #[arg(long)]
     order: usize,
+}
+
+impl Record {
+    /// Checks the order, then reads the column and averages blocks of `decimate` samples.
+    fn load(&self, decimate: usize) -> Result<Vec<f64>, Fail> {
+        check_order("--order", self.order)?;
+        check_decimate(decimate)?;
+        Ok(block_average(
+            &read_column(&self.files, &self.column)?,
+            decimate,
+        ))
+    }
+}
+
+/// The record and settings of `compare` and `report`.
+#[derive(Args)]
+struct Comparison {
+    #[command(flatten)]
+    record: Record,
     /// Forgetting factor, in (0, 1].
     #[arg(long, default_value_t = DEFAULT_LAMBDA, allow_negative_numbers = true)]
     lambda: f64,
@@ -298,23 +349,21 @@ struct Comparison {
 impl Comparison {
     /// Checks the settings, then reads (and decimates) the record; returns it with `delta`.
     fn load(&self) -> Result<(Vec<f64>, f64), Fail> {
-        check_order("--order", self.order)?;
         check_lambda(self.lambda)?;
         if let Some(d) = self.delta {
             check_delta(d)?;
         }
-        check_decimate(self.decimate)?;
         if !(self.train > 0.0 && self.train < 1.0) {
             return Err(Fail(format!("--train {}: must be in (0, 1)", self.train)));
         }
-        let x = block_average(&read_column(&self.files, &self.column)?, self.decimate);
+        let x = self.record.load(self.decimate)?;
         let delta = self.delta.unwrap_or_else(|| default_delta(&x));
         Ok((x, delta))
     }
 }
 
 /// A one-line error for stderr; the tool exits with status 2.
-struct Fail(String);
+pub(crate) struct Fail(pub(crate) String);
 
 impl<E: std::fmt::Display> From<E> for Fail {
     fn from(e: E) -> Self {
@@ -427,9 +476,9 @@ fn run(command: Command) -> Result<String, Fail> {
         }
         Command::Compare { run, json } => {
             let (x, delta) = run.load()?;
-            let (order, lambda) = (run.order, run.lambda);
+            let (order, lambda) = (run.record.order, run.lambda);
             let mut v = with_order!(order, compare(&x, lambda, delta, run.train))
-                .map_err(|Fail(e)| with_file(&run.files, e))?;
+                .map_err(|Fail(e)| with_file(&run.record.files, e))?;
             v["decimate"] = json!(run.decimate);
             Ok(if json {
                 format!("{v}\n")
@@ -456,7 +505,7 @@ fn run(command: Command) -> Result<String, Fail> {
         } => {
             let rate = check_rate(rate)? / run.decimate.max(1) as f64;
             let reference = match reference {
-                Some(path) => Some(read_reference(&path, &run.column)?),
+                Some(path) => Some(read_reference(&path, &run.record.column)?),
                 None => None,
             };
             let (x, delta) = run.load()?;
@@ -470,9 +519,41 @@ fn run(command: Command) -> Result<String, Fail> {
                 reference,
                 out: &out,
             };
-            let v =
-                with_order!(run.order, report(&r)).map_err(|Fail(e)| with_file(&run.files, e))?;
+            let v = with_order!(run.record.order, report(&r))
+                .map_err(|Fail(e)| with_file(&run.record.files, e))?;
             Ok(format!("{v}\n"))
+        }
+        Command::Kalman {
+            record,
+            method,
+            rate,
+            decimate,
+            filter_rate,
+            json,
+        } => {
+            if method.recursive() {
+                return Err(Fail(format!(
+                    "--method {}: the hand-off takes a batch fit (ls, yule-walker, burg)",
+                    method.name()
+                )));
+            }
+            let rate = check_rate(rate)? / decimate as f64;
+            let filter_rate = match filter_rate {
+                Some(f) => check_rate(f).map_err(|_| {
+                    Fail(format!(
+                        "--filter-rate {f}: must be a positive number of Hz"
+                    ))
+                })?,
+                None => rate,
+            };
+            let x = record.load(decimate)?;
+            let v = with_order!(record.order, handoff(method, &x, rate, filter_rate))
+                .map_err(|Fail(e)| with_file(&record.files, e))?;
+            Ok(if json {
+                format!("{v}\n")
+            } else {
+                kalman::text(&v)
+            })
         }
         Command::Order {
             files,
@@ -648,7 +729,7 @@ fn with_file(files: &[PathBuf], e: impl std::fmt::Display) -> Fail {
     Fail(format!("{}: {e}", names.join("+")))
 }
 
-fn batch_fit<const P: usize>(
+pub(crate) fn batch_fit<const P: usize>(
     method: Method,
     x: &[f64],
     config: &BatchConfig<f64>,

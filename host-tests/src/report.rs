@@ -106,7 +106,7 @@ pub fn report<const P: usize>(r: &Report) -> Result<Value, Fail> {
 
     let files = [
         coefficients_png::<P>(r, &coef, &train_fit)?,
-        error_png(r, &se, n_train as f64 * dt)?,
+        error_png(r, &se, &mse, n_train as f64 * dt)?,
         psd_png(r, &whole_fit)?,
         adev_png(r, &whole_fit)?,
     ];
@@ -164,6 +164,25 @@ fn caption(r: &Report, what: &str) -> String {
     )
 }
 
+/// A linear axis label: plain decimals from 0.01 up, scientific below.
+fn tick(v: f64) -> String {
+    if v == 0.0 || (1e-2..1e4).contains(&v.abs()) {
+        format!("{v:.3}")
+    } else {
+        format!("{v:.2e}")
+    }
+}
+
+/// `v` to 4 significant digits: decimals from 0.01 up, scientific below.
+fn significant(v: f64) -> String {
+    if (1e-2..1e4).contains(&v.abs()) {
+        let decimals = (3 - v.abs().log10().floor() as i32).max(0) as usize;
+        format!("{v:.decimals$}")
+    } else {
+        format!("{v:.3e}")
+    }
+}
+
 /// Range of finite values, widened a little.
 fn span(values: impl Iterator<Item = f64>) -> (f64, f64) {
     let (lo, hi) = values
@@ -209,7 +228,9 @@ fn coefficients_png<const P: usize>(
     .map_err(draw_err)?;
     chart
         .configure_mesh()
+        .light_line_style(WHITE)
         .x_desc("time (s)")
+        .x_label_formatter(&|t| format!("{t:.0}"))
         .y_desc("coefficient a_k (1)")
         .draw()
         .map_err(draw_err)?;
@@ -235,56 +256,74 @@ fn coefficients_png<const P: usize>(
             .legend(move |(x, y)| Circle::new((x + 10, y), 3, color.filled()));
         let a = batch.a()[k];
         chart
-            .draw_series(LineSeries::new(
+            .draw_series(DashedLineSeries::new(
                 [(0.0, a), (t_end, a)],
-                BLACK.stroke_width(1),
+                8,
+                5,
+                color.stroke_width(2),
             ))
-            .map_err(draw_err)?;
+            .map_err(draw_err)?
+            .label(format!("a_{} batch LS, first part ({a:.3})", k + 1))
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color.stroke_width(2)));
     }
     legend(&mut chart, SeriesLabelPosition::UpperRight)?;
     root.present().map_err(draw_err)?;
     Ok(path.clone())
 }
 
-fn error_png(r: &Report, se: &[Vec<(f64, f64)>; 3], t_train: f64) -> Result<PathBuf, Fail> {
+fn error_png(
+    r: &Report,
+    se: &[Vec<(f64, f64)>; 3],
+    mse: &[f64; 3],
+    t_train: f64,
+) -> Result<PathBuf, Fail> {
     let path = r.out.join("prediction_error.png");
     let root = BitMapBackend::new(&path, SIZE).into_drawing_area();
     root.fill(&WHITE).map_err(draw_err)?;
     let t_end = se[0].last().map_or(1.0, |p| p.0);
-    let positive = se.iter().flatten().map(|p| p.1).filter(|v| *v > 0.0);
-    let hi = positive.clone().fold(0.0f64, f64::max);
-    let lo = positive.fold(f64::INFINITY, f64::min).max(hi * 1e-9);
+    // The first tenth of the record is the recursive estimators' start: leave it out of the range.
+    let settled = se.iter().flatten().filter(|p| p.0 > 0.1 * t_end);
+    let hi = settled
+        .map(|p| p.1)
+        .filter(|v| v.is_finite())
+        .fold(0.0f64, f64::max);
+    let hi = if hi > 0.0 { hi * 1.1 } else { 1.0 };
     let mut chart = builder(
         &root,
         caption(r, "One-step prediction error, block means"),
         80,
     )
-    .build_cartesian_2d(0.0..t_end, (lo * 0.9..hi * 1.1).log_scale())
+    .build_cartesian_2d(0.0..t_end, 0.0..hi)
     .map_err(draw_err)?;
     chart
         .configure_mesh()
         .x_desc(format!(
-            "time (s); batch LS fitted on the first {t_train:.0} s"
+            "time (s); batch LS fitted before {t_train:.0} s, MSE over the rest"
         ))
+        .light_line_style(WHITE)
+        .x_label_formatter(&|t| format!("{t:.0}"))
         .y_desc(format!("mean squared error ({})^2", r.unit))
+        .y_label_formatter(&|v| tick(*v))
         .draw()
         .map_err(draw_err)?;
     let names = ["batch LS", "RLS", "lattice"];
     let colors = [BLACK, BLUE, RED];
-    for ((series, name), color) in se.iter().zip(names).zip(colors) {
+    for (((series, name), color), mse) in se.iter().zip(names).zip(colors).zip(mse) {
         chart
             .draw_series(LineSeries::new(
-                series.iter().copied().filter(|p| p.1 > 0.0),
+                series.iter().copied().map(|(t, v)| (t, v.min(hi))),
                 color.stroke_width(1),
             ))
             .map_err(draw_err)?
-            .label(name)
+            .label(format!("{name}: MSE {}", significant(*mse)))
             .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color.stroke_width(2)));
     }
     chart
-        .draw_series(LineSeries::new(
-            [(t_train, lo), (t_train, hi)],
-            BLACK.mix(0.4),
+        .draw_series(DashedLineSeries::new(
+            [(t_train, 0.0), (t_train, hi)],
+            6,
+            4,
+            BLACK.stroke_width(2),
         ))
         .map_err(draw_err)?;
     legend(&mut chart, SeriesLabelPosition::UpperRight)?;

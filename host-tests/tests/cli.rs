@@ -595,3 +595,108 @@ fn report_writes_four_pngs_and_a_summary() {
         String::from_utf8_lossy(&short.stderr)
     );
 }
+
+/// `imu-ar kalman FILE --column x ARGS.. --json`.
+fn kalman(file: &Path, args: &[&str]) -> Output {
+    let mut all = vec!["kalman", file.to_str().unwrap(), "--column", "x"];
+    all.extend_from_slice(args);
+    all.push("--json");
+    imu_ar(&all)
+}
+
+fn matrix(v: &serde_json::Value) -> Vec<Vec<f64>> {
+    let rows = v.as_array().unwrap().iter();
+    rows.map(|r| {
+        r.as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect()
+    })
+    .collect()
+}
+
+#[test]
+fn kalman_hands_over_phi_q_and_the_allan_check() {
+    // An AR(1) with phi = 0.9 at 10 Hz: a Gauss-Markov process with T_c = -0.1 / ln 0.9 s.
+    let out = imu_ar(&[
+        "simulate", "--a", "0.9", "--sigma", "0.5", "--n", "200000", "--seed", "8", "--rate", "10",
+    ]);
+    assert!(out.status.success());
+    let ar1 = temp_file("kalman-ar1.csv", &String::from_utf8(out.stdout).unwrap());
+    let v = json(&kalman(
+        &ar1,
+        &["--order", "1", "--rate", "10", "--filter-rate", "100"],
+    ));
+    let a1 = v["a"][0].as_f64().unwrap();
+    let s2 = v["noise_variance"].as_f64().unwrap();
+    assert!((a1 - 0.9).abs() < 0.005, "a_1 {a1}");
+    assert!((s2 - 0.25).abs() < 0.005, "sigma_w^2 {s2}");
+    // Phi and Q of the 0.01 s filter step, from the fitted a_1 and sigma_w^2 by hand: the
+    // Gauss-Markov process sampled at a tenth of the model's interval.
+    let tc = -0.1 / a1.ln();
+    let sigma2 = s2 / (1.0 - a1 * a1);
+    let phi = (-0.01 / tc).exp();
+    let gm = &v["gauss_markov"];
+    assert!((gm["correlation_time_s"].as_f64().unwrap() - tc).abs() < 1e-12 * tc);
+    assert!((gm["sigma"].as_f64().unwrap() - sigma2.sqrt()).abs() < 1e-12);
+    assert!((matrix(&v["phi"])[0][0] - phi).abs() < 1e-12);
+    assert!((matrix(&v["q"])[0][0] - sigma2 * (1.0 - phi * phi)).abs() < 1e-12 * sigma2);
+    assert!((matrix(&v["p0"])[0][0] - sigma2).abs() < 1e-9 * sigma2);
+    // The data are the model's process: the Allan check holds where the standard error is
+    // below the 10 % floor (tau up to 100 s, 2000 clusters).
+    let explained = v["explained_up_to_s"].as_f64().unwrap();
+    assert!(explained >= 100.0, "explained up to {explained} s");
+
+    // An AR(2) at 100 Hz for a 20 Hz filter: Phi^5 and Q_5 of the companion form, multiplied
+    // out here step by step.
+    let file = drift_record("kalman-ar2.csv", "20000");
+    let v = json(&kalman(
+        &file,
+        &["--order", "2", "--rate", "100", "--filter-rate", "20"],
+    ));
+    assert_eq!(v["steps"].as_u64(), Some(5));
+    let a: Vec<f64> = v["a"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    let s2 = v["noise_variance"].as_f64().unwrap();
+    let step = [[a[0], a[1]], [1.0, 0.0]];
+    let mul = |x: [[f64; 2]; 2], y: [[f64; 2]; 2]| -> [[f64; 2]; 2] {
+        core::array::from_fn(|i| core::array::from_fn(|j| x[i][0] * y[0][j] + x[i][1] * y[1][j]))
+    };
+    let transpose = |x: [[f64; 2]; 2]| [[x[0][0], x[1][0]], [x[0][1], x[1][1]]];
+    let (mut phi, mut q) = ([[1.0, 0.0], [0.0, 1.0]], [[0.0; 2]; 2]);
+    for _ in 0..5 {
+        q = mul(mul(step, q), transpose(step));
+        q[0][0] += s2;
+        phi = mul(step, phi);
+    }
+    for (got, want) in [(matrix(&v["phi"]), phi), (matrix(&v["q"]), q)] {
+        for i in 0..2 {
+            for j in 0..2 {
+                assert!((got[i][j] - want[i][j]).abs() < 1e-12 * (1.0 + want[i][j].abs()));
+            }
+        }
+    }
+    // A drifting process is not stationary over the record: the check fails somewhere.
+    assert_ne!(
+        v["explained_up_to_s"],
+        v["allan"].as_array().unwrap().last().unwrap()["tau_s"]
+    );
+
+    // Misuse: a rate that is no integer fraction of an AR(2)'s, a recursive method.
+    for args in [
+        &["--order", "2", "--rate", "100", "--filter-rate", "30"][..],
+        &["--order", "2", "--rate", "100", "--method", "lattice"][..],
+        &["--order", "2", "--rate", "100", "--filter-rate", "-1"][..],
+    ] {
+        let out = kalman(&file, args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        assert!(out.stdout.is_empty());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(err.lines().count(), 1, "{err}");
+    }
+}
