@@ -4,6 +4,7 @@
 use imu_ar::ArModel;
 use imu_ar::recursive::{Config, ConfigError, Lattice, OrderRule, OrderSelector, Rls, RlsInit};
 use imu_ar::sim::ArSimulator;
+use imu_ar_host::reference::{Regularisation, Section0, running_mean_removed};
 use rand_chacha::ChaCha8Rng;
 use rand_core::SeedableRng;
 
@@ -70,33 +71,90 @@ fn rejected_samples_change_nothing_and_are_counted() {
 
 #[test]
 fn stuck_sensor_then_normal_data() {
-    // 100,000 identical samples, then the AR(2) again: every output stays finite, nothing
-    // restarts, and the model recovers within a few memory lengths.
-    let config = Config::new(0.99f32, 0.1, 0.01).unwrap();
-    let mut lattice = Lattice::<f32, 2>::new(&config);
-    let mut rls = Rls::<f32, 2>::new(&config, RlsInit::ShiftConsistent);
-    for _ in 0..100_000 {
-        let e = lattice.update(&config, 3.25).unwrap();
-        assert!(e.is_finite());
-        assert!(rls.update(&config, 3.25).unwrap().is_finite());
+    // 10^6 identical samples, then the AR(2) again, at lambda 0.99 and 0.999: every output
+    // stays finite, nothing restarts, and 5/(1 - lambda) samples later the f32 estimators
+    // equal the f64 direct solve of everything they took (stuck run included) to 1e-4, and
+    // the direct solve of the normal data alone to 1e-2: the stuck run is forgotten.
+    for lambda in [0.99, 0.999] {
+        let config = Config::new(lambda as f32, 0.1, 0.01).unwrap();
+        let mut lattice = Lattice::<f32, 2>::new(&config);
+        let mut rls = Rls::<f32, 2>::new(&config, RlsInit::ShiftConsistent);
+        let mut everything = Vec::new();
+        for _ in 0..1_000_000 {
+            assert!(lattice.update(&config, 3.25).unwrap().is_finite());
+            assert!(rls.update(&config, 3.25).unwrap().is_finite());
+            everything.push(3.25);
+        }
+        let m = lattice.model(&config).unwrap();
+        assert!(m.a().iter().all(|a| a.is_finite()) && m.noise_variance().is_finite());
+        let normal: Vec<f64> = ar2((5.0 / (1.0 - lambda)) as usize, 2)
+            .into_iter()
+            .map(f64::from)
+            .collect();
+        for &v in &normal {
+            assert!(lattice.update(&config, v as f32).unwrap().is_finite());
+            assert!(rls.update(&config, v as f32).unwrap().is_finite());
+            everything.push(v);
+        }
+        let solve = |x: &[f64]| {
+            let mut s = Section0::new(2, lambda, 0.1);
+            for y in running_mean_removed(x, lambda) {
+                s.push(y);
+            }
+            s.solve(2, Regularisation::ShiftConsistent).0
+        };
+        let (all, fresh) = (solve(&everything), solve(&normal));
+        for (name, a) in [
+            ("lattice", lattice.coefficients(2).unwrap()),
+            ("RLS", *rls.coefficients()),
+        ] {
+            for k in 0..2 {
+                let a = f64::from(a[k]);
+                assert!(
+                    (a - all[k]).abs() <= 1e-4,
+                    "{name} {lambda}: {a} vs {all:?}"
+                );
+                assert!(
+                    (a - fresh[k]).abs() <= 1e-2,
+                    "{name} {lambda}: {a} vs {fresh:?}"
+                );
+            }
+        }
+        assert_eq!(lattice.health().restarts + rls.health().restarts, 0);
     }
-    let m = lattice.model(&config).unwrap();
-    assert!(m.a().iter().all(|a| a.is_finite()) && m.noise_variance().is_finite());
-    for &v in &ar2(2_000, 2) {
-        assert!(lattice.update(&config, v).unwrap().is_finite());
-        assert!(rls.update(&config, v).unwrap().is_finite());
+}
+
+#[test]
+fn saturated_sensor_is_detected_and_counted() {
+    // An AR(2) of mean 3 and standard deviation about 2.3 read by a sensor with a full scale
+    // of +-4, and a limit set 0.1 % inside it: every clipped sample (and every one within
+    // 0.1 % of the rail) is counted as saturated and skipped, and the model is the one of the
+    // samples inside the limit.
+    let full_scale = 4.0f32;
+    let limit = full_scale * 0.999;
+    let config = Config::new(0.99f32, 0.1, 0.01)
+        .unwrap()
+        .with_saturation(limit)
+        .unwrap();
+    let x = ar2(20_000, 5);
+    let mut sensor = Lattice::<f32, 2>::new(&config);
+    let mut inside = Lattice::<f32, 2>::new(&config);
+    let (mut clipped, mut at_rail) = (0, 0);
+    for &v in &x {
+        let read = v.clamp(-full_scale, full_scale);
+        clipped += u64::from(read.abs() == full_scale);
+        let e = sensor.update(&config, read);
+        if read.abs() >= limit {
+            at_rail += 1;
+            assert_eq!(e, None);
+        } else {
+            assert_eq!(e, inside.update(&config, read));
+        }
     }
-    let a = *lattice.model(&config).unwrap().a();
-    assert!(
-        (a[0] - 1.2).abs() < 0.1 && (a[1] + 0.5).abs() < 0.1,
-        "lattice a = {a:?}"
-    );
-    let a = *rls.model(&config).unwrap().a();
-    assert!(
-        (a[0] - 1.2).abs() < 0.1 && (a[1] + 0.5).abs() < 0.1,
-        "RLS a = {a:?}"
-    );
-    assert_eq!(lattice.health().restarts + rls.health().restarts, 0);
+    assert!(clipped > 1000, "{clipped} clipped samples");
+    assert!(at_rail >= clipped);
+    assert_eq!(sensor.health().saturated, at_rail);
+    assert_eq!(sensor.coefficients(2), inside.coefficients(2));
 }
 
 #[test]
