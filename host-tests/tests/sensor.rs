@@ -213,6 +213,7 @@ fn mpu6050_bus_error_mid_fifo_is_propagated_and_counted() {
     // Still usable afterwards.
     expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x00]));
     expect.push(I2c::write_read(ADDR, vec![0x72], vec![0, 0]));
+    expect.push(I2c::write_read(ADDR, vec![0x6A], vec![0x40])); // empty: USER_CTRL, FIFO on
     let mut imu = Mpu6050::new(I2cMock::new(&expect), ADDR);
     imu.enable_fifo().unwrap();
     let mut out = [RawSample::default(); 16];
@@ -223,6 +224,54 @@ fn mpu6050_bus_error_mid_fifo_is_propagated_and_counted() {
         "the 8 packets read before the error are lost"
     );
     assert_eq!(imu.read_fifo(&mut out), Ok(0));
+    imu.destroy().done();
+}
+
+#[test]
+fn mpu6050_resetting_itself_is_detected_recovered_and_counted() {
+    // Two good samples; then a supply glitch resets the chip: its FIFO is off and empty. The
+    // reader finds USER_CTRL cleared, the caller recovers it after an outage of 350 ms (35
+    // samples at 100 Hz), and the stream goes on.
+    let mut expect = mpu_init();
+    expect.extend(mpu_fifo_enable());
+    expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x01]));
+    expect.push(I2c::write_read(ADDR, vec![0x72], vec![0, 24]));
+    let packets = [mpu_packet([1; 3], [2; 3]), mpu_packet([3; 3], [4; 3])];
+    expect.push(I2c::write_read(ADDR, vec![0x74], packets.concat()));
+    expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x00]));
+    expect.push(I2c::write_read(ADDR, vec![0x72], vec![0, 0]));
+    expect.push(I2c::write_read(ADDR, vec![0x6A], vec![0x00])); // USER_CTRL after a reset
+    // The first recovery attempt meets a bus error at WHO_AM_I; the second succeeds.
+    expect.push(I2c::write_read(ADDR, vec![0x75], vec![0x68]).with_error(ErrorKind::Other));
+    expect.extend(mpu_init());
+    expect.extend(mpu_fifo_enable());
+    expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x01]));
+    expect.push(I2c::write_read(ADDR, vec![0x72], vec![0, 12]));
+    expect.push(I2c::write_read(
+        ADDR,
+        vec![0x74],
+        mpu_packet([5; 3], [6; 3]),
+    ));
+    let mut imu = Mpu6050::new(I2cMock::new(&expect), ADDR);
+    imu.init(&mut NoopDelay, mpu_config()).unwrap();
+    imu.enable_fifo().unwrap();
+    let mut out = [RawSample::default(); 4];
+    assert_eq!(imu.read_fifo(&mut out), Ok(2));
+    assert_eq!(imu.read_fifo(&mut out), Err(Error::SensorReset));
+    assert_eq!(
+        imu.recover(&mut NoopDelay, 350_000),
+        Err(Error::Bus(ErrorKind::Other))
+    );
+    assert_eq!(
+        imu.fifo_stats().resets,
+        0,
+        "a failed recovery counts nothing"
+    );
+    assert_eq!(imu.recover(&mut NoopDelay, 350_000), Ok(0x68));
+    assert_eq!(imu.read_fifo(&mut out), Ok(1));
+    assert_eq!(out[0].gyro, [6; 3]);
+    let stats = imu.fifo_stats();
+    assert_eq!((stats.samples, stats.resets, stats.lost), (3, 1, 35));
     imu.destroy().done();
 }
 
@@ -413,6 +462,36 @@ fn icm42688_fifo_overflow_is_counted_and_recovered() {
         (stats.overflows, stats.discarded, stats.samples),
         (1, 128, 1)
     );
+    imu.destroy().done();
+}
+
+#[test]
+fn icm42688_resetting_itself_is_detected_recovered_and_counted() {
+    // One good sample, then the chip resets: FIFO_CONFIG reads back bypass mode. Recovered
+    // after 120 ms at 100 Hz: 12 samples lost.
+    let mut expect = icm_init();
+    expect.extend(icm_fifo_enable());
+    expect.extend(spi_read(0x2D, vec![0x08]));
+    expect.extend(spi_read(0x2E, vec![0, 16]));
+    expect.extend(spi_read(0x30, icm_packet(0x68, [1; 3], [2; 3], 0)));
+    expect.extend(spi_read(0x2D, vec![0x00]));
+    expect.extend(spi_read(0x2E, vec![0, 0]));
+    expect.extend(spi_read(0x16, vec![0x00])); // FIFO_CONFIG after a reset: bypass
+    expect.extend(icm_init());
+    expect.extend(icm_fifo_enable());
+    expect.extend(spi_read(0x2D, vec![0x08]));
+    expect.extend(spi_read(0x2E, vec![0, 0]));
+    expect.extend(spi_read(0x16, vec![0x40])); // stream mode: simply empty
+    let mut imu = Icm42688::new(SpiMock::new(&expect));
+    imu.init(&mut NoopDelay, icm_config()).unwrap();
+    imu.enable_fifo().unwrap();
+    let mut out = [RawSample::default(); 4];
+    assert_eq!(imu.read_fifo(&mut out), Ok(1));
+    assert_eq!(imu.read_fifo(&mut out), Err(Error::SensorReset));
+    imu.recover(&mut NoopDelay, 120_000).unwrap();
+    assert_eq!(imu.read_fifo(&mut out), Ok(0));
+    let stats = imu.fifo_stats();
+    assert_eq!((stats.samples, stats.resets, stats.lost), (1, 1, 12));
     imu.destroy().done();
 }
 

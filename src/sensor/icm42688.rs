@@ -39,6 +39,8 @@ const ID: u8 = 0x47;
 const READ: u8 = 0x80;
 const FIFO_FULL: u8 = 1 << 1;
 const FIFO_FLUSH: u8 = 1 << 1;
+/// FIFO_CONFIG: stream-to-FIFO mode (0 after a reset: bypass).
+const FIFO_STREAM: u8 = 0b0100_0000;
 /// Packet 3: header, accel x/y/z, gyro x/y/z (big-endian), temperature (1 byte), timestamp (2).
 const PACKET: usize = 16;
 /// Header bits: HEADER_MSG (7, FIFO empty), HEADER_ACCEL (6), HEADER_GYRO (5).
@@ -134,6 +136,23 @@ pub enum Odr {
     Hz50 = 9,
     /// 25 Hz.
     Hz25 = 10,
+}
+
+impl Odr {
+    /// The rate in Hz.
+    pub fn hz(self) -> f32 {
+        match self {
+            Odr::Hz8000 => 8000.0,
+            Odr::Hz4000 => 4000.0,
+            Odr::Hz2000 => 2000.0,
+            Odr::Hz1000 => 1000.0,
+            Odr::Hz500 => 500.0,
+            Odr::Hz200 => 200.0,
+            Odr::Hz100 => 100.0,
+            Odr::Hz50 => 50.0,
+            Odr::Hz25 => 25.0,
+        }
+    }
 }
 
 /// Configuration written by [`Icm42688::init`] (gyro and accelerometer at the same rate).
@@ -279,6 +298,29 @@ impl<SPI: SpiDevice> Icm42688<SPI> {
         Ok(())
     }
 
+    /// Brings the chip back after [`Error::SensorReset`] (or any suspected glitch): probes
+    /// WHO_AM_I, writes the last configuration again and re-enables the FIFO if it was on.
+    /// `outage_us` is the time from the last good FIFO read to now, by the caller's clock; the
+    /// samples the chip produced in it are counted in [`FifoStats::lost`].
+    ///
+    /// # Errors
+    ///
+    /// As [`Icm42688::init`]; nothing is counted until the recovery succeeds, so it can simply
+    /// be called again.
+    pub fn recover(
+        &mut self,
+        delay: &mut impl DelayNs,
+        outage_us: u32,
+    ) -> Result<(), Error<SPI::Error>> {
+        let fifo = self.fifo;
+        self.init(delay, self.config)?;
+        if fifo {
+            self.enable_fifo()?;
+        }
+        self.stats.recovered(outage_us, self.config.odr.hz());
+        Ok(())
+    }
+
     /// The configuration written by the last `init`.
     pub fn config(&self) -> &Icm42688Config {
         &self.config
@@ -292,7 +334,7 @@ impl<SPI: SpiDevice> Icm42688<SPI> {
     /// [`Error::Bus`].
     pub fn enable_fifo(&mut self) -> Result<(), Error<SPI::Error>> {
         self.write(FIFO_CONFIG1, 0b0000_0111)?;
-        self.write(FIFO_CONFIG, 0b0100_0000)?;
+        self.write(FIFO_CONFIG, FIFO_STREAM)?;
         self.write(SIGNAL_PATH_RESET, FIFO_FLUSH)?;
         self.fifo = true;
         Ok(())
@@ -347,6 +389,14 @@ impl<SPI: SpiDevice> ImuReader for Icm42688<SPI> {
             return Err(self.stats.overflow(bytes, PACKET));
         }
         let available = usize::from(self.fifo_count()?) / PACKET;
+        if available == 0 {
+            // An empty FIFO may be a chip that reset itself: its FIFO is then in bypass mode.
+            let mut mode = [0];
+            self.read_regs(FIFO_CONFIG, &mut mode)?;
+            if mode[0] != FIFO_STREAM {
+                return Err(Error::SensorReset);
+            }
+        }
         let spi = &mut self.spi;
         let read = |buf: &mut [u8]| {
             spi.transaction(&mut [Operation::Write(&[FIFO_DATA | READ]), Operation::Read(buf)])

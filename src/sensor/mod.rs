@@ -120,6 +120,11 @@ pub struct FifoStats {
     pub discarded: u64,
     /// FIFO packets rejected as malformed (wrong header) and skipped.
     pub malformed: u64,
+    /// Chip resets detected ([`Error::SensorReset`]) and recovered from.
+    pub resets: u64,
+    /// Samples the chip would have delivered during the outages passed to `recover`: from the
+    /// last good FIFO read to the FIFO running again, at the configured output data rate.
+    pub lost: u64,
 }
 
 /// A reader's error: the bus's own, or one of the reader's.
@@ -140,6 +145,9 @@ pub enum Error<E> {
     },
     /// The FIFO is not enabled (call `enable_fifo` first).
     FifoDisabled,
+    /// The chip has reset itself (a supply glitch or brown-out): its FIFO is off and its
+    /// configuration gone. Call the reader's `recover`.
+    SensorReset,
     /// No sample is available (a replay at its end).
     NoData,
 }
@@ -159,6 +167,7 @@ impl<E: fmt::Debug> fmt::Display for Error<E> {
                 write!(f, "FIFO overflow: reset, {discarded} samples discarded")
             }
             Self::FifoDisabled => f.write_str("FIFO is not enabled"),
+            Self::SensorReset => f.write_str("the sensor has reset itself: recover it"),
             Self::NoData => f.write_str("no sample available"),
         }
     }
@@ -186,7 +195,8 @@ pub trait ImuReader {
     /// # Errors
     ///
     /// [`Error::FifoOverflow`] after resetting an overflowed FIFO (nothing is written; call
-    /// again), [`Error::FifoDisabled`], or [`Error::Bus`].
+    /// again), [`Error::SensorReset`] when the FIFO is empty because the chip has reset
+    /// itself, [`Error::FifoDisabled`], or [`Error::Bus`].
     fn read_fifo(&mut self, out: &mut [RawSample]) -> Result<usize, Error<Self::BusError>>;
 
     /// FIFO accounting so far.
@@ -224,6 +234,12 @@ const CHUNK: usize = 8;
 const MAX_PACKET: usize = 16;
 
 impl FifoStats {
+    /// Counts a recovery after an outage of `outage_us` microseconds at `rate_hz`.
+    pub(crate) fn recovered(&mut self, outage_us: u32, rate_hz: f32) {
+        self.resets += 1;
+        self.lost += libm::round(f64::from(outage_us) * f64::from(rate_hz) * 1e-6) as u64;
+    }
+
     /// Counts an overflow whose reset lost the complete packets in `bytes` bytes of FIFO.
     pub(crate) fn overflow<E>(&mut self, bytes: u16, packet: usize) -> Error<E> {
         let discarded = bytes / packet as u16;

@@ -275,6 +275,30 @@ impl<I2C: I2c> Mpu6050<I2C> {
         Ok(id)
     }
 
+    /// Brings the chip back after [`Error::SensorReset`] (or any suspected glitch): probes
+    /// WHO_AM_I, writes the last configuration again and re-enables the FIFO if it was on.
+    /// `outage_us` is the time from the last good FIFO read to now, by the caller's clock; the
+    /// samples the chip produced in it are counted in [`FifoStats::lost`]. Returns WHO_AM_I.
+    ///
+    /// # Errors
+    ///
+    /// As [`Mpu6050::init`]; nothing is counted until the recovery succeeds, so it can simply
+    /// be called again.
+    pub fn recover(
+        &mut self,
+        delay: &mut impl DelayNs,
+        outage_us: u32,
+    ) -> Result<u8, Error<I2C::Error>> {
+        let fifo = self.fifo;
+        let id = self.init(delay, self.config)?;
+        if fifo {
+            self.enable_fifo()?;
+        }
+        self.stats
+            .recovered(outage_us, self.config.sample_rate_hz());
+        Ok(id)
+    }
+
     /// The configuration written by the last `init`.
     pub fn config(&self) -> &Mpu6050Config {
         &self.config
@@ -327,7 +351,9 @@ impl<I2C: I2c> ImuReader for Mpu6050<I2C> {
     }
 
     /// Reads INT_STATUS first: on FIFO_OFLOW_INT the FIFO is reset (its complete packets are
-    /// counted as discarded) and [`Error::FifoOverflow`] is returned. Otherwise the whole
+    /// counted as discarded) and [`Error::FifoOverflow`] is returned. An empty FIFO is checked
+    /// against USER_CTRL: a chip that has reset itself has its FIFO off, and
+    /// [`Error::SensorReset`] is returned (see [`Mpu6050::recover`]). Otherwise the whole
     /// packets in the FIFO (up to `out.len()`) are read, 8 per I2C transfer; a partial packet
     /// stays in the FIFO for the next call. A bus error after some packets were read loses them:
     /// they are counted in [`FifoStats::discarded`].
@@ -344,6 +370,14 @@ impl<I2C: I2c> ImuReader for Mpu6050<I2C> {
             return Err(self.stats.overflow(bytes, PACKET));
         }
         let available = usize::from(self.fifo_count()?) / PACKET;
+        if available == 0 {
+            // An empty FIFO may be a chip that reset itself: its FIFO is then off.
+            let mut user_ctrl = [0];
+            self.read_regs(USER_CTRL, &mut user_ctrl)?;
+            if user_ctrl[0] & USER_CTRL_FIFO_EN == 0 {
+                return Err(Error::SensorReset);
+            }
+        }
         let (i2c, address) = (&mut self.i2c, self.address);
         let read = |buf: &mut [u8]| {
             i2c.write_read(address, &[FIFO_R_W], buf)

@@ -15,7 +15,7 @@
 use cortex_m_rt::entry;
 use defmt_rtt as _;
 use imu_ar::recursive::{Config, Lattice};
-use imu_ar::sensor::{AccelUnit, GyroUnit, ImuReader, Mpu6050, Mpu6050Config, RawSample};
+use imu_ar::sensor::{AccelUnit, Error, GyroUnit, ImuReader, Mpu6050, Mpu6050Config, RawSample};
 use panic_probe as _;
 use stm32f4xx_hal::{i2c::I2c, pac, prelude::*};
 
@@ -49,15 +49,28 @@ fn main() -> ! {
     let scale = imu.scale();
     let mut batch = [RawSample::default(); 32];
     let mut samples = 0u32;
+    // Time since the last good FIFO read, by the polling period.
+    let mut since_good_ms = 0u32;
     loop {
         delay.delay_ms(50u32);
+        since_good_ms = since_good_ms.saturating_add(50);
         let n = match imu.read_fifo(&mut batch) {
             Ok(n) => n,
+            Err(Error::SensorReset) => {
+                // The outage runs until the FIFO is on again, after init's 100 ms.
+                let outage_us = since_good_ms.saturating_add(100).saturating_mul(1000);
+                match imu.recover(&mut delay, outage_us) {
+                    Ok(_) => defmt::warn!("MPU-6050 reset itself: recovered"),
+                    Err(e) => defmt::warn!("recovery failed: {}", defmt::Debug2Format(&e)),
+                }
+                continue;
+            }
             Err(e) => {
                 defmt::warn!("FIFO: {}", defmt::Debug2Format(&e));
                 continue;
             }
         };
+        since_good_ms = 0;
         for s in &batch[..n] {
             let gyro = scale.gyro(s.gyro, GyroUnit::DegPerSec);
             let accel = scale.accel(s.accel, AccelUnit::G);
