@@ -2,7 +2,7 @@
 
 use std::fmt;
 use std::fs::File;
-use std::io::{BufReader, IsTerminal, Write};
+use std::io::{BufReader, IsTerminal, Read, Write};
 use std::path::{Path, PathBuf};
 
 /// A problem with an input file, for a one-line message `FILE[:LINE]: problem`.
@@ -43,18 +43,31 @@ fn error(file: &Path, line: Option<u64>, problem: impl Into<String>) -> DataErro
 /// Every cell must be a finite number: a missing column, an empty or non-numeric cell, NaN or
 /// infinity is an error naming the file and line, and so is a file without data rows.
 pub fn read_column(files: &[PathBuf], column: &str) -> Result<Vec<f64>, DataError> {
-    read_cells(files, column, |cell| match cell.parse::<f64>() {
-        Ok(v) if v.is_finite() => Ok(v),
-        Ok(_) => Err(format!(
-            "column '{column}': '{cell}' is not a finite number"
-        )),
-        Err(_) => Err(format!("column '{column}': '{cell}' is not a number")),
-    })
+    read_cells(files, column, finite(column))
 }
 
 /// Reads column `column` of each file as text, as [`read_column`] reads numbers.
 pub fn read_text_column(files: &[PathBuf], column: &str) -> Result<Vec<String>, DataError> {
     read_cells(files, column, |cell| Ok(cell.to_string()))
+}
+
+/// Reads column `column` of CSV text held in memory, as [`read_column`] reads a file;
+/// errors name `label` as the file.
+pub fn parse_column(label: &Path, bytes: &[u8], column: &str) -> Result<Vec<f64>, DataError> {
+    let mut out = Vec::new();
+    read_source(label, bytes, column, &finite(column), &mut out, false)?;
+    Ok(out)
+}
+
+/// A cell as a finite number, or what is wrong with it.
+fn finite(column: &str) -> impl Fn(&str) -> Result<f64, String> + '_ {
+    move |cell| match cell.parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(_) => Err(format!(
+            "column '{column}': '{cell}' is not a finite number"
+        )),
+        Err(_) => Err(format!("column '{column}': '{cell}' is not a number")),
+    }
 }
 
 /// The cells of `column`, each converted by `parse` (whose error names the problem).
@@ -67,55 +80,69 @@ fn read_cells<T>(
     let mut out = Vec::new();
     for path in files {
         let file = File::open(path).map_err(|e| error(path, None, format!("cannot open: {e}")))?;
-        let mut reader = csv::ReaderBuilder::new()
-            .comment(Some(b'#'))
-            .trim(csv::Trim::All)
-            .flexible(true)
-            .from_reader(BufReader::with_capacity(1 << 16, file));
-        let headers = reader
-            .headers()
-            .map_err(|e| error(path, None, format!("cannot read the header: {e}")))?
-            .clone();
-        if headers.is_empty() {
-            return Err(error(path, None, "empty file (no header row)"));
-        }
-        let Some(index) = headers.iter().position(|h| h == column) else {
-            let names: Vec<&str> = headers.iter().collect();
-            return Err(error(
-                path,
-                None,
-                format!("no column '{column}' (columns: {})", names.join(", ")),
-            ));
-        };
-        let start = out.len();
-        let mut record = csv::StringRecord::new();
-        loop {
-            match reader.read_record(&mut record) {
-                Ok(false) => break,
-                Ok(true) => {}
-                Err(e) => {
-                    let line = e.position().map(|p| p.line());
-                    return Err(error(path, line, format!("malformed CSV: {e}")));
-                }
-            }
-            let line = record.position().map(|p| p.line());
-            let cell = record.get(index).ok_or_else(|| {
-                error(path, line, format!("column '{column}' missing in this row"))
-            })?;
-            out.push(parse(cell).map_err(|problem| error(path, line, problem))?);
-            if progress && out.len() % 100_000 == 0 {
-                eprint!("\rread {} rows", out.len());
-                let _ = std::io::stderr().flush();
-            }
-        }
-        if out.len() == start {
-            return Err(error(path, None, "no data rows"));
-        }
+        let source = BufReader::with_capacity(1 << 16, file);
+        read_source(path, source, column, &parse, &mut out, progress)?;
     }
     if progress && out.len() >= 100_000 {
         eprintln!("\rread {} rows", out.len());
     }
     Ok(out)
+}
+
+/// Appends the cells of `column` of one CSV source (named `path` in errors) to `out`.
+fn read_source<T>(
+    path: &Path,
+    source: impl Read,
+    column: &str,
+    parse: &impl Fn(&str) -> Result<T, String>,
+    out: &mut Vec<T>,
+    progress: bool,
+) -> Result<(), DataError> {
+    let mut reader = csv::ReaderBuilder::new()
+        .comment(Some(b'#'))
+        .trim(csv::Trim::All)
+        .flexible(true)
+        .from_reader(source);
+    let headers = reader
+        .headers()
+        .map_err(|e| error(path, None, format!("cannot read the header: {e}")))?
+        .clone();
+    if headers.is_empty() {
+        return Err(error(path, None, "empty file (no header row)"));
+    }
+    let Some(index) = headers.iter().position(|h| h == column) else {
+        let names: Vec<&str> = headers.iter().collect();
+        return Err(error(
+            path,
+            None,
+            format!("no column '{column}' (columns: {})", names.join(", ")),
+        ));
+    };
+    let start = out.len();
+    let mut record = csv::StringRecord::new();
+    loop {
+        match reader.read_record(&mut record) {
+            Ok(false) => break,
+            Ok(true) => {}
+            Err(e) => {
+                let line = e.position().map(|p| p.line());
+                return Err(error(path, line, format!("malformed CSV: {e}")));
+            }
+        }
+        let line = record.position().map(|p| p.line());
+        let cell = record
+            .get(index)
+            .ok_or_else(|| error(path, line, format!("column '{column}' missing in this row")))?;
+        out.push(parse(cell).map_err(|problem| error(path, line, problem))?);
+        if progress && out.len().is_multiple_of(100_000) {
+            eprint!("\rread {} rows", out.len());
+            let _ = std::io::stderr().flush();
+        }
+    }
+    if out.len() == start {
+        return Err(error(path, None, "no data rows"));
+    }
+    Ok(())
 }
 
 /// Averages of consecutive blocks of `m` samples (a last, incomplete block is dropped): the

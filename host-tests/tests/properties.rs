@@ -7,8 +7,13 @@ use imu_ar::fixed_point::{FixedConfig, FixedLattice};
 use imu_ar::recursive::{Config, Health, Lattice, Rls, RlsInit};
 use proptest::prelude::*;
 
-/// Cases per property; `PROPTEST_CASES` overrides it.
-const CASES: u32 = 256;
+/// Cases per property: 256, or `PROPTEST_CASES`.
+fn cases() -> u32 {
+    std::env::var("PROPTEST_CASES")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(256)
+}
 
 /// The state of one estimator behind one interface.
 trait Estimator {
@@ -180,7 +185,7 @@ fn all_finite(v: &[f64]) -> bool {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(CASES))]
+    #![proptest_config(ProptestConfig::with_cases(cases()))]
 
     /// Finite input: every error and everything published is finite (NaN only marks "no
     /// model yet"), and each sample is either taken or rejected as saturated, never lost.

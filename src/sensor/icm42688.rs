@@ -189,7 +189,11 @@ impl Icm42688Config {
 /// #         for op in ops {
 /// #             match op {
 /// #                 Operation::Write(w) => reg = w[0],
-/// #                 Operation::Read(b) => { b.fill(0); if reg == 0xF5 { b[0] = 0x47; } }
+/// #                 Operation::Read(b) => {
+/// #                     b.fill(0);
+/// #                     if reg == 0xF5 { b[0] = 0x47; } // WHO_AM_I
+/// #                     if reg == 0x96 { b[0] = 0x40; } // FIFO_CONFIG: stream mode
+/// #                 }
 /// #                 _ => {}
 /// #             }
 /// #         }
