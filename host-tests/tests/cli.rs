@@ -152,153 +152,152 @@ fn fit_reports_the_documented_keys_and_convention() {
     std::fs::remove_file(file).unwrap();
 }
 
-#[test]
-fn bad_input_exits_2_with_one_line_and_no_stdout() {
-    let good = temp_file(
-        "good.csv",
-        "# a comment\nt_s,x\n0,1\n0.01,2\n0.02,1.5\n0.03,0.5\n",
-    );
-    let text = temp_file("text.csv", "t_s,x\n0,1\n0.01,abc\n");
-    let nan = temp_file("nan.csv", "t_s,x\n0,1\n0.01,2\n0.02,NaN\n");
-    let empty = temp_file("empty.csv", "");
-    let header = temp_file("header.csv", "t_s,x\n");
-    let constant = temp_file("constant.csv", &format!("x\n{}", "3\n".repeat(50)));
-    let (g, t, n, e, h, c) = (
-        good.to_str().unwrap(),
-        text.to_str().unwrap(),
-        nan.to_str().unwrap(),
-        empty.to_str().unwrap(),
-        header.to_str().unwrap(),
-        constant.to_str().unwrap(),
-    );
-    let cases: Vec<(Vec<&str>, String)> = vec![
-        (
-            vec![
-                "fit",
-                "/nonexistent/log.csv",
-                "--column",
-                "x",
-                "--method",
-                "ls",
-                "--order",
-                "1",
-            ],
-            "/nonexistent/log.csv: cannot open".into(),
-        ),
-        (
-            vec!["fit", g, "--column", "gq", "--method", "ls", "--order", "1"],
-            format!("{g}: no column 'gq' (columns: t_s, x)"),
-        ),
-        (
-            vec!["fit", t, "--column", "x", "--method", "ls", "--order", "1"],
-            format!("{t}:3: column 'x': 'abc' is not a number"),
-        ),
-        (
-            vec!["fit", n, "--column", "x", "--method", "ls", "--order", "1"],
-            format!("{n}:4: column 'x': 'NaN' is not a finite number"),
-        ),
-        (
-            vec!["adev", e, "--column", "x", "--rate", "100"],
-            format!("{e}: empty file"),
-        ),
-        (
-            vec!["adev", h, "--column", "x", "--rate", "100"],
-            format!("{h}: no data rows"),
-        ),
-        (
-            vec!["fit", g, "--column", "x", "--method", "ls", "--order", "3"],
-            format!("{g}: 4 samples given, at least 6 needed"),
-        ),
-        (
-            vec!["fit", g, "--column", "x", "--method", "ls", "--order", "33"],
-            "--order 33: the order must be 1 to 32".into(),
-        ),
-        (
-            vec!["fit", g, "--column", "x", "--method", "ls", "--order", "0"],
-            "--order 0: the order must be 1 to 32".into(),
-        ),
-        (
-            vec![
-                "order",
-                g,
-                "--column",
-                "x",
-                "--method",
-                "ls",
-                "--max-order",
-                "40",
-            ],
-            "--max-order 40: the order must be 1 to 32".into(),
-        ),
-        (
-            vec![
-                "fit", c, "--column", "x", "--method", "burg", "--order", "1",
-            ],
-            format!("{c}: data have zero variance"),
-        ),
-        (
-            vec!["adev", g, "--column", "x", "--rate", "-5"],
-            "--rate -5: must be a positive number".into(),
-        ),
-        (
-            vec![
-                "fit", g, "--column", "x", "--method", "ls", "--order", "1", "--rate", "0",
-            ],
-            "--rate 0: must be a positive number".into(),
-        ),
-        (
-            vec![
-                "fit", g, "--column", "x", "--method", "kalman", "--order", "1",
-            ],
-            "invalid value 'kalman' for '--method".into(),
-        ),
-        (
-            vec![
-                "fit", g, "--column", "x", "--method", "ls", "--order", "two",
-            ],
-            "invalid value 'two' for '--order".into(),
-        ),
-        (
-            vec![
-                "simulate", "--a", "1.0", "--sigma", "1", "--n", "10", "--seed", "1",
-            ],
-            "the model is not stationary".into(),
-        ),
-        (
-            vec![
-                "simulate", "--a", "0.5", "--sigma", "nan", "--n", "10", "--seed", "1",
-            ],
-            "--sigma NaN: must be finite".into(),
-        ),
-        (
-            vec!["adev", g, "--rate", "100"],
-            "the following required arguments were not provided".into(),
-        ),
-    ];
-    for (args, expected) in cases {
-        let out = imu_ar(&args);
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(
-            out.status.code(),
-            Some(2),
-            "{args:?}: status {:?}, stderr {stderr}",
-            out.status
-        );
-        assert!(out.stdout.is_empty(), "{args:?}: wrote to stdout");
-        assert_eq!(
-            stderr.lines().count(),
-            1,
-            "{args:?}: stderr is not one line: {stderr}"
-        );
-        assert!(stderr.starts_with("imu-ar: "), "{args:?}: {stderr}");
-        assert!(
-            stderr.contains(&expected),
-            "{args:?}: {stderr:?} does not contain {expected:?}"
-        );
+/// Six input files for a misuse case, named after it: good, text cell, NaN cell, empty,
+/// header only, constant. Removed when dropped.
+struct Inputs([PathBuf; 6]);
+
+impl Inputs {
+    fn new(case: &str) -> Self {
+        let contents = [
+            "# a comment\nt_s,x\n0,1\n0.01,2\n0.02,1.5\n0.03,0.5\n".to_string(),
+            "t_s,x\n0,1\n0.01,abc\n".to_string(),
+            "t_s,x\n0,1\n0.01,2\n0.02,NaN\n".to_string(),
+            String::new(),
+            "t_s,x\n".to_string(),
+            format!("x\n{}", "3\n".repeat(50)),
+        ];
+        let names = ["good", "text", "nan", "empty", "header", "constant"];
+        Self(core::array::from_fn(|i| {
+            temp_file(&format!("{case}-{}.csv", names[i]), &contents[i])
+        }))
     }
-    for f in [good, text, nan, empty, header, constant] {
-        std::fs::remove_file(f).unwrap();
+
+    fn paths(&self) -> [&str; 6] {
+        core::array::from_fn(|i| self.0[i].to_str().unwrap())
     }
+}
+
+impl Drop for Inputs {
+    fn drop(&mut self) {
+        for f in &self.0 {
+            let _ = std::fs::remove_file(f);
+        }
+    }
+}
+
+/// `imu-ar ARGS` exits with status 2, prints nothing on stdout and one line on stderr that
+/// contains `expected`.
+fn misused(args: &[&str], expected: &str) {
+    let out = imu_ar(args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(
+        out.status.code(),
+        Some(2),
+        "{args:?}: status {:?}, stderr {stderr}",
+        out.status
+    );
+    assert!(out.stdout.is_empty(), "{args:?}: wrote to stdout");
+    assert_eq!(
+        stderr.lines().count(),
+        1,
+        "{args:?}: stderr is not one line: {stderr}"
+    );
+    assert!(stderr.starts_with("imu-ar: "), "{args:?}: {stderr}");
+    assert!(
+        stderr.contains(expected),
+        "{args:?}: {stderr:?} does not contain {expected:?}"
+    );
+}
+
+/// One test per misuse: `name: |[good, text, nan, empty, header, constant]| (args, expected)`.
+macro_rules! misuse {
+    ($($name:ident: $case:expr;)*) => {
+        $(
+            #[test]
+            fn $name() {
+                let inputs = Inputs::new(stringify!($name));
+                #[allow(unused_variables)]
+                let case: fn([&str; 6]) -> (Vec<&str>, String) = $case;
+                let (args, expected) = case(inputs.paths());
+                misused(&args, &expected);
+            }
+        )*
+    };
+}
+
+misuse! {
+    missing_file: |[g, t, n, e, h, c]| (
+        vec!["fit", "/nonexistent/log.csv", "--column", "x", "--method", "ls", "--order", "1"],
+        "/nonexistent/log.csv: cannot open".into(),
+    );
+    missing_column: |[g, t, n, e, h, c]| (
+        vec!["fit", g, "--column", "gq", "--method", "ls", "--order", "1"],
+        format!("{g}: no column 'gq' (columns: t_s, x)"),
+    );
+    non_numeric_cell: |[g, t, n, e, h, c]| (
+        vec!["fit", t, "--column", "x", "--method", "ls", "--order", "1"],
+        format!("{t}:3: column 'x': 'abc' is not a number"),
+    );
+    nan_cell: |[g, t, n, e, h, c]| (
+        vec!["fit", n, "--column", "x", "--method", "ls", "--order", "1"],
+        format!("{n}:4: column 'x': 'NaN' is not a finite number"),
+    );
+    empty_file: |[g, t, n, e, h, c]| (
+        vec!["adev", e, "--column", "x", "--rate", "100"],
+        format!("{e}: empty file"),
+    );
+    header_only: |[g, t, n, e, h, c]| (
+        vec!["adev", h, "--column", "x", "--rate", "100"],
+        format!("{h}: no data rows"),
+    );
+    too_few_samples_for_the_order: |[g, t, n, e, h, c]| (
+        vec!["fit", g, "--column", "x", "--method", "ls", "--order", "3"],
+        format!("{g}: 4 samples given, at least 6 needed"),
+    );
+    order_above_32: |[g, t, n, e, h, c]| (
+        vec!["fit", g, "--column", "x", "--method", "ls", "--order", "33"],
+        "--order 33: the order must be 1 to 32".into(),
+    );
+    order_zero: |[g, t, n, e, h, c]| (
+        vec!["fit", g, "--column", "x", "--method", "ls", "--order", "0"],
+        "--order 0: the order must be 1 to 32".into(),
+    );
+    max_order_above_32: |[g, t, n, e, h, c]| (
+        vec!["order", g, "--column", "x", "--method", "ls", "--max-order", "40"],
+        "--max-order 40: the order must be 1 to 32".into(),
+    );
+    constant_data: |[g, t, n, e, h, c]| (
+        vec!["fit", c, "--column", "x", "--method", "burg", "--order", "1"],
+        format!("{c}: data have zero variance"),
+    );
+    negative_rate: |[g, t, n, e, h, c]| (
+        vec!["adev", g, "--column", "x", "--rate", "-5"],
+        "--rate -5: must be a positive number".into(),
+    );
+    zero_rate: |[g, t, n, e, h, c]| (
+        vec!["fit", g, "--column", "x", "--method", "ls", "--order", "1", "--rate", "0"],
+        "--rate 0: must be a positive number".into(),
+    );
+    unknown_method: |[g, t, n, e, h, c]| (
+        vec!["fit", g, "--column", "x", "--method", "kalman", "--order", "1"],
+        "invalid value 'kalman' for '--method".into(),
+    );
+    order_not_a_number: |[g, t, n, e, h, c]| (
+        vec!["fit", g, "--column", "x", "--method", "ls", "--order", "two"],
+        "invalid value 'two' for '--order".into(),
+    );
+    non_stationary_simulation: |[g, t, n, e, h, c]| (
+        vec!["simulate", "--a", "1.0", "--sigma", "1", "--n", "10", "--seed", "1"],
+        "the model is not stationary".into(),
+    );
+    nan_sigma: |[g, t, n, e, h, c]| (
+        vec!["simulate", "--a", "0.5", "--sigma", "nan", "--n", "10", "--seed", "1"],
+        "--sigma NaN: must be finite".into(),
+    );
+    missing_argument: |[g, t, n, e, h, c]| (
+        vec!["adev", g, "--rate", "100"],
+        "the following required arguments were not provided".into(),
+    );
 }
 
 #[test]
