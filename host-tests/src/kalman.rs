@@ -74,8 +74,8 @@ pub fn handoff<const P: usize>(
             .sqrt();
         let tau = m as f64 / rate;
         // The measured value scatters about the model's, by the standard error.
-        let (ratio, tol) = (data / fitted, tolerance(n, m));
-        let agrees = (ratio - 1.0).abs() <= tol;
+        let (data_over_model, tol) = (data / fitted, tolerance(n, m));
+        let agrees = (data_over_model - 1.0).abs() <= tol;
         agreeing &= agrees;
         if agreeing {
             explained_up_to = Some(tau);
@@ -84,7 +84,7 @@ pub fn handoff<const P: usize>(
             "tau_s": tau,
             "data_adev": data,
             "model_adev": fitted,
-            "data_over_model": ratio,
+            "data_over_model": data_over_model,
             "tolerance": tol,
             "agrees": agrees,
         }));

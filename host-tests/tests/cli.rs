@@ -529,20 +529,13 @@ fn decimate_fits_the_block_averages() {
 fn report_writes_four_pngs_and_a_summary() {
     let file = drift_record("report.csv", "20000");
     let out = std::env::temp_dir().join(format!("imu-ar-cli-{}-report", std::process::id()));
-    let v = json(&imu_ar(&[
-        "report",
-        file.to_str().unwrap(),
-        "--column",
-        "x",
-        "--order",
-        "2",
-        "--lambda",
-        "0.99",
-        "--rate",
-        "100",
-        "--out",
-        out.to_str().unwrap(),
-    ]));
+    let (f, o) = (file.to_str().unwrap(), out.to_str().unwrap());
+    let report = |extra: &[&'static str]| {
+        let mut args = vec!["report", f, "--column", "x", "--order", "2", "--out", o];
+        args.extend_from_slice(extra);
+        args
+    };
+    let v = json(&imu_ar(&report(&["--lambda", "0.99", "--rate", "100"])));
     for name in ["coefficients", "prediction_error", "psd", "adev"] {
         let png = std::fs::read(out.join(format!("{name}.png"))).unwrap();
         assert!(png.len() > 10_000, "{name}.png: {} bytes", png.len());
@@ -558,40 +551,13 @@ fn report_writes_four_pngs_and_a_summary() {
         v["lattice_mse"].as_f64().unwrap(),
     );
     assert!(lattice < batch, "lattice {lattice}, batch {batch}");
-    let bad = imu_ar(&[
-        "report",
-        file.to_str().unwrap(),
-        "--column",
-        "x",
-        "--order",
-        "2",
-        "--rate",
-        "0",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert_eq!(bad.status.code(), Some(2));
-    assert!(bad.stdout.is_empty());
-    let short = imu_ar(&[
-        "report",
-        file.to_str().unwrap(),
-        "--column",
-        "x",
-        "--order",
-        "2",
-        "--rate",
-        "100",
-        "--decimate",
-        "1000",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert_eq!(short.status.code(), Some(2));
-    assert!(
-        String::from_utf8_lossy(&short.stderr)
-            .contains("at least 64 samples (after --decimate), not 20"),
-        "{}",
-        String::from_utf8_lossy(&short.stderr)
+    misused(
+        &report(&["--rate", "0"]),
+        "--rate 0: must be a positive number",
+    );
+    misused(
+        &report(&["--rate", "100", "--decimate", "1000"]),
+        "at least 64 samples (after --decimate), not 20",
     );
 }
 
@@ -687,15 +653,19 @@ fn kalman_hands_over_phi_q_and_the_allan_check() {
     );
 
     // Misuse: a rate that is no integer fraction of an AR(2)'s, a recursive method.
-    for args in [
-        &["--order", "2", "--rate", "100", "--filter-rate", "30"][..],
-        &["--order", "2", "--rate", "100", "--method", "lattice"][..],
-        &["--order", "2", "--rate", "100", "--filter-rate", "-1"][..],
+    let f = file.to_str().unwrap();
+    for (extra, expected) in [
+        (["--filter-rate", "30"], "is not an integer multiple of it"),
+        (["--method", "lattice"], "the hand-off takes a batch fit"),
+        (
+            ["--filter-rate", "-1"],
+            "--filter-rate -1: must be a positive number",
+        ),
     ] {
-        let out = kalman(&file, args);
-        assert_eq!(out.status.code(), Some(2), "{args:?}");
-        assert!(out.stdout.is_empty());
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(err.lines().count(), 1, "{err}");
+        let mut args = vec![
+            "kalman", f, "--column", "x", "--order", "2", "--rate", "100",
+        ];
+        args.extend_from_slice(&extra);
+        misused(&args, expected);
     }
 }
