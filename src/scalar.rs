@@ -29,6 +29,8 @@ pub trait Scalar:
     const ZERO: Self;
     /// One.
     const ONE: Self;
+    /// Machine epsilon: the distance from 1 to the next larger value.
+    const EPSILON: Self;
 
     /// The value nearest to `x` (rounded to nearest, saturating where the type is bounded).
     fn from_f64(x: f64) -> Self;
@@ -48,6 +50,7 @@ macro_rules! impl_scalar_float {
         impl Scalar for $t {
             const ZERO: Self = 0.0;
             const ONE: Self = 1.0;
+            const EPSILON: Self = <$t>::EPSILON;
 
             #[inline]
             fn from_f64(x: f64) -> Self {

@@ -29,7 +29,7 @@ use imu_ar::allan::overlapping_avar;
 use imu_ar::batch::criteria::Criterion;
 use imu_ar::batch::{BatchConfig, BatchError, Fit, burg, covariance, yule_walker};
 use imu_ar::fixed_point::{FixedConfig, FixedLattice};
-use imu_ar::recursive::{Config, FloatArith, Lattice, Rls, RlsInit};
+use imu_ar::recursive::{Config, FloatArith, Lattice, Rls, RlsInit, Sftf};
 use imu_ar::sim::StandardNormal;
 use imu_ar_host::data::{block_average, read_column};
 use kalman::handoff;
@@ -94,6 +94,9 @@ pub(crate) enum Method {
     Rls,
     /// EF-LSL lattice, model after the last sample.
     Lattice,
+    /// Stabilised fast transversal filter with its divergence monitor, model after the last
+    /// sample (the last good one if it was just rescued).
+    Sftf,
 }
 
 impl Method {
@@ -104,11 +107,12 @@ impl Method {
             Method::Burg => "burg",
             Method::Rls => "rls",
             Method::Lattice => "lattice",
+            Method::Sftf => "sftf",
         }
     }
 
     fn recursive(self) -> bool {
-        matches!(self, Method::Rls | Method::Lattice)
+        matches!(self, Method::Rls | Method::Lattice | Method::Sftf)
     }
 }
 
@@ -485,13 +489,16 @@ fn run(command: Command) -> Result<String, Fail> {
             } else {
                 format!(
                     "AR({order}), lambda {lambda}: training {} samples, evaluation {}\n\
-                     one-step prediction MSE: batch LS {}, RLS {}, lattice {}\n\
+                     one-step prediction MSE: batch LS {}, RLS {}, lattice {}, SFTF {} \
+                     ({} rescues)\n\
                      lattice against batch: {:.1} % lower\n",
                     v["n_train"],
                     v["n_eval"],
                     v["batch_mse"],
                     v["rls_mse"],
                     v["lattice_mse"],
+                    v["sftf_mse"],
+                    v["sftf_restarts"],
                     v["reduction_percent"].as_f64().unwrap_or(f64::NAN)
                 )
             })
@@ -738,7 +745,9 @@ pub(crate) fn batch_fit<const P: usize>(
         Method::Ls => covariance::<f64, P>(x, config),
         Method::YuleWalker => yule_walker::<f64, P>(x, config),
         Method::Burg => burg::<f64, P>(x, config),
-        Method::Rls | Method::Lattice => unreachable!("recursive methods go to recursive_fit"),
+        Method::Rls | Method::Lattice | Method::Sftf => {
+            unreachable!("recursive methods go to recursive_fit")
+        }
     }
 }
 
@@ -753,7 +762,7 @@ struct Recursive {
     rate: Option<f64>,
 }
 
-/// Runs RLS or the lattice in `T` over `x` and reports the model after the last sample.
+/// Runs RLS, the lattice or the SFTF in `T` over `x` and reports the model after the last sample.
 fn recursive_fit<T: FloatArith, const P: usize>(x: &[f64], r: &Recursive) -> Result<Value, Fail> {
     let config = Config::new(
         T::from_f64(r.lambda),
@@ -768,6 +777,13 @@ fn recursive_fit<T: FloatArith, const P: usize>(x: &[f64], r: &Recursive) -> Res
                 rls.update(&config, T::from_f64(v));
             }
             (rls.model(&config), rls.health(), None)
+        }
+        Method::Sftf => {
+            let mut sftf = Sftf::<T, P>::new(&config);
+            for &v in x {
+                sftf.update(&config, T::from_f64(v));
+            }
+            (sftf.model(&config), sftf.health(), None)
         }
         _ => {
             let mut lattice = Lattice::<T, P>::new(&config);
@@ -856,7 +872,8 @@ fn gauss_markov_json(v: &mut Value, a: &[f64], noise_variance: f64, dt: f64) {
 }
 
 /// One-step prediction MSE on the evaluation part `x[n_train..]`: batch LS fitted on
-/// `x[..n_train]`, RLS and lattice (f64) running over the whole record.
+/// `x[..n_train]`, RLS, lattice and SFTF (f64) running over the whole record. The SFTF's MSE
+/// is over the samples it returned an error for (all but its rescues, `sftf_restarts`).
 fn compare<const P: usize>(x: &[f64], lambda: f64, delta: f64, train: f64) -> Result<Value, Fail> {
     let n_train = (train * x.len() as f64) as usize;
     let n_eval = x.len() - n_train;
@@ -867,12 +884,19 @@ fn compare<const P: usize>(x: &[f64], lambda: f64, delta: f64, train: f64) -> Re
     let config = Config::new(lambda, delta, 1.0)?;
     let mut rls = Rls::<f64, P>::new(&config, RlsInit::ShiftConsistent);
     let mut lattice = Lattice::<f64, P>::new(&config);
+    let mut sftf = Sftf::<f64, P>::new(&config);
     let (mut batch_se, mut rls_se, mut lattice_se) = (0.0, 0.0, 0.0);
+    let (mut sftf_se, mut sftf_n) = (0.0, 0usize);
     for (n, &v) in x.iter().enumerate() {
         let e_rls = rls.update(&config, v).unwrap_or(f64::NAN);
         let e_lattice = lattice.update(&config, v).unwrap_or(f64::NAN);
+        let e_sftf = sftf.update(&config, v);
         if n < n_train {
             continue;
+        }
+        if let Some(e) = e_sftf {
+            sftf_se += e * e;
+            sftf_n += 1;
         }
         let past: [f64; P] = core::array::from_fn(|k| x[n - 1 - k]);
         let e_batch = v - batch.predict(&past);
@@ -890,6 +914,8 @@ fn compare<const P: usize>(x: &[f64], lambda: f64, delta: f64, train: f64) -> Re
         "batch_mse": batch_mse,
         "rls_mse": rls_mse,
         "lattice_mse": lattice_mse,
+        "sftf_mse": sftf_se / sftf_n as f64,
+        "sftf_restarts": sftf.health().restarts,
         "reduction_percent": 100.0 * (batch_mse - lattice_mse) / batch_mse,
     }))
 }
@@ -934,6 +960,9 @@ fn fit_text(v: &Value) -> String {
     );
     if let Some(k) = v.get("reflection") {
         s += &format!("reflection {k}\n");
+    }
+    if let Some(r) = v.get("restarts") {
+        s += &format!("restarts {r}\n");
     }
     if let Some(gm) = v.get("gauss_markov") {
         s += &format!(

@@ -29,6 +29,7 @@ pub(crate) mod lattice;
 mod mean;
 mod order;
 mod rls;
+mod sftf;
 
 use core::fmt;
 
@@ -39,6 +40,7 @@ pub use lattice::{Core, Lattice};
 pub use mean::RunningMean;
 pub use order::{OrderRule, OrderSelector};
 pub use rls::{Rls, RlsInit};
+pub use sftf::Sftf;
 
 /// Why a [`Config`] was refused.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -1,0 +1,237 @@
+//! The stabilised fast transversal filter (SFTF), `O(P)` per sample, with its divergence
+//! monitor and rescue.
+
+use super::{Config, Health, Shell};
+use crate::{ArModel, Scalar};
+
+/// Added to both energy updates, as in the lattice: keeps `alpha` and `beta` positive (and
+/// divisible) however long the input is exactly zero.
+const FLOOR: f64 = 1e-30;
+
+/// The monitor's threshold `tau` on the disagreement of the two backward errors: `1e-2` in
+/// single precision, `1e-6` in double. The largest disagreement of a healthy run measured over
+/// 10^6 samples of the section 8 processes is `5.4e-3` in `f32` and `1.2e-11` in `f64` (both
+/// on the Percival-Walden AR(4), `cond R ~ 1e6`, at `lambda = 0.9999`).
+fn tau<T: Scalar>() -> T {
+    if T::EPSILON > T::from_f64(1e-10) {
+        T::from_f64(1e-2)
+    } else {
+        T::from_f64(1e-6)
+    }
+}
+
+/// Largest healthy conversion factor: rounding may set `gamma` a little above 1.
+const GAMMA_MAX: f64 = 1.0 + 1e-3;
+
+/// Exponentially weighted least-squares AR estimator that outputs the transversal coefficients
+/// every sample at `O(P)` cost: the stabilised fast transversal filter of Slock & Kailath
+/// (1991, IEEE Trans. SP 39(1):92-114), with the conversion factor computed directly, as
+/// written in numerics.md section 2.3.
+///
+/// State: forward and backward predictors `a`, `b`, the gain `g`, the energies `alpha`,
+/// `beta`, the conversion factor `gamma` and the delay line `phi_n = [y_{n-1} .. y_{n-P}]`.
+/// Per sample `y_n`:
+///
+/// ```text
+/// e     = y_n - a^T phi_n,   eps = gamma e                a-priori / a-posteriori error
+/// c     = e / (lambda alpha),   gbar = [c; g - c a]        extended gain (old a), length P+1
+/// a    <- a + eps g,   alpha <- lambda alpha + eps e
+/// r_f   = y_{n-P} - b^T phi_{n+1},   r_s = lambda beta gbar_P
+/// r1    = 1.5 r_f - 0.5 r_s,   r2 = 2.5 r_f - 1.5 r_s     the backward error, twice, fed back
+/// g    <- gbar_{0..P-1} + gbar_P b
+/// gamma = 1 / (1 + g^T phi_{n+1})
+/// beta <- lambda beta + gamma r2^2,   b <- b + gamma r1 g
+/// ```
+///
+/// from `a = b = g = 0`, `gamma = 1`, `alpha = delta lambda^P`, `beta = delta`, the initial
+/// state of the problem in the [module docs](super): in exact arithmetic `a` is the same
+/// `a_n` the lattice and [`Rls`](super::Rls) compute, and `alpha` the lattice's order-`P`
+/// energy. About `7P` multiplications and two divisions per sample.
+///
+/// The fast transversal filters are only conditionally stable in finite precision: the
+/// feedback of `r_f - r_s` keeps this one stable for `lambda > 1 - 1/(2P)` on data its order
+/// describes, but not below that, and not when the order under-fits a resonant input
+/// (numerics.md section 8); there the error grows in `f64` as well as in `f32`. So every sample
+/// is checked, and the state is re-initialised (a rescue, counted in [`Health::restarts`]) when
+///
+/// * the two backward errors disagree: `|r_f - r_s| > tau (|r_f| + sqrt((1 - lambda) beta))`,
+///   `tau = 1e-2` in `f32`, `1e-6` in `f64`;
+/// * `gamma` leaves `(0, 1 + 1e-3]`, or `alpha` or `beta` is not positive;
+/// * any value is not finite.
+///
+/// The rescue zeroes the delay line and restarts from the initial state, and
+/// [`Sftf::model`] keeps returning the last model published before it for `3/(1 - lambda)`
+/// samples. Where the lattice and this filter both apply, prefer the [`Lattice`](super::Lattice):
+/// it never needs rescuing; this filter is for firmware that must have `a` every sample.
+///
+/// ```
+/// use imu_ar::recursive::{Config, Sftf};
+/// use imu_ar::{ArModel, sim::ArSimulator};
+/// # struct Lcg(u64);
+/// # impl rand_core::RngCore for Lcg {
+/// #     fn next_u32(&mut self) -> u32 { (self.next_u64() >> 32) as u32 }
+/// #     fn next_u64(&mut self) -> u64 { self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407); self.0 }
+/// #     fn fill_bytes(&mut self, d: &mut [u8]) { rand_core::impls::fill_bytes_via_next(self, d) }
+/// # }
+///
+/// let truth = ArModel::new([1.2f32, -0.5], 1.0, 0.0, 0.01).unwrap();
+/// let mut sensor = ArSimulator::new(truth);
+/// let mut rng = Lcg(7);
+///
+/// let config = Config::new(0.999f32, 0.1, 0.01).unwrap();
+/// let mut sftf = Sftf::<f32, 2>::new(&config);
+/// for _ in 0..20_000 {
+///     sftf.update(&config, sensor.next(&mut rng));
+/// }
+/// let a = sftf.coefficients();
+/// assert!((a[0] - 1.2).abs() < 0.05 && (a[1] + 0.5).abs() < 0.05);
+/// assert_eq!(sftf.health().restarts, 0);
+/// ```
+#[derive(Clone, Copy, Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Sftf<T, const P: usize> {
+    a: [T; P],
+    b: [T; P],
+    g: [T; P],
+    /// `y_{n-1} .. y_{n-P}` for the next sample.
+    phi: [T; P],
+    alpha: T,
+    beta: T,
+    gamma: T,
+    error: T,
+    shell: Shell<T, P>,
+}
+
+impl<T: Scalar, const P: usize> Sftf<T, P> {
+    /// A filter at the initial state of the problem.
+    pub fn new(config: &Config<T>) -> Self {
+        const { assert!(P > 0, "the model order P must be at least 1") };
+        Self {
+            a: [T::ZERO; P],
+            b: [T::ZERO; P],
+            g: [T::ZERO; P],
+            phi: [T::ZERO; P],
+            alpha: config.delta_lambda_pow(P),
+            beta: config.delta(),
+            gamma: T::ONE,
+            error: T::ZERO,
+            shell: Shell::new(),
+        }
+    }
+
+    /// Takes one sample and returns the a-priori prediction error `x_n - xhat_n`.
+    ///
+    /// Returns `None` when the sample was rejected (NaN, infinite or saturated: counted, the
+    /// state is unchanged) or when the monitor found the recursion diverging, which
+    /// re-initialises the filter (counted as a restart).
+    pub fn update(&mut self, config: &Config<T>, x: T) -> Option<T> {
+        let y = self.shell.intake(config, x)?;
+        let lambda = config.lambda();
+        let floor = T::from_f64(FLOOR);
+
+        let e = self
+            .a
+            .iter()
+            .zip(&self.phi)
+            .fold(y, |e, (&a, &p)| e - a * p);
+        let eps = self.gamma * e;
+        let c = e / (lambda * self.alpha);
+        // gbar = [c; g - c a] with the old a, then a <- a + eps g.
+        let mut gbar = [T::ZERO; P];
+        let mut carry = c;
+        for ((gb, a), &g) in gbar.iter_mut().zip(&mut self.a).zip(&self.g) {
+            *gb = carry;
+            carry = g - c * *a;
+            *a += eps * g;
+        }
+        let gbar_p = carry;
+        self.alpha = lambda * self.alpha + eps * e + floor;
+
+        let oldest = self.phi[P - 1];
+        self.phi.copy_within(0..P - 1, 1);
+        self.phi[0] = y;
+        // r_f = y_{n-P} - b^T phi_{n+1}; g <- gbar + gbar_P b; 1/gamma = 1 + g^T phi_{n+1}.
+        let (mut r_f, mut inv_gamma) = (oldest, T::ONE);
+        for (((g, gb), &b), &p) in self.g.iter_mut().zip(&gbar).zip(&self.b).zip(&self.phi) {
+            r_f -= b * p;
+            *g = *gb + gbar_p * b;
+            inv_gamma += *g * p;
+        }
+        let r_s = lambda * self.beta * gbar_p;
+        let r_1 = T::from_f64(1.5) * r_f - T::from_f64(0.5) * r_s;
+        let r_2 = T::from_f64(2.5) * r_f - T::from_f64(1.5) * r_s;
+        self.gamma = T::ONE / inv_gamma;
+        self.beta = lambda * self.beta + self.gamma * r_2 * r_2 + floor;
+        let k = self.gamma * r_1;
+        for (b, &g) in self.b.iter_mut().zip(&self.g) {
+            *b += k * g;
+        }
+
+        if !self.healthy(lambda, r_f, r_s) {
+            self.shell.restart(config);
+            *self = Self {
+                shell: self.shell,
+                ..Self::new(config)
+            };
+            return None;
+        }
+        self.error = e;
+        Some(e)
+    }
+
+    /// The monitor: the two backward errors agree, `gamma`, `alpha` and `beta` are in range,
+    /// and every value is finite.
+    fn healthy(&self, lambda: T, r_f: T, r_s: T) -> bool {
+        // |r_f - r_s| <= tau (|r_f| + sqrt((1 - lambda) beta)), without the square root.
+        let excess = (r_f - r_s).abs() / tau::<T>() - r_f.abs();
+        let agree = excess <= T::ZERO || excess * excess <= (T::ONE - lambda) * self.beta;
+        let in_range = self.gamma > T::ZERO
+            && self.gamma <= T::from_f64(GAMMA_MAX)
+            && self.alpha > T::ZERO
+            && self.beta > T::ZERO;
+        let sum = self
+            .a
+            .iter()
+            .zip(&self.b)
+            .zip(&self.g)
+            .fold(self.alpha + self.beta, |s, ((&a, &b), &g)| s + a + b + g);
+        agree && in_range && sum.is_finite()
+    }
+
+    /// The coefficients `a_1..a_P` after the last sample.
+    pub fn coefficients(&self) -> &[T; P] {
+        &self.a
+    }
+
+    /// The last a-priori prediction error.
+    pub fn error(&self) -> T {
+        self.error
+    }
+
+    /// The forward energy `alpha_n = min J_n + delta lambda^(n+P)`.
+    pub fn energy(&self) -> T {
+        self.alpha
+    }
+
+    /// Innovation variance `alpha_n / W_n`; `None` before the first sample.
+    pub fn innovation_variance(&self) -> Option<T> {
+        self.shell.per_sample(self.alpha)
+    }
+
+    /// The weighted running mean removed from the input (0 without mean removal).
+    pub fn mean(&self) -> T {
+        self.shell.mean.mean()
+    }
+
+    /// What happened to the samples so far; [`Health::restarts`] counts the rescues.
+    pub fn health(&self) -> Health {
+        self.shell.health
+    }
+
+    /// The model after the last sample; the last good one while a rescued filter settles.
+    pub fn model(&mut self, config: &Config<T>) -> Option<ArModel<T, P>> {
+        let (a, variance, mean) = (self.a, self.innovation_variance(), self.mean());
+        self.shell
+            .publish(|| ArModel::new(a, variance?, mean, config.dt()).ok())
+    }
+}
