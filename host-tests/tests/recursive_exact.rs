@@ -1,7 +1,7 @@
-//! f64 exactness of the recursive cores against the direct solve of numerics.md section 0.
+//! f64 exactness of the recursive cores (lattice, RLS, SFTF) against the direct solve of numerics.md section 0.
 
 use imu_ar::ArModel;
-use imu_ar::recursive::{Config, Lattice, Rls, RlsInit};
+use imu_ar::recursive::{Config, Lattice, Rls, RlsInit, Sftf};
 use imu_ar::sim::ArSimulator;
 use imu_ar_host::reference::{Regularisation, Section0, running_mean_removed};
 use rand_chacha::ChaCha8Rng;
@@ -27,28 +27,29 @@ fn rel(x: &[f64], y: &[f64]) -> f64 {
     if err == 0.0 { 0.0 } else { err / scale }
 }
 
-/// Runs lattice and both RLS starts over `x`, checking against the direct solve at every
-/// `n` in `checked`; returns the worst relative differences (lattice a, lattice energy,
-/// lattice a-priori error, RLS, RLS ridge).
+/// Runs lattice, both RLS starts and the SFTF over `x`, checking against the direct solve at
+/// every `n` in `checked`; returns the worst relative differences (lattice a, lattice energy,
+/// lattice a-priori error, RLS, RLS ridge, SFTF a, SFTF energy, SFTF a-priori error).
 fn check<const P: usize>(
     x: &[f64],
     lambda: f64,
     demean: bool,
     checked: impl Fn(usize) -> bool,
-) -> [f64; 5] {
+) -> [f64; 8] {
     let config = Config::new(lambda, DELTA, 0.01)
         .unwrap()
         .with_demean(demean);
     let mut lattice = Lattice::<f64, P>::new(&config);
     let mut rls = Rls::<f64, P>::new(&config, RlsInit::ShiftConsistent);
     let mut ridge = Rls::<f64, P>::new(&config, RlsInit::Ridge);
+    let mut sftf = Sftf::<f64, P>::new(&config);
     let y = if demean {
         running_mean_removed(x, lambda)
     } else {
         x.to_vec()
     };
     let mut reference = Section0::new(P, lambda, DELTA);
-    let mut worst = [0.0f64; 5];
+    let mut worst = [0.0f64; 8];
     let mut previous = vec![0.0; P];
     for (n, (&xn, &yn)) in x.iter().zip(&y).enumerate() {
         let err_ref = reference.a_priori_error(&previous, yn);
@@ -56,11 +57,14 @@ fn check<const P: usize>(
         let e = lattice.update(&config, xn).unwrap();
         rls.update(&config, xn).unwrap();
         ridge.update(&config, xn).unwrap();
+        let e_sftf = sftf.update(&config, xn).unwrap();
         previous = reference.solve(P, Regularisation::ShiftConsistent).0;
         if !checked(n + 1) {
             continue;
         }
-        worst[2] = worst[2].max((e - err_ref).abs() / err_ref.abs().max(1e-300));
+        let err_scale = err_ref.abs().max(1e-300);
+        worst[2] = worst[2].max((e - err_ref).abs() / err_scale);
+        worst[7] = worst[7].max((e_sftf - err_ref).abs() / err_scale);
         for m in 1..=P {
             let (a_ref, energy_ref) = reference.solve(m, Regularisation::ShiftConsistent);
             let a = lattice.coefficients(m).unwrap();
@@ -68,25 +72,33 @@ fn check<const P: usize>(
             let energy = lattice.energy(m).unwrap();
             worst[1] = worst[1].max((energy - energy_ref).abs() / energy_ref);
         }
-        let (a_ref, _) = reference.solve(P, Regularisation::ShiftConsistent);
+        let (a_ref, energy_ref) = reference.solve(P, Regularisation::ShiftConsistent);
         worst[3] = worst[3].max(rel(rls.coefficients(), &a_ref));
+        worst[5] = worst[5].max(rel(sftf.coefficients(), &a_ref));
+        worst[6] = worst[6].max((sftf.energy() - energy_ref).abs() / energy_ref);
         let (a_ridge, _) = reference.solve(P, Regularisation::Ridge);
         worst[4] = worst[4].max(rel(ridge.coefficients(), &a_ridge));
     }
     assert_eq!(
-        lattice.health().restarts + rls.health().restarts + ridge.health().restarts,
+        lattice.health().restarts
+            + rls.health().restarts
+            + ridge.health().restarts
+            + sftf.health().restarts,
         0
     );
     worst
 }
 
-fn assert_exact(name: &str, worst: [f64; 5]) {
+fn assert_exact(name: &str, worst: [f64; 8]) {
     let labels = [
         "lattice a",
         "lattice energy",
         "lattice a-priori error",
         "RLS (delta D)^-1",
         "RLS I/delta vs ridge",
+        "SFTF a",
+        "SFTF energy",
+        "SFTF a-priori error",
     ];
     println!("{name}: {worst:?}");
     for (label, w) in labels.iter().zip(worst) {

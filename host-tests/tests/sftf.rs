@@ -1,0 +1,326 @@
+//! The stabilised fast transversal filter on the cases of numerics.md section 8 and on the real
+//! records: where it diverges the monitor fires, every output stays finite and the published
+//! model is the last good one; where it does not, it never fires. The tests print the restarts
+//! per 10^6 samples of SFTF, lattice and RLS that `tools/readme-tables.sh sftf` puts into
+//! README.md.
+
+use imu_ar::ArModel;
+use imu_ar::recursive::{Config, FloatArith, Lattice, Rls, RlsInit, Sftf};
+use imu_ar_host::data::read_column;
+use imu_ar_host::fixtures::{AXES, add, ar, real_records};
+use imu_ar_host::reference::{Regularisation, Section0};
+
+const N: usize = 1_000_000;
+
+/// What one SFTF run did.
+#[derive(Default)]
+struct Rescues {
+    restarts: u64,
+    /// Rescues the last-good check was made at (those outside the hold of an earlier one).
+    checked: u64,
+    /// Largest `max_k |a_k - a_ref,k|` of the model published just before a checked rescue,
+    /// against the direct solve of the problem the filter was solving.
+    worst: f64,
+}
+
+/// Runs an order-`P` SFTF in `T` over `x` and checks, sample by sample: every error it returns
+/// is finite and it returns none only when it rescues; the model is finite after every sample;
+/// a rescue keeps publishing the model of the sample before it for `3/(1 - lambda)` samples.
+///
+/// Without mean removal it also solves, in `f64`, the problem the filter solves (restarted with
+/// it), and measures the model published just before each rescue against it.
+fn sftf_run<T: FloatArith, const P: usize>(
+    x: &[f64],
+    lambda: f64,
+    delta: f64,
+    demean: bool,
+) -> Rescues {
+    let config = Config::new(T::from_f64(lambda), T::from_f64(delta), T::from_f64(0.01))
+        .unwrap()
+        .with_demean(demean);
+    // The hold is 3/(1 - lambda) of lambda in T.
+    let hold = (3.0 / (1.0 - config.lambda().to_f64())) as usize;
+    let mut sftf = Sftf::<T, P>::new(&config);
+    let mut reference = (!demean).then(|| Section0::new(P, lambda, delta));
+    let mut out = Rescues::default();
+    let mut published: Option<ArModel<T, P>> = None;
+    let mut held: Option<(ArModel<T, P>, usize)> = None;
+    for (n, &v) in x.iter().enumerate() {
+        let restarts = sftf.health().restarts;
+        let e = sftf.update(&config, T::from_f64(v));
+        let rescued = sftf.health().restarts > restarts;
+        match e {
+            Some(e) => assert!(e.is_finite() && !rescued, "sample {n}: error {e:?}"),
+            None => assert!(rescued, "sample {n}: a finite sample was rejected"),
+        }
+        if rescued {
+            let last = published.expect("a model before the first rescue");
+            if held.is_none_or(|(_, until)| n >= until) {
+                if let Some(r) = &reference {
+                    // The reference holds the samples up to n - 1, as the filter did.
+                    let (a_ref, _) = r.solve(P, Regularisation::ShiftConsistent);
+                    let err = last
+                        .a()
+                        .iter()
+                        .zip(&a_ref)
+                        .fold(0.0f64, |m, (a, b)| m.max((a.to_f64() - b).abs()));
+                    out.worst = out.worst.max(err);
+                    out.checked += 1;
+                }
+                held = Some((last, n + hold));
+            }
+            // The rescued filter starts the problem again, without sample n.
+            if let Some(r) = &mut reference {
+                *r = Section0::new(P, lambda, delta);
+            }
+        } else if let Some(r) = &mut reference {
+            r.push(v);
+        }
+        let model = sftf.model(&config).expect("a model after every sample");
+        let finite = model.a().iter().all(|a| a.is_finite()) && model.noise_variance().is_finite();
+        assert!(finite, "sample {n}: {model:?}");
+        if let Some((m, until)) = held
+            && n < until
+        {
+            assert_eq!(model, m, "sample {n}: the held model changed");
+        }
+        published = Some(model);
+    }
+    out.restarts = sftf.health().restarts;
+    out
+}
+
+/// Restarts of an order-`P` f32 lattice and f32 RLS over `x`; every returned error finite.
+fn others<const P: usize>(x: &[f64], lambda: f64, delta: f64, demean: bool) -> (u64, u64) {
+    let config = Config::new(lambda as f32, delta as f32, 0.01)
+        .unwrap()
+        .with_demean(demean);
+    let mut lattice = Lattice::<f32, P>::new(&config);
+    let mut rls = Rls::<f32, P>::new(&config, RlsInit::ShiftConsistent);
+    for &v in x {
+        for e in [
+            lattice.update(&config, v as f32),
+            rls.update(&config, v as f32),
+        ]
+        .into_iter()
+        .flatten()
+        {
+            assert!(e.is_finite());
+        }
+    }
+    (lattice.health().restarts, rls.health().restarts)
+}
+
+/// One row of the table: SFTF in f32 and f64, lattice and RLS in f32.
+struct Row {
+    sftf32: Rescues,
+    sftf64: Rescues,
+    lattice: u64,
+    rls: u64,
+}
+
+fn row<const P: usize>(x: &[f64], lambda: f64, delta: f64, demean: bool) -> Row {
+    let (lattice, rls) = others::<P>(x, lambda, delta, demean);
+    Row {
+        sftf32: sftf_run::<f32, P>(x, lambda, delta, demean),
+        sftf64: sftf_run::<f64, P>(x, lambda, delta, demean),
+        lattice,
+        rls,
+    }
+}
+
+/// Restarts per 10^6 samples.
+fn per_million(restarts: u64, samples: usize) -> String {
+    let rate = restarts as f64 * 1e6 / samples as f64;
+    if rate == 0.0 || rate >= 10.0 {
+        format!("{rate:.0}")
+    } else {
+        format!("{rate:.1}")
+    }
+}
+
+#[test]
+fn section_8_cases() {
+    let white = ar([0.0], 1.0, N, 10);
+    let gm = ar([0.999], 0.05, N, 11);
+    let gm_white = add(&gm, &white);
+    let sine = |amplitude: f64, cycles: f64| -> Vec<f64> {
+        let w = 2.0 * std::f64::consts::PI * cycles;
+        (0..N).map(|n| amplitude * (w * n as f64).sin()).collect()
+    };
+    let weak_sine = add(&gm_white, &sine(1.0, 0.1));
+    let strong_sine = add(&gm_white, &sine(3.0, 0.05));
+    let pw = ar([2.7607, -3.8106, 2.6535, -0.9238], 1.0, N, 12);
+    let r = 0.89f64;
+    let resonant = ar(
+        [2.0 * r * std::f64::consts::FRAC_PI_4.cos(), -r * r],
+        1.0,
+        N,
+        13,
+    );
+    // (process, p, lambda, row, whether the SFTF is expected to diverge)
+    let mut rows = Vec::new();
+    for lambda in [0.99, 0.999, 0.9999] {
+        let gm4 = row::<4>(&gm_white, lambda, 0.1, false);
+        rows.push(("GM(0.999) + white", 4, lambda, gm4, false));
+        let pw4 = row::<4>(&pw, lambda, 100.0, false);
+        rows.push(("Percival-Walden AR(4)", 4, lambda, pw4, false));
+    }
+    let weak = "GM + white + sinusoid (amplitude 1, 0.1 cycles/sample)";
+    let strong = "GM + white + sinusoid (amplitude 3, 0.05 cycles/sample)";
+    rows.extend([
+        (weak, 3, 0.99, row::<3>(&weak_sine, 0.99, 0.1, false), false),
+        (weak, 4, 0.99, row::<4>(&weak_sine, 0.99, 0.1, false), false),
+        (
+            "AR(2), poles 0.89, under-fitted",
+            1,
+            0.99,
+            row::<1>(&resonant, 0.99, 0.1, false),
+            true,
+        ),
+        (
+            "Percival-Walden AR(4), under-fitted",
+            1,
+            0.99,
+            row::<1>(&pw, 0.99, 100.0, false),
+            true,
+        ),
+        (
+            "Percival-Walden AR(4), under-fitted",
+            2,
+            0.99,
+            row::<2>(&pw, 0.99, 100.0, false),
+            true,
+        ),
+        (
+            "Percival-Walden AR(4), under-fitted",
+            3,
+            0.99,
+            row::<3>(&pw, 0.99, 100.0, false),
+            true,
+        ),
+        (
+            strong,
+            3,
+            0.99,
+            row::<3>(&strong_sine, 0.99, 0.1, false),
+            true,
+        ),
+        (
+            strong,
+            4,
+            0.99,
+            row::<4>(&strong_sine, 0.99, 0.1, false),
+            true,
+        ),
+        (
+            "white, lambda < 1 - 1/(2p)",
+            10,
+            0.94,
+            row::<10>(&white, 0.94, 0.1, false),
+            true,
+        ),
+        (
+            "GM(0.999), lambda < 1 - 1/(2p)",
+            10,
+            0.94,
+            row::<10>(&gm, 0.94, 0.1, false),
+            true,
+        ),
+    ]);
+    println!(
+        "| process (10^6 samples) | p | lambda | SFTF f32 | SFTF f64 | lattice f32 | RLS f32 \
+         | SFTF model before a rescue, max abs error (f32 / f64) |"
+    );
+    println!("|---|---|---|---|---|---|---|---|");
+    for (name, p, lambda, r, _) in &rows {
+        let last_good = if r.sftf32.checked + r.sftf64.checked > 0 {
+            format!("{:.1e} / {:.1e}", r.sftf32.worst, r.sftf64.worst)
+        } else {
+            "no rescue".into()
+        };
+        println!(
+            "| {name} | {p} | {lambda} | {} | {} | {} | {} | {last_good} |",
+            per_million(r.sftf32.restarts, N),
+            per_million(r.sftf64.restarts, N),
+            per_million(r.lattice, N),
+            per_million(r.rls, N),
+        );
+    }
+    for (name, p, lambda, r, diverges) in &rows {
+        let case = format!("{name}, p = {p}, lambda = {lambda}");
+        assert_eq!(
+            (r.lattice, r.rls),
+            (0, 0),
+            "{case}: lattice / RLS restarted"
+        );
+        for (scalar, s) in [("f32", &r.sftf32), ("f64", &r.sftf64)] {
+            if *diverges {
+                assert!(s.restarts > 0, "{case}: the {scalar} monitor never fired");
+                assert!(s.checked > 0, "{case}: {scalar}: no rescue outside a hold");
+                // Section 8 calls a run diverged once its error passes 0.05: the model held
+                // through a rescue has not.
+                assert!(
+                    s.worst < 0.05,
+                    "{case}: {scalar}: the model before a rescue is {:e} off",
+                    s.worst
+                );
+            } else {
+                assert_eq!(s.restarts, 0, "{case}: {scalar}: a healthy run was rescued");
+            }
+        }
+    }
+}
+
+#[test]
+fn real_records_every_axis() {
+    let Some(records) = real_records() else {
+        return;
+    };
+    println!(
+        "| record (six axes, mean removed) | p | lambda | samples | SFTF f32 | SFTF f64 \
+         | lattice f32 | RLS f32 |"
+    );
+    println!("|---|---|---|---|---|---|---|---|");
+    for record in &records {
+        let axes: Vec<Vec<f64>> = AXES
+            .iter()
+            .map(|axis| read_column(&record.files, axis).unwrap())
+            .collect();
+        let samples: usize = axes.iter().map(Vec::len).sum();
+        for lambda in [0.99, 0.999, 0.9999] {
+            for p in [4, 8] {
+                let mut total = [0u64; 4];
+                for x in &axes {
+                    let mean = x.iter().sum::<f64>() / x.len() as f64;
+                    let var =
+                        x.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / x.len() as f64;
+                    let delta = 0.1 * var;
+                    let r = match p {
+                        4 => row::<4>(x, lambda, delta, true),
+                        _ => row::<8>(x, lambda, delta, true),
+                    };
+                    for (t, v) in total.iter_mut().zip([
+                        r.sftf32.restarts,
+                        r.sftf64.restarts,
+                        r.lattice,
+                        r.rls,
+                    ]) {
+                        *t += v;
+                    }
+                }
+                let [s32, s64, lattice, rls] = total.map(|t| per_million(t, samples));
+                println!(
+                    "| {} | {p} | {lambda} | {samples} | {s32} | {s64} | {lattice} | {rls} |",
+                    record.name
+                );
+                assert_eq!(
+                    (total[2], total[3]),
+                    (0, 0),
+                    "{}: lattice / RLS restarted",
+                    record.name
+                );
+            }
+        }
+    }
+}
