@@ -11,7 +11,7 @@
 //! `black_box`), subtracts the cost of the same loop without the call, and prints one line per
 //! row: `<estimator> <scalar> p=<P> insns/sample=<N>`. These are instruction counts, not cycles.
 //!
-//! Rows: `lattice` (f32 and fixed), `rls` (f32) per sample at p = 1, 2, 4, 8, 16, 32, and at
+//! Rows: `lattice` (f32 and fixed), `rls` and `sftf` (f32) per sample at p = 1, 2, 4, 8, 16, 32, and at
 //! p = 3, 5, 6, 7 for the f32 lattice and RLS (where one overtakes the other); `extract` per
 //! request of the exact coefficients of order p; `frame6` per six-axis frame of order-4
 //! lattices. Then the state of one channel, `<estimator> <scalar> p=<P> bytes=<N>`
@@ -28,7 +28,7 @@ mod firmware {
 
     use cortex_m::peripheral::{SYST, syst::SystClkSource};
     use imu_ar::fixed_point::{FixedConfig, FixedLattice};
-    use imu_ar::recursive::{Config, Lattice, Rls, RlsInit};
+    use imu_ar::recursive::{Config, Lattice, Rls, RlsInit, Sftf};
 
     use super::common;
 
@@ -151,6 +151,25 @@ mod firmware {
             let bytes = core::mem::size_of::<Rls<f32, P>>();
             defmt::info!("rls f32 p={=usize} bytes={=usize}", P, bytes);
         }
+
+        fn sftf_f32<const P: usize>(&mut self) {
+            let config = Config::new(0.999f32, 0.1, 0.01).unwrap_or_else(|_| common::exit(false));
+            let mut state = Sftf::<f32, P>::new(&config);
+            let x = self.x;
+            let cell = core::cell::RefCell::new(&mut state);
+            let n = self.insns_per_sample(|i| {
+                black_box(cell.borrow_mut().update(&config, black_box(x[i])));
+            });
+            let rescues = cell.borrow().health().restarts;
+            defmt::info!("sftf f32 p={=usize} insns/sample={=u32}", P, n);
+            let bytes = core::mem::size_of::<Sftf<f32, P>>();
+            defmt::info!("sftf f32 p={=usize} bytes={=usize}", P, bytes);
+            if rescues > 0 {
+                // A rescue on the benchmark record would make the count meaningless.
+                defmt::error!("sftf f32 p={=usize}: {=u64} rescues", P, rescues);
+                common::exit(false);
+            }
+        }
     }
 
     pub fn run() -> ! {
@@ -195,6 +214,7 @@ mod firmware {
         orders!(lattice_f32);
         orders!(lattice_fixed);
         orders!(rls_f32);
+        orders!(sftf_f32);
         macro_rules! between {
             ($f:ident) => {
                 bench.$f::<3>();

@@ -19,7 +19,7 @@ mod firmware {
     use cortex_m_semihosting::debug;
     use imu_ar::allan::AllanStream;
     use imu_ar::fixed_point::{FixedConfig, FixedLattice};
-    use imu_ar::recursive::{Config, Lattice, OrderRule, OrderSelector, Rls, RlsInit};
+    use imu_ar::recursive::{Config, Lattice, OrderRule, OrderSelector, Rls, RlsInit, Sftf};
 
     unsafe extern "C" {
         /// Deliberately undefined: referencing it from a live panic path breaks the link.
@@ -39,6 +39,7 @@ mod firmware {
     fn exercise<const P: usize>(config: &Config<f32>, x: &[f32]) -> bool {
         let mut lattice = Lattice::<f32, P>::new(config);
         let mut rls = Rls::<f32, P>::new(config, RlsInit::ShiftConsistent);
+        let mut sftf = Sftf::<f32, P>::new(config);
         let mut selector = OrderSelector::<f32, P>::new(OrderRule::Pls, 100, 3);
         let mut allan = AllanStream::<12>::new();
         let mut fixed = match FixedConfig::new(config, black_box(2.0)) {
@@ -55,6 +56,9 @@ mod firmware {
             if let Some(e) = rls.update(config, v) {
                 finite &= e.is_finite();
             }
+            if let Some(e) = sftf.update(config, v) {
+                finite &= e.is_finite();
+            }
             allan.push(v);
             black_box(fixed.1.update(&fixed.0, v));
             black_box(fixed.1.update_counts(&fixed.0, black_box(v as i16)));
@@ -62,8 +66,10 @@ mod firmware {
         finite &= fixed.1.model(&fixed.0).is_some();
         let order = black_box(selector.order());
         finite &= order <= P;
-        match (lattice.model(config), rls.model(config)) {
-            (Some(a), Some(b)) => finite &= a.a()[0].is_finite() && b.a()[0].is_finite(),
+        match (lattice.model(config), rls.model(config), sftf.model(config)) {
+            (Some(a), Some(b), Some(c)) => {
+                finite &= a.a()[0].is_finite() && b.a()[0].is_finite() && c.a()[0].is_finite()
+            }
             _ => finite = false,
         }
         finite && black_box(lattice.coefficients(P)).is_some()

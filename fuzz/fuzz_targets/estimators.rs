@@ -4,7 +4,7 @@
 #![no_main]
 
 use imu_ar::fixed_point::{FixedConfig, FixedLattice};
-use imu_ar::recursive::{Config, Health, Lattice, Rls, RlsInit};
+use imu_ar::recursive::{Config, Health, Lattice, Rls, RlsInit, Sftf};
 use libfuzzer_sys::fuzz_target;
 
 fn counted(h: Health, n: usize) {
@@ -25,6 +25,7 @@ fuzz_target!(|data: &[u8]| {
         .collect();
     let mut lattice = Lattice::<f32, 4>::new(&config);
     let mut rls = Rls::<f32, 4>::new(&config, RlsInit::ShiftConsistent);
+    let mut sftf = Sftf::<f32, 4>::new(&config);
     let fixed_config = FixedConfig::new(&config, 1.0).unwrap();
     let mut fixed = FixedLattice::<4>::new(&fixed_config);
     for &x in &f32s {
@@ -34,11 +35,18 @@ fuzz_target!(|data: &[u8]| {
         if let Some(e) = rls.update(&config, x) {
             assert!(e.is_finite());
         }
+        if let Some(e) = sftf.update(&config, x) {
+            assert!(e.is_finite());
+        }
         fixed.update(&fixed_config, x);
     }
-    for m in [lattice.model(&config), rls.model(&config)]
-        .into_iter()
-        .flatten()
+    for m in [
+        lattice.model(&config),
+        rls.model(&config),
+        sftf.model(&config),
+    ]
+    .into_iter()
+    .flatten()
     {
         assert!(m.a().iter().all(|a| a.is_finite()) && m.noise_variance().is_finite());
     }
@@ -47,12 +55,14 @@ fuzz_target!(|data: &[u8]| {
     }
     counted(lattice.health(), f32s.len());
     counted(rls.health(), f32s.len());
+    counted(sftf.health(), f32s.len());
     counted(fixed.health(), f32s.len());
 
     let config = Config::new(f64::from(lambda), 0.01, 0.01)
         .unwrap()
         .with_demean(demean);
     let mut lattice = Lattice::<f64, 8>::new(&config);
+    let mut sftf = Sftf::<f64, 8>::new(&config);
     let f64s: Vec<f64> = data
         .chunks_exact(8)
         .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
@@ -61,9 +71,16 @@ fuzz_target!(|data: &[u8]| {
         if let Some(e) = lattice.update(&config, x) {
             assert!(e.is_finite());
         }
+        if let Some(e) = sftf.update(&config, x) {
+            assert!(e.is_finite());
+        }
     }
-    if let Some(m) = lattice.model(&config) {
+    for m in [lattice.model(&config), sftf.model(&config)]
+        .into_iter()
+        .flatten()
+    {
         assert!(m.a().iter().all(|a| a.is_finite()) && m.noise_variance().is_finite());
     }
     counted(lattice.health(), f64s.len());
+    counted(sftf.health(), f64s.len());
 });

@@ -4,7 +4,7 @@
 
 use imu_ar::batch::{BatchConfig, BatchError, burg, covariance, yule_walker};
 use imu_ar::fixed_point::{FixedConfig, FixedLattice};
-use imu_ar::recursive::{Config, Health, Lattice, Rls, RlsInit};
+use imu_ar::recursive::{Config, FloatArith, Health, Lattice, Rls, RlsInit, Sftf};
 use proptest::prelude::*;
 
 /// Cases per property: 256, or `PROPTEST_CASES`.
@@ -52,11 +52,9 @@ fn bad() -> impl Strategy<Value = f64> {
     prop_oneof![Just(f64::NAN), Just(f64::INFINITY), Just(f64::NEG_INFINITY)]
 }
 
-struct FloatLattice<T: imu_ar::recursive::FloatArith, const P: usize>(Lattice<T, P>, Config<T>);
-struct FloatRls<T: imu_ar::recursive::FloatArith, const P: usize>(Rls<T, P>, Config<T>);
 struct Fixed<const P: usize>(FixedLattice<P>, FixedConfig);
 
-fn config<T: imu_ar::recursive::FloatArith>(lambda: f64, demean: bool) -> Config<T> {
+fn config<T: FloatArith>(lambda: f64, demean: bool) -> Config<T> {
     Config::new(T::from_f64(lambda), T::from_f64(0.01), T::from_f64(0.01))
         .unwrap()
         .with_demean(demean)
@@ -79,31 +77,31 @@ fn model_values<T: imu_ar::Scalar, const P: usize>(
     v
 }
 
-impl<T: imu_ar::recursive::FloatArith, const P: usize> Estimator for FloatLattice<T, P> {
-    fn step(&mut self, x: f64) -> Option<f64> {
-        self.0.update(&self.1, T::from_f64(x)).map(|e| e.to_f64())
-    }
-    fn health(&self) -> Health {
-        self.0.health()
-    }
-    fn published(&mut self) -> Vec<f64> {
-        let c = self.0.coefficients(P);
-        model_values(c, self.0.model(&self.1))
-    }
+/// A float estimator `$state` with its configuration, as `$wrapper`; `$coefficients` reads
+/// its order-`P` coefficients from the state `$s`.
+macro_rules! float_estimator {
+    ($wrapper:ident, $state:ident, |$s:ident| $coefficients:expr) => {
+        struct $wrapper<T: FloatArith, const P: usize>($state<T, P>, Config<T>);
+
+        impl<T: FloatArith, const P: usize> Estimator for $wrapper<T, P> {
+            fn step(&mut self, x: f64) -> Option<f64> {
+                self.0.update(&self.1, T::from_f64(x)).map(|e| e.to_f64())
+            }
+            fn health(&self) -> Health {
+                self.0.health()
+            }
+            fn published(&mut self) -> Vec<f64> {
+                let $s = &self.0;
+                let c = $coefficients;
+                model_values(c, self.0.model(&self.1))
+            }
+        }
+    };
 }
 
-impl<T: imu_ar::recursive::FloatArith, const P: usize> Estimator for FloatRls<T, P> {
-    fn step(&mut self, x: f64) -> Option<f64> {
-        self.0.update(&self.1, T::from_f64(x)).map(|e| e.to_f64())
-    }
-    fn health(&self) -> Health {
-        self.0.health()
-    }
-    fn published(&mut self) -> Vec<f64> {
-        let c = Some(*self.0.coefficients());
-        model_values(c, self.0.model(&self.1))
-    }
-}
+float_estimator!(FloatLattice, Lattice, |s| s.coefficients(P));
+float_estimator!(FloatRls, Rls, |s| Some(*s.coefficients()));
+float_estimator!(FloatSftf, Sftf, |s| Some(*s.coefficients()));
 
 impl<const P: usize> Estimator for Fixed<P> {
     fn step(&mut self, x: f64) -> Option<f64> {
@@ -118,8 +116,8 @@ impl<const P: usize> Estimator for Fixed<P> {
     }
 }
 
-/// Every estimator under test, fresh: the lattice and RLS in f32 and f64 at orders 1, 4 and 8,
-/// with and without mean removal, and the fixed-point lattice.
+/// Every estimator under test, fresh: the lattice, RLS and SFTF in f32 and f64 at orders 1, 4
+/// and 8, with and without mean removal, and the fixed-point lattice.
 fn estimators() -> Vec<(&'static str, Box<dyn Estimator>)> {
     let fixed = |demean| {
         let c = FixedConfig::new(&config::<f32>(0.99, demean), 1e-3).unwrap();
@@ -172,6 +170,28 @@ fn estimators() -> Vec<(&'static str, Box<dyn Estimator>)> {
             "rls f64 p=8 no demean",
             Box::new(FloatRls(
                 Rls::<f64, 8>::new(&config(0.9, false), RlsInit::ShiftConsistent),
+                config(0.9, false),
+            )),
+        ),
+        (
+            "sftf f32 p=1",
+            Box::new(FloatSftf(
+                Sftf::<f32, 1>::new(&config(0.99, true)),
+                config(0.99, true),
+            )),
+        ),
+        (
+            "sftf f32 p=4",
+            Box::new(FloatSftf(
+                Sftf::<f32, 4>::new(&config(0.99, true)),
+                config(0.99, true),
+            )),
+        ),
+        (
+            // lambda below 1 - 1/(2p): the monitor's busiest case.
+            "sftf f64 p=8 no demean",
+            Box::new(FloatSftf(
+                Sftf::<f64, 8>::new(&config(0.9, false)),
                 config(0.9, false),
             )),
         ),

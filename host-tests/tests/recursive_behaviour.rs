@@ -2,7 +2,9 @@
 //! restarts, order selection.
 
 use imu_ar::ArModel;
-use imu_ar::recursive::{Config, ConfigError, Lattice, OrderRule, OrderSelector, Rls, RlsInit};
+use imu_ar::recursive::{
+    Config, ConfigError, Lattice, OrderRule, OrderSelector, Rls, RlsInit, Sftf,
+};
 use imu_ar::sim::ArSimulator;
 use imu_ar_host::reference::{Regularisation, Section0, running_mean_removed};
 use rand_chacha::ChaCha8Rng;
@@ -75,14 +77,17 @@ fn stuck_sensor_then_normal_data() {
     // stays finite, nothing restarts, and 5/(1 - lambda) samples later the f32 estimators
     // equal the f64 direct solve of everything they took (stuck run included) to 1e-4, and
     // the direct solve of the normal data alone to 1e-2: the stuck run is forgotten.
+    // The same holds for the SFTF, whose energies decay to their floor in the stuck run.
     for lambda in [0.99, 0.999] {
         let config = Config::new(lambda as f32, 0.1, 0.01).unwrap();
         let mut lattice = Lattice::<f32, 2>::new(&config);
         let mut rls = Rls::<f32, 2>::new(&config, RlsInit::ShiftConsistent);
+        let mut sftf = Sftf::<f32, 2>::new(&config);
         let mut everything = Vec::new();
         for _ in 0..1_000_000 {
             assert!(lattice.update(&config, 3.25).unwrap().is_finite());
             assert!(rls.update(&config, 3.25).unwrap().is_finite());
+            assert!(sftf.update(&config, 3.25).unwrap().is_finite());
             everything.push(3.25);
         }
         let m = lattice.model(&config).unwrap();
@@ -94,6 +99,7 @@ fn stuck_sensor_then_normal_data() {
         for &v in &normal {
             assert!(lattice.update(&config, v as f32).unwrap().is_finite());
             assert!(rls.update(&config, v as f32).unwrap().is_finite());
+            assert!(sftf.update(&config, v as f32).unwrap().is_finite());
             everything.push(v);
         }
         let solve = |x: &[f64]| {
@@ -107,6 +113,7 @@ fn stuck_sensor_then_normal_data() {
         for (name, a) in [
             ("lattice", lattice.coefficients(2).unwrap()),
             ("RLS", *rls.coefficients()),
+            ("SFTF", *sftf.coefficients()),
         ] {
             for k in 0..2 {
                 let a = f64::from(a[k]);
@@ -120,7 +127,10 @@ fn stuck_sensor_then_normal_data() {
                 );
             }
         }
-        assert_eq!(lattice.health().restarts + rls.health().restarts, 0);
+        assert_eq!(
+            lattice.health().restarts + rls.health().restarts + sftf.health().restarts,
+            0
+        );
     }
 }
 

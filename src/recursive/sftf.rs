@@ -136,26 +136,25 @@ impl<T: Scalar, const P: usize> Sftf<T, P> {
             .fold(y, |e, (&a, &p)| e - a * p);
         let eps = self.gamma * e;
         let c = e / (lambda * self.alpha);
-        // gbar = [c; g - c a] with the old a, then a <- a + eps g.
-        let mut gbar = [T::ZERO; P];
-        let mut carry = c;
-        for ((gb, a), &g) in gbar.iter_mut().zip(&mut self.a).zip(&self.g) {
-            *gb = carry;
-            carry = g - c * *a;
-            *a += eps * g;
-        }
-        let gbar_p = carry;
         self.alpha = lambda * self.alpha + eps * e + floor;
 
-        let oldest = self.phi[P - 1];
-        self.phi.copy_within(0..P - 1, 1);
-        self.phi[0] = y;
-        // r_f = y_{n-P} - b^T phi_{n+1}; g <- gbar + gbar_P b; 1/gamma = 1 + g^T phi_{n+1}.
-        let (mut r_f, mut inv_gamma) = (oldest, T::ONE);
-        for (((g, gb), &b), &p) in self.g.iter_mut().zip(&gbar).zip(&self.b).zip(&self.phi) {
-            r_f -= b * p;
-            *g = *gb + gbar_p * b;
-            inv_gamma += *g * p;
+        // One pass over k = 0..P-1, with the old a_k, g_k: gbar_k = [c; g - c a]_k,
+        // a_k <- a_k + eps g_k, the delay line shifts to phi_{n+1}, g_k <- gbar_k + gbar_P b_k,
+        // and the sums r_f = y_{n-P} - b^T phi_{n+1} and 1/gamma = 1 + g^T phi_{n+1}.
+        let gbar_p = self.g[P - 1] - c * self.a[P - 1];
+        let (mut gbar_k, mut shifted) = (c, y);
+        let (mut r_f, mut inv_gamma, mut a_sum) = (self.phi[P - 1], T::ONE, T::ZERO);
+        let state = self.a.iter_mut().zip(&mut self.g).zip(&mut self.phi);
+        for (((a, g), p), &b) in state.zip(&self.b) {
+            let (a_old, g_old, p_old) = (*a, *g, *p);
+            *a = a_old + eps * g_old;
+            a_sum += *a;
+            *p = shifted;
+            r_f -= b * shifted;
+            *g = gbar_k + gbar_p * b;
+            inv_gamma += *g * shifted;
+            gbar_k = g_old - c * a_old;
+            shifted = p_old;
         }
         let r_s = lambda * self.beta * gbar_p;
         let r_1 = T::from_f64(1.5) * r_f - T::from_f64(0.5) * r_s;
@@ -167,7 +166,7 @@ impl<T: Scalar, const P: usize> Sftf<T, P> {
             *b += k * g;
         }
 
-        if !self.healthy(lambda, r_f, r_s) {
+        if !self.healthy(lambda, r_f, r_s, a_sum) {
             self.shell.restart(config);
             *self = Self {
                 shell: self.shell,
@@ -180,8 +179,10 @@ impl<T: Scalar, const P: usize> Sftf<T, P> {
     }
 
     /// The monitor: the two backward errors agree, `gamma`, `alpha` and `beta` are in range,
-    /// and every value is finite.
-    fn healthy(&self, lambda: T, r_f: T, r_s: T) -> bool {
+    /// and every value is finite. A non-finite `b` makes `r_f` NaN and a non-finite `g` makes
+    /// `gamma` NaN (`0 * inf` is NaN too), and NaN fails every comparison: so only the sum of
+    /// the coefficients `a` (`a_sum`) and the energies need checking here.
+    fn healthy(&self, lambda: T, r_f: T, r_s: T, a_sum: T) -> bool {
         // |r_f - r_s| <= tau (|r_f| + sqrt((1 - lambda) beta)), without the square root.
         let excess = (r_f - r_s).abs() / tau::<T>() - r_f.abs();
         let agree = excess <= T::ZERO || excess * excess <= (T::ONE - lambda) * self.beta;
@@ -189,13 +190,7 @@ impl<T: Scalar, const P: usize> Sftf<T, P> {
             && self.gamma <= T::from_f64(GAMMA_MAX)
             && self.alpha > T::ZERO
             && self.beta > T::ZERO;
-        let sum = self
-            .a
-            .iter()
-            .zip(&self.b)
-            .zip(&self.g)
-            .fold(self.alpha + self.beta, |s, ((&a, &b), &g)| s + a + b + g);
-        agree && in_range && sum.is_finite()
+        agree && in_range && (a_sum + self.alpha + self.beta).is_finite()
     }
 
     /// The coefficients `a_1..a_P` after the last sample.
