@@ -8,10 +8,10 @@ use crate::{ArModel, Scalar};
 /// divisible) however long the input is exactly zero.
 const FLOOR: f64 = 1e-30;
 
-/// The monitor's threshold `tau` on the disagreement of the two backward errors: `1e-2` in
-/// single precision, `1e-6` in double. The largest disagreement of a healthy run measured over
-/// 10^6 samples of the section 8 processes is `5.4e-3` in `f32` and `1.2e-11` in `f64` (both
-/// on the Percival-Walden AR(4), `cond R ~ 1e6`, at `lambda = 0.9999`).
+/// The monitor's threshold `tau` on the disagreement of the two backward errors
+/// ([`Sftf::disagreement`]): `1e-2` in single precision, `1e-6` in double. The largest
+/// disagreement of the healthy runs of `host-tests/tests/sftf.rs` is printed in README's table
+/// next to their restarts; the worst is the Percival-Walden AR(4) (`cond R ~ 1e6`).
 fn tau<T: Scalar>() -> T {
     if T::EPSILON > T::from_f64(1e-10) {
         T::from_f64(1e-2)
@@ -99,6 +99,8 @@ pub struct Sftf<T, const P: usize> {
     beta: T,
     gamma: T,
     error: T,
+    /// The backward errors `r_f`, `r_s` of the last sample, for [`Sftf::disagreement`].
+    backward: (T, T),
     shell: Shell<T, P>,
 }
 
@@ -115,6 +117,7 @@ impl<T: Scalar, const P: usize> Sftf<T, P> {
             beta: config.delta(),
             gamma: T::ONE,
             error: T::ZERO,
+            backward: (T::ZERO, T::ZERO),
             shell: Shell::new(),
         }
     }
@@ -175,6 +178,7 @@ impl<T: Scalar, const P: usize> Sftf<T, P> {
             return None;
         }
         self.error = e;
+        self.backward = (r_f, r_s);
         Some(e)
     }
 
@@ -201,6 +205,18 @@ impl<T: Scalar, const P: usize> Sftf<T, P> {
     /// The last a-priori prediction error.
     pub fn error(&self) -> T {
         self.error
+    }
+
+    /// The monitor's value after the last sample,
+    /// `d = |r_f - r_s| / (|r_f| + sqrt((1 - lambda) beta))` (0 before the first): how far
+    /// the two backward errors disagree. The filter is rescued when `d` passes `tau` (`1e-2`
+    /// in `f32`, `1e-6` in `f64`); a healthy run stays below it.
+    pub fn disagreement(&self, config: &Config<T>) -> T {
+        let (r_f, r_s) = self.backward;
+        let floor = libm::sqrt((1.0 - config.lambda().to_f64()) * self.beta.to_f64());
+        let scale = r_f.abs().to_f64() + floor;
+        let d = (r_f - r_s).abs().to_f64();
+        T::from_f64(if d > 0.0 { d / scale } else { 0.0 })
     }
 
     /// The forward energy `alpha_n = min J_n + delta lambda^(n+P)`.
