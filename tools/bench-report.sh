@@ -60,7 +60,7 @@ if [ "$only" = all ] || [ "$only" = host ]; then
 import json, os
 orders = [1, 2, 4, 8, 16, 32]
 rows = [("lattice", "f32"), ("lattice", "f64"), ("lattice", "fixed"), ("rls", "f32"),
-        ("rls", "f64"), ("extract", "f32"), ("frame6", "f32")]
+        ("rls", "f64"), ("sftf", "f32"), ("sftf", "f64"), ("extract", "f32"), ("frame6", "f32")]
 print("| estimator | scalar | " + " | ".join(f"p = {p}" for p in orders) + " |")
 print("|---|---|" + "---|" * len(orders))
 for est, scalar in rows:

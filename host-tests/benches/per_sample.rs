@@ -1,7 +1,8 @@
 //! Host cost per sample of the recursive cores: `cargo bench -p imu-ar-host --bench per_sample`.
 //!
 //! The rows of the target's `cargo qemu bench`, and the f64 cores: each iteration feeds a block
-//! of 1000 samples of an AR(2) record (as raw counts for the fixed-point lattice); criterion
+//! of 1000 samples of an AR(2) record (as raw counts for the fixed-point lattice; an AR(1) for
+//! the SFTF, which must not be rescued while it is timed); criterion
 //! reports the time per block and, through the throughput, per sample. `extract` times one
 //! request of the exact coefficients, `frame6` one six-axis frame of order-4 lattices.
 //! `tools/bench-report.sh` reads the results.
@@ -11,7 +12,7 @@ use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use imu_ar::fixed_point::{FixedConfig, FixedLattice};
-use imu_ar::recursive::{Config, Lattice, Rls, RlsInit};
+use imu_ar::recursive::{Config, Lattice, Rls, RlsInit, Sftf};
 use imu_ar::sim::ArSimulator;
 use imu_ar::{ArModel, Scalar};
 use rand_chacha::ChaCha8Rng;
@@ -20,7 +21,12 @@ use rand_core::SeedableRng;
 const BLOCK: usize = 1000;
 
 fn record<T: Scalar>() -> Vec<T> {
-    let model = ArModel::new([1.2f64, -0.5], 1.0, 0.0, 0.01).unwrap();
+    ar_record([1.2, -0.5])
+}
+
+/// One block of the AR process `a`, unit innovation variance.
+fn ar_record<T: Scalar, const Q: usize>(a: [f64; Q]) -> Vec<T> {
+    let model = ArModel::new(a, 1.0, 0.0, 0.01).unwrap();
     let mut sim = ArSimulator::new(model);
     let mut rng = ChaCha8Rng::seed_from_u64(1);
     (0..BLOCK)
@@ -104,6 +110,17 @@ fn rls<T: Scalar, const P: usize>(c: &mut Criterion, name: &str) {
     });
 }
 
+fn sftf<T: Scalar, const P: usize>(c: &mut Criterion, name: &str) {
+    let config = config::<T>();
+    let mut state = Sftf::<T, P>::new(&config);
+    // An AR(1): the AR(2) record would make the order-1 filter under-fit and diverge, and
+    // the rescues would be timed with it.
+    bench_block(c, name, P, &ar_record::<T, 1>([0.9]), |v| {
+        black_box(state.update(&config, v));
+    });
+    assert_eq!(state.health().restarts, 0, "{name} p = {P}: rescued");
+}
+
 fn per_sample(c: &mut Criterion) {
     macro_rules! orders {
         ($f:ident, $t:ty, $name:expr) => {
@@ -119,6 +136,8 @@ fn per_sample(c: &mut Criterion) {
     orders!(lattice, f64, "lattice_f64");
     orders!(rls, f32, "rls_f32");
     orders!(rls, f64, "rls_f64");
+    orders!(sftf, f32, "sftf_f32");
+    orders!(sftf, f64, "sftf_f64");
     lattice_fixed::<1>(c);
     lattice_fixed::<2>(c);
     lattice_fixed::<4>(c);

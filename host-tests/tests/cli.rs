@@ -392,12 +392,17 @@ fn recursive_fits_and_the_drifting_ar2_comparison() {
             (rls - lattice).abs() < 1e-9 * lattice,
             "RLS and lattice solve the same problem"
         );
+        // So does the SFTF, which holds at p = 2 and these lambdas.
+        assert_eq!(v["sftf_restarts"], 0, "lambda {lambda}: {v}");
+        let sftf = v["sftf_mse"].as_f64().unwrap();
+        assert!((sftf - lattice).abs() < 1e-9 * lattice, "{v}");
         assert_eq!(
             (v["n_train"].as_u64(), v["n_eval"].as_u64()),
             (Some(50_000), Some(50_000))
         );
     }
-    // The recursive fits report the documented keys; f32 and f64 agree closely.
+    // The recursive fits report the documented keys; f32 and f64 agree closely, and RLS and
+    // the SFTF equal the lattice in f64.
     let f64_fit = fit_json(
         &file,
         "lattice",
@@ -411,6 +416,11 @@ fn recursive_fits_and_the_drifting_ar2_comparison() {
         &["--lambda", "0.999", "--delta", "0.5", "--scalar", "f32"],
     );
     let rls_fit = fit_json(&file, "rls", "2", &["--lambda", "0.999", "--delta", "0.5"]);
+    let sftf_fit = fit_json(&file, "sftf", "2", &["--lambda", "0.999", "--delta", "0.5"]);
+    assert_eq!(
+        (sftf_fit["method"].as_str(), sftf_fit["restarts"].as_u64()),
+        (Some("sftf"), Some(0))
+    );
     assert_eq!(f32_fit["scalar"], "f32");
     let fixed_fit = fit_json(
         &file,
@@ -440,9 +450,10 @@ fn recursive_fits_and_the_drifting_ar2_comparison() {
             f32_fit["a"][k].as_f64().unwrap(),
             rls_fit["a"][k].as_f64().unwrap(),
         );
+        let d = sftf_fit["a"][k].as_f64().unwrap();
         assert!(
-            (a - b).abs() < 1e-4 && (a - c).abs() < 1e-9,
-            "a_{}: {a} {b} {c}",
+            (a - b).abs() < 1e-4 && (a - c).abs() < 1e-9 && (a - d).abs() < 1e-9,
+            "a_{}: {a} {b} {c} {d}",
             k + 1
         );
     }
