@@ -183,9 +183,10 @@ impl<T: Scalar, const P: usize> Sftf<T, P> {
     }
 
     /// The monitor: the two backward errors agree, `gamma`, `alpha` and `beta` are in range,
-    /// and every value is finite. A non-finite `b` makes `r_f` NaN and a non-finite `g` makes
-    /// `gamma` NaN (`0 * inf` is NaN too), and NaN fails every comparison: so only the sum of
-    /// the coefficients `a` (`a_sum`) and the energies need checking here.
+    /// and every value is finite. A non-finite `g` makes `gamma` NaN or 0 in the same sample,
+    /// a non-finite `b` does the same through the next sample's `g`, before either can reach
+    /// `a` (which takes the `g` of the sample before), and NaN fails every comparison: so only
+    /// the coefficients `a` (their sum `a_sum`) and the energies need checking here.
     fn healthy(&self, lambda: T, r_f: T, r_s: T, a_sum: T) -> bool {
         // |r_f - r_s| <= tau (|r_f| + sqrt((1 - lambda) beta)), without the square root.
         let excess = (r_f - r_s).abs() / tau::<T>() - r_f.abs();
