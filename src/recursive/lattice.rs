@@ -338,11 +338,9 @@ impl<T: FloatArith, const P: usize> Lattice<T, P> {
     /// `F_P / W_n`, the running mean and `dt`. Returns the last good model while a restarted
     /// lattice settles, and `None` before the first sample or if no finite model exists yet.
     pub fn model(&mut self, config: &Config<T>) -> Option<ArModel<T, P>> {
-        let a = self.coefficients(P);
-        let variance = self.innovation_variance(P);
-        let mean = self.mean();
+        let core = &self.core;
         self.shell
-            .publish(|| ArModel::new(a?, variance?, mean, config.dt()).ok())
+            .model(config, core.f_energy_p, || core.coefficients(P, |k| k))
     }
 }
 

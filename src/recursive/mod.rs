@@ -301,14 +301,19 @@ impl<T: Scalar, const P: usize> Shell<T, P> {
         (self.weight.0 > T::ZERO).then(|| energy / self.weight.0)
     }
 
-    /// The model `make` builds, unless a restarted estimator is still settling: then (and when
-    /// `make` finds no valid model) the last one published.
-    pub(crate) fn publish(
+    /// The model of coefficients `a` (computed only when needed) and energy `energy`
+    /// (innovation variance `energy / W_n`), unless a restarted estimator is still settling:
+    /// then, and when no valid model can be made, the last one published.
+    pub(crate) fn model(
         &mut self,
-        make: impl FnOnce() -> Option<crate::ArModel<T, P>>,
+        config: &Config<T>,
+        energy: T,
+        a: impl FnOnce() -> Option<[T; P]>,
     ) -> Option<crate::ArModel<T, P>> {
         if self.hold == 0
-            && let Some(m) = make()
+            && let Some(variance) = self.per_sample(energy)
+            && let Some(a) = a()
+            && let Ok(m) = crate::ArModel::new(a, variance, self.mean.mean(), config.dt())
         {
             self.published = Some(m);
         }

@@ -181,9 +181,8 @@ impl<T: Scalar, const P: usize> Rls<T, P> {
 
     /// The model after the last sample; the last good one while a restarted state settles.
     pub fn model(&mut self, config: &Config<T>) -> Option<ArModel<T, P>> {
-        let (a, variance, mean) = (self.a, self.innovation_variance(), self.mean());
-        self.shell
-            .publish(|| ArModel::new(a, variance?, mean, config.dt()).ok())
+        let a = self.a;
+        self.shell.model(config, self.energy, || Some(a))
     }
 }
 
