@@ -77,11 +77,20 @@ fn model_values<T: imu_ar::Scalar, const P: usize>(
     v
 }
 
-/// A float estimator `$state` with its configuration, as `$wrapper`; `$coefficients` reads
-/// its order-`P` coefficients from the state `$s`.
+/// A float estimator `$state` with its configuration, as `$wrapper`; `$new` makes the state
+/// from the configuration `$c`, `$coefficients` reads its order-`P` coefficients from the
+/// state `$s`.
 macro_rules! float_estimator {
-    ($wrapper:ident, $state:ident, |$s:ident| $coefficients:expr) => {
+    ($wrapper:ident, $state:ident, |$c:ident| $new:expr, |$s:ident| $coefficients:expr) => {
         struct $wrapper<T: FloatArith, const P: usize>($state<T, P>, Config<T>);
+
+        impl<T: FloatArith + 'static, const P: usize> $wrapper<T, P> {
+            /// A fresh state at `lambda`, with or without mean removal.
+            fn boxed(lambda: f64, demean: bool) -> Box<dyn Estimator> {
+                let $c = &config::<T>(lambda, demean);
+                Box::new(Self($new, *$c))
+            }
+        }
 
         impl<T: FloatArith, const P: usize> Estimator for $wrapper<T, P> {
             fn step(&mut self, x: f64) -> Option<f64> {
@@ -99,9 +108,17 @@ macro_rules! float_estimator {
     };
 }
 
-float_estimator!(FloatLattice, Lattice, |s| s.coefficients(P));
-float_estimator!(FloatRls, Rls, |s| Some(*s.coefficients()));
-float_estimator!(FloatSftf, Sftf, |s| Some(*s.coefficients()));
+float_estimator!(FloatLattice, Lattice, |c| Lattice::new(c), |s| s
+    .coefficients(P));
+float_estimator!(
+    FloatRls,
+    Rls,
+    |c| Rls::new(c, RlsInit::ShiftConsistent),
+    |s| Some(*s.coefficients())
+);
+float_estimator!(FloatSftf, Sftf, |c| Sftf::new(c), |s| Some(
+    *s.coefficients()
+));
 
 impl<const P: usize> Estimator for Fixed<P> {
     fn step(&mut self, x: f64) -> Option<f64> {
@@ -124,76 +141,28 @@ fn estimators() -> Vec<(&'static str, Box<dyn Estimator>)> {
         Fixed(FixedLattice::<4>::new(&c), c)
     };
     vec![
-        (
-            "lattice f32 p=1",
-            Box::new(FloatLattice(
-                Lattice::<f32, 1>::new(&config(0.99, true)),
-                config(0.99, true),
-            )),
-        ),
-        (
-            "lattice f32 p=4",
-            Box::new(FloatLattice(
-                Lattice::<f32, 4>::new(&config(0.99, true)),
-                config(0.99, true),
-            )),
-        ),
+        ("lattice f32 p=1", FloatLattice::<f32, 1>::boxed(0.99, true)),
+        ("lattice f32 p=4", FloatLattice::<f32, 4>::boxed(0.99, true)),
         (
             "lattice f32 p=8 no demean",
-            Box::new(FloatLattice(
-                Lattice::<f32, 8>::new(&config(0.9, false)),
-                config(0.9, false),
-            )),
+            FloatLattice::<f32, 8>::boxed(0.9, false),
         ),
         (
             "lattice f64 p=4",
-            Box::new(FloatLattice(
-                Lattice::<f64, 4>::new(&config(0.999, true)),
-                config(0.999, true),
-            )),
+            FloatLattice::<f64, 4>::boxed(0.999, true),
         ),
-        (
-            "rls f32 p=1",
-            Box::new(FloatRls(
-                Rls::<f32, 1>::new(&config(0.99, true), RlsInit::ShiftConsistent),
-                config(0.99, true),
-            )),
-        ),
-        (
-            "rls f32 p=4",
-            Box::new(FloatRls(
-                Rls::<f32, 4>::new(&config(0.99, true), RlsInit::ShiftConsistent),
-                config(0.99, true),
-            )),
-        ),
+        ("rls f32 p=1", FloatRls::<f32, 1>::boxed(0.99, true)),
+        ("rls f32 p=4", FloatRls::<f32, 4>::boxed(0.99, true)),
         (
             "rls f64 p=8 no demean",
-            Box::new(FloatRls(
-                Rls::<f64, 8>::new(&config(0.9, false), RlsInit::ShiftConsistent),
-                config(0.9, false),
-            )),
+            FloatRls::<f64, 8>::boxed(0.9, false),
         ),
+        ("sftf f32 p=1", FloatSftf::<f32, 1>::boxed(0.99, true)),
+        ("sftf f32 p=4", FloatSftf::<f32, 4>::boxed(0.99, true)),
+        // lambda below 1 - 1/(2p): the monitor's busiest case.
         (
-            "sftf f32 p=1",
-            Box::new(FloatSftf(
-                Sftf::<f32, 1>::new(&config(0.99, true)),
-                config(0.99, true),
-            )),
-        ),
-        (
-            "sftf f32 p=4",
-            Box::new(FloatSftf(
-                Sftf::<f32, 4>::new(&config(0.99, true)),
-                config(0.99, true),
-            )),
-        ),
-        (
-            // lambda below 1 - 1/(2p): the monitor's busiest case.
             "sftf f64 p=8 no demean",
-            Box::new(FloatSftf(
-                Sftf::<f64, 8>::new(&config(0.9, false)),
-                config(0.9, false),
-            )),
+            FloatSftf::<f64, 8>::boxed(0.9, false),
         ),
         ("fixed lattice p=4", Box::new(fixed(true))),
         ("fixed lattice p=4 no demean", Box::new(fixed(false))),
