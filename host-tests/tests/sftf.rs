@@ -163,75 +163,44 @@ fn section_8_cases() {
         N,
         13,
     );
-    // (process, p, lambda, row, whether the SFTF is expected to diverge)
+    // case!(process, name, p, lambda, delta, whether the SFTF is expected to diverge)
+    macro_rules! case {
+        ($x:expr, $name:expr, $p:literal, $lambda:expr, $delta:expr, $diverges:expr) => {
+            (
+                $name,
+                $p,
+                $lambda,
+                row::<$p>($x, $lambda, $delta, false),
+                $diverges,
+            )
+        };
+    }
     let mut rows = Vec::new();
     for lambda in [0.99, 0.999, 0.9999] {
-        let gm4 = row::<4>(&gm_white, lambda, 0.1, false);
-        rows.push(("GM(0.999) + white", 4, lambda, gm4, false));
-        let pw4 = row::<4>(&pw, lambda, 100.0, false);
-        rows.push(("Percival-Walden AR(4)", 4, lambda, pw4, false));
+        rows.push(case!(&gm_white, "GM(0.999) + white", 4, lambda, 0.1, false));
+        rows.push(case!(&pw, "Percival-Walden AR(4)", 4, lambda, 100.0, false));
     }
     let weak = "GM + white + sinusoid (amplitude 1, 0.1 cycles/sample)";
     let strong = "GM + white + sinusoid (amplitude 3, 0.05 cycles/sample)";
+    let under = "Percival-Walden AR(4), under-fitted";
     rows.extend([
-        (weak, 3, 0.99, row::<3>(&weak_sine, 0.99, 0.1, false), false),
-        (weak, 4, 0.99, row::<4>(&weak_sine, 0.99, 0.1, false), false),
-        (
+        case!(&weak_sine, weak, 3, 0.99, 0.1, false),
+        case!(&weak_sine, weak, 4, 0.99, 0.1, false),
+        case!(
+            &resonant,
             "AR(2), poles 0.89, under-fitted",
             1,
             0.99,
-            row::<1>(&resonant, 0.99, 0.1, false),
-            true,
+            0.1,
+            true
         ),
-        (
-            "Percival-Walden AR(4), under-fitted",
-            1,
-            0.99,
-            row::<1>(&pw, 0.99, 100.0, false),
-            true,
-        ),
-        (
-            "Percival-Walden AR(4), under-fitted",
-            2,
-            0.99,
-            row::<2>(&pw, 0.99, 100.0, false),
-            true,
-        ),
-        (
-            "Percival-Walden AR(4), under-fitted",
-            3,
-            0.99,
-            row::<3>(&pw, 0.99, 100.0, false),
-            true,
-        ),
-        (
-            strong,
-            3,
-            0.99,
-            row::<3>(&strong_sine, 0.99, 0.1, false),
-            true,
-        ),
-        (
-            strong,
-            4,
-            0.99,
-            row::<4>(&strong_sine, 0.99, 0.1, false),
-            true,
-        ),
-        (
-            "white, lambda < 1 - 1/(2p)",
-            10,
-            0.94,
-            row::<10>(&white, 0.94, 0.1, false),
-            true,
-        ),
-        (
-            "GM(0.999), lambda < 1 - 1/(2p)",
-            10,
-            0.94,
-            row::<10>(&gm, 0.94, 0.1, false),
-            true,
-        ),
+        case!(&pw, under, 1, 0.99, 100.0, true),
+        case!(&pw, under, 2, 0.99, 100.0, true),
+        case!(&pw, under, 3, 0.99, 100.0, true),
+        case!(&strong_sine, strong, 3, 0.99, 0.1, true),
+        case!(&strong_sine, strong, 4, 0.99, 0.1, true),
+        case!(&white, "white, lambda < 1 - 1/(2p)", 10, 0.94, 0.1, true),
+        case!(&gm, "GM(0.999), lambda < 1 - 1/(2p)", 10, 0.94, 0.1, true),
     ]);
     println!(
         "| process (10^6 samples) | p | lambda | SFTF f32 | SFTF f64 | lattice f32 | RLS f32 \
