@@ -8,6 +8,7 @@
 use embedded_hal::delay::DelayNs;
 use embedded_hal::spi::{Operation, SpiDevice};
 
+use super::fifo::{self, FifoChip, FifoState};
 use super::{Error, FifoStats, ImuReader, Packet, RawSample, Scale, be_i16, be_i16x3};
 
 /// DEVICE_CONFIG: SOFT_RESET_CONFIG in bit 0 (1 ms to complete).
@@ -35,17 +36,33 @@ const FIFO_CONFIG1: u8 = 0x5F;
 /// WHO_AM_I, 0x47.
 const WHO_AM_I: u8 = 0x75;
 
+/// WHO_AM_I of the ICM-42688-P.
 const ID: u8 = 0x47;
+/// SPI: bit 7 of the address byte set for a read.
 const READ: u8 = 0x80;
-const FIFO_FULL: u8 = 1 << 1;
+/// DEVICE_CONFIG: SOFT_RESET_CONFIG.
+const SOFT_RESET: u8 = 1 << 0;
+/// INT_STATUS: FIFO_FULL_INT.
+const INT_FIFO_FULL: u8 = 1 << 1;
+/// SIGNAL_PATH_RESET: FIFO_FLUSH.
 const FIFO_FLUSH: u8 = 1 << 1;
 /// FIFO_CONFIG: stream-to-FIFO mode (0 after a reset: bypass).
 const FIFO_STREAM: u8 = 0b0100_0000;
+/// FIFO_CONFIG1: FIFO_TEMP_EN, FIFO_GYRO_EN, FIFO_ACCEL_EN (packet 3).
+const FIFO_TEMP_GYRO_ACCEL: u8 = 0b0000_0111;
+/// PWR_MGMT0: GYRO_MODE and ACCEL_MODE low noise.
+const PWR_LOW_NOISE: u8 = 0b0000_1111;
 /// Packet 3: header, accel x/y/z, gyro x/y/z (big-endian), temperature (1 byte), timestamp (2).
 const PACKET: usize = 16;
+/// FIFO size: 2 KiB.
+const FIFO_BYTES: u16 = 2048;
 /// Header bits: HEADER_MSG (7, FIFO empty), HEADER_ACCEL (6), HEADER_GYRO (5).
 const HEADER_EMPTY: u8 = 1 << 7;
 const HEADER_ACCEL_GYRO: u8 = 0b0110_0000;
+/// The invalid-data marker of a 16-bit FIFO field (TDK's driver: `INVALID_VALUE_FIFO`).
+const INVALID: i16 = i16::MIN;
+/// The invalid-data marker of the 8-bit FIFO temperature (`INVALID_VALUE_FIFO_1B`).
+const INVALID_TEMP: i8 = i8::MIN;
 
 /// Gyro full-scale range (GYRO_FS_SEL).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -139,6 +156,21 @@ pub enum Odr {
 }
 
 impl Odr {
+    /// The rate in mHz.
+    fn millihz(self) -> u32 {
+        match self {
+            Odr::Hz8000 => 8_000_000,
+            Odr::Hz4000 => 4_000_000,
+            Odr::Hz2000 => 2_000_000,
+            Odr::Hz1000 => 1_000_000,
+            Odr::Hz500 => 500_000,
+            Odr::Hz200 => 200_000,
+            Odr::Hz100 => 100_000,
+            Odr::Hz50 => 50_000,
+            Odr::Hz25 => 25_000,
+        }
+    }
+
     /// The rate in Hz.
     pub fn hz(self) -> f32 {
         match self {
@@ -227,8 +259,7 @@ impl Icm42688Config {
 pub struct Icm42688<SPI> {
     spi: SPI,
     config: Icm42688Config,
-    fifo: bool,
-    stats: FifoStats,
+    fifo: FifoState,
 }
 
 impl<SPI: SpiDevice> Icm42688<SPI> {
@@ -237,8 +268,7 @@ impl<SPI: SpiDevice> Icm42688<SPI> {
         Self {
             spi,
             config: Icm42688Config::default(),
-            fifo: false,
-            stats: FifoStats::default(),
+            fifo: FifoState::default(),
         }
     }
 
@@ -271,7 +301,8 @@ impl<SPI: SpiDevice> Icm42688<SPI> {
 
     /// Probes WHO_AM_I (0x47), soft-resets the chip (1 ms), writes ranges and rates and puts
     /// gyro and accelerometer in low-noise mode (then 1 ms; the gyro needs about 30 ms more
-    /// before its data are valid). The FIFO is off afterwards.
+    /// before its data are valid: until then the FIFO carries the invalid marker, and those
+    /// packets are skipped and counted in [`FifoStats::invalid`]). The FIFO is off afterwards.
     ///
     /// # Errors
     ///
@@ -281,11 +312,20 @@ impl<SPI: SpiDevice> Icm42688<SPI> {
         delay: &mut impl DelayNs,
         config: Icm42688Config,
     ) -> Result<(), Error<SPI::Error>> {
+        self.fifo.off();
+        self.configure(delay, config)
+    }
+
+    fn configure(
+        &mut self,
+        delay: &mut impl DelayNs,
+        config: Icm42688Config,
+    ) -> Result<(), Error<SPI::Error>> {
         let id = self.who_am_i()?;
         if id != ID {
             return Err(Error::WrongDevice { found: id });
         }
-        self.write(DEVICE_CONFIG, 0x01)?;
+        self.write(DEVICE_CONFIG, SOFT_RESET)?;
         delay.delay_ms(1);
         self.write(
             GYRO_CONFIG0,
@@ -295,33 +335,36 @@ impl<SPI: SpiDevice> Icm42688<SPI> {
             ACCEL_CONFIG0,
             (config.accel_range as u8) << 5 | config.odr as u8,
         )?;
-        self.write(PWR_MGMT0, 0x0F)?;
+        self.write(PWR_MGMT0, PWR_LOW_NOISE)?;
         delay.delay_ms(1);
         self.config = config;
-        self.fifo = false;
         Ok(())
     }
 
-    /// Brings the chip back after [`Error::SensorReset`] (or any suspected glitch): probes
-    /// WHO_AM_I, writes the last configuration again and re-enables the FIFO if it was on.
-    /// `outage_us` is the time from the last good FIFO read to now, by the caller's clock; the
-    /// samples the chip produced in it are counted in [`FifoStats::lost`].
+    /// Brings the chip back after [`Error::SensorReset`], [`Error::FifoNotRunning`] (or any
+    /// suspected glitch): probes WHO_AM_I, writes the last configuration again and re-enables
+    /// the FIFO if `enable_fifo` was called since `init`. `outage_us` is the time in
+    /// microseconds from the last `read_fifo` that accounted for the FIFO (see
+    /// [`FifoStats::lost`]) to now, by the caller's clock; the samples the chip produced in it
+    /// are counted in [`FifoStats::lost`].
     ///
     /// # Errors
     ///
-    /// As [`Icm42688::init`]; nothing is counted until the recovery succeeds, so it can simply
-    /// be called again.
+    /// As [`Icm42688::init`]; nothing is counted until the recovery succeeds, and until then
+    /// `read_fifo` returns [`Error::FifoNotRunning`]: it can simply be called again.
     pub fn recover(
         &mut self,
         delay: &mut impl DelayNs,
-        outage_us: u32,
+        outage_us: u64,
     ) -> Result<(), Error<SPI::Error>> {
-        let fifo = self.fifo;
-        self.init(delay, self.config)?;
-        if fifo {
+        self.fifo.restarting();
+        self.configure(delay, self.config)?;
+        if self.fifo.wanted {
             self.enable_fifo()?;
         }
-        self.stats.recovered(outage_us, self.config.odr.hz());
+        self.fifo
+            .stats
+            .recovered(outage_us, self.config.odr.millihz(), 1000);
         Ok(())
     }
 
@@ -335,12 +378,15 @@ impl<SPI: SpiDevice> Icm42688<SPI> {
     ///
     /// # Errors
     ///
-    /// [`Error::Bus`].
+    /// [`Error::Bus`]; until a later call (or `recover`) succeeds, `read_fifo` returns
+    /// [`Error::FifoNotRunning`].
     pub fn enable_fifo(&mut self) -> Result<(), Error<SPI::Error>> {
-        self.write(FIFO_CONFIG1, 0b0000_0111)?;
+        self.fifo.wanted = true;
+        self.fifo.restarting();
+        self.write(FIFO_CONFIG1, FIFO_TEMP_GYRO_ACCEL)?;
         self.write(FIFO_CONFIG, FIFO_STREAM)?;
-        self.write(SIGNAL_PATH_RESET, FIFO_FLUSH)?;
-        self.fifo = true;
+        self.reset_fifo()?;
+        self.fifo.running = true;
         Ok(())
     }
 
@@ -357,6 +403,66 @@ impl<SPI: SpiDevice> Icm42688<SPI> {
     }
 }
 
+impl<SPI: SpiDevice> FifoChip for Icm42688<SPI> {
+    type BusError = SPI::Error;
+    const PACKET: usize = PACKET;
+    const FIFO_BYTES: u16 = FIFO_BYTES;
+
+    fn state(&mut self) -> &mut FifoState {
+        &mut self.fifo
+    }
+
+    fn overflow_flag(&mut self) -> Result<bool, Error<SPI::Error>> {
+        let mut status = [0];
+        self.read_regs(INT_STATUS, &mut status)?;
+        Ok(status[0] & INT_FIFO_FULL != 0)
+    }
+
+    fn fifo_count(&mut self) -> Result<u16, Error<SPI::Error>> {
+        Icm42688::fifo_count(self)
+    }
+
+    fn fifo_configured(&mut self) -> Result<bool, Error<SPI::Error>> {
+        let mut mode = [0];
+        self.read_regs(FIFO_CONFIG, &mut mode)?;
+        Ok(mode[0] == FIFO_STREAM)
+    }
+
+    /// One write, SIGNAL_PATH_RESET.FIFO_FLUSH, with the channels left on. Unlike the MPU-6050
+    /// (see its `reset_fifo`), neither the datasheet nor ArduPilot asks for the channels to be
+    /// off: libraries/AP_InertialSensor/AP_InertialSensor_Invensensev3.cpp,
+    /// `AP_InertialSensor_Invensensev3::fifo_reset`, writes FIFO_CONFIG1 with accel, gyro and
+    /// temperature on and then SIGNAL_PATH_RESET = 2 (FIFO_FLUSH). The flush is one write, so
+    /// nothing enters the FIFO between a count and a completed flush within one call.
+    fn reset_fifo(&mut self) -> Result<(), Error<SPI::Error>> {
+        self.write(SIGNAL_PATH_RESET, FIFO_FLUSH)
+    }
+
+    fn read_data(&mut self, buf: &mut [u8]) -> Result<(), Error<SPI::Error>> {
+        self.read_regs(FIFO_DATA, buf)
+    }
+
+    fn parse(p: &[u8]) -> Packet {
+        let header = p.first().copied().unwrap_or(HEADER_EMPTY);
+        if header & HEADER_EMPTY != 0 {
+            return Packet::End;
+        }
+        if header & HEADER_ACCEL_GYRO != HEADER_ACCEL_GYRO {
+            return Packet::Malformed;
+        }
+        let (accel, gyro) = (be_i16x3(p, 1), be_i16x3(p, 7));
+        let temp = p.get(13).map(|&t| t as i8);
+        if accel.contains(&INVALID) || gyro.contains(&INVALID) || temp == Some(INVALID_TEMP) {
+            return Packet::Invalid;
+        }
+        Packet::Sample(RawSample {
+            accel,
+            gyro,
+            temperature: temp.map(|t| i16::from(t) * 64),
+        })
+    }
+}
+
 impl<SPI: SpiDevice> ImuReader for Icm42688<SPI> {
     type BusError = SPI::Error;
 
@@ -364,65 +470,40 @@ impl<SPI: SpiDevice> ImuReader for Icm42688<SPI> {
         self.config.scale()
     }
 
-    /// One burst read of TEMP_DATA1 .. GYRO_DATA_Z0.
+    /// One burst read of TEMP_DATA1 .. GYRO_DATA_Z0. Data registers holding the invalid-data
+    /// marker (-32768, while a sensor is starting) give [`Error::NoData`], counted in
+    /// [`FifoStats::invalid`].
     fn read(&mut self) -> Result<RawSample, Error<SPI::Error>> {
         let mut b = [0u8; 14];
         self.read_regs(TEMP_DATA1, &mut b)?;
-        Ok(RawSample {
+        let s = RawSample {
             temperature: Some(be_i16(&b, 0)),
             accel: be_i16x3(&b, 2),
             gyro: be_i16x3(&b, 8),
-        })
+        };
+        if s.accel.contains(&INVALID) || s.gyro.contains(&INVALID) || s.temperature == Some(INVALID)
+        {
+            self.fifo.stats.invalid = self.fifo.stats.invalid.saturating_add(1);
+            return Err(Error::NoData);
+        }
+        Ok(s)
     }
 
-    /// Reads INT_STATUS first: on FIFO_FULL_INT the FIFO is flushed (its complete packets are
-    /// counted as discarded) and [`Error::FifoOverflow`] is returned. Otherwise whole packets
-    /// (up to `out.len()`) are read, 8 per SPI transaction; a packet whose header does not
-    /// announce accelerometer and gyro data is skipped and counted as malformed, and a header
-    /// with HEADER_MSG set (FIFO empty) ends the batch. A bus error after some packets were read
-    /// loses them: they are counted in [`FifoStats::discarded`].
+    /// Reads INT_STATUS and FIFO_COUNT first. On FIFO_FULL_INT, or a count at or above the
+    /// FIFO's 2048 bytes, the FIFO is flushed (its complete packets are counted as discarded)
+    /// and [`Error::FifoOverflow`] is returned. Otherwise whole packets (up to `out.len()`)
+    /// are read, 8 per SPI transaction; a packet whose header does not announce accelerometer
+    /// and gyro data is skipped and counted as malformed, one carrying the invalid-data marker
+    /// (-32768, or -128 for the temperature) is skipped and counted as invalid, and a header
+    /// with HEADER_MSG set (FIFO empty) ends the batch. A read that fails part-way is followed
+    /// by a flush, as TDK's driver does: the samples of the call and those left in the FIFO
+    /// are counted as discarded and [`Error::FifoResync`] is returned. A flush that meets a bus
+    /// error itself is remembered and finished by the next call.
     fn read_fifo(&mut self, out: &mut [RawSample]) -> Result<usize, Error<SPI::Error>> {
-        if !self.fifo {
-            return Err(Error::FifoDisabled);
-        }
-        let mut status = [0];
-        self.read_regs(INT_STATUS, &mut status)?;
-        if status[0] & FIFO_FULL != 0 {
-            let bytes = self.fifo_count()?;
-            self.write(SIGNAL_PATH_RESET, FIFO_FLUSH)?;
-            return Err(self.stats.overflow(bytes, PACKET));
-        }
-        let available = usize::from(self.fifo_count()?) / PACKET;
-        if available == 0 {
-            // An empty FIFO may be a chip that reset itself: its FIFO is then in bypass mode.
-            let mut mode = [0];
-            self.read_regs(FIFO_CONFIG, &mut mode)?;
-            if mode[0] != FIFO_STREAM {
-                return Err(Error::SensorReset);
-            }
-        }
-        let spi = &mut self.spi;
-        let read = |buf: &mut [u8]| {
-            spi.transaction(&mut [Operation::Write(&[FIFO_DATA | READ]), Operation::Read(buf)])
-                .map_err(Error::Bus)
-        };
-        self.stats.drain(available, PACKET, out, read, |p| {
-            let header = p.first().copied().unwrap_or(HEADER_EMPTY);
-            if header & HEADER_EMPTY != 0 {
-                Packet::End
-            } else if header & HEADER_ACCEL_GYRO != HEADER_ACCEL_GYRO {
-                Packet::Malformed
-            } else {
-                Packet::Sample(RawSample {
-                    accel: be_i16x3(p, 1),
-                    gyro: be_i16x3(p, 7),
-                    temperature: p.get(13).map(|&t| i16::from(t as i8) * 64),
-                })
-            }
-        })
+        fifo::read_fifo(self, out)
     }
 
     fn fifo_stats(&self) -> FifoStats {
-        self.stats
+        self.fifo.stats
     }
 }

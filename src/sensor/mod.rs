@@ -13,6 +13,7 @@
 //! Units are typed ([`GyroUnit`], [`AccelUnit`]); the conversion factors are the datasheet
 //! sensitivities of the configured full-scale range.
 
+mod fifo;
 mod icm42688;
 mod mpu6050;
 mod replay;
@@ -34,6 +35,23 @@ pub struct RawSample {
     /// Raw temperature, where the chip reports one with this sample (see the reader's
     /// `temperature_celsius`).
     pub temperature: Option<i16>,
+}
+
+impl RawSample {
+    /// Some gyro axis reads a rail (`i16::MAX` or `i16::MIN`): the chip clipped it.
+    pub fn gyro_clipped(&self) -> bool {
+        self.gyro.iter().any(|&c| c == i16::MAX || c == i16::MIN)
+    }
+
+    /// Some accelerometer axis reads a rail (`i16::MAX` or `i16::MIN`): the chip clipped it.
+    pub fn accel_clipped(&self) -> bool {
+        self.accel.iter().any(|&c| c == i16::MAX || c == i16::MIN)
+    }
+
+    /// Some axis reads a rail: the raw-count test for saturation, which needs no range.
+    pub fn clipped(&self) -> bool {
+        self.gyro_clipped() || self.accel_clipped()
+    }
 }
 
 /// The unit of angular rate.
@@ -85,6 +103,33 @@ impl Scale {
         }
     }
 
+    /// The saturation limit of the gyro axes in `unit`, for
+    /// [`Config::with_saturation`](crate::recursive::Config::with_saturation): half a count
+    /// below the rail `i16::MAX`, so that a clipped reading (`i16::MAX` or `i16::MIN` counts) is
+    /// at or beyond it and every reading short of the rails is inside it.
+    ///
+    /// The nominal range is no limit: at +-1000 deg/s (32.8 counts per deg/s) the rail is
+    /// 32767 / 32.8 = 998.99 deg/s, so `with_saturation(1000.0)` never fires.
+    ///
+    /// ```
+    /// use imu_ar::sensor::{GyroUnit, Scale};
+    ///
+    /// let s = Scale { gyro_counts_per_dps: 32.8, accel_counts_per_g: 2048.0 };
+    /// let limit = s.gyro_saturation(GyroUnit::DegPerSec);
+    /// assert!(s.gyro([i16::MAX; 3], GyroUnit::DegPerSec)[0] >= limit);
+    /// assert!(s.gyro([i16::MAX - 1; 3], GyroUnit::DegPerSec)[0] < limit);
+    /// assert!(limit < 1000.0);
+    /// ```
+    pub fn gyro_saturation(&self, unit: GyroUnit) -> f32 {
+        RAIL * self.gyro_lsb(unit)
+    }
+
+    /// The saturation limit of the accelerometer axes in `unit`, as
+    /// [`Scale::gyro_saturation`].
+    pub fn accel_saturation(&self, unit: AccelUnit) -> f32 {
+        RAIL * self.accel_lsb(unit)
+    }
+
     /// The angular rate of `raw` in `unit`.
     ///
     /// ```
@@ -106,6 +151,9 @@ impl Scale {
     }
 }
 
+/// Half a count below the positive rail of an `i16` reading.
+const RAIL: f32 = 32_766.5;
+
 /// FIFO accounting of a reader.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -114,16 +162,30 @@ pub struct FifoStats {
     pub samples: u64,
     /// FIFO overflows detected (each followed by a FIFO reset).
     pub overflows: u64,
-    /// Complete samples that were in the FIFO when it was reset after an overflow, and so
-    /// lost. Samples the chip dropped while its FIFO was full are not knowable from the FIFO and
-    /// are not included: count the overflows, or compare with the output data rate.
+    /// Complete samples dropped by FIFO resets: those in the FIFO when it was reset after an
+    /// overflow or a failed read, and those already read in a call that then failed. Samples
+    /// the chip dropped while its FIFO was full are not knowable from the FIFO and are not
+    /// included: count the overflows, or compare with the output data rate.
     pub discarded: u64,
+    /// Bytes dropped by FIFO resets, partial packets included.
+    pub discarded_bytes: u64,
+    /// FIFO resets after a data read that failed part-way ([`Error::FifoResync`]).
+    pub resyncs: u64,
     /// FIFO packets rejected as malformed (wrong header) and skipped.
     pub malformed: u64,
+    /// FIFO packets skipped because the chip marked their data invalid (the ICM-42688-P writes
+    /// -32768, or -128 for the temperature, while a sensor is starting).
+    pub invalid: u64,
+    /// Delivered samples with some axis at a rail ([`RawSample::clipped`]); they are
+    /// delivered, and the estimators' saturation limits decide.
+    pub clipped: u64,
     /// Chip resets detected ([`Error::SensorReset`]) and recovered from.
     pub resets: u64,
     /// Samples the chip would have delivered during the outages passed to `recover`: from the
-    /// last good FIFO read to the FIFO running again, at the configured output data rate.
+    /// last `read_fifo` that accounted for the FIFO (`Ok`, [`Error::FifoOverflow`] or
+    /// [`Error::FifoResync`]) to the FIFO running again, at the configured output data rate.
+    /// Exact when that read emptied the FIFO (an `out` as large as the FIFO) and the FIFO did
+    /// not overflow in the outage.
     pub lost: u64,
 }
 
@@ -138,17 +200,35 @@ pub enum Error<E> {
         /// The value read.
         found: u8,
     },
+    /// WHO_AM_I identified a chip of the family that this reader does not handle: the
+    /// MPU-6500 (0x70) or MPU-9250 (0x71), whose temperature formula, sample-rate divider and
+    /// accelerometer filter register differ from the MPU-6050's.
+    UnsupportedDevice {
+        /// The value read.
+        found: u8,
+    },
     /// The FIFO had overflowed; it was reset and is collecting again (see [`FifoStats`]).
     FifoOverflow {
         /// Complete samples lost by the reset.
         discarded: u16,
     },
+    /// A FIFO data read failed part-way: the FIFO was reset to realign its packets (TDK's own
+    /// drivers do the same) and `discarded` complete samples were dropped (see
+    /// [`FifoStats`]). Call again.
+    FifoResync {
+        /// Complete samples dropped.
+        discarded: u16,
+    },
     /// The FIFO is not enabled (call `enable_fifo` first).
     FifoDisabled,
+    /// The FIFO should be on but is not: the last `recover` or `enable_fifo` failed part-way.
+    /// Call it again.
+    FifoNotRunning,
     /// The chip has reset itself (a supply glitch or brown-out): its FIFO is off and its
     /// configuration gone. Call the reader's `recover`.
     SensorReset,
-    /// No sample is available (a replay at its end).
+    /// No sample is available (a replay at its end, or data registers holding the chip's
+    /// invalid-data marker).
     NoData,
 }
 
@@ -163,6 +243,15 @@ impl<E: fmt::Debug> fmt::Display for Error<E> {
         match self {
             Self::Bus(e) => write!(f, "bus error: {e:?}"),
             Self::WrongDevice { found } => write!(f, "unexpected WHO_AM_I 0x{found:02x}"),
+            Self::UnsupportedDevice { found } => write!(
+                f,
+                "WHO_AM_I 0x{found:02x}: MPU-6500/MPU-9250, not supported by this reader"
+            ),
+            Self::FifoResync { discarded } => write!(
+                f,
+                "FIFO read failed part-way: reset, {discarded} samples discarded"
+            ),
+            Self::FifoNotRunning => f.write_str("FIFO not running: recover again"),
             Self::FifoOverflow { discarded } => {
                 write!(f, "FIFO overflow: reset, {discarded} samples discarded")
             }
@@ -194,9 +283,11 @@ pub trait ImuReader {
     ///
     /// # Errors
     ///
-    /// [`Error::FifoOverflow`] after resetting an overflowed FIFO (nothing is written; call
-    /// again), [`Error::SensorReset`] when the FIFO is empty because the chip has reset
-    /// itself, [`Error::FifoDisabled`], or [`Error::Bus`].
+    /// [`Error::FifoOverflow`] after resetting an overflowed FIFO and [`Error::FifoResync`]
+    /// after resetting it behind a failed read (nothing is written; call again),
+    /// [`Error::SensorReset`] when the FIFO is empty because the chip has reset itself,
+    /// [`Error::FifoNotRunning`] when a recovery is unfinished, [`Error::FifoDisabled`], or
+    /// [`Error::Bus`].
     fn read_fifo(&mut self, out: &mut [RawSample]) -> Result<usize, Error<Self::BusError>>;
 
     /// FIFO accounting so far.
@@ -222,71 +313,23 @@ fn be_i16x3(b: &[u8], i: usize) -> [i16; 3] {
 pub(crate) enum Packet {
     /// A sample.
     Sample(RawSample),
+    /// A packet the chip marked invalid: skipped and counted.
+    Invalid,
     /// A packet of the wrong layout: skipped and counted.
     Malformed,
     /// The chip's "FIFO empty" marker: the batch ends.
     End,
 }
 
-/// Packets read per bus transfer.
-const CHUNK: usize = 8;
-/// The longest FIFO packet of the supported chips.
-const MAX_PACKET: usize = 16;
-
 impl FifoStats {
-    /// Counts a recovery after an outage of `outage_us` microseconds at `rate_hz`.
-    pub(crate) fn recovered(&mut self, outage_us: u32, rate_hz: f32) {
-        self.resets += 1;
-        self.lost += libm::round(f64::from(outage_us) * f64::from(rate_hz) * 1e-6) as u64;
-    }
-
-    /// Counts an overflow whose reset lost the complete packets in `bytes` bytes of FIFO.
-    pub(crate) fn overflow<E>(&mut self, bytes: u16, packet: usize) -> Error<E> {
-        let discarded = bytes / packet as u16;
-        self.overflows += 1;
-        self.discarded += u64::from(discarded);
-        Error::FifoOverflow { discarded }
-    }
-
-    /// Reads `available` whole packets of `packet` bytes (at most `out.len()` samples), 8 per
-    /// transfer through `read`, and parses them into `out`. A failed transfer loses the
-    /// packets read before it: they are counted as discarded.
-    pub(crate) fn drain<E>(
-        &mut self,
-        available: usize,
-        packet: usize,
-        out: &mut [RawSample],
-        mut read: impl FnMut(&mut [u8]) -> Result<(), Error<E>>,
-        parse: impl Fn(&[u8]) -> Packet,
-    ) -> Result<usize, Error<E>> {
-        let packet = packet.clamp(1, MAX_PACKET);
-        let mut buf = [0u8; MAX_PACKET * CHUNK];
-        let (mut remaining, mut delivered) = (available, 0);
-        while remaining > 0 && delivered < out.len() {
-            let n = remaining.min(CHUNK).min(out.len() - delivered);
-            let bytes = &mut buf[..n * packet];
-            if let Err(e) = read(bytes) {
-                self.discarded += delivered as u64;
-                return Err(e);
-            }
-            remaining -= n;
-            for p in bytes.chunks_exact(packet) {
-                match parse(p) {
-                    Packet::Sample(s) => {
-                        if let Some(slot) = out.get_mut(delivered) {
-                            *slot = s;
-                            delivered += 1;
-                        }
-                    }
-                    Packet::Malformed => self.malformed += 1,
-                    Packet::End => {
-                        remaining = 0;
-                        break;
-                    }
-                }
-            }
-        }
-        self.samples += delivered as u64;
-        Ok(delivered)
+    /// Counts a recovery after an outage of `outage_us` microseconds at `hz / div` samples per
+    /// second, rounded to the nearest sample.
+    pub(crate) fn recovered(&mut self, outage_us: u64, hz: u32, div: u32) {
+        let den = 1_000_000u128 * u128::from(div.max(1));
+        let lost = (u128::from(outage_us) * u128::from(hz) + den / 2) / den;
+        self.resets = self.resets.saturating_add(1);
+        self.lost = self
+            .lost
+            .saturating_add(u64::try_from(lost).unwrap_or(u64::MAX));
     }
 }

@@ -1,4 +1,7 @@
-//! InvenSense MPU-6050 over I2C (and the register-compatible subset of MPU-6500/MPU-9250).
+//! InvenSense MPU-6050 over I2C. The MPU-6500 and MPU-9250 answer the same protocol but differ
+//! in their temperature formula, in how SMPLRT_DIV applies with the 260 Hz filter and in their
+//! accelerometer filter register (ACCEL_CONFIG2, 0x1D): they are rejected with
+//! [`Error::UnsupportedDevice`] rather than handled with MPU-6050 formulas.
 //!
 //! Registers, bits and scale factors from "MPU-6000 and MPU-6050 Register Map and
 //! Descriptions", RM-MPU-6000A-00 revision 4.2 (register numbers below), and "MPU-6000 and
@@ -8,6 +11,7 @@
 use embedded_hal::delay::DelayNs;
 use embedded_hal::i2c::I2c;
 
+use super::fifo::{self, FifoChip, FifoState};
 use super::{Error, FifoStats, ImuReader, Packet, RawSample, Scale, be_i16, be_i16x3};
 
 /// Register 25, SMPLRT_DIV: sample rate = gyro output rate / (1 + SMPLRT_DIV).
@@ -37,16 +41,35 @@ const FIFO_R_W: u8 = 0x74;
 /// Register 117, WHO_AM_I.
 const WHO_AM_I: u8 = 0x75;
 
-const FIFO_OFLOW: u8 = 1 << 4;
+/// INT_STATUS and INT_ENABLE: FIFO_OFLOW_INT / FIFO_OFLOW_EN.
+const INT_FIFO_OFLOW: u8 = 1 << 4;
+/// USER_CTRL: FIFO_EN.
 const USER_CTRL_FIFO_EN: u8 = 1 << 6;
+/// USER_CTRL: FIFO_RESET (self-clearing; resets the FIFO "while FIFO_EN equals 0").
 const USER_CTRL_FIFO_RESET: u8 = 1 << 2;
-/// XG | YG | ZG | ACCEL: each FIFO packet is accel x, y, z then gyro x, y, z (register order).
-const FIFO_EN_ACCEL_GYRO: u8 = 0b0111_1000;
+/// PWR_MGMT_1: DEVICE_RESET.
+const PWR_DEVICE_RESET: u8 = 1 << 7;
+/// PWR_MGMT_1: awake (SLEEP clear), clock from the X-gyro PLL (CLKSEL = 1).
+const PWR_CLK_PLL_X: u8 = 0x01;
+/// FIFO_EN: XG_FIFO_EN.
+const FIFO_EN_XG: u8 = 1 << 6;
+/// FIFO_EN: YG_FIFO_EN.
+const FIFO_EN_YG: u8 = 1 << 5;
+/// FIFO_EN: ZG_FIFO_EN.
+const FIFO_EN_ZG: u8 = 1 << 4;
+/// FIFO_EN: ACCEL_FIFO_EN.
+const FIFO_EN_ACCEL: u8 = 1 << 3;
+/// Each FIFO packet is accel x, y, z then gyro x, y, z (register order).
+const FIFO_EN_ACCEL_GYRO: u8 = FIFO_EN_XG | FIFO_EN_YG | FIFO_EN_ZG | FIFO_EN_ACCEL;
 /// Bytes per FIFO packet with accelerometer and gyro enabled.
 const PACKET: usize = 12;
+/// FIFO size (register map, FIFO_COUNT: 1024 bytes).
+const FIFO_BYTES: u16 = 1024;
 
-/// WHO_AM_I of the MPU-6050, MPU-6500 and MPU-9250.
-const KNOWN_IDS: [u8; 3] = [0x68, 0x70, 0x71];
+/// WHO_AM_I of the MPU-6050.
+const MPU6050_ID: u8 = 0x68;
+/// WHO_AM_I of the MPU-6500 and MPU-9250: recognised, and rejected.
+const UNSUPPORTED_IDS: [u8; 2] = [0x70, 0x71];
 
 /// Gyro full-scale range (FS_SEL).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -137,6 +160,13 @@ pub struct Mpu6050Config {
     pub sample_rate_divider: u8,
 }
 
+impl Dlpf {
+    /// The gyro output rate in Hz: 8 kHz with [`Dlpf::Hz260`], otherwise 1 kHz.
+    fn gyro_rate_hz(self) -> u32 {
+        if self == Self::Hz260 { 8000 } else { 1000 }
+    }
+}
+
 impl Default for Mpu6050Config {
     /// +-250 deg/s, +-2 g, 44 Hz filter, 100 Hz sample rate.
     fn default() -> Self {
@@ -152,12 +182,7 @@ impl Default for Mpu6050Config {
 impl Mpu6050Config {
     /// The sample rate in Hz.
     pub fn sample_rate_hz(&self) -> f32 {
-        let gyro_rate = if self.dlpf == Dlpf::Hz260 {
-            8000.0
-        } else {
-            1000.0
-        };
-        gyro_rate / (1.0 + f32::from(self.sample_rate_divider))
+        self.dlpf.gyro_rate_hz() as f32 / (1.0 + f32::from(self.sample_rate_divider))
     }
 
     /// The sensitivities of this configuration.
@@ -204,8 +229,7 @@ pub struct Mpu6050<I2C> {
     i2c: I2C,
     address: u8,
     config: Mpu6050Config,
-    fifo: bool,
-    stats: FifoStats,
+    fifo: FifoState,
 }
 
 impl<I2C: I2c> Mpu6050<I2C> {
@@ -215,8 +239,7 @@ impl<I2C: I2c> Mpu6050<I2C> {
             i2c,
             address,
             config: Mpu6050Config::default(),
-            fifo: false,
-            stats: FifoStats::default(),
+            fifo: FifoState::default(),
         }
     }
 
@@ -247,55 +270,72 @@ impl<I2C: I2c> Mpu6050<I2C> {
     }
 
     /// Probes WHO_AM_I, resets the chip (DEVICE_RESET, then 100 ms), wakes it on the X-gyro
-    /// PLL clock and writes `config`. Returns the WHO_AM_I value (0x68 MPU-6050, 0x70
-    /// MPU-6500, 0x71 MPU-9250). The FIFO is off afterwards.
+    /// PLL clock and writes `config`. Returns the WHO_AM_I value, 0x68. The FIFO is off
+    /// afterwards.
     ///
     /// # Errors
     ///
-    /// [`Error::WrongDevice`] or [`Error::Bus`]; after a bus error `init` can simply be called
-    /// again.
+    /// [`Error::UnsupportedDevice`] for an MPU-6500 or MPU-9250 (0x70, 0x71),
+    /// [`Error::WrongDevice`] for anything else, or [`Error::Bus`]; after a bus error `init`
+    /// can simply be called again.
     pub fn init(
         &mut self,
         delay: &mut impl DelayNs,
         config: Mpu6050Config,
     ) -> Result<u8, Error<I2C::Error>> {
+        self.fifo.off();
+        self.configure(delay, config)
+    }
+
+    fn configure(
+        &mut self,
+        delay: &mut impl DelayNs,
+        config: Mpu6050Config,
+    ) -> Result<u8, Error<I2C::Error>> {
         let id = self.who_am_i()?;
-        if !KNOWN_IDS.contains(&id) {
+        if UNSUPPORTED_IDS.contains(&id) {
+            return Err(Error::UnsupportedDevice { found: id });
+        }
+        if id != MPU6050_ID {
             return Err(Error::WrongDevice { found: id });
         }
-        self.write(PWR_MGMT_1, 0x80)?;
+        self.write(PWR_MGMT_1, PWR_DEVICE_RESET)?;
         delay.delay_ms(100);
-        self.write(PWR_MGMT_1, 0x01)?;
+        self.write(PWR_MGMT_1, PWR_CLK_PLL_X)?;
         self.write(SMPLRT_DIV, config.sample_rate_divider)?;
         self.write(CONFIG, config.dlpf as u8)?;
         self.write(GYRO_CONFIG, (config.gyro_range as u8) << 3)?;
         self.write(ACCEL_CONFIG, (config.accel_range as u8) << 3)?;
         self.config = config;
-        self.fifo = false;
         Ok(id)
     }
 
-    /// Brings the chip back after [`Error::SensorReset`] (or any suspected glitch): probes
-    /// WHO_AM_I, writes the last configuration again and re-enables the FIFO if it was on.
-    /// `outage_us` is the time from the last good FIFO read to now, by the caller's clock; the
-    /// samples the chip produced in it are counted in [`FifoStats::lost`]. Returns WHO_AM_I.
+    /// Brings the chip back after [`Error::SensorReset`], [`Error::FifoNotRunning`] (or any
+    /// suspected glitch): probes WHO_AM_I, writes the last configuration again and re-enables
+    /// the FIFO if `enable_fifo` was called since `init`. `outage_us` is the time in
+    /// microseconds from the last `read_fifo` that accounted for the FIFO (see
+    /// [`FifoStats::lost`]) to now, by the caller's clock; the samples the chip produced in it
+    /// are counted in [`FifoStats::lost`]. Returns WHO_AM_I.
     ///
     /// # Errors
     ///
-    /// As [`Mpu6050::init`]; nothing is counted until the recovery succeeds, so it can simply
-    /// be called again.
+    /// As [`Mpu6050::init`]; nothing is counted until the recovery succeeds, and until then
+    /// `read_fifo` returns [`Error::FifoNotRunning`]: it can simply be called again.
     pub fn recover(
         &mut self,
         delay: &mut impl DelayNs,
-        outage_us: u32,
+        outage_us: u64,
     ) -> Result<u8, Error<I2C::Error>> {
-        let fifo = self.fifo;
-        let id = self.init(delay, self.config)?;
-        if fifo {
+        self.fifo.restarting();
+        let id = self.configure(delay, self.config)?;
+        if self.fifo.wanted {
             self.enable_fifo()?;
         }
-        self.stats
-            .recovered(outage_us, self.config.sample_rate_hz());
+        self.fifo.stats.recovered(
+            outage_us,
+            self.config.dlpf.gyro_rate_hz(),
+            1 + u32::from(self.config.sample_rate_divider),
+        );
         Ok(id)
     }
 
@@ -304,18 +344,19 @@ impl<I2C: I2c> Mpu6050<I2C> {
         &self.config
     }
 
-    /// Resets and enables the FIFO with accelerometer and gyro samples (12 bytes each) and the
-    /// overflow flag.
+    /// Enables the overflow flag and resets and enables the FIFO with accelerometer and gyro
+    /// samples (12 bytes each).
     ///
     /// # Errors
     ///
-    /// [`Error::Bus`].
+    /// [`Error::Bus`]; until a later call (or `recover`) succeeds, `read_fifo` returns
+    /// [`Error::FifoNotRunning`].
     pub fn enable_fifo(&mut self) -> Result<(), Error<I2C::Error>> {
-        self.write(USER_CTRL, USER_CTRL_FIFO_RESET)?;
-        self.write(FIFO_EN, FIFO_EN_ACCEL_GYRO)?;
-        self.write(INT_ENABLE, FIFO_OFLOW)?;
-        self.write(USER_CTRL, USER_CTRL_FIFO_EN)?;
-        self.fifo = true;
+        self.fifo.wanted = true;
+        self.fifo.restarting();
+        self.write(INT_ENABLE, INT_FIFO_OFLOW)?;
+        self.reset_fifo()?;
+        self.fifo.running = true;
         Ok(())
     }
 
@@ -329,6 +370,60 @@ impl<I2C: I2c> Mpu6050<I2C> {
         let mut b = [0; 2];
         self.read_regs(FIFO_COUNTH, &mut b)?;
         Ok(u16::from_be_bytes(b))
+    }
+}
+
+impl<I2C: I2c> FifoChip for Mpu6050<I2C> {
+    type BusError = I2C::Error;
+    const PACKET: usize = PACKET;
+    const FIFO_BYTES: u16 = FIFO_BYTES;
+
+    fn state(&mut self) -> &mut FifoState {
+        &mut self.fifo
+    }
+
+    fn overflow_flag(&mut self) -> Result<bool, Error<I2C::Error>> {
+        let mut status = [0];
+        self.read_regs(INT_STATUS, &mut status)?;
+        Ok(status[0] & INT_FIFO_OFLOW != 0)
+    }
+
+    fn fifo_count(&mut self) -> Result<u16, Error<I2C::Error>> {
+        Mpu6050::fifo_count(self)
+    }
+
+    fn fifo_configured(&mut self) -> Result<bool, Error<I2C::Error>> {
+        let mut user_ctrl = [0];
+        self.read_regs(USER_CTRL, &mut user_ctrl)?;
+        Ok(user_ctrl[0] & USER_CTRL_FIFO_EN != 0)
+    }
+
+    /// The channels are taken off the FIFO before it is reset, as ArduPilot does
+    /// (libraries/AP_InertialSensor/AP_InertialSensor_Invensense.cpp,
+    /// `AP_InertialSensor_Invensense::_fifo_reset`: FIFO_EN = 0, USER_CTRL without FIFO_EN,
+    /// USER_CTRL | FIFO_RESET, USER_CTRL | FIFO_EN, then the FIFO_EN channels), and as the
+    /// register map requires of USER_CTRL (FIFO_RESET "resets the FIFO buffer when set to 1
+    /// while FIFO_EN equals 0"). With the channels off first, nothing enters the FIFO between
+    /// its count and its reset, which makes the count of discarded samples exact.
+    fn reset_fifo(&mut self) -> Result<(), Error<I2C::Error>> {
+        self.write(FIFO_EN, 0)?;
+        self.write(USER_CTRL, 0)?;
+        self.write(USER_CTRL, USER_CTRL_FIFO_RESET)?;
+        self.write(USER_CTRL, USER_CTRL_FIFO_EN)?;
+        self.write(FIFO_EN, FIFO_EN_ACCEL_GYRO)?;
+        Ok(())
+    }
+
+    fn read_data(&mut self, buf: &mut [u8]) -> Result<(), Error<I2C::Error>> {
+        self.read_regs(FIFO_R_W, buf)
+    }
+
+    fn parse(p: &[u8]) -> Packet {
+        Packet::Sample(RawSample {
+            accel: be_i16x3(p, 0),
+            gyro: be_i16x3(p, 6),
+            temperature: None,
+        })
     }
 }
 
@@ -350,49 +445,23 @@ impl<I2C: I2c> ImuReader for Mpu6050<I2C> {
         })
     }
 
-    /// Reads INT_STATUS first: on FIFO_OFLOW_INT the FIFO is reset (its complete packets are
-    /// counted as discarded) and [`Error::FifoOverflow`] is returned. An empty FIFO is checked
-    /// against USER_CTRL: a chip that has reset itself has its FIFO off, and
-    /// [`Error::SensorReset`] is returned (see [`Mpu6050::recover`]). Otherwise the whole
-    /// packets in the FIFO (up to `out.len()`) are read, 8 per I2C transfer; a partial packet
-    /// stays in the FIFO for the next call. A bus error after some packets were read loses them:
-    /// they are counted in [`FifoStats::discarded`].
+    /// Reads INT_STATUS and FIFO_COUNT first. On FIFO_OFLOW_INT, or a count at or above the
+    /// FIFO's 1024 bytes, the FIFO is reset (its complete packets are counted as discarded)
+    /// and [`Error::FifoOverflow`] is returned. An empty FIFO is checked against USER_CTRL: a
+    /// chip that has reset itself has its FIFO off, and [`Error::SensorReset`] is returned (see
+    /// [`Mpu6050::recover`]). Otherwise the whole packets in the FIFO (up to `out.len()`) are
+    /// read, 8 per I2C transfer; a partial packet stays in the FIFO for the next call.
+    ///
+    /// MPU packets have no header: a read that fails part-way would leave the FIFO misaligned
+    /// for good. So, as TDK's drivers do, the FIFO is then reset: the samples of the call and
+    /// those left in the FIFO are counted as discarded and [`Error::FifoResync`] is returned.
+    /// A reset that meets a bus error itself is remembered and finished by the next call, so
+    /// an overflow, whose flag is cleared by reading it, is never lost.
     fn read_fifo(&mut self, out: &mut [RawSample]) -> Result<usize, Error<I2C::Error>> {
-        if !self.fifo {
-            return Err(Error::FifoDisabled);
-        }
-        let mut status = [0];
-        self.read_regs(INT_STATUS, &mut status)?;
-        if status[0] & FIFO_OFLOW != 0 {
-            let bytes = self.fifo_count()?;
-            self.write(USER_CTRL, USER_CTRL_FIFO_RESET)?;
-            self.write(USER_CTRL, USER_CTRL_FIFO_EN)?;
-            return Err(self.stats.overflow(bytes, PACKET));
-        }
-        let available = usize::from(self.fifo_count()?) / PACKET;
-        if available == 0 {
-            // An empty FIFO may be a chip that reset itself: its FIFO is then off.
-            let mut user_ctrl = [0];
-            self.read_regs(USER_CTRL, &mut user_ctrl)?;
-            if user_ctrl[0] & USER_CTRL_FIFO_EN == 0 {
-                return Err(Error::SensorReset);
-            }
-        }
-        let (i2c, address) = (&mut self.i2c, self.address);
-        let read = |buf: &mut [u8]| {
-            i2c.write_read(address, &[FIFO_R_W], buf)
-                .map_err(Error::Bus)
-        };
-        self.stats.drain(available, PACKET, out, read, |p| {
-            Packet::Sample(RawSample {
-                accel: be_i16x3(p, 0),
-                gyro: be_i16x3(p, 6),
-                temperature: None,
-            })
-        })
+        fifo::read_fifo(self, out)
     }
 
     fn fifo_stats(&self) -> FifoStats {
-        self.stats
+        self.fifo.stats
     }
 }
