@@ -30,9 +30,13 @@ pub(crate) struct PendingReset {
     /// Bytes of the dropped packets already taken out of the FIFO: read before a failed
     /// transfer, or clocked out by it.
     consumed: u16,
-    /// The most bytes the FIFO was seen to hold since the reset was decided. The chips stop
-    /// writing the FIFO at the first step of the reset, so its count only grows before that
-    /// step and only falls after it: the largest count seen is what the reset drops.
+    /// The most bytes the FIFO was seen to hold since the reset was decided, or since a reset
+    /// attempt last emptied it. Each reset takes the channels off the FIFO before emptying
+    /// it, and goes no further when that fails: until the emptying step succeeds, the count
+    /// only grows (channels on) or stays (channels off, or emptied by a write that reported a
+    /// failure, leaving 0), so the largest count seen is what the reset drops. Once it has
+    /// succeeded these bytes are dropped for sure and move to `consumed`; later counts are
+    /// samples written since.
     held: u16,
 }
 
@@ -85,9 +89,10 @@ pub(crate) trait FifoChip {
     fn fifo_count(&mut self) -> Result<u16, Error<Self::BusError>>;
     /// Reads back the FIFO mode after an empty count: `false` when the chip has reset itself.
     fn fifo_configured(&mut self) -> Result<bool, Error<Self::BusError>>;
-    /// Empties the FIFO and starts it again. Every step can be repeated: after a failure the
-    /// whole sequence is simply run again.
-    fn reset_fifo(&mut self) -> Result<(), Error<Self::BusError>>;
+    /// Takes the channels off the FIFO, empties it (setting `emptied` once that write has
+    /// succeeded) and starts it again. Every step can be repeated: after a failure the whole
+    /// sequence is simply run again.
+    fn reset_fifo(&mut self, emptied: &mut bool) -> Result<(), Error<Self::BusError>>;
     /// Reads `buf.len()` bytes from the FIFO data register.
     fn read_data(&mut self, buf: &mut [u8]) -> Result<(), Error<Self::BusError>>;
     /// Classifies one packet.
@@ -195,8 +200,14 @@ fn resync<C: FifoChip>(chip: &mut C, count: u16, at_most: usize) {
 /// Carries out the pending reset and counts it: [`Error::FifoOverflow`] or
 /// [`Error::FifoResync`]; a bus error keeps it pending.
 fn finish_reset<C: FifoChip>(chip: &mut C, packet: usize) -> Result<usize, Error<C::BusError>> {
-    chip.reset_fifo()?;
+    let mut emptied = false;
+    let result = chip.reset_fifo(&mut emptied);
     let state = chip.state();
+    if emptied && let Some(p) = state.pending.as_mut() {
+        p.consumed = p.consumed.saturating_add(p.held);
+        p.held = 0;
+    }
+    result?;
     let Some(p) = state.pending.take() else {
         return Ok(0);
     };

@@ -383,9 +383,8 @@ impl<SPI: SpiDevice> Icm42688<SPI> {
     pub fn enable_fifo(&mut self) -> Result<(), Error<SPI::Error>> {
         self.fifo.wanted = true;
         self.fifo.restarting();
-        self.write(FIFO_CONFIG1, FIFO_TEMP_GYRO_ACCEL)?;
         self.write(FIFO_CONFIG, FIFO_STREAM)?;
-        self.reset_fifo()?;
+        self.reset_fifo(&mut false)?;
         self.fifo.running = true;
         Ok(())
     }
@@ -428,14 +427,18 @@ impl<SPI: SpiDevice> FifoChip for Icm42688<SPI> {
         Ok(mode[0] == FIFO_STREAM)
     }
 
-    /// One write, SIGNAL_PATH_RESET.FIFO_FLUSH, with the channels left on. Unlike the MPU-6050
-    /// (see its `reset_fifo`), neither the datasheet nor ArduPilot asks for the channels to be
-    /// off: libraries/AP_InertialSensor/AP_InertialSensor_Invensensev3.cpp,
+    /// SIGNAL_PATH_RESET.FIFO_FLUSH between FIFO_CONFIG1 = 0 (channels off) and the channels
+    /// on again. Neither the datasheet nor ArduPilot asks for the channels to be off for a
+    /// flush (libraries/AP_InertialSensor/AP_InertialSensor_Invensensev3.cpp,
     /// `AP_InertialSensor_Invensensev3::fifo_reset`, writes FIFO_CONFIG1 with accel, gyro and
-    /// temperature on and then SIGNAL_PATH_RESET = 2 (FIFO_FLUSH). The flush is one write, so
-    /// nothing enters the FIFO between a count and a completed flush within one call.
-    fn reset_fifo(&mut self) -> Result<(), Error<SPI::Error>> {
-        self.write(SIGNAL_PATH_RESET, FIFO_FLUSH)
+    /// temperature on and then SIGNAL_PATH_RESET = 2); they are taken off here so that nothing
+    /// enters the FIFO while a flush is in doubt (a write that reported a failure may still
+    /// have been done), which keeps the count of discarded samples exact.
+    fn reset_fifo(&mut self, emptied: &mut bool) -> Result<(), Error<SPI::Error>> {
+        self.write(FIFO_CONFIG1, 0)?;
+        self.write(SIGNAL_PATH_RESET, FIFO_FLUSH)?;
+        *emptied = true;
+        self.write(FIFO_CONFIG1, FIFO_TEMP_GYRO_ACCEL)
     }
 
     fn read_data(&mut self, buf: &mut [u8]) -> Result<(), Error<SPI::Error>> {

@@ -355,7 +355,7 @@ impl<I2C: I2c> Mpu6050<I2C> {
         self.fifo.wanted = true;
         self.fifo.restarting();
         self.write(INT_ENABLE, INT_FIFO_OFLOW)?;
-        self.reset_fifo()?;
+        self.reset_fifo(&mut false)?;
         self.fifo.running = true;
         Ok(())
     }
@@ -405,10 +405,11 @@ impl<I2C: I2c> FifoChip for Mpu6050<I2C> {
     /// register map requires of USER_CTRL (FIFO_RESET "resets the FIFO buffer when set to 1
     /// while FIFO_EN equals 0"). With the channels off first, nothing enters the FIFO between
     /// its count and its reset, which makes the count of discarded samples exact.
-    fn reset_fifo(&mut self) -> Result<(), Error<I2C::Error>> {
+    fn reset_fifo(&mut self, emptied: &mut bool) -> Result<(), Error<I2C::Error>> {
         self.write(FIFO_EN, 0)?;
         self.write(USER_CTRL, 0)?;
         self.write(USER_CTRL, USER_CTRL_FIFO_RESET)?;
+        *emptied = true;
         self.write(USER_CTRL, USER_CTRL_FIFO_EN)?;
         self.write(FIFO_EN, FIFO_EN_ACCEL_GYRO)?;
         Ok(())
