@@ -36,11 +36,19 @@ fn mpu_init() -> Vec<I2c> {
 }
 
 fn mpu_fifo_enable() -> Vec<I2c> {
+    let mut v = vec![I2c::write(ADDR, vec![0x38, 0x10])]; // INT_ENABLE: FIFO_OFLOW_EN
+    v.extend(mpu_fifo_reset());
+    v
+}
+
+/// The FIFO reset, channels off first (ArduPilot's `_fifo_reset`).
+fn mpu_fifo_reset() -> Vec<I2c> {
     vec![
+        I2c::write(ADDR, vec![0x23, 0x00]), // FIFO_EN: no channels
+        I2c::write(ADDR, vec![0x6A, 0x00]), // USER_CTRL: FIFO off
         I2c::write(ADDR, vec![0x6A, 0x04]), // USER_CTRL: FIFO_RESET
-        I2c::write(ADDR, vec![0x23, 0x78]), // FIFO_EN: XG YG ZG ACCEL
-        I2c::write(ADDR, vec![0x38, 0x10]), // INT_ENABLE: FIFO_OFLOW_EN
         I2c::write(ADDR, vec![0x6A, 0x40]), // USER_CTRL: FIFO_EN
+        I2c::write(ADDR, vec![0x23, 0x78]), // FIFO_EN: XG YG ZG ACCEL
     ]
 }
 
@@ -175,8 +183,7 @@ fn mpu6050_fifo_overflow_is_counted_and_recovered() {
     let mut expect = mpu_fifo_enable();
     expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x10])); // FIFO_OFLOW_INT
     expect.push(I2c::write_read(ADDR, vec![0x72], vec![0x04, 0x00])); // 1024 bytes
-    expect.push(I2c::write(ADDR, vec![0x6A, 0x04])); // FIFO_RESET
-    expect.push(I2c::write(ADDR, vec![0x6A, 0x40])); // FIFO_EN
+    expect.extend(mpu_fifo_reset());
     expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x00]));
     expect.push(I2c::write_read(ADDR, vec![0x72], vec![0, 12]));
     expect.push(I2c::write_read(
@@ -210,6 +217,10 @@ fn mpu6050_bus_error_mid_fifo_is_propagated_and_counted() {
         .collect();
     expect.push(I2c::write_read(ADDR, vec![0x74], packets));
     expect.push(I2c::write_read(ADDR, vec![0x74], vec![0; 24]).with_error(ErrorKind::Other));
+    // FIFO_COUNT tells how much the failed read took out (one packet of the two), then the
+    // FIFO is reset to realign the packets: all 10 are discarded.
+    expect.push(I2c::write_read(ADDR, vec![0x72], vec![0, 12]));
+    expect.extend(mpu_fifo_reset());
     // Still usable afterwards.
     expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x00]));
     expect.push(I2c::write_read(ADDR, vec![0x72], vec![0, 0]));
@@ -217,11 +228,15 @@ fn mpu6050_bus_error_mid_fifo_is_propagated_and_counted() {
     let mut imu = Mpu6050::new(I2cMock::new(&expect), ADDR);
     imu.enable_fifo().unwrap();
     let mut out = [RawSample::default(); 16];
-    assert_eq!(imu.read_fifo(&mut out), Err(Error::Bus(ErrorKind::Other)));
     assert_eq!(
-        imu.fifo_stats().discarded,
-        8,
-        "the 8 packets read before the error are lost"
+        imu.read_fifo(&mut out),
+        Err(Error::FifoResync { discarded: 10 })
+    );
+    let stats = imu.fifo_stats();
+    assert_eq!(
+        (stats.discarded, stats.discarded_bytes, stats.resyncs),
+        (10, 120, 1),
+        "the 8 packets read before the error, and the 2 of the failed read, are lost"
     );
     assert_eq!(imu.read_fifo(&mut out), Ok(0));
     imu.destroy().done();
@@ -315,10 +330,15 @@ fn icm_init() -> Vec<Spi<u8>> {
 }
 
 fn icm_fifo_enable() -> Vec<Spi<u8>> {
+    [spi_write(0x16, 0x40), icm_fifo_reset()].concat() // FIFO_CONFIG: stream-to-FIFO
+}
+
+/// The FIFO flush, channels off around it.
+fn icm_fifo_reset() -> Vec<Spi<u8>> {
     [
-        spi_write(0x5F, 0x07), // FIFO_CONFIG1: temp, gyro, accel (packet 3)
-        spi_write(0x16, 0x40), // FIFO_CONFIG: stream-to-FIFO
+        spi_write(0x5F, 0x00), // FIFO_CONFIG1: no channels
         spi_write(0x4B, 0x02), // SIGNAL_PATH_RESET: FIFO_FLUSH
+        spi_write(0x5F, 0x07), // FIFO_CONFIG1: temp, gyro, accel (packet 3)
     ]
     .concat()
 }
@@ -445,7 +465,7 @@ fn icm42688_fifo_overflow_is_counted_and_recovered() {
     let mut expect = icm_fifo_enable();
     expect.extend(spi_read(0x2D, vec![0x02])); // FIFO_FULL_INT
     expect.extend(spi_read(0x2E, vec![0x08, 0x00])); // 2048 bytes
-    expect.extend(spi_write(0x4B, 0x02)); // FIFO_FLUSH
+    expect.extend(icm_fifo_reset());
     expect.extend(spi_read(0x2D, vec![0x00]));
     expect.extend(spi_read(0x2E, vec![0, 16]));
     expect.extend(spi_read(0x30, icm_packet(0x68, [1; 3], [2; 3], 0)));
@@ -577,4 +597,92 @@ fn replay_serves_the_record() {
     replay.rewind();
     assert_eq!(replay.remaining(), 5);
     assert_eq!(replay.scale(), scale);
+}
+
+/// Issue 24 item 4: the ICM-42688-P's invalid-data marker (-32768; -128 for the FIFO
+/// temperature) was delivered as a real sample: -1998 deg/s at +-2000 deg/s, -36.8 deg C.
+#[test]
+fn icm42688_invalid_marker_is_skipped_and_counted() {
+    let mut expect = icm_fifo_enable();
+    expect.extend(spi_read(0x2D, vec![0x00]));
+    expect.extend(spi_read(0x2E, vec![0, 4 * 16]));
+    let data = [
+        icm_packet(0x68, [1, 2, 3], [i16::MIN; 3], 10),
+        icm_packet(0x68, [i16::MIN, 0, 0], [4, 5, 6], 10),
+        icm_packet(0x68, [1, 2, 3], [4, 5, 6], i8::MIN),
+        icm_packet(0x68, [7, 8, 9], [10, 11, 12], 10),
+    ]
+    .concat();
+    expect.extend(spi_read(0x30, data));
+    let mut burst = Vec::new();
+    for v in [1325i16, 0, 0, 0, i16::MIN, i16::MIN, i16::MIN] {
+        burst.extend(v.to_be_bytes());
+    }
+    expect.extend(spi_read(0x1D, burst));
+    let mut imu = Icm42688::new(SpiMock::new(&expect));
+    imu.enable_fifo().unwrap();
+    let mut out = [RawSample::default(); 8];
+    assert_eq!(imu.read_fifo(&mut out), Ok(1));
+    assert_eq!((out[0].accel, out[0].gyro), ([7, 8, 9], [10, 11, 12]));
+    assert_eq!(imu.read(), Err(Error::NoData), "data registers still invalid");
+    let stats = imu.fifo_stats();
+    assert_eq!((stats.samples, stats.invalid), (1, 4));
+    imu.destroy().done();
+}
+
+/// Issue 24 item 5: a limit at the nominal range never fires (the rail of +-1000 deg/s is
+/// 32767 / 32.8 = 998.99 deg/s); the limit from the scale rejects every clipped reading, per
+/// channel, and the raw-count test needs no limit at all.
+#[test]
+fn saturation_limits_from_the_scale_fire_at_the_rails() {
+    use imu_ar::recursive::{Config, Lattice};
+    let scale = Scale {
+        gyro_counts_per_dps: IcmGyroRange::Dps1000.counts_per_dps(),
+        accel_counts_per_g: IcmAccelRange::G2.counts_per_g(),
+    };
+    let rail = RawSample {
+        gyro: [i16::MAX, 0, i16::MIN],
+        accel: [0, i16::MIN, 0],
+        temperature: None,
+    };
+    assert!(rail.gyro_clipped() && rail.accel_clipped() && rail.clipped());
+    assert!(!RawSample::default().clipped());
+    let base = Config::new(0.999f32, 1e-4, 0.001).unwrap();
+    let nominal = base.with_saturation(1000.0).unwrap();
+    let gyro = base
+        .with_saturation(scale.gyro_saturation(GyroUnit::DegPerSec))
+        .unwrap();
+    let accel = base
+        .with_saturation(scale.accel_saturation(AccelUnit::G))
+        .unwrap();
+    let g = scale.gyro(rail.gyro, GyroUnit::DegPerSec);
+    let a = scale.accel(rail.accel, AccelUnit::G);
+    let mut l = Lattice::<f32, 2>::new(&nominal);
+    l.update(&nominal, g[0]);
+    assert_eq!(l.health().saturated, 0, "the nominal range lets the rail through");
+    let mut l = Lattice::<f32, 2>::new(&gyro);
+    for x in [g[0], g[2], scale.gyro([i16::MAX - 1; 3], GyroUnit::DegPerSec)[0]] {
+        l.update(&gyro, x);
+    }
+    assert_eq!((l.health().saturated, l.health().samples), (2, 1));
+    let mut l = Lattice::<f32, 2>::new(&accel);
+    for x in [a[1], scale.accel([i16::MIN + 2; 3], AccelUnit::G)[0]] {
+        l.update(&accel, x);
+    }
+    assert_eq!((l.health().saturated, l.health().samples), (1, 1));
+    // Per channel: the gyro's limit in g would let every clipped accel sample through.
+    assert!(scale.gyro_saturation(GyroUnit::DegPerSec) > a[1].abs());
+}
+
+/// Issue 24 item 6: MPU-6500 and MPU-9250 were handled with MPU-6050 formulas.
+#[test]
+fn mpu6500_and_mpu9250_are_rejected_clearly() {
+    for id in [0x70, 0x71] {
+        let expect = [I2c::write_read(ADDR, vec![0x75], vec![id])];
+        let mut imu = Mpu6050::new(I2cMock::new(&expect), ADDR);
+        let err = imu.init(&mut NoopDelay, mpu_config());
+        assert_eq!(err, Err(Error::UnsupportedDevice { found: id }));
+        assert!(err.unwrap_err().to_string().contains("not supported"));
+        imu.destroy().done();
+    }
 }

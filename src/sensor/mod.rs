@@ -106,7 +106,9 @@ impl Scale {
     /// The saturation limit of the gyro axes in `unit`, for
     /// [`Config::with_saturation`](crate::recursive::Config::with_saturation): half a count
     /// below the rail `i16::MAX`, so that a clipped reading (`i16::MAX` or `i16::MIN` counts) is
-    /// at or beyond it and every reading short of the rails is inside it.
+    /// at or beyond it and every reading of at most 32766 counts either way is inside it. (The
+    /// estimators' screen is symmetric: -32767 counts, one count from the negative rail, is
+    /// rejected too.)
     ///
     /// The nominal range is no limit: at +-1000 deg/s (32.8 counts per deg/s) the rail is
     /// 32767 / 32.8 = 998.99 deg/s, so `with_saturation(1000.0)` never fires.
