@@ -12,6 +12,7 @@
 #![no_std]
 #![no_main]
 
+use cortex_m::peripheral::DWT;
 use cortex_m_rt::entry;
 use defmt_rtt as _;
 use imu_ar::recursive::{Config, Lattice};
@@ -20,15 +21,42 @@ use panic_probe as _;
 use stm32f4xx_hal::{i2c::I2c, pac, prelude::*};
 
 const NAMES: [&str; 6] = ["gx", "gy", "gz", "ax", "ay", "az"];
+/// The wait after DEVICE_RESET inside `init` and `recover`.
+const INIT_DELAY_US: u64 = 100_000;
+
+/// Microseconds since start from the DWT cycle counter, extended to 64 bits: it must be read
+/// at least once per wrap of the 32-bit counter (51 s at 84 MHz); the loop reads it every
+/// 50 ms.
+struct Clock {
+    cycles_per_us: u64,
+    last: u32,
+    cycles: u64,
+}
+
+impl Clock {
+    fn now_us(&mut self) -> u64 {
+        let now = DWT::cycle_count();
+        self.cycles += u64::from(now.wrapping_sub(self.last));
+        self.last = now;
+        self.cycles / self.cycles_per_us
+    }
+}
 
 #[entry]
 fn main() -> ! {
     let dp = pac::Peripherals::take().expect("device peripherals");
-    let cp = cortex_m::Peripherals::take().expect("core peripherals");
+    let mut cp = cortex_m::Peripherals::take().expect("core peripherals");
     let rcc = dp.RCC.constrain();
     let clocks = rcc.cfgr.use_hse(25.MHz()).sysclk(84.MHz()).freeze();
     let gpiob = dp.GPIOB.split();
     let i2c = I2c::new(dp.I2C1, (gpiob.pb6, gpiob.pb7), 400.kHz(), &clocks);
+    cp.DCB.enable_trace();
+    cp.DWT.enable_cycle_counter();
+    let mut clock = Clock {
+        cycles_per_us: u64::from(clocks.sysclk().raw() / 1_000_000),
+        last: DWT::cycle_count(),
+        cycles: 0,
+    };
     let mut delay = cp.SYST.delay(&clocks);
 
     let mut imu = Mpu6050::new(i2c, 0x68);
@@ -41,26 +69,42 @@ fn main() -> ! {
         defmt::panic!("FIFO enable failed: {}", defmt::Debug2Format(&e));
     }
 
-    let estimator = Config::new(0.9995f32, 1e-4, 1.0 / config.sample_rate_hz())
-        .expect("valid configuration")
-        .with_saturation(240.0)
-        .expect("valid saturation limit");
-    let mut axes = [Lattice::<f32, 4>::new(&estimator); 6];
+    // Each channel's saturation limit comes from its own range: a clipped reading (at the
+    // rails of the i16 counts) is at or beyond it.
     let scale = imu.scale();
+    let base =
+        Config::new(0.9995f32, 1e-4, 1.0 / config.sample_rate_hz()).expect("valid configuration");
+    let gyro = base
+        .with_saturation(scale.gyro_saturation(GyroUnit::DegPerSec))
+        .expect("valid gyro saturation limit");
+    let accel = base
+        .with_saturation(scale.accel_saturation(AccelUnit::G))
+        .expect("valid accel saturation limit");
+    let estimators = [gyro, gyro, gyro, accel, accel, accel];
+    let mut axes: [Lattice<f32, 4>; 6] = core::array::from_fn(|i| Lattice::new(&estimators[i]));
     let mut batch = [RawSample::default(); 32];
     let mut samples = 0u32;
-    // Time since the last good FIFO read, by the polling period.
-    let mut since_good_ms = 0u32;
+    // When a read last accounted for the FIFO: the start of an outage, by the board's clock.
+    let mut accounted_us = clock.now_us();
     loop {
         delay.delay_ms(50u32);
-        since_good_ms = since_good_ms.saturating_add(50);
         let n = match imu.read_fifo(&mut batch) {
             Ok(n) => n,
-            Err(Error::SensorReset) => {
+            Err(e @ (Error::FifoOverflow { .. } | Error::FifoResync { .. })) => {
+                accounted_us = clock.now_us();
+                defmt::warn!("FIFO: {}", defmt::Debug2Format(&e));
+                continue;
+            }
+            Err(e @ (Error::SensorReset | Error::FifoNotRunning)) => {
+                defmt::warn!("FIFO: {}: recovering", defmt::Debug2Format(&e));
                 // The outage runs until the FIFO is on again, after init's 100 ms.
-                let outage_us = since_good_ms.saturating_add(100).saturating_mul(1000);
+                let outage_us = clock.now_us() - accounted_us + INIT_DELAY_US;
                 match imu.recover(&mut delay, outage_us) {
-                    Ok(_) => defmt::warn!("MPU-6050 reset itself: recovered"),
+                    Ok(_) => {
+                        accounted_us = clock.now_us();
+                        defmt::warn!("MPU-6050 recovered after {=u64} us", outage_us);
+                    }
+                    // read_fifo says FifoNotRunning until a recovery succeeds.
                     Err(e) => defmt::warn!("recovery failed: {}", defmt::Debug2Format(&e)),
                 }
                 continue;
@@ -70,17 +114,23 @@ fn main() -> ! {
                 continue;
             }
         };
-        since_good_ms = 0;
+        accounted_us = clock.now_us();
         for s in &batch[..n] {
             let gyro = scale.gyro(s.gyro, GyroUnit::DegPerSec);
             let accel = scale.accel(s.accel, AccelUnit::G);
-            for (lattice, x) in axes.iter_mut().zip(gyro.into_iter().chain(accel)) {
-                lattice.update(&estimator, x);
+            for ((lattice, estimator), x) in axes
+                .iter_mut()
+                .zip(&estimators)
+                .zip(gyro.into_iter().chain(accel))
+            {
+                lattice.update(estimator, x);
             }
             samples += 1;
             if samples.is_multiple_of(1000) {
-                for (name, lattice) in NAMES.iter().zip(axes.iter_mut()) {
-                    if let Some(m) = lattice.model(&estimator) {
+                for ((name, lattice), estimator) in
+                    NAMES.iter().zip(axes.iter_mut()).zip(&estimators)
+                {
+                    if let Some(m) = lattice.model(estimator) {
                         defmt::info!(
                             "{=str}: a={=[?]} sigma^2={=f32} mean={=f32} {}",
                             name,
