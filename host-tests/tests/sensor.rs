@@ -624,7 +624,11 @@ fn icm42688_invalid_marker_is_skipped_and_counted() {
     let mut out = [RawSample::default(); 8];
     assert_eq!(imu.read_fifo(&mut out), Ok(1));
     assert_eq!((out[0].accel, out[0].gyro), ([7, 8, 9], [10, 11, 12]));
-    assert_eq!(imu.read(), Err(Error::NoData), "data registers still invalid");
+    assert_eq!(
+        imu.read(),
+        Err(Error::NoData),
+        "data registers still invalid"
+    );
     let stats = imu.fifo_stats();
     assert_eq!((stats.samples, stats.invalid), (1, 4));
     imu.destroy().done();
@@ -659,9 +663,17 @@ fn saturation_limits_from_the_scale_fire_at_the_rails() {
     let a = scale.accel(rail.accel, AccelUnit::G);
     let mut l = Lattice::<f32, 2>::new(&nominal);
     l.update(&nominal, g[0]);
-    assert_eq!(l.health().saturated, 0, "the nominal range lets the rail through");
+    assert_eq!(
+        l.health().saturated,
+        0,
+        "the nominal range lets the rail through"
+    );
     let mut l = Lattice::<f32, 2>::new(&gyro);
-    for x in [g[0], g[2], scale.gyro([i16::MAX - 1; 3], GyroUnit::DegPerSec)[0]] {
+    for x in [
+        g[0],
+        g[2],
+        scale.gyro([i16::MAX - 1; 3], GyroUnit::DegPerSec)[0],
+    ] {
         l.update(&gyro, x);
     }
     assert_eq!((l.health().saturated, l.health().samples), (2, 1));

@@ -121,7 +121,10 @@ fn invalid_marker_after_start_up_is_skipped_and_counted() {
     sim.borrow_mut().tick(40);
     let mut out = [RawSample::default(); 160];
     assert_eq!(imu.read_fifo(&mut out), Ok(10));
-    assert_eq!(out[..10].iter().map(decode).collect::<Vec<_>>(), (30..40).map(Some).collect::<Vec<_>>());
+    assert_eq!(
+        out[..10].iter().map(decode).collect::<Vec<_>>(),
+        (30..40).map(Some).collect::<Vec<_>>()
+    );
     let stats = imu.fifo_stats();
     assert_eq!((stats.invalid, stats.samples), (30, 10));
 }

@@ -75,7 +75,11 @@ fn overflow_survives_a_failed_count_read() {
     let stats = imu.fifo_stats();
     assert_eq!((stats.overflows, stats.discarded), (1, 85));
     expect_samples(&sim, &mut imu, 9);
-    assert_eq!(sim.borrow().dropped, 15, "100 - 85 packets damaged by the chip");
+    assert_eq!(
+        sim.borrow().dropped,
+        15,
+        "100 - 85 packets damaged by the chip"
+    );
 }
 
 /// Item 2: the second USER_CTRL write of the overflow reset fails; the next call reported a
@@ -167,7 +171,8 @@ fn count_at_or_above_the_fifo_size_is_an_overflow() {
 fn full_fifo_without_its_flag_is_an_overflow() {
     let (sim, mut imu) = reader(8);
     sim.borrow_mut().tick(90);
-    sim.borrow_mut().fail_applied(Kind::Read(mpu::INT_STATUS), 0);
+    sim.borrow_mut()
+        .fail_applied(Kind::Read(mpu::INT_STATUS), 0);
     let mut out = [RawSample::default(); 128];
     assert!(matches!(imu.read_fifo(&mut out), Err(Error::Bus(_))));
     assert_eq!(

@@ -68,7 +68,9 @@ impl FifoState {
     }
 
     fn mark_overflow(&mut self) {
-        self.pending.get_or_insert_with(PendingReset::default).overflow = true;
+        self.pending
+            .get_or_insert_with(PendingReset::default)
+            .overflow = true;
     }
 }
 
@@ -192,7 +194,10 @@ fn resync<C: FifoChip>(chip: &mut C, count: u16, at_most: usize) {
         Some(left) => (count.saturating_sub(left), left),
         None => (at_most, count - at_most),
     };
-    let pending = chip.state().pending.get_or_insert_with(PendingReset::default);
+    let pending = chip
+        .state()
+        .pending
+        .get_or_insert_with(PendingReset::default);
     pending.consumed = consumed;
     pending.held = pending.held.max(held);
 }

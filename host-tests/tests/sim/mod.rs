@@ -127,7 +127,11 @@ pub struct Sim {
 pub fn sample(seq: u64) -> ([i16; 3], [i16; 3]) {
     let f = |v: u64| i16::try_from(v).unwrap();
     (
-        [f(seq & 0x3FFF), f((seq >> 14) & 0x3FFF), f(1000 + seq % 977)],
+        [
+            f(seq & 0x3FFF),
+            f((seq >> 14) & 0x3FFF),
+            f(1000 + seq % 977),
+        ],
         [-f(seq % 1013), f((seq * 7) % 2003), f((seq >> 28) & 0x3FFF)],
     )
 }
@@ -666,7 +670,9 @@ where
     );
     recoveries += 1;
     sim.borrow_mut().tick(50);
-    let k = reader.read_fifo(&mut out).expect("samples after one recover");
+    let k = reader
+        .read_fifo(&mut out)
+        .expect("samples after one recover");
     assert!(k > 0, "no samples after one recover");
     delivered += accept(&out[..k], &mut last_seq);
 
