@@ -37,19 +37,27 @@ fn mpu_init() -> Vec<I2c> {
 
 fn mpu_fifo_enable() -> Vec<I2c> {
     let mut v = vec![I2c::write(ADDR, vec![0x38, 0x10])]; // INT_ENABLE: FIFO_OFLOW_EN
-    v.extend(mpu_fifo_reset());
+    v.extend(mpu_fifo_reset(0));
     v
 }
 
-/// The FIFO reset, channels off first (ArduPilot's `_fifo_reset`).
-fn mpu_fifo_reset() -> Vec<I2c> {
-    vec![
+/// The FIFO reset, channels off first (ArduPilot's `_fifo_reset`), with `held` bytes in the
+/// FIFO once they are off; an empty FIFO is checked against a chip reset (PWR_MGMT_1).
+fn mpu_fifo_reset(held: u16) -> Vec<I2c> {
+    let mut v = vec![
         I2c::write(ADDR, vec![0x23, 0x00]), // FIFO_EN: no channels
         I2c::write(ADDR, vec![0x6A, 0x00]), // USER_CTRL: FIFO off
+        I2c::write_read(ADDR, vec![0x72], held.to_be_bytes().to_vec()), // FIFO_COUNT
+    ];
+    if held == 0 {
+        v.push(I2c::write_read(ADDR, vec![0x6B], vec![0x01])); // PWR_MGMT_1: awake, PLL
+    }
+    v.extend([
         I2c::write(ADDR, vec![0x6A, 0x04]), // USER_CTRL: FIFO_RESET
         I2c::write(ADDR, vec![0x6A, 0x40]), // USER_CTRL: FIFO_EN
         I2c::write(ADDR, vec![0x23, 0x78]), // FIFO_EN: XG YG ZG ACCEL
-    ]
+    ]);
+    v
 }
 
 /// A FIFO packet: accel x, y, z then gyro x, y, z, big-endian.
@@ -148,11 +156,13 @@ fn mpu6050_bus_error_at_every_init_step_then_a_clean_init() {
 
 #[test]
 fn mpu6050_fifo_whole_packets_chunks_and_partial_packets() {
-    let mut expect = mpu_fifo_enable();
+    let mut expect = mpu_init();
+    expect.extend(mpu_fifo_enable());
     // 10 packets and 5 stray bytes: 8 packets in the first transfer, 2 in the second; the
     // partial packet stays in the FIFO.
     expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x01])); // INT_STATUS: data ready only
     expect.push(I2c::write_read(ADDR, vec![0x72], vec![0, 125])); // FIFO_COUNT = 10*12 + 5
+    expect.push(I2c::write_read(ADDR, vec![0x72], vec![0, 125])); // read again: the same
     let packets: Vec<Vec<u8>> = (0..10i16)
         .map(|i| mpu_packet([i, 0, 4096], [-i, 1, 2]))
         .collect();
@@ -161,10 +171,13 @@ fn mpu6050_fifo_whole_packets_chunks_and_partial_packets() {
     // The next call asks for fewer samples than there are.
     expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x00]));
     expect.push(I2c::write_read(ADDR, vec![0x72], vec![0, 41])); // 3 packets + 5 bytes
+    expect.push(I2c::write_read(ADDR, vec![0x72], vec![0, 41]));
     expect.push(I2c::write_read(ADDR, vec![0x74], packets[..2].concat()));
     let mut imu = Mpu6050::new(I2cMock::new(&expect), ADDR);
     let mut out = [RawSample::default(); 16];
     assert_eq!(imu.read_fifo(&mut out), Err(Error::FifoDisabled));
+    assert_eq!(imu.enable_fifo(), Err(Error::NotInitialised));
+    imu.init(&mut NoopDelay, mpu_config()).unwrap();
     imu.enable_fifo().unwrap();
     assert_eq!(imu.read_fifo(&mut out), Ok(10));
     for (i, s) in out[..10].iter().enumerate() {
@@ -180,11 +193,13 @@ fn mpu6050_fifo_whole_packets_chunks_and_partial_packets() {
 
 #[test]
 fn mpu6050_fifo_overflow_is_counted_and_recovered() {
-    let mut expect = mpu_fifo_enable();
+    let mut expect = mpu_init();
+    expect.extend(mpu_fifo_enable());
     expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x10])); // FIFO_OFLOW_INT
     expect.push(I2c::write_read(ADDR, vec![0x72], vec![0x04, 0x00])); // 1024 bytes
-    expect.extend(mpu_fifo_reset());
+    expect.extend(mpu_fifo_reset(1024));
     expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x00]));
+    expect.push(I2c::write_read(ADDR, vec![0x72], vec![0, 12]));
     expect.push(I2c::write_read(ADDR, vec![0x72], vec![0, 12]));
     expect.push(I2c::write_read(
         ADDR,
@@ -192,6 +207,7 @@ fn mpu6050_fifo_overflow_is_counted_and_recovered() {
         mpu_packet([1, 2, 3], [4, 5, 6]),
     ));
     let mut imu = Mpu6050::new(I2cMock::new(&expect), ADDR);
+    imu.init(&mut NoopDelay, mpu_config()).unwrap();
     imu.enable_fifo().unwrap();
     let mut out = [RawSample::default(); 4];
     assert_eq!(
@@ -209,9 +225,11 @@ fn mpu6050_fifo_overflow_is_counted_and_recovered() {
 
 #[test]
 fn mpu6050_bus_error_mid_fifo_is_propagated_and_counted() {
-    let mut expect = mpu_fifo_enable();
+    let mut expect = mpu_init();
+    expect.extend(mpu_fifo_enable());
     expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x00]));
     expect.push(I2c::write_read(ADDR, vec![0x72], vec![0, 120])); // 10 packets
+    expect.push(I2c::write_read(ADDR, vec![0x72], vec![0, 120]));
     let packets: Vec<u8> = (0..8)
         .flat_map(|i| mpu_packet([i, i, i], [i, i, i]))
         .collect();
@@ -220,12 +238,14 @@ fn mpu6050_bus_error_mid_fifo_is_propagated_and_counted() {
     // FIFO_COUNT tells how much the failed read took out (one packet of the two), then the
     // FIFO is reset to realign the packets: all 10 are discarded.
     expect.push(I2c::write_read(ADDR, vec![0x72], vec![0, 12]));
-    expect.extend(mpu_fifo_reset());
+    expect.extend(mpu_fifo_reset(12));
     // Still usable afterwards.
     expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x00]));
     expect.push(I2c::write_read(ADDR, vec![0x72], vec![0, 0]));
-    expect.push(I2c::write_read(ADDR, vec![0x6A], vec![0x40])); // empty: USER_CTRL, FIFO on
+    // Empty: USER_CTRL with the FIFO on, PWR_MGMT_1 awake on the PLL clock.
+    expect.push(I2c::write_read(ADDR, vec![0x6A], vec![0x40, 0x01]));
     let mut imu = Mpu6050::new(I2cMock::new(&expect), ADDR);
+    imu.init(&mut NoopDelay, mpu_config()).unwrap();
     imu.enable_fifo().unwrap();
     let mut out = [RawSample::default(); 16];
     assert_eq!(
@@ -251,16 +271,19 @@ fn mpu6050_resetting_itself_is_detected_recovered_and_counted() {
     expect.extend(mpu_fifo_enable());
     expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x01]));
     expect.push(I2c::write_read(ADDR, vec![0x72], vec![0, 24]));
+    expect.push(I2c::write_read(ADDR, vec![0x72], vec![0, 24]));
     let packets = [mpu_packet([1; 3], [2; 3]), mpu_packet([3; 3], [4; 3])];
     expect.push(I2c::write_read(ADDR, vec![0x74], packets.concat()));
     expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x00]));
     expect.push(I2c::write_read(ADDR, vec![0x72], vec![0, 0]));
-    expect.push(I2c::write_read(ADDR, vec![0x6A], vec![0x00])); // USER_CTRL after a reset
+    // USER_CTRL and PWR_MGMT_1 after a reset: FIFO off, asleep.
+    expect.push(I2c::write_read(ADDR, vec![0x6A], vec![0x00, 0x40]));
     // The first recovery attempt meets a bus error at WHO_AM_I; the second succeeds.
     expect.push(I2c::write_read(ADDR, vec![0x75], vec![0x68]).with_error(ErrorKind::Other));
     expect.extend(mpu_init());
     expect.extend(mpu_fifo_enable());
     expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x01]));
+    expect.push(I2c::write_read(ADDR, vec![0x72], vec![0, 12]));
     expect.push(I2c::write_read(ADDR, vec![0x72], vec![0, 12]));
     expect.push(I2c::write_read(
         ADDR,
@@ -330,17 +353,23 @@ fn icm_init() -> Vec<Spi<u8>> {
 }
 
 fn icm_fifo_enable() -> Vec<Spi<u8>> {
-    [spi_write(0x16, 0x40), icm_fifo_reset()].concat() // FIFO_CONFIG: stream-to-FIFO
+    [spi_write(0x16, 0x40), icm_fifo_reset(0)].concat() // FIFO_CONFIG: stream-to-FIFO
 }
 
-/// The FIFO flush, channels off around it.
-fn icm_fifo_reset() -> Vec<Spi<u8>> {
-    [
-        spi_write(0x5F, 0x00), // FIFO_CONFIG1: no channels
-        spi_write(0x4B, 0x02), // SIGNAL_PATH_RESET: FIFO_FLUSH
-        spi_write(0x5F, 0x07), // FIFO_CONFIG1: temp, gyro, accel (packet 3)
+/// The FIFO flush, channels off around it, with `held` bytes in the FIFO once they are off;
+/// an empty FIFO is checked against a chip reset (PWR_MGMT0).
+fn icm_fifo_reset(held: u16) -> Vec<Spi<u8>> {
+    let mut v = [
+        spi_write(0x5F, 0x00),                       // FIFO_CONFIG1: no channels
+        spi_read(0x2E, held.to_be_bytes().to_vec()), // FIFO_COUNT
     ]
-    .concat()
+    .concat();
+    if held == 0 {
+        v.extend(spi_read(0x4E, vec![0x0F])); // PWR_MGMT0: low noise
+    }
+    v.extend(spi_write(0x4B, 0x02)); // SIGNAL_PATH_RESET: FIFO_FLUSH
+    v.extend(spi_write(0x5F, 0x07)); // FIFO_CONFIG1: temp, gyro, accel (packet 3)
+    v
 }
 
 /// Packet 3: header, accel, gyro (big-endian), temperature (1 byte), timestamp (2 bytes).
@@ -416,7 +445,8 @@ fn icm42688_wrong_device_is_a_typed_error() {
 
 #[test]
 fn icm42688_fifo_packets_malformed_empty_and_partial() {
-    let mut expect = icm_fifo_enable();
+    let mut expect = icm_init();
+    expect.extend(icm_fifo_enable());
     expect.extend(spi_read(0x2D, vec![0x08])); // INT_STATUS: data ready
     expect.extend(spi_read(0x2E, vec![0, 3 * 16 + 7])); // 3 packets and 7 stray bytes
     let data = [
@@ -426,7 +456,8 @@ fn icm42688_fifo_packets_malformed_empty_and_partial() {
     ]
     .concat();
     expect.extend(spi_read(0x30, data));
-    // An empty-FIFO header ends the batch.
+    // An empty-FIFO header inside the counted bytes is a damaged header: counted as malformed;
+    // the packet after it, clocked out in the same transaction, is delivered.
     expect.extend(spi_read(0x2D, vec![0x00]));
     expect.extend(spi_read(0x2E, vec![0, 32]));
     expect.extend(spi_read(
@@ -440,6 +471,7 @@ fn icm42688_fifo_packets_malformed_empty_and_partial() {
     let mut imu = Icm42688::new(SpiMock::new(&expect));
     let mut out = [RawSample::default(); 8];
     assert_eq!(imu.read_fifo(&mut out), Err(Error::FifoDisabled));
+    imu.init(&mut NoopDelay, icm_config()).unwrap();
     imu.enable_fifo().unwrap();
     assert_eq!(imu.read_fifo(&mut out), Ok(2));
     assert_eq!(
@@ -454,22 +486,25 @@ fn icm42688_fifo_packets_malformed_empty_and_partial() {
     assert!(
         (Icm42688::<SpiMock<u8>>::temperature_celsius(640) - (10.0 / 2.07 + 25.0)).abs() < 1e-4
     );
-    assert_eq!(imu.read_fifo(&mut out), Ok(0));
+    assert_eq!(imu.read_fifo(&mut out), Ok(1));
+    assert_eq!((out[0].accel, out[0].gyro), ([9; 3], [9; 3]));
     let stats = imu.fifo_stats();
-    assert_eq!((stats.samples, stats.malformed), (2, 1));
+    assert_eq!((stats.samples, stats.malformed), (3, 2));
     imu.destroy().done();
 }
 
 #[test]
 fn icm42688_fifo_overflow_is_counted_and_recovered() {
-    let mut expect = icm_fifo_enable();
+    let mut expect = icm_init();
+    expect.extend(icm_fifo_enable());
     expect.extend(spi_read(0x2D, vec![0x02])); // FIFO_FULL_INT
     expect.extend(spi_read(0x2E, vec![0x08, 0x00])); // 2048 bytes
-    expect.extend(icm_fifo_reset());
+    expect.extend(icm_fifo_reset(2048));
     expect.extend(spi_read(0x2D, vec![0x00]));
     expect.extend(spi_read(0x2E, vec![0, 16]));
     expect.extend(spi_read(0x30, icm_packet(0x68, [1; 3], [2; 3], 0)));
     let mut imu = Icm42688::new(SpiMock::new(&expect));
+    imu.init(&mut NoopDelay, icm_config()).unwrap();
     imu.enable_fifo().unwrap();
     let mut out = [RawSample::default(); 4];
     assert_eq!(
@@ -603,7 +638,8 @@ fn replay_serves_the_record() {
 /// temperature) was delivered as a real sample: -1998 deg/s at +-2000 deg/s, -36.8 deg C.
 #[test]
 fn icm42688_invalid_marker_is_skipped_and_counted() {
-    let mut expect = icm_fifo_enable();
+    let mut expect = icm_init();
+    expect.extend(icm_fifo_enable());
     expect.extend(spi_read(0x2D, vec![0x00]));
     expect.extend(spi_read(0x2E, vec![0, 4 * 16]));
     let data = [
@@ -620,6 +656,7 @@ fn icm42688_invalid_marker_is_skipped_and_counted() {
     }
     expect.extend(spi_read(0x1D, burst));
     let mut imu = Icm42688::new(SpiMock::new(&expect));
+    imu.init(&mut NoopDelay, icm_config()).unwrap();
     imu.enable_fifo().unwrap();
     let mut out = [RawSample::default(); 8];
     assert_eq!(imu.read_fifo(&mut out), Ok(1));
@@ -630,7 +667,11 @@ fn icm42688_invalid_marker_is_skipped_and_counted() {
         "data registers still invalid"
     );
     let stats = imu.fifo_stats();
-    assert_eq!((stats.samples, stats.invalid), (1, 4));
+    assert_eq!(
+        (stats.samples, stats.invalid),
+        (1, 3),
+        "FIFO packets only: the data-register read is no FIFO packet"
+    );
     imu.destroy().done();
 }
 

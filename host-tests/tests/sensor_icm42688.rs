@@ -129,18 +129,26 @@ fn invalid_marker_after_start_up_is_skipped_and_counted() {
     assert_eq!((stats.invalid, stats.samples), (30, 10));
 }
 
-/// Item 8: with the bus stuck high, FIFO_COUNT reads 65535: at most 128 packets fit.
+/// Item 8: with the bus stuck high, FIFO_COUNT reads 65535: no count at all (not a full
+/// FIFO of 128 packets, which would count 123 samples the chip never wrote). Nothing is read
+/// or counted; the overflow flag read as set is kept, and once the bus is back the FIFO is
+/// flushed and its 5 real samples counted.
 #[test]
-fn count_at_or_above_the_fifo_size_is_an_overflow() {
+fn count_above_the_fifo_size_is_no_count() {
     let (sim, mut imu) = reader(7);
     sim.borrow_mut().tick(5);
     sim.borrow_mut().stuck_high = true;
     let mut out = [RawSample::default(); 160];
     assert_eq!(
         imu.read_fifo(&mut out),
-        Err(Error::FifoOverflow { discarded: 128 })
+        Err(Error::BadFifoCount { count: 0xFFFF })
     );
+    assert_eq!(imu.fifo_stats().discarded, 0);
     sim.borrow_mut().stuck_high = false;
+    assert_eq!(
+        imu.read_fifo(&mut out),
+        Err(Error::FifoOverflow { discarded: 5 })
+    );
     expect_samples(&sim, &mut imu, 6);
 }
 

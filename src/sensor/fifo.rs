@@ -10,7 +10,10 @@
 //!   false, and `read_fifo` says so ([`Error::FifoNotRunning`]) until a retry completes;
 //! - a FIFO reset, once decided (an overflow seen in INT_STATUS or in FIFO_COUNT, or a failed
 //!   data read), is remembered in [`FifoState::pending`] until it has been carried out, so an
-//!   overflow flag cleared by its read is never lost.
+//!   overflow flag cleared by its read is never lost;
+//! - every reset takes the channels off, then reads FIFO_COUNT (stable from then on), then
+//!   empties the FIFO: what it drops is counted exactly, and an empty FIFO is first checked
+//!   against a chip reset, so that starting the FIFO again never hides one.
 
 use super::{Error, FifoStats, Packet, RawSample};
 
@@ -25,46 +28,101 @@ const COUNT_TRIES: usize = 4;
 /// A FIFO reset that has been decided but not yet carried out.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub(crate) struct PendingReset {
-    /// The reset is for an overflow (otherwise for a failed data read).
+    /// The reset is for an overflow.
     overflow: bool,
+    /// The reset is for a failed data read.
+    resync: bool,
     /// Bytes of the dropped packets already taken out of the FIFO: read before a failed
     /// transfer, or clocked out by it.
-    consumed: u16,
+    consumed: u32,
     /// The most bytes the FIFO was seen to hold since the reset was decided, or since a reset
-    /// attempt last emptied it. Each reset takes the channels off the FIFO before emptying
-    /// it, and goes no further when that fails: until the emptying step succeeds, the count
-    /// only grows (channels on) or stays (channels off, or emptied by a write that reported a
-    /// failure, leaving 0), so the largest count seen is what the reset drops. Once it has
-    /// succeeded these bytes are dropped for sure and move to `consumed`; later counts are
-    /// samples written since.
+    /// attempt last emptied it. Each reset takes the channels off the FIFO and reads the count
+    /// before emptying it, and goes no further when that fails: until the emptying step
+    /// succeeds, the count only grows (channels on) or stays (channels off, or emptied by a
+    /// write that reported a failure, leaving 0), so the largest count seen is what the reset
+    /// drops. Once it has succeeded these bytes are dropped for sure and move to `consumed`;
+    /// later counts are samples written since.
     held: u16,
+    /// A failed data read whose clocked-out bytes are not known yet: resolved by the next
+    /// count read.
+    unresolved: Option<Unresolved>,
+}
+
+/// A failed data read not yet matched with a count.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct Unresolved {
+    /// Bytes in the FIFO at the last count before the failed transfer, less those read since.
+    left: u16,
+    /// Bytes the failed transfer asked for: it clocked out at most these.
+    len: u16,
+}
+
+impl PendingReset {
+    /// A count of the FIFO read while the reset is pending (before it empties the FIFO).
+    ///
+    /// The bytes a failed transfer clocked out are `left - count` when nothing entered the
+    /// FIFO in between. When more came in than went out (the count grew), the samples that
+    /// entered are whole packets, so the bytes clocked out are congruent to `left - count`
+    /// modulo the packet size: the smallest such number is taken.
+    fn observe(&mut self, count: u16, packet: usize) {
+        if let Some(u) = self.unresolved.take() {
+            let out = if u.left >= count {
+                (u.left - count).min(u.len)
+            } else {
+                let grown = usize::from(count - u.left) % packet;
+                let out = (packet - grown) % packet;
+                u16::try_from(out).unwrap_or(0).min(u.len)
+            };
+            self.consumed = self.consumed.saturating_add(u32::from(out));
+        }
+        self.held = self.held.max(count);
+    }
 }
 
 /// A reader's FIFO bookkeeping.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct FifoState {
+    /// `init` has completed: the chip is configured.
+    pub(crate) initialised: bool,
     /// The FIFO should be on: `enable_fifo` was called since the last `init`.
     pub(crate) wanted: bool,
     /// The FIFO is on: the last `enable_fifo` or recovery completed.
     pub(crate) running: bool,
     /// A FIFO reset still to be carried out.
     pub(crate) pending: Option<PendingReset>,
+    /// `read_fifo` reported [`Error::SensorReset`] and no recovery has completed since.
+    pub(crate) reset_seen: bool,
     /// The counts.
     pub(crate) stats: FifoStats,
 }
 
 impl FifoState {
-    /// `init`: the chip has been reset, its FIFO is off and nobody asked for it.
+    /// `init` begins: the chip is being reset, its FIFO is off and nobody asked for it.
     pub(crate) fn off(&mut self) {
+        self.initialised = false;
         self.wanted = false;
         self.running = false;
         self.pending = None;
+        self.reset_seen = false;
     }
 
-    /// A recovery or `enable_fifo` begins: the chip's FIFO is not known to be on.
-    pub(crate) fn restarting(&mut self) {
+    /// A recovery begins: the chip is reset and configured again, which empties its FIFO.
+    /// The bytes of a pending reset are inside the outage (counted in [`FifoStats::lost`]);
+    /// its cause (an overflow, a failed read) is kept, and counted when the FIFO runs again.
+    pub(crate) fn recovering(&mut self) {
         self.running = false;
-        self.pending = None;
+        self.pending = self.pending.map(|p| PendingReset {
+            overflow: p.overflow,
+            resync: p.resync,
+            ..PendingReset::default()
+        });
+    }
+
+    /// A recovery has succeeded after an outage of `outage_us` at `hz / div` samples per
+    /// second.
+    pub(crate) fn recovered(&mut self, outage_us: u64, hz: u32, div: u32) {
+        let chip_reset = core::mem::take(&mut self.reset_seen);
+        self.stats.recovered(chip_reset, outage_us, hz, div);
     }
 
     fn mark_overflow(&mut self) {
@@ -80,8 +138,11 @@ pub(crate) trait FifoChip {
     type BusError;
     /// Bytes per FIFO packet (at most [`MAX_PACKET`]).
     const PACKET: usize;
-    /// The FIFO's size in bytes: a count at or above it is an overflow.
+    /// The FIFO's size in bytes: a count at it is an overflow, a count above it no count.
     const FIFO_BYTES: u16;
+    /// FIFO_COUNT is read a second time before data are read, and the smaller count is used:
+    /// for packets without a header, whose data cannot show a count that was wrong.
+    const CONFIRM_COUNT: bool;
 
     /// The reader's FIFO bookkeeping.
     fn state(&mut self) -> &mut FifoState;
@@ -91,14 +152,59 @@ pub(crate) trait FifoChip {
     fn fifo_count(&mut self) -> Result<u16, Error<Self::BusError>>;
     /// Reads back the FIFO mode after an empty count: `false` when the chip has reset itself.
     fn fifo_configured(&mut self) -> Result<bool, Error<Self::BusError>>;
-    /// Takes the channels off the FIFO, empties it (setting `emptied` once that write has
-    /// succeeded) and starts it again. Every step can be repeated: after a failure the whole
-    /// sequence is simply run again.
-    fn reset_fifo(&mut self, emptied: &mut bool) -> Result<(), Error<Self::BusError>>;
+    /// Reads back a register of the chip's configuration that no FIFO reset writes: `true`
+    /// when the chip has reset itself.
+    fn chip_reset(&mut self) -> Result<bool, Error<Self::BusError>>;
+    /// The first write of `enable_fifo`, before the FIFO reset.
+    fn prepare_fifo(&mut self) -> Result<(), Error<Self::BusError>>;
+    /// Takes the channels off the FIFO (and, where needed, the FIFO itself).
+    fn stop_fifo(&mut self) -> Result<(), Error<Self::BusError>>;
+    /// Empties the FIFO, its channels off.
+    fn empty_fifo(&mut self) -> Result<(), Error<Self::BusError>>;
+    /// Starts the FIFO and its channels.
+    fn start_fifo(&mut self) -> Result<(), Error<Self::BusError>>;
     /// Reads `buf.len()` bytes from the FIFO data register.
     fn read_data(&mut self, buf: &mut [u8]) -> Result<(), Error<Self::BusError>>;
     /// Classifies one packet.
     fn parse(packet: &[u8]) -> Packet;
+}
+
+/// Reads FIFO_COUNT; a count above the FIFO's size is [`Error::BadFifoCount`].
+fn count<C: FifoChip>(chip: &mut C) -> Result<u16, Error<C::BusError>> {
+    let count = chip.fifo_count()?;
+    if count > C::FIFO_BYTES {
+        return Err(Error::BadFifoCount { count });
+    }
+    Ok(count)
+}
+
+/// A count read while a reset is pending.
+fn observe<C: FifoChip>(chip: &mut C, count: u16) {
+    let packet = C::PACKET.clamp(1, MAX_PACKET);
+    if let Some(p) = chip.state().pending.as_mut() {
+        p.observe(count, packet);
+    }
+}
+
+/// `enable_fifo` of every chip: the chip's first write, then a FIFO reset. A FIFO that an
+/// earlier attempt left running is emptied by it: its samples are counted as discarded, and a
+/// reset still pending (an overflow, a failed read) is counted as done.
+pub(crate) fn enable<C: FifoChip>(chip: &mut C) -> Result<(), Error<C::BusError>> {
+    let state = chip.state();
+    if !state.initialised {
+        return Err(Error::NotInitialised);
+    }
+    state.wanted = true;
+    state.running = false;
+    state.pending.get_or_insert_with(PendingReset::default);
+    chip.prepare_fifo()?;
+    reset(chip)?;
+    let state = chip.state();
+    state.running = true;
+    if let Some(p) = state.pending.take() {
+        count_reset(&mut state.stats, p, C::PACKET.clamp(1, MAX_PACKET));
+    }
+    Ok(())
 }
 
 /// `ImuReader::read_fifo` of every chip; see the readers' documentation.
@@ -117,23 +223,29 @@ pub(crate) fn read_fifo<C: FifoChip>(
     if chip.overflow_flag()? {
         chip.state().mark_overflow();
     }
-    let count = chip.fifo_count()?;
-    if count >= C::FIFO_BYTES {
-        // A full FIFO overwrites its oldest bytes: its packets are no longer aligned. A count
-        // above the size (a bus stuck high) is no count at all.
+    let first = count(chip)?;
+    observe(chip, first);
+    // The count the data are read by, and the latest count, which the bytes of a failed read
+    // are reckoned from.
+    let (mut readable, mut latest) = (first, first);
+    if C::CONFIRM_COUNT && usize::from(first) >= packet && chip.state().pending.is_none() {
+        latest = count(chip)?;
+        readable = readable.min(latest);
+    }
+    if latest >= C::FIFO_BYTES {
+        // A full FIFO overwrites its oldest bytes: its packets are no longer aligned.
         chip.state().mark_overflow();
     }
-    let count = count.min(C::FIFO_BYTES);
-    if let Some(p) = chip.state().pending.as_mut() {
-        p.held = p.held.max(count);
-        return finish_reset(chip, packet);
+    if chip.state().pending.is_some() {
+        return finish_reset(chip);
     }
-    let available = usize::from(count) / packet;
+    let available = usize::from(readable) / packet;
     if available == 0 {
         // An empty FIFO may be a chip that reset itself: its FIFO is then off.
         return if chip.fifo_configured()? {
             Ok(0)
         } else {
+            chip.state().reset_seen = true;
             Err(Error::SensorReset)
         };
     }
@@ -144,8 +256,8 @@ pub(crate) fn read_fifo<C: FifoChip>(
         let n = remaining.min(CHUNK).min(out.len() - delivered);
         let bytes = &mut buf[..n * packet];
         if let Err(e) = chip.read_data(bytes) {
-            resync(chip, count, taken + n * packet);
-            return match finish_reset(chip, packet) {
+            resync(chip, latest, taken, n * packet);
+            return match finish_reset(chip) {
                 Err(Error::Bus(_)) => Err(e),
                 other => other,
             };
@@ -164,8 +276,10 @@ pub(crate) fn read_fifo<C: FifoChip>(
                 Packet::Invalid => invalid += 1,
                 Packet::Malformed => malformed += 1,
                 Packet::End => {
+                    // The "FIFO empty" marker inside the counted bytes: a damaged header. The
+                    // packets after it in this transfer are parsed; the batch ends with it.
+                    malformed += 1;
                     remaining = 0;
-                    break;
                 }
             }
         }
@@ -178,55 +292,86 @@ pub(crate) fn read_fifo<C: FifoChip>(
     Ok(delivered)
 }
 
-/// A data read failed with `count` bytes in the FIFO at the start of the call and at most
-/// `at_most` of them taken out: decides a reset, and learns from FIFO_COUNT how many bytes the
-/// failed transfer clocked out. Without a count, the whole failed transfer is taken as read.
-fn resync<C: FifoChip>(chip: &mut C, count: u16, at_most: usize) {
-    let mut left = None;
-    for _ in 0..COUNT_TRIES {
-        if let Ok(c) = chip.fifo_count() {
-            left = Some(c.min(C::FIFO_BYTES));
-            break;
-        }
-    }
-    let at_most = u16::try_from(at_most).unwrap_or(u16::MAX).min(count);
-    let (consumed, held) = match left {
-        Some(left) => (count.saturating_sub(left), left),
-        None => (at_most, count - at_most),
-    };
+/// A data read of `len` bytes failed with `latest` bytes in the FIFO at the last count and
+/// `taken` of them read before: decides a reset, and learns from FIFO_COUNT how many bytes the
+/// failed transfer clocked out. Without a count, the first count read later (before the FIFO
+/// is emptied) settles it.
+fn resync<C: FifoChip>(chip: &mut C, latest: u16, taken: usize, len: usize) {
+    let taken = u16::try_from(taken).unwrap_or(u16::MAX).min(latest);
     let pending = chip
         .state()
         .pending
         .get_or_insert_with(PendingReset::default);
-    pending.consumed = consumed;
-    pending.held = pending.held.max(held);
+    pending.resync = true;
+    pending.consumed = pending.consumed.saturating_add(u32::from(taken));
+    pending.unresolved = Some(Unresolved {
+        left: latest - taken,
+        len: u16::try_from(len).unwrap_or(u16::MAX),
+    });
+    for _ in 0..COUNT_TRIES {
+        match count(chip) {
+            Ok(c) => {
+                observe(chip, c);
+                break;
+            }
+            Err(Error::BadFifoCount { .. }) => break,
+            Err(_) => {}
+        }
+    }
+}
+
+/// The FIFO reset: channels off, the count of what it drops (stable now), a check that the
+/// chip has not reset itself when the FIFO is empty, then empty and start. Every step can be
+/// repeated: after a failure the whole sequence is simply run again.
+fn reset<C: FifoChip>(chip: &mut C) -> Result<(), Error<C::BusError>> {
+    chip.stop_fifo()?;
+    let held = count(chip)?;
+    observe(chip, held);
+    if held == 0 && chip.chip_reset()? {
+        // A chip that reset itself: starting its FIFO would hide the reset (the FIFO would
+        // look configured, and stay empty).
+        chip.state().reset_seen = true;
+        return Err(Error::SensorReset);
+    }
+    let emptied = chip.empty_fifo();
+    if emptied.is_ok()
+        && let Some(p) = chip.state().pending.as_mut()
+    {
+        p.consumed = p.consumed.saturating_add(u32::from(p.held));
+        p.held = 0;
+    }
+    emptied?;
+    chip.start_fifo()
+}
+
+/// Counts a reset that has been carried out: its bytes as discarded, its cause. Returns the
+/// complete samples discarded.
+fn count_reset(stats: &mut FifoStats, p: PendingReset, packet: usize) -> u16 {
+    let bytes = p.consumed.saturating_add(u32::from(p.held));
+    let discarded = bytes / u32::try_from(packet.max(1)).unwrap_or(1);
+    stats.discarded += u64::from(discarded);
+    stats.discarded_bytes += u64::from(bytes);
+    if p.overflow {
+        stats.overflows += 1;
+    } else if p.resync {
+        stats.resyncs += 1;
+    }
+    u16::try_from(discarded).unwrap_or(u16::MAX)
 }
 
 /// Carries out the pending reset and counts it: [`Error::FifoOverflow`] or
 /// [`Error::FifoResync`]; a bus error keeps it pending.
-fn finish_reset<C: FifoChip>(chip: &mut C, packet: usize) -> Result<usize, Error<C::BusError>> {
-    let mut emptied = false;
-    let result = chip.reset_fifo(&mut emptied);
+fn finish_reset<C: FifoChip>(chip: &mut C) -> Result<usize, Error<C::BusError>> {
+    let packet = C::PACKET.clamp(1, MAX_PACKET);
+    reset(chip)?;
     let state = chip.state();
-    if emptied && let Some(p) = state.pending.as_mut() {
-        p.consumed = p.consumed.saturating_add(p.held);
-        p.held = 0;
-    }
-    result?;
     let Some(p) = state.pending.take() else {
         return Ok(0);
     };
-    let bytes = u32::from(p.consumed) + u32::from(p.held);
-    let discarded = bytes / u32::try_from(packet).unwrap_or(1);
-    let stats = &mut state.stats;
-    stats.discarded += u64::from(discarded);
-    stats.discarded_bytes += u64::from(bytes);
-    let discarded = u16::try_from(discarded).unwrap_or(u16::MAX);
+    let discarded = count_reset(&mut state.stats, p, packet);
     if p.overflow {
-        stats.overflows += 1;
         Err(Error::FifoOverflow { discarded })
     } else {
-        stats.resyncs += 1;
         Err(Error::FifoResync { discarded })
     }
 }

@@ -56,9 +56,11 @@ const PWR_LOW_NOISE: u8 = 0b0000_1111;
 const PACKET: usize = 16;
 /// FIFO size: 2 KiB.
 const FIFO_BYTES: u16 = 2048;
-/// Header bits: HEADER_MSG (7, FIFO empty), HEADER_ACCEL (6), HEADER_GYRO (5).
+/// Header bits: HEADER_MSG (7, FIFO empty), HEADER_ACCEL (6), HEADER_GYRO (5), HEADER_20 (4,
+/// a 20-byte packet 4).
 const HEADER_EMPTY: u8 = 1 << 7;
 const HEADER_ACCEL_GYRO: u8 = 0b0110_0000;
+const HEADER_20: u8 = 1 << 4;
 /// The invalid-data marker of a 16-bit FIFO field (TDK's driver: `INVALID_VALUE_FIFO`).
 const INVALID: i16 = i16::MIN;
 /// The invalid-data marker of the 8-bit FIFO temperature (`INVALID_VALUE_FIFO_1B`).
@@ -225,6 +227,7 @@ impl Icm42688Config {
 /// #                     b.fill(0);
 /// #                     if reg == 0xF5 { b[0] = 0x47; } // WHO_AM_I
 /// #                     if reg == 0x96 { b[0] = 0x40; } // FIFO_CONFIG: stream mode
+/// #                     if reg == 0xCE { b[0] = 0x0F; } // PWR_MGMT0: low noise
 /// #                 }
 /// #                 _ => {}
 /// #             }
@@ -303,6 +306,7 @@ impl<SPI: SpiDevice> Icm42688<SPI> {
     /// gyro and accelerometer in low-noise mode (then 1 ms; the gyro needs about 30 ms more
     /// before its data are valid: until then the FIFO carries the invalid marker, and those
     /// packets are skipped and counted in [`FifoStats::invalid`]). The FIFO is off afterwards.
+    /// `enable_fifo` and `recover` need a successful `init` first.
     ///
     /// # Errors
     ///
@@ -313,7 +317,9 @@ impl<SPI: SpiDevice> Icm42688<SPI> {
         config: Icm42688Config,
     ) -> Result<(), Error<SPI::Error>> {
         self.fifo.off();
-        self.configure(delay, config)
+        self.configure(delay, config)?;
+        self.fifo.initialised = true;
+        Ok(())
     }
 
     fn configure(
@@ -345,25 +351,31 @@ impl<SPI: SpiDevice> Icm42688<SPI> {
     /// suspected glitch): probes WHO_AM_I, writes the last configuration again and re-enables
     /// the FIFO if `enable_fifo` was called since `init`. `outage_us` is the time in
     /// microseconds from the last `read_fifo` that accounted for the FIFO (see
-    /// [`FifoStats::lost`]) to now, by the caller's clock; the samples the chip produced in it
-    /// are counted in [`FifoStats::lost`].
+    /// [`FifoStats::lost`]) to the FIFO running again, by the caller's clock: the time of the
+    /// call plus the 2 ms of the chip reset and start; the samples the chip produced in it are
+    /// counted in [`FifoStats::lost`]. A recovery after [`Error::SensorReset`] is counted in
+    /// [`FifoStats::resets`]. A FIFO reset still pending (an overflow, a failed read) is
+    /// replaced by the recovery and counted as done; its samples are inside the outage.
     ///
     /// # Errors
     ///
-    /// As [`Icm42688::init`]; nothing is counted until the recovery succeeds, and until then
-    /// `read_fifo` returns [`Error::FifoNotRunning`]: it can simply be called again.
+    /// [`Error::NotInitialised`] before `init`; otherwise as [`Icm42688::init`]; nothing is
+    /// counted until the recovery succeeds, and until then `read_fifo` returns
+    /// [`Error::FifoNotRunning`]: it can simply be called again.
     pub fn recover(
         &mut self,
         delay: &mut impl DelayNs,
         outage_us: u64,
     ) -> Result<(), Error<SPI::Error>> {
-        self.fifo.restarting();
+        if !self.fifo.initialised {
+            return Err(Error::NotInitialised);
+        }
+        self.fifo.recovering();
         self.configure(delay, self.config)?;
         if self.fifo.wanted {
             self.enable_fifo()?;
         }
         self.fifo
-            .stats
             .recovered(outage_us, self.config.odr.millihz(), 1000);
         Ok(())
     }
@@ -374,19 +386,16 @@ impl<SPI: SpiDevice> Icm42688<SPI> {
     }
 
     /// Enables the FIFO in stream mode with packet 3 (accelerometer, gyro, temperature,
-    /// timestamp: 16 bytes) and flushes it.
+    /// timestamp: 16 bytes) and flushes it. Samples in the FIFO (one left running by an earlier
+    /// call that failed part-way) are counted in [`FifoStats::discarded`].
     ///
     /// # Errors
     ///
-    /// [`Error::Bus`]; until a later call (or `recover`) succeeds, `read_fifo` returns
-    /// [`Error::FifoNotRunning`].
+    /// [`Error::NotInitialised`] before `init`; [`Error::SensorReset`] when the chip has
+    /// reset itself (call `recover`); [`Error::Bus`] (or [`Error::BadFifoCount`]): until a
+    /// later call (or `recover`) succeeds, `read_fifo` returns [`Error::FifoNotRunning`].
     pub fn enable_fifo(&mut self) -> Result<(), Error<SPI::Error>> {
-        self.fifo.wanted = true;
-        self.fifo.restarting();
-        self.write(FIFO_CONFIG, FIFO_STREAM)?;
-        self.reset_fifo(&mut false)?;
-        self.fifo.running = true;
-        Ok(())
+        fifo::enable(self)
     }
 
     /// Temperature in deg C from a raw register value: `raw / 132.48 + 25`. FIFO samples carry
@@ -406,6 +415,7 @@ impl<SPI: SpiDevice> FifoChip for Icm42688<SPI> {
     type BusError = SPI::Error;
     const PACKET: usize = PACKET;
     const FIFO_BYTES: u16 = FIFO_BYTES;
+    const CONFIRM_COUNT: bool = false;
 
     fn state(&mut self) -> &mut FifoState {
         &mut self.fifo
@@ -427,17 +437,34 @@ impl<SPI: SpiDevice> FifoChip for Icm42688<SPI> {
         Ok(mode[0] == FIFO_STREAM)
     }
 
+    /// PWR_MGMT0: gyro and accelerometer not in low-noise mode (off after a reset).
+    fn chip_reset(&mut self) -> Result<bool, Error<SPI::Error>> {
+        let mut pwr = [0];
+        self.read_regs(PWR_MGMT0, &mut pwr)?;
+        Ok(pwr[0] & PWR_LOW_NOISE != PWR_LOW_NOISE)
+    }
+
+    fn prepare_fifo(&mut self) -> Result<(), Error<SPI::Error>> {
+        self.write(FIFO_CONFIG, FIFO_STREAM)
+    }
+
     /// SIGNAL_PATH_RESET.FIFO_FLUSH between FIFO_CONFIG1 = 0 (channels off) and the channels
     /// on again. Neither the datasheet nor ArduPilot asks for the channels to be off for a
     /// flush (libraries/AP_InertialSensor/AP_InertialSensor_Invensensev3.cpp,
     /// `AP_InertialSensor_Invensensev3::fifo_reset`, writes FIFO_CONFIG1 with accel, gyro and
     /// temperature on and then SIGNAL_PATH_RESET = 2); they are taken off here so that nothing
-    /// enters the FIFO while a flush is in doubt (a write that reported a failure may still
-    /// have been done), which keeps the count of discarded samples exact.
-    fn reset_fifo(&mut self, emptied: &mut bool) -> Result<(), Error<SPI::Error>> {
-        self.write(FIFO_CONFIG1, 0)?;
-        self.write(SIGNAL_PATH_RESET, FIFO_FLUSH)?;
-        *emptied = true;
+    /// enters the FIFO between the count read after this step and the flush, nor while a
+    /// flush is in doubt (a write that reported a failure may still have been done), which
+    /// keeps the count of discarded samples exact.
+    fn stop_fifo(&mut self) -> Result<(), Error<SPI::Error>> {
+        self.write(FIFO_CONFIG1, 0)
+    }
+
+    fn empty_fifo(&mut self) -> Result<(), Error<SPI::Error>> {
+        self.write(SIGNAL_PATH_RESET, FIFO_FLUSH)
+    }
+
+    fn start_fifo(&mut self) -> Result<(), Error<SPI::Error>> {
         self.write(FIFO_CONFIG1, FIFO_TEMP_GYRO_ACCEL)
     }
 
@@ -450,7 +477,7 @@ impl<SPI: SpiDevice> FifoChip for Icm42688<SPI> {
         if header & HEADER_EMPTY != 0 {
             return Packet::End;
         }
-        if header & HEADER_ACCEL_GYRO != HEADER_ACCEL_GYRO {
+        if header & (HEADER_ACCEL_GYRO | HEADER_20) != HEADER_ACCEL_GYRO {
             return Packet::Malformed;
         }
         let (accel, gyro) = (be_i16x3(p, 1), be_i16x3(p, 7));
@@ -474,8 +501,8 @@ impl<SPI: SpiDevice> ImuReader for Icm42688<SPI> {
     }
 
     /// One burst read of TEMP_DATA1 .. GYRO_DATA_Z0. Data registers holding the invalid-data
-    /// marker (-32768, while a sensor is starting) give [`Error::NoData`], counted in
-    /// [`FifoStats::invalid`].
+    /// marker (-32768, while a sensor is starting) give [`Error::NoData`]; they are no FIFO
+    /// packet, and are not counted in [`FifoStats::invalid`].
     fn read(&mut self) -> Result<RawSample, Error<SPI::Error>> {
         let mut b = [0u8; 14];
         self.read_regs(TEMP_DATA1, &mut b)?;
@@ -486,7 +513,6 @@ impl<SPI: SpiDevice> ImuReader for Icm42688<SPI> {
         };
         if s.accel.contains(&INVALID) || s.gyro.contains(&INVALID) || s.temperature == Some(INVALID)
         {
-            self.fifo.stats.invalid = self.fifo.stats.invalid.saturating_add(1);
             return Err(Error::NoData);
         }
         Ok(s)
@@ -496,9 +522,12 @@ impl<SPI: SpiDevice> ImuReader for Icm42688<SPI> {
     /// FIFO's 2048 bytes, the FIFO is flushed (its complete packets are counted as discarded)
     /// and [`Error::FifoOverflow`] is returned. Otherwise whole packets (up to `out.len()`)
     /// are read, 8 per SPI transaction; a packet whose header does not announce accelerometer
-    /// and gyro data is skipped and counted as malformed, one carrying the invalid-data marker
-    /// (-32768, or -128 for the temperature) is skipped and counted as invalid, and a header
-    /// with HEADER_MSG set (FIFO empty) ends the batch. A read that fails part-way is followed
+    /// and gyro data, or announces a 20-byte packet (HEADER_20), is skipped and counted as
+    /// malformed, one carrying the invalid-data marker (-32768, or -128 for the temperature)
+    /// is skipped and counted as invalid, and a header with HEADER_MSG set (FIFO empty) inside
+    /// the counted bytes is a damaged header: counted as malformed, the packets after it in
+    /// the same transaction parsed, and the batch ended (the rest stays in the FIFO). A count
+    /// above the FIFO's 2048 bytes is no count ([`Error::BadFifoCount`], nothing read). A read that fails part-way is followed
     /// by a flush, as TDK's driver does: the samples of the call and those left in the FIFO
     /// are counted as discarded and [`Error::FifoResync`] is returned. A flush that meets a bus
     /// error itself is remembered and finished by the next call.

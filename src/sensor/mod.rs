@@ -162,32 +162,42 @@ const RAIL: f32 = 32_766.5;
 pub struct FifoStats {
     /// Samples delivered from the FIFO.
     pub samples: u64,
-    /// FIFO overflows detected (each followed by a FIFO reset).
+    /// FIFO overflows detected (each followed by a FIFO reset, or by the recovery that
+    /// replaced it).
     pub overflows: u64,
     /// Complete samples dropped by FIFO resets: those in the FIFO when it was reset after an
-    /// overflow or a failed read, and those already read in a call that then failed. Samples
-    /// the chip dropped while its FIFO was full are not knowable from the FIFO and are not
-    /// included: count the overflows, or compare with the output data rate.
+    /// overflow or a failed read (counted with the channels off), those already read in a
+    /// call that then failed, and those a FIFO left running by a failed `enable_fifo` held
+    /// when `enable_fifo` was called again. Samples the chip dropped while its FIFO was full
+    /// are not knowable from the FIFO and are not included: count the overflows, or compare
+    /// with the output data rate. Samples in the FIFO when `recover` resets the chip are
+    /// inside the outage, counted in `lost`.
     pub discarded: u64,
     /// Bytes dropped by FIFO resets, partial packets included.
     pub discarded_bytes: u64,
     /// FIFO resets after a data read that failed part-way ([`Error::FifoResync`]).
     pub resyncs: u64,
-    /// FIFO packets rejected as malformed (wrong header) and skipped.
+    /// FIFO packets rejected as malformed (wrong header, including a "FIFO empty" marker or a
+    /// 20-byte packet flag inside the counted bytes) and skipped.
     pub malformed: u64,
     /// FIFO packets skipped because the chip marked their data invalid (the ICM-42688-P writes
-    /// -32768, or -128 for the temperature, while a sensor is starting).
+    /// -32768, or -128 for the temperature, while a sensor is starting). Data-register reads
+    /// (`read`) are not FIFO packets and are not counted here.
     pub invalid: u64,
     /// Delivered samples with some axis at a rail ([`RawSample::clipped`]); they are
     /// delivered, and the estimators' saturation limits decide.
     pub clipped: u64,
-    /// Chip resets detected ([`Error::SensorReset`]) and recovered from.
+    /// Chip resets detected ([`Error::SensorReset`]) and then recovered from: a `recover` that
+    /// completes after `read_fifo` (or `enable_fifo`) reported one. A `recover` for any other
+    /// reason ([`Error::FifoNotRunning`], a suspected glitch) counts its outage in `lost` but
+    /// no reset here.
     pub resets: u64,
     /// Samples the chip would have delivered during the outages passed to `recover`: from the
     /// last `read_fifo` that accounted for the FIFO (`Ok`, [`Error::FifoOverflow`] or
-    /// [`Error::FifoResync`]) to the FIFO running again, at the configured output data rate.
-    /// Exact when that read emptied the FIFO (an `out` as large as the FIFO) and the FIFO did
-    /// not overflow in the outage.
+    /// [`Error::FifoResync`]) to the FIFO running again (the end of the successful `recover`,
+    /// after its reset delays), at the configured output data rate. Exact when that read
+    /// emptied the FIFO (an `out` as large as the FIFO) and the FIFO did not overflow in the
+    /// outage.
     pub lost: u64,
 }
 
@@ -221,8 +231,16 @@ pub enum Error<E> {
         /// Complete samples dropped.
         discarded: u16,
     },
+    /// FIFO_COUNT read above the FIFO's size: no count at all (a bus stuck high, or bit
+    /// errors). Nothing was read from the FIFO and nothing counted; call again.
+    BadFifoCount {
+        /// The value read.
+        count: u16,
+    },
     /// The FIFO is not enabled (call `enable_fifo` first).
     FifoDisabled,
+    /// `enable_fifo` or `recover` before a successful `init`: the chip is not configured.
+    NotInitialised,
     /// The FIFO should be on but is not: the last `recover` or `enable_fifo` failed part-way.
     /// Call it again.
     FifoNotRunning,
@@ -257,7 +275,14 @@ impl<E: fmt::Debug> fmt::Display for Error<E> {
             Self::FifoOverflow { discarded } => {
                 write!(f, "FIFO overflow: reset, {discarded} samples discarded")
             }
+            Self::BadFifoCount { count } => {
+                write!(
+                    f,
+                    "FIFO_COUNT read {count}, above the FIFO's size: bus fault"
+                )
+            }
             Self::FifoDisabled => f.write_str("FIFO is not enabled"),
+            Self::NotInitialised => f.write_str("the reader is not initialised: call init"),
             Self::SensorReset => f.write_str("the sensor has reset itself: recover it"),
             Self::NoData => f.write_str("no sample available"),
         }
@@ -288,7 +313,8 @@ pub trait ImuReader {
     /// [`Error::FifoOverflow`] after resetting an overflowed FIFO and [`Error::FifoResync`]
     /// after resetting it behind a failed read (nothing is written; call again),
     /// [`Error::SensorReset`] when the FIFO is empty because the chip has reset itself,
-    /// [`Error::FifoNotRunning`] when a recovery is unfinished, [`Error::FifoDisabled`], or
+    /// [`Error::FifoNotRunning`] when a recovery is unfinished, [`Error::FifoDisabled`],
+    /// [`Error::BadFifoCount`] when FIFO_COUNT reads above the FIFO's size, or
     /// [`Error::Bus`].
     fn read_fifo(&mut self, out: &mut [RawSample]) -> Result<usize, Error<Self::BusError>>;
 
@@ -319,17 +345,19 @@ pub(crate) enum Packet {
     Invalid,
     /// A packet of the wrong layout: skipped and counted.
     Malformed,
-    /// The chip's "FIFO empty" marker: the batch ends.
+    /// The chip's "FIFO empty" marker: inside the counted bytes, a damaged header (counted as
+    /// malformed); the batch ends with it.
     End,
 }
 
 impl FifoStats {
     /// Counts a recovery after an outage of `outage_us` microseconds at `hz / div` samples per
-    /// second, rounded to the nearest sample.
-    pub(crate) fn recovered(&mut self, outage_us: u64, hz: u32, div: u32) {
+    /// second, rounded to the nearest sample; `chip_reset` when it followed
+    /// [`Error::SensorReset`].
+    pub(crate) fn recovered(&mut self, chip_reset: bool, outage_us: u64, hz: u32, div: u32) {
         let den = 1_000_000u128 * u128::from(div.max(1));
         let lost = (u128::from(outage_us) * u128::from(hz) + den / 2) / den;
-        self.resets = self.resets.saturating_add(1);
+        self.resets = self.resets.saturating_add(u64::from(chip_reset));
         self.lost = self
             .lost
             .saturating_add(u64::try_from(lost).unwrap_or(u64::MAX));

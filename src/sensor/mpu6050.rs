@@ -51,6 +51,9 @@ const USER_CTRL_FIFO_RESET: u8 = 1 << 2;
 const PWR_DEVICE_RESET: u8 = 1 << 7;
 /// PWR_MGMT_1: awake (SLEEP clear), clock from the X-gyro PLL (CLKSEL = 1).
 const PWR_CLK_PLL_X: u8 = 0x01;
+/// PWR_MGMT_1: SLEEP and CLKSEL, compared with [`PWR_CLK_PLL_X`] to detect a chip reset (its
+/// power-on value is SLEEP set, CLKSEL 0).
+const PWR_SLEEP_CLKSEL: u8 = 0x47;
 /// FIFO_EN: XG_FIFO_EN.
 const FIFO_EN_XG: u8 = 1 << 6;
 /// FIFO_EN: YG_FIFO_EN.
@@ -271,7 +274,7 @@ impl<I2C: I2c> Mpu6050<I2C> {
 
     /// Probes WHO_AM_I, resets the chip (DEVICE_RESET, then 100 ms), wakes it on the X-gyro
     /// PLL clock and writes `config`. Returns the WHO_AM_I value, 0x68. The FIFO is off
-    /// afterwards.
+    /// afterwards. `enable_fifo` and `recover` need a successful `init` first.
     ///
     /// # Errors
     ///
@@ -284,7 +287,9 @@ impl<I2C: I2c> Mpu6050<I2C> {
         config: Mpu6050Config,
     ) -> Result<u8, Error<I2C::Error>> {
         self.fifo.off();
-        self.configure(delay, config)
+        let id = self.configure(delay, config)?;
+        self.fifo.initialised = true;
+        Ok(id)
     }
 
     fn configure(
@@ -314,24 +319,33 @@ impl<I2C: I2c> Mpu6050<I2C> {
     /// suspected glitch): probes WHO_AM_I, writes the last configuration again and re-enables
     /// the FIFO if `enable_fifo` was called since `init`. `outage_us` is the time in
     /// microseconds from the last `read_fifo` that accounted for the FIFO (see
-    /// [`FifoStats::lost`]) to now, by the caller's clock; the samples the chip produced in it
-    /// are counted in [`FifoStats::lost`]. Returns WHO_AM_I.
+    /// [`FifoStats::lost`]) to the FIFO running again, by the caller's clock: the time of the
+    /// call plus the 100 ms of the chip reset (the caller cannot read its clock after
+    /// `recover` and still count on it); the samples the chip produced in it are counted in
+    /// [`FifoStats::lost`]. A recovery after [`Error::SensorReset`] is counted in
+    /// [`FifoStats::resets`]. A FIFO reset still pending (an overflow, a failed read) is
+    /// replaced by the recovery and counted as done; its samples are inside the outage.
+    /// Returns WHO_AM_I.
     ///
     /// # Errors
     ///
-    /// As [`Mpu6050::init`]; nothing is counted until the recovery succeeds, and until then
-    /// `read_fifo` returns [`Error::FifoNotRunning`]: it can simply be called again.
+    /// [`Error::NotInitialised`] before `init`; otherwise as [`Mpu6050::init`]; nothing is
+    /// counted until the recovery succeeds, and until then `read_fifo` returns
+    /// [`Error::FifoNotRunning`]: it can simply be called again.
     pub fn recover(
         &mut self,
         delay: &mut impl DelayNs,
         outage_us: u64,
     ) -> Result<u8, Error<I2C::Error>> {
-        self.fifo.restarting();
+        if !self.fifo.initialised {
+            return Err(Error::NotInitialised);
+        }
+        self.fifo.recovering();
         let id = self.configure(delay, self.config)?;
         if self.fifo.wanted {
             self.enable_fifo()?;
         }
-        self.fifo.stats.recovered(
+        self.fifo.recovered(
             outage_us,
             self.config.dlpf.gyro_rate_hz(),
             1 + u32::from(self.config.sample_rate_divider),
@@ -345,19 +359,16 @@ impl<I2C: I2c> Mpu6050<I2C> {
     }
 
     /// Enables the overflow flag and resets and enables the FIFO with accelerometer and gyro
-    /// samples (12 bytes each).
+    /// samples (12 bytes each). Samples in the FIFO (one left running by an earlier call that
+    /// failed part-way) are counted in [`FifoStats::discarded`].
     ///
     /// # Errors
     ///
-    /// [`Error::Bus`]; until a later call (or `recover`) succeeds, `read_fifo` returns
-    /// [`Error::FifoNotRunning`].
+    /// [`Error::NotInitialised`] before `init`; [`Error::SensorReset`] when the chip has
+    /// reset itself (call `recover`); [`Error::Bus`] (or [`Error::BadFifoCount`]): until a
+    /// later call (or `recover`) succeeds, `read_fifo` returns [`Error::FifoNotRunning`].
     pub fn enable_fifo(&mut self) -> Result<(), Error<I2C::Error>> {
-        self.fifo.wanted = true;
-        self.fifo.restarting();
-        self.write(INT_ENABLE, INT_FIFO_OFLOW)?;
-        self.reset_fifo(&mut false)?;
-        self.fifo.running = true;
-        Ok(())
+        fifo::enable(self)
     }
 
     /// Temperature in deg C from the raw value: `raw / 340 + 36.53` (register map, registers
@@ -377,6 +388,7 @@ impl<I2C: I2c> FifoChip for Mpu6050<I2C> {
     type BusError = I2C::Error;
     const PACKET: usize = PACKET;
     const FIFO_BYTES: u16 = FIFO_BYTES;
+    const CONFIRM_COUNT: bool = true;
 
     fn state(&mut self) -> &mut FifoState {
         &mut self.fifo
@@ -392,10 +404,23 @@ impl<I2C: I2c> FifoChip for Mpu6050<I2C> {
         Mpu6050::fifo_count(self)
     }
 
+    /// USER_CTRL and PWR_MGMT_1 in one read: the FIFO on, and the chip awake on its PLL clock
+    /// (a chip reset leaves it asleep; `enable_fifo` could have set USER_CTRL.FIFO_EN on it).
     fn fifo_configured(&mut self) -> Result<bool, Error<I2C::Error>> {
-        let mut user_ctrl = [0];
-        self.read_regs(USER_CTRL, &mut user_ctrl)?;
-        Ok(user_ctrl[0] & USER_CTRL_FIFO_EN != 0)
+        let mut b = [0; 2];
+        self.read_regs(USER_CTRL, &mut b)?;
+        Ok(b[0] & USER_CTRL_FIFO_EN != 0 && b[1] & PWR_SLEEP_CLKSEL == PWR_CLK_PLL_X)
+    }
+
+    /// PWR_MGMT_1: asleep, or not on the PLL clock.
+    fn chip_reset(&mut self) -> Result<bool, Error<I2C::Error>> {
+        let mut pwr = [0];
+        self.read_regs(PWR_MGMT_1, &mut pwr)?;
+        Ok(pwr[0] & PWR_SLEEP_CLKSEL != PWR_CLK_PLL_X)
+    }
+
+    fn prepare_fifo(&mut self) -> Result<(), Error<I2C::Error>> {
+        self.write(INT_ENABLE, INT_FIFO_OFLOW)
     }
 
     /// The channels are taken off the FIFO before it is reset, as ArduPilot does
@@ -404,15 +429,20 @@ impl<I2C: I2c> FifoChip for Mpu6050<I2C> {
     /// USER_CTRL | FIFO_RESET, USER_CTRL | FIFO_EN, then the FIFO_EN channels), and as the
     /// register map requires of USER_CTRL (FIFO_RESET "resets the FIFO buffer when set to 1
     /// while FIFO_EN equals 0"). With the channels off first, nothing enters the FIFO between
-    /// its count and its reset, which makes the count of discarded samples exact.
-    fn reset_fifo(&mut self, emptied: &mut bool) -> Result<(), Error<I2C::Error>> {
+    /// the count read after this step and the reset, which makes the count of discarded
+    /// samples exact.
+    fn stop_fifo(&mut self) -> Result<(), Error<I2C::Error>> {
         self.write(FIFO_EN, 0)?;
-        self.write(USER_CTRL, 0)?;
-        self.write(USER_CTRL, USER_CTRL_FIFO_RESET)?;
-        *emptied = true;
+        self.write(USER_CTRL, 0)
+    }
+
+    fn empty_fifo(&mut self) -> Result<(), Error<I2C::Error>> {
+        self.write(USER_CTRL, USER_CTRL_FIFO_RESET)
+    }
+
+    fn start_fifo(&mut self) -> Result<(), Error<I2C::Error>> {
         self.write(USER_CTRL, USER_CTRL_FIFO_EN)?;
-        self.write(FIFO_EN, FIFO_EN_ACCEL_GYRO)?;
-        Ok(())
+        self.write(FIFO_EN, FIFO_EN_ACCEL_GYRO)
     }
 
     fn read_data(&mut self, buf: &mut [u8]) -> Result<(), Error<I2C::Error>> {
@@ -446,12 +476,17 @@ impl<I2C: I2c> ImuReader for Mpu6050<I2C> {
         })
     }
 
-    /// Reads INT_STATUS and FIFO_COUNT first. On FIFO_OFLOW_INT, or a count at or above the
-    /// FIFO's 1024 bytes, the FIFO is reset (its complete packets are counted as discarded)
-    /// and [`Error::FifoOverflow`] is returned. An empty FIFO is checked against USER_CTRL: a
-    /// chip that has reset itself has its FIFO off, and [`Error::SensorReset`] is returned (see
-    /// [`Mpu6050::recover`]). Otherwise the whole packets in the FIFO (up to `out.len()`) are
-    /// read, 8 per I2C transfer; a partial packet stays in the FIFO for the next call.
+    /// Reads INT_STATUS and FIFO_COUNT first; a non-empty count is read a second time and the
+    /// smaller taken (the packets have no header: a count corrupted on the wire would
+    /// otherwise have the reader read past the FIFO's end and deliver its repeated last byte
+    /// as samples). A count above the FIFO's 1024 bytes is no count ([`Error::BadFifoCount`],
+    /// nothing read). On FIFO_OFLOW_INT, or a count of 1024 bytes, the FIFO is reset (its
+    /// complete packets are counted as discarded) and [`Error::FifoOverflow`] is returned. An
+    /// empty FIFO is checked against USER_CTRL and PWR_MGMT_1: a chip that has reset itself
+    /// has its FIFO off and is asleep, and [`Error::SensorReset`] is returned (see
+    /// [`Mpu6050::recover`]); a FIFO reset finds such a chip by PWR_MGMT_1, and returns the
+    /// same. Otherwise the whole packets in the FIFO (up to `out.len()`) are read, 8 per I2C
+    /// transfer; a partial packet stays in the FIFO for the next call.
     ///
     /// MPU packets have no header: a read that fails part-way would leave the FIFO misaligned
     /// for good. So, as TDK's drivers do, the FIFO is then reset: the samples of the call and

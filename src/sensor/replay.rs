@@ -85,6 +85,7 @@ impl ImuReader for Replay<'_> {
         out[..n].copy_from_slice(&rest[..n]);
         self.next += n;
         self.stats.samples += n as u64;
+        self.stats.clipped += out[..n].iter().filter(|s| s.clipped()).count() as u64;
         Ok(n)
     }
 

@@ -1,5 +1,7 @@
-//! Red-team tests of the reworked sensor readers (issue 24): each test is a confirmed defect,
-//! reproduced against the register-level simulator (`sim`), and fails until it is fixed.
+//! The sensor readers under bus faults that need more than the simulator's own fault rules:
+//! chip resets in the middle of a FIFO reset, samples arriving between the reader's
+//! transfers, corrupted bytes on the wire, and calls in unusual orders. Each test checks one
+//! guarantee of README "Sensors" against the register-level simulator (`sim`).
 //!
 //! Some tests wrap the simulated bus in a `Hooked` bus that advances the chip's clock right
 //! before a chosen transfer (on real hardware samples keep arriving while the reader works: a
@@ -223,15 +225,14 @@ fn assert_accounted<R: ImuReader>(sim: &Rc<RefCell<Sim>>, imu: &R, delivered: u6
 
 // ---------------------------------------------------------------------------------------------
 
-/// DEFECT 1 (stall, MPU-6050). A chip reset (brown-out) while a FIFO reset is pending after a
-/// bus error: the next `read_fifo` finishes the pending reset, which writes USER_CTRL.FIFO_EN
-/// and FIFO_EN again on the freshly reset, sleeping chip. That erases the very evidence
-/// (USER_CTRL without FIFO_EN) that the reset detection relies on: from then on every
-/// `read_fifo` returns `Ok(0)` (empty FIFO, USER_CTRL says "configured"), the chip sleeps with
-/// its configuration gone, and no error ever tells the caller to `recover`.
+/// MPU-6050: a chip reset (brown-out) while a FIFO reset is pending after a bus error. Finishing
+/// the pending reset used to write USER_CTRL.FIFO_EN and FIFO_EN again on the freshly reset,
+/// sleeping chip, which erased the evidence (USER_CTRL without FIFO_EN) the reset detection
+/// relies on: every later `read_fifo` returned `Ok(0)`. The FIFO reset now reads the count with
+/// the channels off and, on an empty FIFO, checks PWR_MGMT_1 before going on.
 /// Expected: `Error::SensorReset` within a few calls (or samples flowing again).
 #[test]
-fn mpu_chip_reset_during_pending_fifo_reset_stalls_forever() {
+fn mpu_chip_reset_with_a_fifo_reset_pending_is_reported() {
     let (sim, _hooks, mut imu) = mpu(1);
     let mut out = [RawSample::default(); 128];
     sim.borrow_mut().tick(10);
@@ -258,14 +259,13 @@ fn mpu_chip_reset_during_pending_fifo_reset_stalls_forever() {
     );
 }
 
-/// DEFECT 2 (count lies, MPU-6050; ICM-42688-P's `enable_fifo` is the same). `enable_fifo`
-/// that fails at its last write after the write took effect leaves the chip's FIFO running
-/// while the reader says `FifoNotRunning`. The documented remedy is to call `enable_fifo`
-/// again; it resets the FIFO and the samples the chip wrote in the meantime vanish: not
-/// delivered, not `discarded`, not `lost` (enable_fifo takes no outage).
+/// MPU-6050 (the ICM-42688-P's `enable_fifo` is the same routine): `enable_fifo` that fails at
+/// its last write after the write took effect leaves the chip's FIFO running while the reader
+/// says `FifoNotRunning`. The documented remedy is to call `enable_fifo` again; it resets the
+/// FIFO, and the samples the chip wrote in the meantime must not vanish.
 /// Expected: those samples are counted (`discarded`) or delivered.
 #[test]
-fn enable_fifo_retry_drops_samples_uncounted() {
+fn enable_fifo_retry_counts_the_samples_it_drops() {
     let sim = Sim::new(Model::Mpu6050, 2);
     let mut imu = Mpu6050::new(SimI2c(sim.clone()), 0x68);
     imu.init(&mut NoDelay, mpu_config()).unwrap();
@@ -280,13 +280,12 @@ fn enable_fifo_retry_drops_samples_uncounted() {
     assert_accounted(&sim, &imu, k as u64, "enable_fifo retried");
 }
 
-/// DEFECT 3 (count lies, both chips: shared `fifo::finish_reset`). The discarded count of a
-/// FIFO reset is taken from FIFO_COUNT read *before* the channels are taken off the FIFO; a
-/// sample the chip writes between that count and `FIFO_EN = 0` is dropped by the reset but not
-/// counted. README: "the count is exact: the channels are taken off the FIFO before it is
-/// emptied". Expected: FifoResync { discarded: 11 } and every sample accounted for.
+/// Both chips (shared FIFO reset): a sample the chip writes after the reader's FIFO_COUNT read
+/// and before the reset takes the channels off is dropped by the reset, and must be counted
+/// (README: "the count is exact: the channels are taken off the FIFO before it is emptied").
+/// Expected: FifoResync { discarded: 11 } and every sample accounted for.
 #[test]
-fn reset_drops_sample_written_after_the_count_uncounted() {
+fn reset_counts_a_sample_written_after_the_count() {
     let (sim, hooks, mut imu) = mpu(3);
     let mut out = [RawSample::default(); 128];
     sim.borrow_mut().tick(10);
@@ -298,20 +297,21 @@ fn reset_drops_sample_written_after_the_count_uncounted() {
     assert_eq!(r, Err(Error::FifoResync { discarded: 11 }));
 }
 
-/// DEFECT 4 (count lies, both chips: `fifo::resync`). After a failed data read, resync computes
-/// the bytes the failed transfer consumed as `count_before - count_now` (saturating), assuming
-/// the FIFO only shrinks. With the channels still on, a sample arriving meanwhile makes
-/// count_now > count_before: the consumed bytes become 0 and the partly read packet is lost
-/// from the count (here 5 + 127 = 132 bytes = 11 samples dropped, counted 127 bytes = 10).
+/// Both chips (shared resync): after a failed data read, the bytes the failed transfer clocked
+/// out were reckoned as `count_before - count_now` (saturating), as if the FIFO only shrank.
+/// With the channels still on, a sample arriving meanwhile makes count_now > count_before: the
+/// partly read packet was lost from the count (here 5 + 127 = 132 bytes = 11 samples dropped,
+/// counted 127 bytes = 10).
 /// Expected: FifoResync { discarded: 11 }, discarded_bytes 132.
 #[test]
-fn resync_with_fifo_growing_meanwhile_undercounts() {
+fn resync_counts_exactly_while_the_fifo_grows() {
     let (sim, hooks, mut imu) = mpu(4);
     let mut out = [RawSample::default(); 128];
     sim.borrow_mut().tick(10);
     sim.borrow_mut().fail(Kind::Read(mpu::FIFO_R_W), 0, 5);
-    // FIFO_COUNTH is read by read_fifo (skip it), then by resync: a sample arrives before it.
-    hooks.add(Kind::Read(mpu::FIFO_COUNTH), 1, Action::TickBefore(1));
+    // FIFO_COUNTH is read twice by read_fifo (skip both), then by resync: a sample arrives
+    // before it.
+    hooks.add(Kind::Read(mpu::FIFO_COUNTH), 2, Action::TickBefore(1));
     let r = imu.read_fifo(&mut out);
     assert_eq!(
         imu.fifo_stats().discarded_bytes,
@@ -322,13 +322,53 @@ fn resync_with_fifo_growing_meanwhile_undercounts() {
     assert_accounted(&sim, &imu, 0, "resync with the FIFO growing");
 }
 
-/// DEFECT 5 (count lies, both chips). With the bus stuck high (every read 0xFF) each
-/// `read_fifo` "discards" a full FIFO: 85 samples per call on the MPU-6050, though the chip
-/// wrote one sample between calls. Ten calls count 850 discarded samples out of 12 written.
-/// The `discarded` doc: "Complete samples dropped by FIFO resets: those in the FIFO when it was
-/// reset". Expected: never more discarded than the chip wrote.
+/// As above, with the sample arriving between read_fifo's two FIFO_COUNT reads: the data are
+/// read by the smaller count, the bytes of the failed read reckoned from the later one.
 #[test]
-fn stuck_high_bus_counts_phantom_discarded_samples() {
+fn resync_counts_exactly_when_the_fifo_grows_between_the_count_reads() {
+    let (sim, hooks, mut imu) = mpu(4);
+    let mut out = [RawSample::default(); 128];
+    sim.borrow_mut().tick(10);
+    sim.borrow_mut().fail(Kind::Read(mpu::FIFO_R_W), 0, 5);
+    hooks.add(Kind::Read(mpu::FIFO_COUNTH), 1, Action::TickBefore(1));
+    let r = imu.read_fifo(&mut out);
+    assert_eq!(imu.fifo_stats().discarded_bytes, 132);
+    assert_eq!(r, Err(Error::FifoResync { discarded: 11 }));
+    assert_accounted(
+        &sim,
+        &imu,
+        0,
+        "resync with the FIFO growing before the data read",
+    );
+}
+
+/// `recover` and `enable_fifo` before `init`: nothing is configured to recover, and no
+/// outage is counted.
+#[test]
+fn recover_and_enable_fifo_before_init_are_errors() {
+    let sim = Sim::new(Model::Mpu6050, 15);
+    let mut imu = Mpu6050::new(SimI2c(sim.clone()), 0x68);
+    assert_eq!(
+        imu.recover(&mut NoDelay, 1_000_000),
+        Err(Error::NotInitialised)
+    );
+    assert_eq!(imu.fifo_stats(), Default::default());
+    let sim = Sim::new(Model::Icm42688, 15);
+    let mut imu = Icm42688::new(SimSpi(sim.clone()));
+    assert_eq!(imu.enable_fifo(), Err(Error::NotInitialised));
+    assert_eq!(
+        imu.recover(&mut NoDelay, 1_000_000),
+        Err(Error::NotInitialised)
+    );
+    assert_eq!(imu.fifo_stats(), Default::default());
+}
+
+/// Both chips: with the bus stuck high (every read 0xFF) each `read_fifo` used to "discard" a
+/// full FIFO: 85 samples per call on the MPU-6050, though the chip wrote one sample between
+/// calls. A count above the FIFO's size is no count.
+/// Expected: never more discarded than the chip wrote.
+#[test]
+fn stuck_high_bus_discards_no_more_than_the_chip_wrote() {
     let (sim, _hooks, mut imu) = mpu(5);
     let mut out = [RawSample::default(); 128];
     sim.borrow_mut().tick(2);
@@ -347,14 +387,13 @@ fn stuck_high_bus_counts_phantom_discarded_samples() {
     );
 }
 
-/// DEFECT 6 (samples vanish uncounted, ICM-42688-P). A header with HEADER_MSG (bit 7, "FIFO
-/// empty") in the middle of a batch ends the batch, but the packets after it in the same
-/// chunk were already clocked out of the FIFO: they are neither delivered nor counted (not
-/// even the marker packet itself is counted as malformed). One corrupted header byte (0xFF on
-/// the wire) silently loses up to 8 samples. FIFO_COUNT said 3 packets, so an "empty" marker
-/// here is malformed. Expected: the 2 packets counted (malformed/discarded) or delivered.
+/// ICM-42688-P: a header with HEADER_MSG (bit 7, "FIFO empty") in the middle of a batch ended
+/// the batch, and the packets after it in the same transfer, already clocked out of the FIFO,
+/// were neither delivered nor counted (nor the marker packet itself). FIFO_COUNT said 3
+/// packets, so an "empty" marker here is a damaged header (0xFF on the wire).
+/// Expected: the 2 packets counted (malformed/discarded) or delivered.
 #[test]
-fn icm_empty_marker_mid_batch_loses_following_packets() {
+fn icm_empty_marker_inside_the_count_is_malformed() {
     let (sim, hooks, mut imu) = icm(6);
     let mut out = [RawSample::default(); 160];
     let before = imu.fifo_stats();
@@ -378,13 +417,13 @@ fn icm_empty_marker_mid_batch_loses_following_packets() {
     );
 }
 
-/// DEFECT 7 (overflow count lost). An overflow whose FIFO reset meets a bus error is pending;
-/// `recover` (called for FifoNotRunning, or "any suspected glitch" as its doc invites) clears
-/// the pending reset (`FifoState::restarting`) and the overflow is never counted. README: "An
-/// overflow is never lost ... every overflow is counted (`overflows`)".
+/// An overflow whose FIFO reset meets a bus error is pending; `recover` (called for
+/// FifoNotRunning, or "any suspected glitch" as its doc invites) replaces the pending reset,
+/// and the overflow must still be counted. README: "An overflow is never lost ... every
+/// overflow is counted (`overflows`)".
 /// Expected: overflows == 1.
 #[test]
-fn recover_forgets_pending_overflow() {
+fn recover_counts_a_pending_overflow() {
     let (sim, _hooks, mut imu) = mpu(7);
     let mut out = [RawSample::default(); 128];
     sim.borrow_mut().tick(100); // the FIFO overflows
@@ -396,12 +435,12 @@ fn recover_forgets_pending_overflow() {
     assert_eq!(imu.fifo_stats().overflows, 1, "{:#?}", imu.fifo_stats());
 }
 
-/// DEFECT 8 (doc vs behaviour). `FifoStats::resets` is documented as "Chip resets detected
-/// (`Error::SensorReset`) and recovered from", but every successful `recover` increments it,
-/// including one after `FifoNotRunning` (a failed `enable_fifo`, no chip reset at all) and a
-/// `recover` before the reader was ever initialised. Expected: resets == 0.
+/// `FifoStats::resets` is documented as chip resets detected (`Error::SensorReset`) and
+/// recovered from; a `recover` after `FifoNotRunning` (a failed `enable_fifo`, no chip reset at
+/// all) is no chip reset.
+/// Expected: resets == 0.
 #[test]
-fn resets_counts_recoveries_not_chip_resets() {
+fn resets_counts_only_detected_chip_resets() {
     let sim = Sim::new(Model::Mpu6050, 8);
     let mut imu = Mpu6050::new(SimI2c(sim.clone()), 0x68);
     imu.init(&mut NoDelay, mpu_config()).unwrap();
@@ -413,10 +452,11 @@ fn resets_counts_recoveries_not_chip_resets() {
     assert_eq!(imu.fifo_stats().resets, 0, "no chip reset was detected");
 }
 
-/// DEFECT 9 (count lies, `Replay`). `FifoStats::clipped` ("Delivered samples with some axis
-/// at a rail") is never counted by `Replay::read_fifo`. Expected: clipped == 1.
+/// `Replay`: `FifoStats::clipped` ("Delivered samples with some axis at a rail") is counted by
+/// `Replay::read_fifo` too.
+/// Expected: clipped == 1.
 #[test]
-fn replay_does_not_count_clipped_samples() {
+fn replay_counts_clipped_samples() {
     let samples = [
         RawSample {
             gyro: [i16::MAX, 0, 0],
@@ -434,14 +474,13 @@ fn replay_does_not_count_clipped_samples() {
     assert_eq!(replay.fifo_stats().clipped, 1);
 }
 
-/// DEFECT 10 (silent garbage, MPU-6050). A FIFO_COUNT read corrupted on the wire (here 0x0078
-/// = 10 packets while the FIFO holds 2) is trusted: the reader reads past the FIFO's end and
-/// delivers 8 samples made of the FIFO's repeated last byte, uncounted and undetected.
-/// (ArduPilot puts the temperature into the MPU FIFO and checks it to detect such reads;
-/// re-reading FIFO_COUNT and taking the smaller is another cheap guard.)
+/// MPU-6050: a FIFO_COUNT read corrupted on the wire (here 0x0078 = 10 packets while the FIFO
+/// holds 2) was trusted: the reader read past the FIFO's end and delivered 8 samples made of
+/// the FIFO's repeated last byte. (ArduPilot puts the temperature into the MPU FIFO and checks
+/// it to detect such reads; the reader reads FIFO_COUNT twice and takes the smaller.)
 /// Expected: only the 2 samples the chip produced are delivered.
 #[test]
-fn mpu_corrupted_fifo_count_delivers_garbage() {
+fn mpu_corrupted_fifo_count_delivers_no_garbage() {
     let (sim, hooks, mut imu) = mpu(10);
     let mut out = [RawSample::default(); 128];
     sim.borrow_mut().tick(2);
@@ -460,14 +499,14 @@ fn mpu_corrupted_fifo_count_delivers_garbage() {
     );
 }
 
-/// DEFECT 11 (count lies / doc conflict, ICM-42688-P). `FifoStats::invalid` is documented as
-/// "FIFO packets skipped because the chip marked their data invalid", and README's accounting
-/// ("every sample the chip writes into its FIFO is delivered or counted ... invalid") relies
-/// on it; but `Icm42688::read()` (a data-register read, no FIFO packet) adds to it too. A
-/// firmware polling `read()` while the FIFO runs gets more samples accounted than written.
-/// Expected: `invalid` unchanged by `read()` (count it elsewhere).
+/// ICM-42688-P: `FifoStats::invalid` counts FIFO packets the chip marked invalid, and README's
+/// accounting ("every sample the chip writes into its FIFO is delivered or counted ...
+/// invalid") relies on it; `Icm42688::read()` (a data-register read, no FIFO packet) added to
+/// it too, so a firmware polling `read()` while the FIFO ran got more samples accounted than
+/// written.
+/// Expected: `invalid` unchanged by `read()`.
 #[test]
-fn icm_register_read_inflates_fifo_invalid_count() {
+fn icm_register_read_leaves_the_fifo_invalid_count() {
     let (sim, hooks, mut imu) = icm(11);
     let mut out = [RawSample::default(); 160];
     let before = imu.fifo_stats().invalid;
@@ -488,21 +527,20 @@ fn icm_register_read_inflates_fifo_invalid_count() {
     );
 }
 
-/// DEFECT 12 (failure of the failure handling over-counts, both chips: `fifo::resync` then
-/// `finish_reset`). A FIFO read fails part-way (5 of 96 bytes clocked out), the FIFO_COUNT
-/// retries all fail, so resync books the whole failed transfer (96 bytes) as consumed and
-/// 120 - 96 = 24 as held; then the reset fails too. The next call reads FIFO_COUNT = 115 (the
-/// bytes really left) and takes max(24, 115) as held, on top of the 96 "consumed": 211 bytes,
-/// 17 samples "discarded" out of the 10 the chip ever wrote.
+/// Both chips (shared resync and reset): a FIFO read fails part-way (5 of 96 bytes clocked
+/// out), the FIFO_COUNT retries all fail, then the reset fails too. The whole failed transfer
+/// (96 bytes) used to be booked as consumed and 24 as held; the next call read FIFO_COUNT =
+/// 115 (the bytes really left) and took it as held on top of the 96: 211 bytes, 17 samples
+/// "discarded" out of the 10 the chip ever wrote.
 /// Expected: FifoResync { discarded: 10 }, discarded_bytes 120.
 #[test]
-fn failed_count_retries_then_failed_reset_overcounts() {
+fn failed_count_retries_then_failed_reset_count_exactly() {
     let (sim, _hooks, mut imu) = mpu(12);
     let mut out = [RawSample::default(); 128];
     sim.borrow_mut().tick(10);
     sim.borrow_mut().fail(Kind::Read(mpu::FIFO_R_W), 0, 5);
-    // read_fifo's own FIFO_COUNT read passes; resync's 4 retries fail.
-    sim.borrow_mut().fail(Kind::Read(mpu::FIFO_COUNTH), 1, 0);
+    // read_fifo's own two FIFO_COUNT reads pass; resync's 4 retries fail.
+    sim.borrow_mut().fail(Kind::Read(mpu::FIFO_COUNTH), 2, 0);
     for _ in 0..3 {
         sim.borrow_mut().fail(Kind::Read(mpu::FIFO_COUNTH), 0, 0);
     }
@@ -513,13 +551,13 @@ fn failed_count_retries_then_failed_reset_overcounts() {
     assert_eq!(r, Err(Error::FifoResync { discarded: 10 }));
 }
 
-/// DEFECT 13 (silent garbage, ICM-42688-P header flags). `parse` accepts any header with
-/// HEADER_ACCEL and HEADER_GYRO set, including HEADER_20 (bit 4: a 20-byte packet 4, which
-/// this reader never configures). Such a header means the stream is not the 16-byte packet 3
-/// the reader assumes (corruption, or a 20-byte packet whose layout differs): the packet is
-/// delivered as a sample. Expected: counted as malformed, not delivered.
+/// ICM-42688-P: a header with HEADER_ACCEL and HEADER_GYRO set and HEADER_20 (bit 4: a 20-byte
+/// packet 4, which this reader never configures) means the stream is not the 16-byte packet 3
+/// the reader assumes (corruption, or a packet whose layout differs). It was delivered as a
+/// sample.
+/// Expected: counted as malformed, not delivered.
 #[test]
-fn icm_header_20_bit_packet_delivered_as_sample() {
+fn icm_header_20_packet_is_malformed() {
     let (sim, hooks, mut imu) = icm(13);
     let mut out = [RawSample::default(); 160];
     sim.borrow_mut().tick(1);
@@ -537,16 +575,15 @@ fn icm_header_20_bit_packet_delivered_as_sample() {
     );
 }
 
-/// DEFECT 14 (stall, MPU-6050, edge order). `enable_fifo` before `init` (nothing in its doc
-/// requires init first) leaves the chip asleep (PWR_MGMT_1.SLEEP, its power-on state) but
-/// writes USER_CTRL.FIFO_EN, so `read_fifo` returns `Ok(0)` forever: no sample, no error, no
-/// `SensorReset` (same root cause as defect 1: USER_CTRL is the only glitch evidence checked).
+/// MPU-6050: `enable_fifo` before `init` left the chip asleep (PWR_MGMT_1.SLEEP, its power-on
+/// state) but wrote USER_CTRL.FIFO_EN, so `read_fifo` returned `Ok(0)` forever: no sample, no
+/// error. It is now `Error::NotInitialised`.
 /// Expected: an error (FifoDisabled / SensorReset / NotRunning) or samples.
 #[test]
-fn mpu_enable_fifo_before_init_reads_nothing_forever() {
+fn mpu_enable_fifo_before_init_is_an_error() {
     let sim = Sim::new(Model::Mpu6050, 14);
     let mut imu = Mpu6050::new(SimI2c(sim.clone()), 0x68);
-    let _ = imu.enable_fifo();
+    assert_eq!(imu.enable_fifo(), Err(Error::NotInitialised));
     let mut out = [RawSample::default(); 16];
     let mut results = Vec::new();
     for _ in 0..10 {
