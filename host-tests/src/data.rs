@@ -56,7 +56,15 @@ pub fn read_text_column(files: &[PathBuf], column: &str) -> Result<Vec<String>, 
 pub fn parse_column(label: &Path, bytes: &[u8], column: &str) -> Result<Vec<f64>, DataError> {
     let mut out = Vec::new();
     let locate = |byte| line_at(bytes, byte);
-    read_source(label, bytes, column, &finite(column), &mut out, false, &locate)?;
+    read_source(
+        label,
+        bytes,
+        column,
+        &finite(column),
+        &mut out,
+        false,
+        &locate,
+    )?;
     Ok(out)
 }
 
@@ -185,9 +193,13 @@ fn read_source<T>(
             }
         }
         let line = || record.position().and_then(|p| locate(p.byte()));
-        let cell = record
-            .get(index)
-            .ok_or_else(|| error(path, line(), format!("column '{column}' missing in this row")))?;
+        let cell = record.get(index).ok_or_else(|| {
+            error(
+                path,
+                line(),
+                format!("column '{column}' missing in this row"),
+            )
+        })?;
         out.push(parse(cell).map_err(|problem| error(path, line(), problem))?);
         if progress && out.len().is_multiple_of(100_000) {
             eprint!("\rread {} rows", out.len());

@@ -750,9 +750,11 @@ fn default_delta(x: &[f64]) -> Result<f64, String> {
     let mean = head.iter().sum::<f64>() / head.len() as f64;
     let var = head.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / head.len() as f64;
     if !var.is_finite() {
-        return Err("the variance of the first 1000 samples (for the default --delta) overflows \
+        return Err(
+            "the variance of the first 1000 samples (for the default --delta) overflows \
              f64 (values of about 1e154 or more); rescale the record"
-            .into());
+                .into(),
+        );
     }
     Ok(if var > 0.0 { 0.1 * var } else { 1.0 })
 }
@@ -1165,7 +1167,10 @@ fn order_text(v: &Value) -> String {
         sel("bic"),
         sel("fpe")
     );
-    if v["selected"].as_object().is_some_and(|m| m.values().all(Value::is_null)) {
+    if v["selected"]
+        .as_object()
+        .is_some_and(|m| m.values().all(Value::is_null))
+    {
         s += "no order selected: every criterion needs more samples\n";
     }
     s

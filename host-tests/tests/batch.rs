@@ -257,10 +257,16 @@ fn fits_keep_one_residual_degree_of_freedom() {
     let raw = c.with_demean(false);
     let short = |needed, given| Some(BatchError::TooShort { needed, given });
     assert_eq!(covariance::<f64, 1>(&[1.0, 2.0], &c).err(), short(4, 2));
-    assert_eq!(covariance::<f64, 1>(&[1.0, 2.0, 3.0], &c).err(), short(4, 3));
+    assert_eq!(
+        covariance::<f64, 1>(&[1.0, 2.0, 3.0], &c).err(),
+        short(4, 3)
+    );
     assert_eq!(burg::<f64, 1>(&[1.0, 2.0], &c).err(), short(3, 2));
     assert_eq!(yule_walker::<f64, 1>(&[1.0, 2.0], &c).err(), short(3, 2));
-    assert_eq!(covariance::<f64, 2>(&[1.0, 2.0, 4.0, 3.0], &raw).err(), short(5, 4));
+    assert_eq!(
+        covariance::<f64, 2>(&[1.0, 2.0, 4.0, 3.0], &raw).err(),
+        short(5, 4)
+    );
     assert_eq!(burg::<f64, 2>(&[1.0, 2.0], &raw).err(), short(3, 2));
     // At the bound the residual is not zero.
     let ls = covariance::<f64, 1>(&[1.0, 2.0, 3.0, 5.0], &c).unwrap();
@@ -278,9 +284,15 @@ fn fits_keep_one_residual_degree_of_freedom() {
 fn overflowing_energy_is_its_own_error() {
     let x: Vec<f64> = (0..200).map(|n| 1e160 * (1.0 + (n % 7) as f64)).collect();
     let c = config();
-    assert_eq!(covariance::<f64, 2>(&x, &c).err(), Some(BatchError::Overflow));
+    assert_eq!(
+        covariance::<f64, 2>(&x, &c).err(),
+        Some(BatchError::Overflow)
+    );
     assert_eq!(burg::<f64, 2>(&x, &c).err(), Some(BatchError::Overflow));
-    assert_eq!(yule_walker::<f64, 2>(&x, &c).err(), Some(BatchError::Overflow));
+    assert_eq!(
+        yule_walker::<f64, 2>(&x, &c).err(),
+        Some(BatchError::Overflow)
+    );
     // Large but representable data still fit.
     let y: Vec<f64> = x.iter().map(|v| v * 1e-20).collect();
     assert!(burg::<f64, 2>(&y, &c).is_ok());

@@ -52,8 +52,12 @@ fn fit_json(file: &Path, method: &str, order: &str, extra: &[&str]) -> serde_jso
 }
 
 #[test]
+#[cfg_attr(
+    not(imu_ar_data),
+    ignore = "needs the real records (../shared/data/imu or IMU_AR_DATA)"
+)]
 fn adev_reproduces_the_published_adis16405_table() {
-    let Some(dir) = data_dir() else { return };
+    let dir = data_dir().expect("the real records: ../shared/data/imu or IMU_AR_DATA (see README)");
     let part1 = dir.join("adis16405_imu1_part1.csv");
     let part2 = dir.join("adis16405_imu1_part2.csv");
     let reference =
@@ -714,7 +718,12 @@ fn fixed_fit_text_shows_every_count_and_warns() {
     assert!(out.status.success());
     let text = String::from_utf8(out.stdout).unwrap();
     let stderr = String::from_utf8(out.stderr).unwrap();
-    let v = fit_json(&file, "lattice", "2", &["--scalar", "fixed", "--scale", "30"]);
+    let v = fit_json(
+        &file,
+        "lattice",
+        "2",
+        &["--scalar", "fixed", "--scale", "30"],
+    );
     let saturated = v["saturated"].as_u64().unwrap();
     assert!(saturated > 2500, "{v}");
     for key in ["restarts", "saturated", "clipped", "non_finite"] {
@@ -763,7 +772,9 @@ fn fits_without_residual_degrees_of_freedom_are_refused() {
     let t = two.to_str().unwrap();
     for (method, needed) in [("ls", 4), ("burg", 3), ("yule-walker", 3)] {
         misused(
-            &["fit", t, "--column", "x", "--method", method, "--order", "1"],
+            &[
+                "fit", t, "--column", "x", "--method", method, "--order", "1",
+            ],
             &format!("{t}: 2 samples given, at least {needed} needed"),
         );
     }
@@ -771,7 +782,16 @@ fn fits_without_residual_degrees_of_freedom_are_refused() {
     let f = file.to_str().unwrap();
     misused(
         &[
-            "fit", f, "--column", "x", "--method", "ls", "--order", "1", "--decimate", "250",
+            "fit",
+            f,
+            "--column",
+            "x",
+            "--method",
+            "ls",
+            "--order",
+            "1",
+            "--decimate",
+            "250",
         ],
         &format!("{f}: 2 samples given, at least 4 needed"),
     );
@@ -786,7 +806,9 @@ fn simulate_streams_any_length() {
     use std::io::{BufRead, BufReader};
     for n in ["1000000000000", "800000000000000000"] {
         let mut child = Command::new(env!("CARGO_BIN_EXE_imu-ar"))
-            .args(["simulate", "--a", "0.5", "--sigma", "1", "--n", n, "--seed", "1"])
+            .args([
+                "simulate", "--a", "0.5", "--sigma", "1", "--n", n, "--seed", "1",
+            ])
             .stdout(std::process::Stdio::piped())
             .stderr(std::process::Stdio::null())
             .spawn()
@@ -806,14 +828,13 @@ fn simulate_streams_any_length() {
 /// system or a bad `--delta` that was never given.
 #[test]
 fn huge_values_are_reported_as_an_overflow() {
-    let file = column_file(
-        "huge.csv",
-        (0..500).map(|i| format!("{}e160", 1 + i % 7)),
-    );
+    let file = column_file("huge.csv", (0..500).map(|i| format!("{}e160", 1 + i % 7)));
     let f = file.to_str().unwrap();
     for method in ["ls", "burg", "yule-walker", "rls", "lattice"] {
         misused(
-            &["fit", f, "--column", "x", "--method", method, "--order", "2"],
+            &[
+                "fit", f, "--column", "x", "--method", method, "--order", "2",
+            ],
             "overflows f64",
         );
     }
@@ -843,7 +864,16 @@ fn order_on_three_samples_is_refused() {
     let file = temp_file("order-3.csv", "x\n1\n2\n3\n");
     let f = file.to_str().unwrap();
     misused(
-        &["order", f, "--column", "x", "--method", "ls", "--max-order", "1"],
+        &[
+            "order",
+            f,
+            "--column",
+            "x",
+            "--method",
+            "ls",
+            "--max-order",
+            "1",
+        ],
         &format!("{f}: 3 samples given, at least 4 needed"),
     );
     std::fs::remove_file(file).unwrap();
@@ -917,7 +947,10 @@ fn compare_says_higher_for_a_negative_reduction() {
     let args = ["compare", f, "--column", "x", "--order", "32"];
     let v = json(&imu_ar(&[&args[..], &["--json"]].concat()));
     let percent = v["reduction_percent"].as_f64().unwrap();
-    assert!(percent < 0.0, "this record should favour the batch fit: {v}");
+    assert!(
+        percent < 0.0,
+        "this record should favour the batch fit: {v}"
+    );
     let out = imu_ar(&args);
     let text = String::from_utf8(out.stdout).unwrap();
     let line = text.lines().last().unwrap();
@@ -935,7 +968,15 @@ fn kalman_refuses_a_filter_step_beyond_u32() {
     let f = file.to_str().unwrap();
     misused(
         &[
-            "kalman", f, "--column", "x", "--order", "2", "--rate", "100", "--filter-rate",
+            "kalman",
+            f,
+            "--column",
+            "x",
+            "--order",
+            "2",
+            "--rate",
+            "100",
+            "--filter-rate",
             "1e-12",
         ],
         "--filter-rate 0.000000000001: one filter step would be 1e14 model steps",
@@ -968,7 +1009,10 @@ fn an_error_shortens_a_long_cell() {
     let args = ["fit", f, "--column", "x", "--method", "ls", "--order", "1"];
     misused(
         &args,
-        &format!("{f}:2: column 'x': '{}... (100000 bytes)' is not a finite number", "1".repeat(40)),
+        &format!(
+            "{f}:2: column 'x': '{}... (100000 bytes)' is not a finite number",
+            "1".repeat(40)
+        ),
     );
     assert!(imu_ar(&args).stderr.len() < 200 + f.len());
     std::fs::remove_file(file).unwrap();
