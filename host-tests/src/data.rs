@@ -2,7 +2,7 @@
 
 use std::fmt;
 use std::fs::File;
-use std::io::{BufReader, IsTerminal, Read, Write};
+use std::io::{BufRead, BufReader, IsTerminal, Read, Write};
 use std::path::{Path, PathBuf};
 
 /// A problem with an input file, for a one-line message `FILE[:LINE]: problem`.
@@ -55,8 +55,56 @@ pub fn read_text_column(files: &[PathBuf], column: &str) -> Result<Vec<String>, 
 /// errors name `label` as the file.
 pub fn parse_column(label: &Path, bytes: &[u8], column: &str) -> Result<Vec<f64>, DataError> {
     let mut out = Vec::new();
-    read_source(label, bytes, column, &finite(column), &mut out, false)?;
+    let locate = |byte| line_at(bytes, byte);
+    read_source(
+        label,
+        bytes,
+        column,
+        &finite(column),
+        &mut out,
+        false,
+        &locate,
+    )?;
     Ok(out)
+}
+
+/// The 1-based line of the record that starts at `byte` of `source` (or at the first line
+/// after it that is neither blank nor a `#` comment): a record's own line, whatever the line
+/// endings (`\r\n` too) and however many blank lines come before it.
+fn line_at(source: impl Read, byte: u64) -> Option<u64> {
+    let mut reader = BufReader::new(source);
+    let mut head = (&mut reader).take(byte);
+    let mut newlines = 0u64;
+    let mut buf = [0u8; 1 << 16];
+    loop {
+        let n = head.read(&mut buf).ok()?;
+        if n == 0 {
+            break;
+        }
+        newlines += buf[..n].iter().filter(|&&b| b == b'\n').count() as u64;
+    }
+    let mut line = Vec::new();
+    loop {
+        line.clear();
+        if reader.read_until(b'\n', &mut line).ok()? == 0 {
+            break;
+        }
+        let text = line.trim_ascii();
+        if !(text.is_empty() || text.starts_with(b"#")) || !line.ends_with(b"\n") {
+            break;
+        }
+        newlines += 1;
+    }
+    Some(newlines + 1)
+}
+
+/// A cell as shown in an error: cut to its first 40 characters when it is longer.
+fn shown(cell: &str) -> String {
+    const KEEP: usize = 40;
+    match cell.char_indices().nth(KEEP) {
+        Some((end, _)) => format!("{}... ({} bytes)", &cell[..end], cell.len()),
+        None => cell.to_string(),
+    }
 }
 
 /// A cell as a finite number, or what is wrong with it.
@@ -64,9 +112,13 @@ fn finite(column: &str) -> impl Fn(&str) -> Result<f64, String> + '_ {
     move |cell| match cell.parse::<f64>() {
         Ok(v) if v.is_finite() => Ok(v),
         Ok(_) => Err(format!(
-            "column '{column}': '{cell}' is not a finite number"
+            "column '{column}': '{}' is not a finite number",
+            shown(cell)
         )),
-        Err(_) => Err(format!("column '{column}': '{cell}' is not a number")),
+        Err(_) => Err(format!(
+            "column '{column}': '{}' is not a number",
+            shown(cell)
+        )),
     }
 }
 
@@ -81,7 +133,8 @@ fn read_cells<T>(
     for path in files {
         let file = File::open(path).map_err(|e| error(path, None, format!("cannot open: {e}")))?;
         let source = BufReader::with_capacity(1 << 16, file);
-        read_source(path, source, column, &parse, &mut out, progress)?;
+        let locate = |byte| line_at(File::open(path).ok()?, byte);
+        read_source(path, source, column, &parse, &mut out, progress, &locate)?;
     }
     if progress && out.len() >= 100_000 {
         eprintln!("\rread {} rows", out.len());
@@ -89,7 +142,8 @@ fn read_cells<T>(
     Ok(out)
 }
 
-/// Appends the cells of `column` of one CSV source (named `path` in errors) to `out`.
+/// Appends the cells of `column` of one CSV source (named `path` in errors) to `out`;
+/// `locate` gives the line of a byte offset, for errors.
 fn read_source<T>(
     path: &Path,
     source: impl Read,
@@ -97,6 +151,7 @@ fn read_source<T>(
     parse: &impl Fn(&str) -> Result<T, String>,
     out: &mut Vec<T>,
     progress: bool,
+    locate: &dyn Fn(u64) -> Option<u64>,
 ) -> Result<(), DataError> {
     let mut reader = csv::ReaderBuilder::new()
         .comment(Some(b'#'))
@@ -118,6 +173,14 @@ fn read_source<T>(
             format!("no column '{column}' (columns: {})", names.join(", ")),
         ));
     };
+    let copies = headers.iter().filter(|h| *h == column).count();
+    if copies > 1 {
+        return Err(error(
+            path,
+            None,
+            format!("the header names column '{column}' {copies} times"),
+        ));
+    }
     let start = out.len();
     let mut record = csv::StringRecord::new();
     loop {
@@ -125,15 +188,19 @@ fn read_source<T>(
             Ok(false) => break,
             Ok(true) => {}
             Err(e) => {
-                let line = e.position().map(|p| p.line());
+                let line = e.position().and_then(|p| locate(p.byte()));
                 return Err(error(path, line, format!("malformed CSV: {e}")));
             }
         }
-        let line = record.position().map(|p| p.line());
-        let cell = record
-            .get(index)
-            .ok_or_else(|| error(path, line, format!("column '{column}' missing in this row")))?;
-        out.push(parse(cell).map_err(|problem| error(path, line, problem))?);
+        let line = || record.position().and_then(|p| locate(p.byte()));
+        let cell = record.get(index).ok_or_else(|| {
+            error(
+                path,
+                line(),
+                format!("column '{column}' missing in this row"),
+            )
+        })?;
+        out.push(parse(cell).map_err(|problem| error(path, line(), problem))?);
         if progress && out.len().is_multiple_of(100_000) {
             eprint!("\rread {} rows", out.len());
             let _ = std::io::stderr().flush();

@@ -46,14 +46,17 @@ impl Record {
 /// The six axes of every record.
 pub const AXES: [&str; 6] = ["gx", "gy", "gz", "ax", "ay", "az"];
 
-/// `../shared/data/imu` beside the repository, or `None` (saying so) when it is absent.
+/// The folder of the real records, found at build time (`host-tests/build.rs`):
+/// `../shared/data/imu` beside the repository, or the folder named by `IMU_AR_DATA`. `None`
+/// (saying so) when it was absent; the tests that need it are then ignored through
+/// `cfg(imu_ar_data)`.
 pub fn data_dir() -> Option<std::path::PathBuf> {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/imu");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        println!("skipped: {} is absent", dir.display());
-        None
+    match option_env!("IMU_AR_DATA_DIR") {
+        Some(dir) => Some(dir.into()),
+        None => {
+            println!("skipped: the real records were absent at build time");
+            None
+        }
     }
 }
 

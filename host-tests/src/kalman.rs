@@ -48,6 +48,13 @@ pub fn handoff<const P: usize>(
             let (phi, q) = (ar1.transition(), ar1.process_noise());
             (rows(&phi), rows(&q), None)
         }
+        None if steps > f64::from(u32::MAX) => {
+            return Err(Fail(format!(
+                "--filter-rate {filter_rate}: one filter step would be {ratio:e} model steps, \
+                 more than the {} supported",
+                u32::MAX
+            )));
+        }
         None if steps >= 1.0 && (ratio - steps).abs() <= 1e-9 * ratio => {
             let (phi, q) = model.discretize(steps as u32);
             (rows(&phi), rows(&q), Some(steps as u32))

@@ -361,7 +361,10 @@ impl Comparison {
             return Err(Fail(format!("--train {}: must be in (0, 1)", self.train)));
         }
         let x = self.record.load(self.decimate)?;
-        let delta = self.delta.unwrap_or_else(|| default_delta(&x));
+        let delta = match self.delta {
+            Some(d) => d,
+            None => default_delta(&x).map_err(|e| with_file(&self.record.files, e))?,
+        };
         Ok((x, delta))
     }
 }
@@ -447,7 +450,11 @@ fn run(command: Command) -> Result<String, Fail> {
             }
             let x = block_average(&read_column(&files, &column)?, decimate);
             let fit = if method.recursive() {
-                let delta = delta.unwrap_or_else(|| default_delta(&x));
+                let default = delta.is_none();
+                let delta = match delta {
+                    Some(d) => d,
+                    None => default_delta(&x).map_err(|e| with_file(&files, e))?,
+                };
                 let r = Recursive {
                     method,
                     scalar,
@@ -456,13 +463,24 @@ fn run(command: Command) -> Result<String, Fail> {
                     demean: !no_demean,
                     dt,
                     rate,
+                    default_delta: default,
                 };
                 match scalar {
                     ScalarKind::F64 => with_order!(order, recursive_fit::<f64>(&x, &r)),
                     ScalarKind::F32 => with_order!(order, recursive_fit::<f32>(&x, &r)),
                     ScalarKind::Fixed => {
-                        let peak = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-                        let scale = scale.unwrap_or(if peak > 0.0 { 8.0 / peak } else { 1.0 });
+                        // The default scale is taken from the samples the fit will see (centred
+                        // when the mean is removed).
+                        let offset = centre(&x, r.demean);
+                        let peak = x
+                            .iter()
+                            .map(|v| v - offset)
+                            .filter(|v| v.abs() <= f64::from(f32::MAX))
+                            .fold(0.0f64, |m, v| m.max(v.abs()));
+                        let scale = match scale {
+                            Some(s) => Scale::Given(s),
+                            None => Scale::Default(if peak > 0.0 { 8.0 / peak } else { 1.0 }),
+                        };
                         with_order!(order, fixed_fit(&x, &r, scale))
                     }
                 }
@@ -472,6 +490,9 @@ fn run(command: Command) -> Result<String, Fail> {
                 with_order!(order, fit_json(method, &x, &config, rate))
                     .map_err(|e| with_file(&files, e))?
             };
+            if let Some(warning) = rejection_warning(&fit) {
+                eprintln!("imu-ar: warning: {}", with_file(&files, warning).0);
+            }
             Ok(if json {
                 format!("{fit}\n")
             } else {
@@ -491,7 +512,7 @@ fn run(command: Command) -> Result<String, Fail> {
                     "AR({order}), lambda {lambda}: training {} samples, evaluation {}\n\
                      one-step prediction MSE: batch LS {}, RLS {}, lattice {}, SFTF {} \
                      ({} rescues)\n\
-                     lattice against batch: {:.1} % lower\n",
+                     lattice against batch: {}\n",
                     v["n_train"],
                     v["n_eval"],
                     v["batch_mse"],
@@ -499,7 +520,7 @@ fn run(command: Command) -> Result<String, Fail> {
                     v["lattice_mse"],
                     v["sftf_mse"],
                     v["sftf_restarts"],
-                    v["reduction_percent"].as_f64().unwrap_or(f64::NAN)
+                    reduction_text(v["reduction_percent"].as_f64().unwrap_or(f64::NAN))
                 )
             })
         }
@@ -723,12 +744,51 @@ fn check_delta(delta: f64) -> Result<(), Fail> {
 }
 
 /// 0.1 x the variance of the first 1000 samples (what firmware sees at start-up), or 1 when
-/// that is 0.
-fn default_delta(x: &[f64]) -> f64 {
+/// that is 0; an error when that variance overflows f64.
+fn default_delta(x: &[f64]) -> Result<f64, String> {
     let head = &x[..x.len().min(1000)];
     let mean = head.iter().sum::<f64>() / head.len() as f64;
     let var = head.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / head.len() as f64;
-    if var > 0.0 { 0.1 * var } else { 1.0 }
+    if !var.is_finite() {
+        return Err(
+            "the variance of the first 1000 samples (for the default --delta) overflows \
+             f64 (values of about 1e154 or more); rescale the record"
+                .into(),
+        );
+    }
+    Ok(if var > 0.0 { 0.1 * var } else { 1.0 })
+}
+
+/// The offset removed in f64 before a fit in f32 or fixed point: the mean of the samples that
+/// f32 can hold when the mean is removed (so that rounding to f32 does not erase a small
+/// signal on a large offset), else 0.
+fn centre(x: &[f64], demean: bool) -> f64 {
+    if !demean {
+        return 0.0;
+    }
+    let (sum, n) = x
+        .iter()
+        .filter(|v| v.abs() <= f64::from(f32::MAX))
+        .fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    if n == 0 { 0.0 } else { sum / n as f64 }
+}
+
+/// "x % lower" or "x % higher" for a reduction in percent.
+fn reduction_text(percent: f64) -> String {
+    if percent < 0.0 {
+        format!("{:.1} % higher", -percent)
+    } else {
+        format!("{percent:.1} % lower")
+    }
+}
+
+/// A warning when most samples of a fit were rejected (saturated, non-finite).
+fn rejection_warning(v: &Value) -> Option<String> {
+    let n = v["n"].as_u64()?;
+    let rejected = v["saturated"].as_u64().unwrap_or(0) + v["non_finite"].as_u64().unwrap_or(0);
+    (2 * rejected > n).then(|| {
+        format!("{rejected} of {n} samples were rejected (saturated or non-finite); the model rests on the rest")
+    })
 }
 
 fn with_file(files: &[PathBuf], e: impl std::fmt::Display) -> Fail {
@@ -760,35 +820,68 @@ struct Recursive {
     demean: bool,
     dt: f64,
     rate: Option<f64>,
+    /// Whether `delta` is the default (not given).
+    default_delta: bool,
 }
 
-/// Runs RLS, the lattice or the SFTF in `T` over `x` and reports the model after the last sample.
-fn recursive_fit<T: FloatArith, const P: usize>(x: &[f64], r: &Recursive) -> Result<Value, Fail> {
-    let config = Config::new(
+/// The scale of `--scalar fixed`: given, or the default `8 / max |x|`.
+#[derive(Clone, Copy)]
+enum Scale {
+    Given(f64),
+    Default(f64),
+}
+
+/// The configuration in `T`, with an error that says which setting `T` cannot carry.
+fn config_in<T: FloatArith>(r: &Recursive) -> Result<Config<T>, Fail> {
+    Config::new(
         T::from_f64(r.lambda),
         T::from_f64(r.delta),
         T::from_f64(r.dt),
-    )?
-    .with_demean(r.demean);
+    )
+    .map_err(|e| {
+        if r.default_delta {
+            Fail(format!(
+                "{e}: the default --delta (0.1 x the variance of the first 1000 samples) is {}, \
+                 which --scalar {} cannot carry; give --delta",
+                r.delta,
+                r.scalar.name()
+            ))
+        } else {
+            Fail(e.to_string())
+        }
+    })
+}
+
+/// Runs RLS, the lattice or the SFTF in `T` over `x` and reports the model after the last sample.
+///
+/// In f32 the mean (of the samples f32 can hold) is removed in f64 first and added back to
+/// the reported mean, so that rounding to f32 does not erase a small signal on a large offset.
+fn recursive_fit<T: FloatArith, const P: usize>(x: &[f64], r: &Recursive) -> Result<Value, Fail> {
+    let config = config_in::<T>(r)?.with_demean(r.demean);
+    let offset = if core::mem::size_of::<T>() < 8 {
+        centre(x, r.demean)
+    } else {
+        0.0
+    };
     let (model, health, reflection) = match r.method {
         Method::Rls => {
             let mut rls = Rls::<T, P>::new(&config, RlsInit::ShiftConsistent);
             for &v in x {
-                rls.update(&config, T::from_f64(v));
+                rls.update(&config, T::from_f64(v - offset));
             }
             (rls.model(&config), rls.health(), None)
         }
         Method::Sftf => {
             let mut sftf = Sftf::<T, P>::new(&config);
             for &v in x {
-                sftf.update(&config, T::from_f64(v));
+                sftf.update(&config, T::from_f64(v - offset));
             }
             (sftf.model(&config), sftf.health(), None)
         }
         _ => {
             let mut lattice = Lattice::<T, P>::new(&config);
             for &v in x {
-                lattice.update(&config, T::from_f64(v));
+                lattice.update(&config, T::from_f64(v - offset));
             }
             let model = lattice.model(&config);
             let k = model.and_then(|m| m.reflection().ok());
@@ -802,12 +895,13 @@ fn recursive_fit<T: FloatArith, const P: usize>(x: &[f64], r: &Recursive) -> Res
         "scalar": r.scalar.name(),
         "order": P,
         "n": x.len(),
-        "mean": model.mean().to_f64(),
+        "mean": model.mean().to_f64() + offset,
         "a": a,
         "noise_variance": model.noise_variance().to_f64(),
         "lambda": r.lambda,
         "delta": r.delta,
         "restarts": health.restarts,
+        "non_finite": health.non_finite,
     });
     if let Some(k) = reflection {
         v["reflection"] = json!(k.iter().map(|v| v.to_f64()).collect::<Vec<_>>());
@@ -819,13 +913,30 @@ fn recursive_fit<T: FloatArith, const P: usize>(x: &[f64], r: &Recursive) -> Res
     Ok(v)
 }
 
-/// Runs the fixed-point lattice over `x` (in sensor units, scaled by `scale`).
-fn fixed_fit<const P: usize>(x: &[f64], r: &Recursive, scale: f64) -> Result<Value, Fail> {
-    let config = Config::new(r.lambda as f32, r.delta as f32, r.dt as f32)?.with_demean(r.demean);
-    let fixed = FixedConfig::new(&config, scale as f32)?;
+/// Runs the fixed-point lattice over `x` (in sensor units, scaled by `scale`); the mean is
+/// removed in f64 first, as for f32.
+fn fixed_fit<const P: usize>(x: &[f64], r: &Recursive, scale: Scale) -> Result<Value, Fail> {
+    let config = config_in::<f32>(r)?.with_demean(r.demean);
+    let scale_value = match scale {
+        Scale::Given(s) | Scale::Default(s) => s,
+    };
+    let fixed = FixedConfig::new(&config, scale_value as f32).map_err(|e| {
+        let product = r.delta * scale_value * scale_value;
+        match scale {
+            Scale::Given(s) => Fail(format!(
+                "--scale {s}: {e} (delta x scale^2 = {product:e} must be in [1e-9, 1e6))"
+            )),
+            Scale::Default(s) => Fail(format!(
+                "{e}: the default --scale 8 / max |x - mean| = {s:e} and delta {} give \
+                 delta x scale^2 = {product:e}, outside [1e-9, 1e6); give --scale or --delta",
+                r.delta
+            )),
+        }
+    })?;
+    let offset = centre(x, r.demean);
     let mut lattice = FixedLattice::<P>::new(&fixed);
     for &v in x {
-        lattice.update(&fixed, v as f32);
+        lattice.update(&fixed, (v - offset) as f32);
     }
     let health = lattice.health();
     let model = lattice
@@ -837,7 +948,7 @@ fn fixed_fit<const P: usize>(x: &[f64], r: &Recursive, scale: f64) -> Result<Val
         "scalar": "fixed",
         "order": P,
         "n": x.len(),
-        "mean": f64::from(model.mean()),
+        "mean": f64::from(model.mean()) + offset,
         "a": a,
         "noise_variance": f64::from(model.noise_variance()),
         "lambda": fixed.lambda(),
@@ -846,6 +957,7 @@ fn fixed_fit<const P: usize>(x: &[f64], r: &Recursive, scale: f64) -> Result<Val
         "restarts": health.restarts,
         "saturated": health.saturated,
         "clipped": health.clipped,
+        "non_finite": health.non_finite,
     });
     if let Ok(k) = model.reflection() {
         v["reflection"] = json!(k.iter().map(|&v| f64::from(v)).collect::<Vec<_>>());
@@ -880,7 +992,16 @@ fn compare<const P: usize>(x: &[f64], lambda: f64, delta: f64, train: f64) -> Re
     if n_eval == 0 {
         return Err(Fail("the evaluation part is empty".into()));
     }
-    let batch = covariance::<f64, P>(&x[..n_train], &BatchConfig::new(1.0)?)?.model;
+    let batch = match covariance::<f64, P>(&x[..n_train], &BatchConfig::new(1.0)?) {
+        Err(BatchError::TooShort { needed, given }) => {
+            return Err(Fail(format!(
+                "the training part (--train {train} of {} samples) has {given} samples, at least \
+                 {needed} needed for order {P}",
+                x.len()
+            )));
+        }
+        fit => fit?.model,
+    };
     let config = Config::new(lambda, delta, 1.0)?;
     let mut rls = Rls::<f64, P>::new(&config, RlsInit::ShiftConsistent);
     let mut lattice = Lattice::<f64, P>::new(&config);
@@ -961,8 +1082,11 @@ fn fit_text(v: &Value) -> String {
     if let Some(k) = v.get("reflection") {
         s += &format!("reflection {k}\n");
     }
-    if let Some(r) = v.get("restarts") {
-        s += &format!("restarts {r}\n");
+    // Every count that qualifies the result.
+    for key in ["restarts", "non_finite", "saturated", "clipped"] {
+        if let Some(c) = v.get(key) {
+            s += &format!("{key} {c}\n");
+        }
     }
     if let Some(gm) = v.get("gauss_markov") {
         s += &format!(
@@ -993,9 +1117,12 @@ fn order_json<const P: usize>(
             .map(|(k, &s2)| finite_or_null(c.value(n, k, s2)))
             .collect();
         criteria.insert(key.to_string(), Value::Array(values));
+        // An order whose criterion is not finite is no selection (too few samples).
+        let best = c.select(n, variances.iter().copied());
+        let finite = c.value(n, best, variances[best]).is_finite();
         selected.insert(
             key.to_string(),
-            json!(c.select(n, variances.iter().copied())),
+            if finite { json!(best) } else { Value::Null },
         );
     }
     Ok(json!({
@@ -1029,11 +1156,23 @@ fn order_text(v: &Value) -> String {
             cell("fpe")
         );
     }
-    let sel = &v["selected"];
+    let sel = |key: &str| match &v["selected"][key] {
+        Value::Null => "none".to_string(),
+        k => k.to_string(),
+    };
     s += &format!(
         "selected aic {} aicc {} bic {} fpe {}\n",
-        sel["aic"], sel["aicc"], sel["bic"], sel["fpe"]
+        sel("aic"),
+        sel("aicc"),
+        sel("bic"),
+        sel("fpe")
     );
+    if v["selected"]
+        .as_object()
+        .is_some_and(|m| m.values().all(Value::is_null))
+    {
+        s += "no order selected: every criterion needs more samples\n";
+    }
     s
 }
 
@@ -1049,6 +1188,8 @@ struct Simulation<'a> {
 }
 
 /// Draws the record: coefficients move linearly from `a` (sample 0) to `a_end` (last sample).
+/// The CSV is streamed to stdout (any `--n` runs in constant memory); nothing is written
+/// before the settings are checked.
 fn simulate<const P: usize>(sim: &Simulation) -> Result<String, Fail> {
     let at =
         |f: f64| -> [f64; P] { core::array::from_fn(|k| sim.a[k] + f * (sim.a_end[k] - sim.a[k])) };
@@ -1078,12 +1219,20 @@ fn simulate<const P: usize>(sim: &Simulation) -> Result<String, Fail> {
     for _ in 0..sim.burn_in {
         step(&start, &mut rng);
     }
-    let mut s = String::with_capacity(24 * sim.n + 8);
-    s += "t_s,x\n";
+    let mut out = BufWriter::new(std::io::stdout().lock());
     let span = sim.n.saturating_sub(1).max(1) as f64;
-    for i in 0..sim.n {
-        let x = step(&at(i as f64 / span), &mut rng);
-        s += &format!("{},{}\n", i as f64 / sim.rate, x);
+    let mut write = || -> std::io::Result<()> {
+        out.write_all(b"t_s,x\n")?;
+        for i in 0..sim.n {
+            let x = step(&at(i as f64 / span), &mut rng);
+            writeln!(out, "{},{}", i as f64 / sim.rate, x)?;
+        }
+        out.flush()
+    };
+    match write() {
+        Ok(()) => Ok(String::new()),
+        // A closed pipe (`| head`) ends the run quietly.
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(String::new()),
+        Err(e) => Err(Fail(format!("cannot write to stdout: {e}"))),
     }
-    Ok(s)
 }

@@ -50,8 +50,6 @@ fn draw_err(e: impl std::fmt::Debug) -> Fail {
 
 /// Writes the four PNGs and returns a JSON summary.
 pub fn report<const P: usize>(r: &Report) -> Result<Value, Fail> {
-    std::fs::create_dir_all(r.out)
-        .map_err(|e| Fail(format!("{}: cannot create: {e}", r.out.display())))?;
     let x = r.x;
     if x.len() < MIN_SAMPLES {
         return Err(Fail(format!(
@@ -68,6 +66,9 @@ pub fn report<const P: usize>(r: &Report) -> Result<Value, Fail> {
 
     // The recursive estimators over the whole record; their errors and coefficients sampled.
     let config = Config::new(r.lambda, r.delta, dt)?;
+    // Only once the input has passed every check.
+    std::fs::create_dir_all(r.out)
+        .map_err(|e| Fail(format!("{}: cannot create: {e}", r.out.display())))?;
     let mut rls = Rls::<f64, P>::new(&config, RlsInit::ShiftConsistent);
     let mut lattice = Lattice::<f64, P>::new(&config);
     let stride = (x.len() / POINTS).max(1);
@@ -232,6 +233,7 @@ fn coefficients_png<const P: usize>(
         .x_desc("time (s)")
         .x_label_formatter(&|t| format!("{t:.0}"))
         .y_desc("coefficient a_k (1)")
+        .y_label_formatter(&|v| tick(*v))
         .draw()
         .map_err(draw_err)?;
     for k in 0..P {

@@ -246,3 +246,54 @@ fn octave_and_streaming_allan_variance_agree_with_the_model() {
     }
     let _ = Scalar::to_f64(avar[0]);
 }
+
+/// Issue 23 item 6: `[1, 2]` with the mean removed is `[-0.5, 0.5]`, which `a_1 = -1` fits
+/// exactly (Burg's reflection is 1): zero residual degrees of freedom. Every estimator keeps
+/// at least one: `2P + 1` samples for the covariance method, `P + 1` for Burg and Yule-Walker,
+/// one more with mean removal.
+#[test]
+fn fits_keep_one_residual_degree_of_freedom() {
+    let c = config();
+    let raw = c.with_demean(false);
+    let short = |needed, given| Some(BatchError::TooShort { needed, given });
+    assert_eq!(covariance::<f64, 1>(&[1.0, 2.0], &c).err(), short(4, 2));
+    assert_eq!(
+        covariance::<f64, 1>(&[1.0, 2.0, 3.0], &c).err(),
+        short(4, 3)
+    );
+    assert_eq!(burg::<f64, 1>(&[1.0, 2.0], &c).err(), short(3, 2));
+    assert_eq!(yule_walker::<f64, 1>(&[1.0, 2.0], &c).err(), short(3, 2));
+    assert_eq!(
+        covariance::<f64, 2>(&[1.0, 2.0, 4.0, 3.0], &raw).err(),
+        short(5, 4)
+    );
+    assert_eq!(burg::<f64, 2>(&[1.0, 2.0], &raw).err(), short(3, 2));
+    // At the bound the residual is not zero.
+    let ls = covariance::<f64, 1>(&[1.0, 2.0, 3.0, 5.0], &c).unwrap();
+    assert!(ls.model.noise_variance() > 0.0);
+    let b = burg::<f64, 1>(&[1.0, 2.0, 4.0], &c).unwrap();
+    assert!(b.reflection.unwrap()[0].abs() < 1.0);
+    assert!(b.model.noise_variance() > 0.0);
+    let b = burg::<f64, 1>(&[1.0, 2.0], &raw).unwrap();
+    assert!(b.model.noise_variance() > 0.0);
+}
+
+/// Issue 23 item 10: values around 1e160 square to infinity. That is an overflow, not "zero
+/// variance" or "singular".
+#[test]
+fn overflowing_energy_is_its_own_error() {
+    let x: Vec<f64> = (0..200).map(|n| 1e160 * (1.0 + (n % 7) as f64)).collect();
+    let c = config();
+    assert_eq!(
+        covariance::<f64, 2>(&x, &c).err(),
+        Some(BatchError::Overflow)
+    );
+    assert_eq!(burg::<f64, 2>(&x, &c).err(), Some(BatchError::Overflow));
+    assert_eq!(
+        yule_walker::<f64, 2>(&x, &c).err(),
+        Some(BatchError::Overflow)
+    );
+    // Large but representable data still fit.
+    let y: Vec<f64> = x.iter().map(|v| v * 1e-20).collect();
+    assert!(burg::<f64, 2>(&y, &c).is_ok());
+}

@@ -75,10 +75,13 @@ fn section_8_processes_after_a_million_samples() {
 }
 
 #[test]
+#[cfg_attr(
+    not(imu_ar_data),
+    ignore = "needs the real records (../shared/data/imu or IMU_AR_DATA)"
+)]
 fn real_records_as_raw_counts() {
-    let Some(records) = real_records() else {
-        return;
-    };
+    let records =
+        real_records().expect("the real records: ../shared/data/imu or IMU_AR_DATA (see README)");
     println!("| record | axis | counts per unit | lambda | fixed, p = 1..8 | clipped |");
     println!("|---|---|---|---|---|---|");
     for record in &records {

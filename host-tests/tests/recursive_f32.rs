@@ -170,10 +170,13 @@ fn rls_error<const P: usize>(x: &[f64], config: &Config<f32>, reference: &Sectio
 }
 
 #[test]
+#[cfg_attr(
+    not(imu_ar_data),
+    ignore = "needs the real records (../shared/data/imu or IMU_AR_DATA)"
+)]
 fn real_records_every_axis() {
-    let Some(records) = real_records() else {
-        return;
-    };
+    let records =
+        real_records().expect("the real records: ../shared/data/imu or IMU_AR_DATA (see README)");
     println!("| record | axis | lambda | lattice f32, p = 1..8 | RLS f32, p = 1..8 |");
     println!("|---|---|---|---|---|");
     for record in &records {

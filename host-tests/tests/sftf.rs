@@ -249,10 +249,13 @@ fn section_8_cases() {
 }
 
 #[test]
+#[cfg_attr(
+    not(imu_ar_data),
+    ignore = "needs the real records (../shared/data/imu or IMU_AR_DATA)"
+)]
 fn real_records_every_axis() {
-    let Some(records) = real_records() else {
-        return;
-    };
+    let records =
+        real_records().expect("the real records: ../shared/data/imu or IMU_AR_DATA (see README)");
     println!(
         "| record (six axes, mean removed) | p | lambda | samples | SFTF f32 | SFTF f64 \
          | lattice f32 | RLS f32 |"

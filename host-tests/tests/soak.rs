@@ -29,10 +29,13 @@ struct Injected {
 }
 
 #[test]
+#[cfg_attr(
+    not(imu_ar_data),
+    ignore = "needs the real records (../shared/data/imu or IMU_AR_DATA)"
+)]
 fn soak_real_records_with_faults() {
-    let Some(records) = real_records() else {
-        return;
-    };
+    let records =
+        real_records().expect("the real records: ../shared/data/imu or IMU_AR_DATA (see README)");
     let total: u64 = std::env::var("IMU_AR_SOAK_SAMPLES")
         .ok()
         .and_then(|s| s.parse().ok())

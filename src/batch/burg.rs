@@ -24,14 +24,15 @@ use crate::Scalar;
 ///
 /// # Errors
 ///
-/// [`BatchError::TooShort`] below `P + 1` samples, [`BatchError::NonFinite`],
+/// [`BatchError::TooShort`] below `P + 2` samples (`P + 1` without mean removal: one residual
+/// degree of freedom), [`BatchError::NonFinite`], [`BatchError::Overflow`],
 /// [`BatchError::ZeroVariance`] when the data (or the errors of some order) have no energy.
 pub fn burg<T: Scalar, const P: usize>(
     x: &[T],
     config: &BatchConfig<T>,
 ) -> Result<Fit<T, P>, BatchError> {
     const { assert!(P > 0, "the model order P must be at least 1") };
-    let mean = prepare(x, P + 1, config)?;
+    let mean = prepare(x, P, config)?;
     let y = |i: usize| x[i].to_f64() - mean;
     let n = x.len();
 

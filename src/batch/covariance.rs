@@ -17,7 +17,9 @@ use crate::Scalar;
 ///
 /// # Errors
 ///
-/// [`BatchError::TooShort`] below `2P` samples, [`BatchError::NonFinite`],
+/// [`BatchError::TooShort`] below `2P + 2` samples (`2P + 1` without mean removal): the
+/// `N - P` equations keep at least one residual degree of freedom after the `P` coefficients
+/// and the mean. [`BatchError::NonFinite`], [`BatchError::Overflow`],
 /// [`BatchError::ZeroVariance`] for constant data, [`BatchError::Singular`] when the regressors
 /// are linearly dependent.
 ///

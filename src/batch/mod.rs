@@ -71,7 +71,9 @@ impl<T: Scalar> BatchConfig<T> {
 pub enum BatchError {
     /// The sample interval is not positive and finite.
     InvalidInterval,
-    /// Too few samples for the order.
+    /// Too few samples for the order: every fit keeps at least one residual degree of
+    /// freedom (see each estimator's bound), so that an exact fit with zero residual is never
+    /// reported as a model.
     TooShort {
         /// The fewest samples that this estimator and order accept.
         needed: usize,
@@ -85,6 +87,9 @@ pub enum BatchError {
     },
     /// The (mean-removed) data have zero energy, e.g. a constant input.
     ZeroVariance,
+    /// The data's energy (the sum of the squared, mean-removed samples) overflows `f64`:
+    /// values of about `1e154` and above. Rescale the record.
+    Overflow,
     /// The normal equations are singular at this order: the data are exactly predictable by a
     /// model of lower order, e.g. a constant or a pure sinusoid.
     Singular {
@@ -105,6 +110,9 @@ impl fmt::Display for BatchError {
             }
             Self::NonFinite { index } => write!(f, "sample {index} is NaN or infinite"),
             Self::ZeroVariance => f.write_str("data have zero variance (constant input?)"),
+            Self::Overflow => f.write_str(
+                "the data's energy overflows f64 (values of about 1e154 or more); rescale the record",
+            ),
             Self::Singular { order } => {
                 write!(f, "normal equations are singular at order {order}")
             }
@@ -141,8 +149,12 @@ impl<T: Scalar, const P: usize> Fit<T, P> {
     }
 }
 
-/// Checks length and finiteness and returns the mean to remove (0 without demeaning).
-fn prepare<T: Scalar>(x: &[T], needed: usize, config: &BatchConfig<T>) -> Result<f64, BatchError> {
+/// Checks length, finiteness and magnitude, and returns the mean to remove (0 without
+/// demeaning). `params` is the number of samples that the estimator's coefficients use up
+/// (`P` for Burg and Yule-Walker, `2P` for the covariance method); the sample mean uses up one
+/// more, and one residual degree of freedom must remain.
+fn prepare<T: Scalar>(x: &[T], params: usize, config: &BatchConfig<T>) -> Result<f64, BatchError> {
+    let needed = params + usize::from(config.demean) + 1;
     if x.len() < needed {
         return Err(BatchError::TooShort {
             needed,
@@ -152,11 +164,19 @@ fn prepare<T: Scalar>(x: &[T], needed: usize, config: &BatchConfig<T>) -> Result
     if let Some(index) = x.iter().position(|v| !v.is_finite()) {
         return Err(BatchError::NonFinite { index });
     }
-    Ok(if config.demean {
+    let mean = if config.demean {
         x.iter().map(|v| v.to_f64()).sum::<f64>() / x.len() as f64
     } else {
         0.0
-    })
+    };
+    let energy: f64 = x
+        .iter()
+        .map(|v| (v.to_f64() - mean) * (v.to_f64() - mean))
+        .sum();
+    if !(mean.is_finite() && energy.is_finite()) {
+        return Err(BatchError::Overflow);
+    }
+    Ok(mean)
 }
 
 /// Assembles a [`Fit`] from `f64` results.

@@ -14,7 +14,8 @@ use crate::Scalar;
 ///
 /// # Errors
 ///
-/// [`BatchError::TooShort`] below `P + 1` samples, [`BatchError::NonFinite`],
+/// [`BatchError::TooShort`] below `P + 2` samples (`P + 1` without mean removal: one residual
+/// degree of freedom), [`BatchError::NonFinite`], [`BatchError::Overflow`],
 /// [`BatchError::ZeroVariance`] for constant data, [`BatchError::Singular`] when the
 /// autocovariances are not positive definite (an exactly predictable record).
 pub fn yule_walker<T: Scalar, const P: usize>(
@@ -22,7 +23,7 @@ pub fn yule_walker<T: Scalar, const P: usize>(
     config: &BatchConfig<T>,
 ) -> Result<Fit<T, P>, BatchError> {
     const { assert!(P > 0, "the model order P must be at least 1") };
-    let mean = prepare(x, P + 1, config)?;
+    let mean = prepare(x, P, config)?;
     let n = x.len();
     let mut r = [0.0f64; P];
     let mut r0 = 0.0;
