@@ -93,7 +93,7 @@ fn sftf_run<T: FloatArith, const P: usize>(
             assert_eq!(model, m, "sample {n}: the held model changed");
         }
         let settled = held.is_none_or(|(_, until)| n >= until);
-        if !rescued && settled && sftf.health().samples % snapshot_interval(P) == 0 {
+        if !rescued && settled && sftf.health().samples.is_multiple_of(snapshot_interval(P)) {
             let a_ref = reference
                 .as_ref()
                 .map(|r| r.solve(P, Regularisation::ShiftConsistent).0);

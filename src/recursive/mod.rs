@@ -380,10 +380,11 @@ impl<T: Scalar, const P: usize> Shell<T, P> {
         energy: T,
         a: impl FnOnce() -> Option<[T; P]>,
     ) {
-        if self.hold == 0 && self.health.samples & (snapshot_interval(P) - 1) == 0 {
-            if let Some(m) = self.current(config, energy, a) {
-                self.snapshot = Some(m);
-            }
+        if self.health.samples & (snapshot_interval(P) - 1) == 0
+            && self.hold == 0
+            && let Some(m) = self.current(config, energy, a)
+        {
+            self.snapshot = Some(m);
         }
     }
 

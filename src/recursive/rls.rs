@@ -151,8 +151,7 @@ impl<T: Scalar, const P: usize> Rls<T, P> {
         self.phi.copy_within(0..P - 1, 1);
         self.phi[0] = y;
         self.error = e;
-        let a = self.a;
-        self.shell.refresh(config, self.energy, || Some(a));
+        self.shell.refresh(config, self.energy, || Some(self.a));
         Some(e)
     }
 

@@ -177,8 +177,7 @@ impl<T: Scalar, const P: usize> Sftf<T, P> {
         }
         self.error = e;
         self.backward = (r_f, r_s);
-        let a = self.a;
-        self.shell.refresh(config, self.alpha, || Some(a));
+        self.shell.refresh(config, self.alpha, || Some(self.a));
         Some(e)
     }
 
