@@ -178,7 +178,11 @@ fn huge_input_restarts_and_keeps_publishing_the_last_good_model() {
     let mut good = None;
     for &v in &x {
         lattice.update(&config, v);
-        if lattice.health().samples.is_multiple_of(snapshot_interval(2)) {
+        if lattice
+            .health()
+            .samples
+            .is_multiple_of(snapshot_interval(2))
+        {
             good = lattice.model(&config);
         }
     }
