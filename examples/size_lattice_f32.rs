@@ -26,7 +26,7 @@ fn main() -> ! {
         |lattice, x| {
             lattice.update(&config, x);
         },
-        |mut lattice| lattice.model(&config).map_or(f32::NAN, |m| m.a()[0]),
+        |lattice| lattice.model(&config).map_or(f32::NAN, |m| m.a()[0]),
     )
 }
 

@@ -26,7 +26,7 @@ fn main() -> ! {
         |rls, x| {
             rls.update(&config, x);
         },
-        |mut rls| rls.model(&config).map_or(f32::NAN, |m| m.a()[0]),
+        |rls| rls.model(&config).map_or(f32::NAN, |m| m.a()[0]),
     )
 }
 

@@ -34,6 +34,11 @@ pub enum ModelError {
     NoGaussMarkov,
     /// A Gauss-Markov correlation time or sigma that is not positive and finite.
     InvalidGaussMarkov,
+    /// The scalar type cannot represent the AR(1) sampling of a Gauss-Markov process: `dt` is
+    /// so small against the correlation time that the coefficient nearest to
+    /// `exp(-dt / T_c)` misses `1 - exp(-dt / T_c)` by more than 1 % (see
+    /// [`GaussMarkov::to_ar1`]).
+    Unrepresentable,
 }
 
 impl fmt::Display for ModelError {
@@ -52,6 +57,9 @@ impl fmt::Display for ModelError {
             Self::InvalidGaussMarkov => {
                 f.write_str("Gauss-Markov correlation time and sigma must be positive and finite")
             }
+            Self::Unrepresentable => f.write_str(
+                "sample interval too short against the correlation time for this number type",
+            ),
         }
     }
 }
@@ -177,7 +185,15 @@ impl<T: Scalar, const P: usize> ArModel<T, P> {
     /// Two-sided power spectral density at `f` Hz (`|f| <= 1/(2 dt)`), in units^2/Hz:
     /// `S(f) = sigma_w^2 dt / |1 - sum_k a_k exp(-i 2 pi f k dt)|^2`. The one-sided PSD is
     /// `2 S(f)`; `integral S df` over `[-1/(2dt), 1/(2dt)]` is `r(0)`.
-    pub fn psd(&self, f: T) -> T {
+    ///
+    /// A non-stationary model has no spectrum (its variance grows without bound, and the
+    /// formula would give a finite, meaningless value, or an infinite one on a pole).
+    ///
+    /// # Errors
+    ///
+    /// [`ModelError::Unstable`] when the model is not stationary ([`ArModel::is_stable`]).
+    pub fn psd(&self, f: T) -> Result<T, ModelError> {
+        step_down(&self.a_f64())?;
         let dt = self.dt.to_f64();
         let w = 2.0 * core::f64::consts::PI * f.to_f64() * dt;
         let (mut re, mut im) = (1.0, 0.0);
@@ -186,7 +202,9 @@ impl<T: Scalar, const P: usize> ArModel<T, P> {
             re -= a.to_f64() * libm::cos(phase);
             im += a.to_f64() * libm::sin(phase);
         }
-        T::from_f64(self.noise_variance.to_f64() * dt / (re * re + im * im))
+        Ok(T::from_f64(
+            self.noise_variance.to_f64() * dt / (re * re + im * im),
+        ))
     }
 
     /// Allan variance of the model at `tau = m dt` (numerics.md section 6), in units^2:
@@ -332,9 +350,20 @@ impl<T: Scalar> GaussMarkov<T> {
     /// The exact AR(1) sampling of this process every `dt` seconds:
     /// `phi = exp(-dt / T_c)`, `sigma_w^2 = sigma^2 (1 - phi^2)`.
     ///
+    /// `phi` is rounded to `T` once, and the noise variance is made from that rounded `phi`
+    /// (`1 - phi^2 = (1 - phi)(1 + phi)`, with `1 - phi` exact in `f64`), so that the model's
+    /// stationary variance is `sigma^2` whatever the rounding. The rounding moves the
+    /// correlation time the model implies, `-dt / ln phi`, by the relative error of `1 - phi`
+    /// against `-expm1(-dt / T_c)`; where that exceeds 1 % the process is not representable in
+    /// `T`. In `f32` (spacing `6e-8` below 1) that can happen only for `dt / T_c` below `3e-6`
+    /// (for example `dt = 1e-4` s against `T_c = 1000` s), and `phi` rounds to 1 below `3e-8`;
+    /// in `f64` only below `6e-15`.
+    ///
     /// # Errors
     ///
-    /// [`ModelError::NonPositiveInterval`] or [`ModelError::NonFinite`] for a bad `dt` or `mean`.
+    /// [`ModelError::NonPositiveInterval`] or [`ModelError::NonFinite`] for a bad `dt` or `mean`;
+    /// [`ModelError::Unrepresentable`] where `T` cannot represent the process, as above
+    /// (including `phi` rounding to 1, which would be a random walk, not this process).
     pub fn to_ar1(&self, dt: T, mean: T) -> Result<ArModel<T, 1>, ModelError> {
         if !dt.is_finite() || !mean.is_finite() {
             return Err(ModelError::NonFinite);
@@ -342,16 +371,29 @@ impl<T: Scalar> GaussMarkov<T> {
         if dt <= T::ZERO {
             return Err(ModelError::NonPositiveInterval);
         }
-        let phi = libm::exp(-dt.to_f64() / self.correlation_time.to_f64());
+        let ratio = dt.to_f64() / self.correlation_time.to_f64();
+        // 1 - exp(-dt/T_c), to full relative precision however small dt/T_c is.
+        let exact = -libm::expm1(-ratio);
+        let phi = T::from_f64(libm::exp(-ratio));
+        // Exact in f64 for phi in [0.5, 1] (Sterbenz), and f64 holds every f32 exactly.
+        let one_minus = 1.0 - phi.to_f64();
+        if !(exact > 0.0 && one_minus > 0.0)
+            || libm::fabs(one_minus - exact) > GAUSS_MARKOV_TOLERANCE * exact
+        {
+            return Err(ModelError::Unrepresentable);
+        }
         let s = self.sigma.to_f64();
         ArModel::new(
-            [T::from_f64(phi)],
-            T::from_f64(s * s * (1.0 - phi * phi)),
+            [phi],
+            T::from_f64(s * s * one_minus * (1.0 + phi.to_f64())),
             mean,
             dt,
         )
     }
 }
+
+/// Largest relative error of `1 - phi` that [`GaussMarkov::to_ar1`] accepts.
+const GAUSS_MARKOV_TOLERANCE: f64 = 1e-2;
 
 /// Autocovariances `r(0), r(1), ...` of a stationary AR model; see [`ArModel::autocovariances`].
 #[derive(Clone, Debug)]

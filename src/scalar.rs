@@ -31,6 +31,8 @@ pub trait Scalar:
     const ONE: Self;
     /// Machine epsilon: the distance from 1 to the next larger value.
     const EPSILON: Self;
+    /// The smallest positive normal value (values below it lose precision, gradually to 0).
+    const MIN_POSITIVE: Self;
 
     /// The value nearest to `x` (rounded to nearest, saturating where the type is bounded).
     fn from_f64(x: f64) -> Self;
@@ -51,6 +53,7 @@ macro_rules! impl_scalar_float {
             const ZERO: Self = 0.0;
             const ONE: Self = 1.0;
             const EPSILON: Self = <$t>::EPSILON;
+            const MIN_POSITIVE: Self = <$t>::MIN_POSITIVE;
 
             #[inline]
             fn from_f64(x: f64) -> Self {

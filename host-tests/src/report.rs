@@ -372,7 +372,15 @@ fn welch(x: &[f64], rate: f64) -> Vec<(f64, f64)> {
 fn psd_png<const P: usize>(r: &Report, model: &ArModel<f64, P>) -> Result<PathBuf, Fail> {
     let path = r.out.join("psd.png");
     let data = welch(r.x, r.rate);
-    let fitted: Vec<(f64, f64)> = data.iter().map(|&(f, _)| (f, 2.0 * model.psd(f))).collect();
+    let psd = |f: f64| {
+        model
+            .psd(f)
+            .map_err(|e| Fail(format!("model spectrum: {e}")))
+    };
+    let fitted = data
+        .iter()
+        .map(|&(f, _)| Ok((f, 2.0 * psd(f)?)))
+        .collect::<Result<Vec<(f64, f64)>, Fail>>()?;
     let root = BitMapBackend::new(&path, SIZE).into_drawing_area();
     root.fill(&WHITE).map_err(draw_err)?;
     let (f_lo, f_hi) = (data[0].0, data[data.len() - 1].0);

@@ -124,7 +124,7 @@ fn psd_integrates_to_the_variance() {
     let steps = 20_000;
     let df = 2.0 * nyquist / steps as f64;
     let integral: f64 = (0..steps)
-        .map(|i| model.psd(-nyquist + (i as f64 + 0.5) * df) * df)
+        .map(|i| model.psd(-nyquist + (i as f64 + 0.5) * df).unwrap() * df)
         .sum();
     assert!((integral - r0).abs() < 1e-6 * r0, "{integral} vs {r0}");
 }
@@ -149,4 +149,56 @@ fn ar1_allan_variance_equals_the_closed_form() {
             );
         }
     }
+}
+
+/// f32 AR(1) of a slow Gauss-Markov process (issue 23, item 4): the stationary variance is
+/// sigma^2 and the correlation time survives the round trip wherever f32 can represent the
+/// process; where it cannot (`dt / T_c` of 1e-7 and 1e-8), a typed error, not a model with the
+/// wrong variance (0.839 instead of 1) or a random walk (`a = 1`).
+#[test]
+fn f32_gauss_markov_at_small_dt_over_t() {
+    let gm = GaussMarkov::new(1000.0f32, 1.0).unwrap();
+    for dt in [1e-2f32, 3e-2, 0.1, 1.0] {
+        let ar1 = gm.to_ar1(dt, 0.0).unwrap();
+        let p = ar1.stationary_covariance().unwrap()[0][0];
+        assert!((p - 1.0).abs() < 1e-6, "dt {dt}: stationary variance {p}");
+        let tc = ar1.to_gauss_markov().unwrap().correlation_time();
+        assert!((tc - 1000.0).abs() < 10.0, "dt {dt}: correlation time {tc}");
+    }
+    for dt in [1e-4f32, 1e-5] {
+        assert_eq!(
+            gm.to_ar1(dt, 0.0),
+            Err(ModelError::Unrepresentable),
+            "dt {dt}"
+        );
+    }
+    // f64 represents the same processes.
+    let gm64 = GaussMarkov::new(1000.0f64, 1.0).unwrap();
+    for dt in [1e-5, 1e-4] {
+        let ar1 = gm64.to_ar1(dt, 0.0).unwrap();
+        let p = ar1.stationary_covariance().unwrap()[0][0];
+        assert!(
+            (p - 1.0).abs() < 1e-9,
+            "f64, dt {dt}: stationary variance {p}"
+        );
+    }
+}
+
+/// A non-stationary model has no spectrum: `psd` says so instead of returning a finite number
+/// (issue 23, item 12).
+#[test]
+fn psd_of_an_unstable_model_is_an_error() {
+    for a in [[1.0f64, 0.0], [0.5, 0.6], [2.0, -0.5]] {
+        let m = ArModel::new(a, 1.0, 0.0, 0.01).unwrap();
+        for f in [0.0, 10.0, 25.0] {
+            assert!(
+                matches!(m.psd(f), Err(ModelError::Unstable { .. })),
+                "a = {a:?}, f = {f}: {:?}",
+                m.psd(f)
+            );
+        }
+    }
+    let stable = ArModel::new([0.5f64, 0.3], 1.0, 0.0, 0.01).unwrap();
+    // S(0) = sigma^2 dt / (1 - 0.5 - 0.3)^2.
+    assert!((stable.psd(0.0).unwrap() - 0.01 / 0.04).abs() < 1e-12);
 }

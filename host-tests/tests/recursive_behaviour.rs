@@ -3,7 +3,7 @@
 
 use imu_ar::ArModel;
 use imu_ar::recursive::{
-    Config, ConfigError, Lattice, OrderRule, OrderSelector, Rls, RlsInit, Sftf,
+    Config, ConfigError, Lattice, OrderRule, OrderSelector, Rls, RlsInit, Sftf, snapshot_interval,
 };
 use imu_ar::sim::ArSimulator;
 use imu_ar_host::reference::{Regularisation, Section0, running_mean_removed};
@@ -170,14 +170,28 @@ fn saturated_sensor_is_detected_and_counted() {
 #[test]
 fn huge_input_restarts_and_keeps_publishing_the_last_good_model() {
     // A value whose square overflows f32 breaks the recursion down: the lattice restarts,
-    // counts it, and hands out the model it had before for 3/(1 - lambda) samples.
+    // counts it, and hands out the model of its last snapshot (taken every
+    // `snapshot_interval(P)` accepted samples) for 3/(1 - lambda) samples.
     let config = Config::new(0.99f32, 0.1, 0.01).unwrap();
     let mut lattice = Lattice::<f32, 2>::new(&config);
     let x = ar2(3_000, 3);
+    let mut good = None;
     for &v in &x {
         lattice.update(&config, v);
+        if lattice
+            .health()
+            .samples
+            .is_multiple_of(snapshot_interval(2))
+        {
+            good = lattice.model(&config);
+        }
     }
-    let good = lattice.model(&config).unwrap();
+    let good = good.unwrap();
+    assert_ne!(
+        lattice.model(&config),
+        Some(good),
+        "the snapshot is not the newest model"
+    );
     assert_eq!(lattice.update(&config, 3e30), None);
     assert_eq!(lattice.health().restarts, 1);
     for &v in &x[..299] {
@@ -226,5 +240,135 @@ fn order_selection_finds_the_true_order_without_flapping() {
             ),
         }
         assert!(changes <= 3, "{rule:?} changed order {changes} times");
+    }
+}
+
+/// The model held through a restart is the estimator's own snapshot: the same whether `model`
+/// was called after every sample or never (issue 23, item 2).
+#[test]
+fn the_held_model_does_not_depend_on_calls_to_model() {
+    let config = Config::new(0.99f32, 0.1, 0.01).unwrap();
+    let x = ar2(3_000, 3);
+    let run = |ask: bool| {
+        let mut lattice = Lattice::<f32, 2>::new(&config);
+        let mut rls = Rls::<f32, 2>::new(&config, RlsInit::ShiftConsistent);
+        let mut sftf = Sftf::<f32, 2>::new(&config);
+        for &v in x.iter().chain([3e30f32].iter()).chain(&x[..100]) {
+            lattice.update(&config, v);
+            rls.update(&config, v);
+            sftf.update(&config, v);
+            if ask {
+                let _ = (
+                    lattice.model(&config),
+                    rls.model(&config),
+                    sftf.model(&config),
+                );
+            }
+        }
+        let restarts = [lattice.health(), rls.health(), sftf.health()].map(|h| h.restarts);
+        assert_eq!(restarts, [1, 1, 1]);
+        (
+            lattice.model(&config),
+            rls.model(&config),
+            sftf.model(&config),
+        )
+    };
+    let (asked, never) = (run(true), run(false));
+    assert!(never.0.is_some() && never.1.is_some() && never.2.is_some());
+    assert_eq!(asked, never);
+    // The held model is a good one (the truth is a = [1.2, -0.5]).
+    for a in [never.0, never.1, never.2].map(|m| *m.unwrap().a()) {
+        assert!(
+            (a[0] - 1.2).abs() < 0.1 && (a[1] + 0.5).abs() < 0.1,
+            "{a:?}"
+        );
+    }
+}
+
+/// At `lambda = 1` the memory, and `3/(1 - lambda)`, are infinite: the hold after a restart is
+/// bounded at 30 000 samples, after which the lattice publishes its own model again (issue 23,
+/// item 2).
+#[test]
+fn at_lambda_one_the_hold_after_a_restart_ends() {
+    let config = Config::new(1.0f32, 0.1, 0.01).unwrap();
+    let x = ar2(40_000, 8);
+    let mut lattice = Lattice::<f32, 2>::new(&config);
+    for &v in &x[..5_000] {
+        lattice.update(&config, v);
+    }
+    assert_eq!(lattice.update(&config, 3e30), None);
+    let held = lattice
+        .model(&config)
+        .expect("the model held through the restart");
+    for &v in &x[5_000..34_999] {
+        lattice.update(&config, v);
+        assert_eq!(lattice.model(&config), Some(held), "the held model changed");
+    }
+    lattice.update(&config, x[34_999]);
+    let own = lattice.model(&config).expect("a model");
+    assert_ne!(
+        own, held,
+        "the lattice publishes its own model after the hold"
+    );
+    assert!((own.a()[0] - 1.2).abs() < 0.05 && (own.a()[1] + 0.5).abs() < 0.05);
+    assert_eq!(lattice.health().restarts, 1);
+}
+
+/// AIC and BIC at `lambda = 1` (growing memory) score with the number of samples, and find the
+/// true order like PLS does (issue 23, item 1: they picked order 0, every score infinite); an
+/// f32 lambda that rounds to 1 is the same case.
+#[test]
+fn order_selection_at_lambda_one() {
+    let x: Vec<f64> = ar2(50_000, 12).iter().map(|&v| f64::from(v)).collect();
+    let config = Config::new(1.0f64, 0.1, 0.01).unwrap();
+    let config32 = Config::new(0.999_999_99f32, 0.1, 0.01).unwrap();
+    assert_eq!(config32.lambda(), 1.0);
+    for rule in [OrderRule::Pls, OrderRule::Aic, OrderRule::Bic] {
+        let mut lattice = Lattice::<f64, 4>::new(&config);
+        let mut selector = OrderSelector::<f64, 4>::new(rule, 100, 3);
+        let mut lattice32 = Lattice::<f32, 4>::new(&config32);
+        let mut selector32 = OrderSelector::<f32, 4>::new(rule, 100, 3);
+        for &v in &x {
+            if lattice.update(&config, v).is_some() {
+                selector.update(&config, &lattice);
+            }
+            if lattice32.update(&config32, v as f32).is_some() {
+                selector32.update(&config32, &lattice32);
+            }
+        }
+        println!(
+            "{rule:?}: f64 order {}, f32 order {}",
+            selector.order(),
+            selector32.order()
+        );
+        assert_eq!(selector.order(), 2, "{rule:?}, f64");
+        assert_eq!(selector32.order(), 2, "{rule:?}, f32");
+    }
+}
+
+/// A `delta` the scalar cannot carry through the recursion is refused (issue 23, item 8: a
+/// subnormal one was accepted, and then every estimator restarted on almost every sample);
+/// the smallest accepted one fits without a restart.
+#[test]
+fn config_rejects_a_delta_the_scalar_cannot_carry() {
+    assert_eq!(Config::new(0.99f32, 1e-40, 0.01), Err(ConfigError::Delta));
+    assert_eq!(Config::new(0.99f32, 1e-35, 0.01), Err(ConfigError::Delta));
+    assert_eq!(Config::new(0.99f32, 1e35, 0.01), Err(ConfigError::Delta));
+    assert_eq!(Config::new(0.99f64, 1e-310, 0.01), Err(ConfigError::Delta));
+    assert_eq!(Config::new(0.99f64, 1e300, 0.01), Err(ConfigError::Delta));
+    let x = ar2(2_000, 5);
+    for delta in [1e-31f32, 1e31] {
+        let config = Config::new(0.999f32, delta, 0.01).unwrap();
+        let mut lattice = Lattice::<f32, 2>::new(&config);
+        let mut rls = Rls::<f32, 2>::new(&config, RlsInit::ShiftConsistent);
+        let mut sftf = Sftf::<f32, 2>::new(&config);
+        for &v in &x {
+            lattice.update(&config, v);
+            rls.update(&config, v);
+            sftf.update(&config, v);
+        }
+        let restarts = [lattice.health(), rls.health(), sftf.health()].map(|h| h.restarts);
+        assert_eq!(restarts, [0, 0, 0], "delta {delta:e}");
+        assert!(lattice.model(&config).is_some() && rls.model(&config).is_some());
     }
 }

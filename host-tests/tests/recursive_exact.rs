@@ -142,3 +142,95 @@ fn with_running_mean_removal() {
         for_orders!(&x, lambda, true, |n| n % 100 == 0, "demeaned");
     }
 }
+
+/// The coefficients of lattice, RLS and SFTF over `x` scaled by `s`, with `delta` scaled by
+/// `s^2` (the same problem in other units), after every 50th sample; and the restarts of the
+/// three.
+type Fits = (Vec<[f64; 4]>, [u64; 3]);
+
+fn scaled_fits<T: imu_ar::recursive::FloatArith>(x: &[f64], s: f64, lambda: f64) -> Fits {
+    let config = Config::new(
+        T::from_f64(lambda),
+        T::from_f64(DELTA * s * s),
+        T::from_f64(0.01),
+    )
+    .unwrap();
+    let mut lattice = Lattice::<T, 4>::new(&config);
+    let mut rls = Rls::<T, 4>::new(&config, RlsInit::ShiftConsistent);
+    let mut sftf = Sftf::<T, 4>::new(&config);
+    let mut out = Vec::new();
+    for (n, &v) in x.iter().enumerate() {
+        let v = T::from_f64(v * s);
+        lattice.update(&config, v);
+        rls.update(&config, v);
+        sftf.update(&config, v);
+        if (n + 1) % 50 == 0 {
+            for a in [
+                lattice.coefficients(4).unwrap(),
+                *rls.coefficients(),
+                *sftf.coefficients(),
+            ] {
+                out.push(a.map(|a| a.to_f64()));
+            }
+        }
+    }
+    let restarts = [lattice.health(), rls.health(), sftf.health()].map(|h| h.restarts);
+    (out, restarts)
+}
+
+/// A record in other units (rad/s against deg/s, nT, ...) gives the same coefficients: the
+/// estimators' safeguards scale with `delta` (issue 23, item 9: with an absolute energy floor
+/// of 1e-30, data scaled by 1e-16 or 1e-20 gave other coefficients, and the SFTF was rescued
+/// again and again at 1e-14).
+#[test]
+fn the_coefficients_do_not_depend_on_the_scale_of_the_data() {
+    let x: Vec<f64> = data(2_000, 4).iter().map(|v| v + 0.3).collect();
+    for lambda in [0.99, 1.0] {
+        let unscaled = scaled_fits::<f64>(&x, 1.0, lambda);
+        assert_eq!(unscaled.1, [0, 0, 0]);
+        // The unscaled fit is the direct solve's (of the input less its running mean).
+        let mut reference = Section0::new(4, lambda, DELTA);
+        for &v in &running_mean_removed(&x, lambda) {
+            reference.push(v);
+        }
+        let (a_ref, _) = reference.solve(4, Regularisation::ShiftConsistent);
+        for a in &unscaled.0[unscaled.0.len() - 3..] {
+            assert!(rel(a, &a_ref) < 1e-9, "{a:?} against {a_ref:?}");
+        }
+        // A power of two scales every operation exactly: the same coefficients, bit for bit.
+        for k in [-66, -47, 60] {
+            let s = 2f64.powi(k);
+            assert_eq!(
+                scaled_fits::<f64>(&x, s, lambda),
+                unscaled,
+                "f64, scale 2^{k}"
+            );
+        }
+        // Decimal scales round the input: the same coefficients to rounding.
+        for s in [1e-20, 1e-16, 1e-14, 1e15] {
+            let scaled = scaled_fits::<f64>(&x, s, lambda);
+            assert_eq!(scaled.1, [0, 0, 0], "f64, scale {s:e}");
+            let worst = scaled
+                .0
+                .iter()
+                .zip(&unscaled.0)
+                .fold(0.0f64, |m, (a, b)| m.max(rel(a, b)));
+            println!("f64, lambda {lambda}, scale {s:e}: {worst:e}");
+            assert!(
+                worst < 1e-9,
+                "f64, scale {s:e}: relative difference {worst:e}"
+            );
+        }
+        // f32 has a narrower exponent range: 2^-46 (1.4e-14) puts the energies near 1e-25.
+        // (Its SFTF is rescued at lambda = 1, at every scale at the same samples.)
+        let unscaled32 = scaled_fits::<f32>(&x, 1.0, lambda);
+        for k in [-46, 40] {
+            let s = 2f64.powi(k);
+            assert_eq!(
+                scaled_fits::<f32>(&x, s, lambda),
+                unscaled32,
+                "f32, scale 2^{k}"
+            );
+        }
+    }
+}

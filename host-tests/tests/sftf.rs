@@ -5,7 +5,7 @@
 //! README.md.
 
 use imu_ar::ArModel;
-use imu_ar::recursive::{Config, FloatArith, Lattice, Rls, RlsInit, Sftf};
+use imu_ar::recursive::{Config, FloatArith, Lattice, Rls, RlsInit, Sftf, snapshot_interval};
 use imu_ar_host::data::read_column;
 use imu_ar_host::fixtures::{AXES, add, ar, real_records};
 use imu_ar_host::reference::{Regularisation, Section0};
@@ -18,8 +18,8 @@ struct Rescues {
     restarts: u64,
     /// Rescues the last-good check was made at (those outside the hold of an earlier one).
     checked: u64,
-    /// Largest `max_k |a_k - a_ref,k|` of the model published just before a checked rescue,
-    /// against the direct solve of the problem the filter was solving.
+    /// Largest `max_k |a_k - a_ref,k|` of the model held through a checked rescue (the last
+    /// snapshot), against the direct solve of the problem the filter was solving then.
     worst: f64,
     /// Largest [`Sftf::disagreement`] after a sample that passed the monitor.
     largest: f64,
@@ -27,10 +27,12 @@ struct Rescues {
 
 /// Runs an order-`P` SFTF in `T` over `x` and checks, sample by sample: every error it returns
 /// is finite and it returns none only when it rescues; the model is finite after every sample;
-/// a rescue keeps publishing the model of the sample before it for `3/(1 - lambda)` samples.
+/// a rescue keeps publishing the model of the filter's last snapshot (the model after the last
+/// sample whose count is a multiple of `snapshot_interval(P)`, outside a hold) for
+/// `3/(1 - lambda)` samples.
 ///
 /// Without mean removal it also solves, in `f64`, the problem the filter solves (restarted with
-/// it), and measures the model published just before each rescue against it.
+/// it), and measures the model held through each rescue against it.
 fn sftf_run<T: FloatArith, const P: usize>(
     x: &[f64],
     lambda: f64,
@@ -45,7 +47,8 @@ fn sftf_run<T: FloatArith, const P: usize>(
     let mut sftf = Sftf::<T, P>::new(&config);
     let mut reference = (!demean).then(|| Section0::new(P, lambda, delta));
     let mut out = Rescues::default();
-    let mut published: Option<ArModel<T, P>> = None;
+    // The last snapshot, with the reference's solution at its sample.
+    let mut snapshot: Option<(ArModel<T, P>, Option<Vec<f64>>)> = None;
     let mut held: Option<(ArModel<T, P>, usize)> = None;
     for (n, &v) in x.iter().enumerate() {
         let restarts = sftf.health().restarts;
@@ -59,11 +62,11 @@ fn sftf_run<T: FloatArith, const P: usize>(
             None => assert!(rescued, "sample {n}: a finite sample was rejected"),
         }
         if rescued {
-            let last = published.expect("a model before the first rescue");
+            let (last, a_ref) = snapshot
+                .clone()
+                .expect("a snapshot before the first rescue");
             if held.is_none_or(|(_, until)| n >= until) {
-                if let Some(r) = &reference {
-                    // The reference holds the samples up to n - 1, as the filter did.
-                    let (a_ref, _) = r.solve(P, Regularisation::ShiftConsistent);
+                if let Some(a_ref) = a_ref {
                     let err = last
                         .a()
                         .iter()
@@ -89,7 +92,13 @@ fn sftf_run<T: FloatArith, const P: usize>(
         {
             assert_eq!(model, m, "sample {n}: the held model changed");
         }
-        published = Some(model);
+        let settled = held.is_none_or(|(_, until)| n >= until);
+        if !rescued && settled && sftf.health().samples.is_multiple_of(snapshot_interval(P)) {
+            let a_ref = reference
+                .as_ref()
+                .map(|r| r.solve(P, Regularisation::ShiftConsistent).0);
+            snapshot = Some((model, a_ref));
+        }
     }
     out.restarts = sftf.health().restarts;
     out
@@ -302,4 +311,58 @@ fn real_records_every_axis() {
             }
         }
     }
+}
+
+/// The variance of a record, for a `delta` in its units.
+fn variance(x: &[f64]) -> f64 {
+    let mean = x.iter().sum::<f64>() / x.len() as f64;
+    x.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / x.len() as f64
+}
+
+/// A rescue shortly before the end of a record leaves the last good model, though `model` was
+/// never called before it: the filter keeps its snapshot itself (issue 23, item 2).
+#[test]
+fn a_rescue_near_the_end_leaves_the_last_good_model() {
+    // Order 1 under-fits this resonant AR(2): the filter is rescued now and then (section 8).
+    let x = ar([1.78, -0.7921], 1.0, 18_000, 7);
+    let config = Config::new(0.99, 0.1 * variance(&x), 0.01).unwrap();
+    let mut probe = Sftf::<f64, 1>::new(&config);
+    let late: Vec<usize> = (0..x.len())
+        .filter(|&n| probe.update(&config, x[n]).is_none() && n > 1_000)
+        .collect();
+    assert!(!late.is_empty(), "the under-fitted case is rescued");
+    for &n in &late {
+        let mut sftf = Sftf::<f64, 1>::new(&config);
+        for &v in &x[..n + 10] {
+            sftf.update(&config, v);
+        }
+        let model = sftf.model(&config);
+        assert!(
+            model.is_some_and(|m| m.a()[0].is_finite() && m.noise_variance() > 0.0),
+            "no model 10 samples after the rescue at sample {n}"
+        );
+    }
+}
+
+/// At `lambda = 1` (`3/(1 - lambda)` is infinite) a rescue still leaves the last good model,
+/// without any call to `model` before it (issue 23, item 2, the f32 `--lambda 1` case).
+#[test]
+fn at_lambda_one_a_rescue_leaves_the_last_good_model() {
+    let x: Vec<f32> = ar([0.7, -0.2], 1.0, 10_000, 5)
+        .iter()
+        .map(|&v| v as f32)
+        .collect();
+    let config = Config::new(1.0f32, 0.1, 0.01).unwrap();
+    let mut sftf = Sftf::<f32, 2>::new(&config);
+    for &v in &x[..5_000] {
+        sftf.update(&config, v);
+    }
+    // e^2 overflows f32: the filter is rescued.
+    assert_eq!(sftf.update(&config, 3e30), None);
+    for &v in &x[5_000..] {
+        sftf.update(&config, v);
+    }
+    assert!(sftf.health().restarts >= 1);
+    let model = sftf.model(&config).expect("a model after the rescue");
+    assert!((model.a()[0] - 0.7).abs() < 0.1 && (model.a()[1] + 0.2).abs() < 0.1);
 }

@@ -84,7 +84,8 @@ pub struct FloatParams<T> {
     /// Forgetting factor.
     pub lambda: T,
     /// Added to every energy update, so that the energies stay positive (and divisible)
-    /// however long the input is exactly zero.
+    /// however long the input is exactly zero: `delta EPSILON^2` (at least the smallest normal
+    /// value), so that it scales with the data.
     pub floor: T,
 }
 
@@ -147,10 +148,11 @@ pub trait FloatArith:
 impl FloatArith for f32 {}
 impl FloatArith for f64 {}
 
-/// The float parameters of a configuration.
-pub(crate) fn float_params<T: Scalar>(lambda: T) -> FloatParams<T> {
+/// The float parameters of a configuration: its forgetting factor and its energy floor
+/// (relative to `delta`, see [`Config::new`](super::Config::new)).
+pub(crate) fn float_params<T: Scalar>(config: &super::Config<T>) -> FloatParams<T> {
     FloatParams {
-        lambda,
-        floor: T::from_f64(1e-30),
+        lambda: config.lambda(),
+        floor: config.floor(),
     }
 }

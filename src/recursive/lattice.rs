@@ -201,11 +201,13 @@ impl<A: Arith, const P: usize> Core<A, P> {
 /// [`Lattice::model`]) exactly, from the reflection coefficients of the last `P` samples
 /// (numerics.md section 1, option 1): `O(P^3/3)` operations per request, `O(P)` per sample.
 ///
-/// Safeguards: every energy update adds a tiny positive value (`1e-30`, so that `F_m` exceeds
-/// the exact energy by `1e-30 W_n`), which keeps the energies divisible however long the input
-/// is exactly zero, and the conversion factor is formed as a ratio that stays in `[0, 1]`; a non-finite state re-initialises the lattice (counted in
-/// [`Health::restarts`]) and [`Lattice::model`] keeps returning the last good model for
-/// `3/(1 - lambda)` samples.
+/// Safeguards: every energy update adds a tiny positive value (the floor `delta EPSILON^2`,
+/// at least the smallest normal value, so that `F_m` exceeds the exact energy by `floor W_n`),
+/// which keeps the energies divisible however long the input is exactly zero. The floor is
+/// relative to `delta`, so a record in other units (with `delta` in those units) gives the
+/// same coefficients. The conversion factor is formed as a ratio that stays in `[0, 1]`; a
+/// non-finite state re-initialises the lattice (counted in [`Health::restarts`]) and
+/// [`Lattice::model`] keeps returning the last good model while the restarted lattice settles.
 ///
 /// ```
 /// use imu_ar::recursive::{Config, Lattice};
@@ -263,7 +265,7 @@ impl<T: FloatArith, const P: usize> Lattice<T, P> {
     pub fn update(&mut self, config: &Config<T>, x: T) -> Option<T> {
         let y = self.shell.intake(config, x)?;
         let mut clip = 0;
-        let f = self.core.step(&float_params(config.lambda()), y, &mut clip);
+        let f = self.core.step(&float_params(config), y, &mut clip);
         // A non-finite value anywhere reaches f_P within a sample or two (the reflection
         // coefficients feed the errors), and an overflowing input reaches F_0 and F_P at once.
         let c = &self.core;
@@ -273,6 +275,9 @@ impl<T: FloatArith, const P: usize> Lattice<T, P> {
             self.core = Self::initial_core(config);
             return None;
         }
+        let core = &self.core;
+        self.shell
+            .refresh(config, core.f_energy_p, || core.coefficients(P, |k| k));
         Some(f)
     }
 
@@ -315,6 +320,12 @@ impl<T: FloatArith, const P: usize> Lattice<T, P> {
         self.shell.mean.mean()
     }
 
+    /// The weighted number of samples since the start or the last restart,
+    /// `W_n = sum_{i<=n} lambda^(n-i)`: `n` at `lambda = 1`, `(1 - lambda^n)/(1 - lambda)` below.
+    pub fn weight(&self) -> T {
+        self.shell.weight.0
+    }
+
     /// What happened to the samples so far.
     pub fn health(&self) -> Health {
         self.shell.health
@@ -335,8 +346,14 @@ impl<T: FloatArith, const P: usize> Lattice<T, P> {
     }
 
     /// The order-`P` model after the last sample: coefficients, innovation variance
-    /// `F_P / W_n`, the running mean and `dt`. Returns the last good model while a restarted
-    /// lattice settles, and `None` before the first sample or if no finite model exists yet.
+    /// `F_P / W_n`, the running mean and `dt` (`O(P^3/3)` operations, no state change).
+    ///
+    /// After a restart, and while the current state makes no valid model, it returns the last
+    /// good model instead: the lattice itself takes a snapshot of its model every
+    /// [`snapshot_interval`](super::snapshot_interval)`(P)` accepted samples (never while a
+    /// restart settles), whether or not this method was ever called, and returns that snapshot
+    /// for `3/(1 - lambda)` samples after a restart, at most 30 000 (so also at `lambda = 1`).
+    /// `None` before the first sample, or if no valid model has existed yet.
     ///
     /// # Stack
     ///
@@ -344,26 +361,31 @@ impl<T: FloatArith, const P: usize> Lattice<T, P> {
     /// bytes, on top of the estimator's own state: for `Lattice<f32, 64>`, 32 KiB of tables.
     /// Measured on the Cortex-M4F (thumbv7em-none-eabihf, release profile, stack painted
     /// below the caller under QEMU): 33,544 bytes of stack for `model()` at `P = 64`, next to
-    /// a 34,656-byte `Lattice<f32, 64>`. Size the stack for it, or call `model()` where the
-    /// stack is large enough, at high orders.
-    pub fn model(&mut self, config: &Config<T>) -> Option<ArModel<T, P>> {
+    /// a 34,656-byte `Lattice<f32, 64>`. [`update`](Self::update) takes its snapshot through
+    /// the same code once every `snapshot_interval(P)` samples, so it needs that stack too.
+    /// Size the stack for it at high orders.
+    pub fn model(&self, config: &Config<T>) -> Option<ArModel<T, P>> {
         let core = &self.core;
         self.shell
             .model(config, core.f_energy_p, || core.coefficients(P, |k| k))
     }
 }
 
+/// Largest hold after a restart, in samples: three memories of `lambda = 0.9999`.
+const HOLD_MAX: f64 = 30_000.0;
+
 /// Samples for which a restarted estimator keeps publishing its last good model:
-/// `3/(1 - lambda)`, or three million for `lambda = 1`.
+/// `3/(1 - lambda)`, at most 30 000 (at `lambda = 1`, where the memory is unbounded, and above
+/// `lambda = 0.9999`, the restarted estimator has then seen 30 000 samples).
 pub(crate) fn hold_after_restart(lambda: f64) -> u32 {
     let memory = if lambda < 1.0 {
         3.0 / (1.0 - lambda)
     } else {
-        3.0e6
+        HOLD_MAX
     };
-    if memory < u32::MAX as f64 {
+    if memory < HOLD_MAX {
         memory as u32
     } else {
-        u32::MAX
+        HOLD_MAX as u32
     }
 }

@@ -48,7 +48,8 @@ pub use sftf::Sftf;
 pub enum ConfigError {
     /// The forgetting factor is not in (0, 1].
     Lambda,
-    /// The initial regularisation `delta` is not positive and finite.
+    /// The initial regularisation `delta` is not positive and finite, or is too small or
+    /// too large for the scalar to carry through the recursion (see [`Config::new`]).
     Delta,
     /// The sample interval is not positive and finite.
     Interval,
@@ -63,7 +64,10 @@ impl fmt::Display for ConfigError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(match self {
             Self::Lambda => "forgetting factor lambda must be in (0, 1]",
-            Self::Delta => "regularisation delta must be positive and finite",
+            Self::Delta => {
+                "regularisation delta must be positive and finite, and within the scalar's range \
+                 (about 1e-31..1e31 in f32, 1e-292..1e292 in f64)"
+            }
             Self::Interval => "sample interval must be positive and finite",
             Self::Saturation => "saturation limit must be positive",
             Self::Scale => "fixed-point scale must be positive and keep delta representable",
@@ -90,6 +94,12 @@ pub struct Config<T> {
     dt: T,
     demean: bool,
     saturation: Option<T>,
+    /// Added to every energy update of the float estimators: `delta EPSILON^2`, at least the
+    /// smallest normal value. Relative to `delta`, so that a record in other units (with
+    /// `delta` in those units) takes the same path through the recursion.
+    floor: T,
+    /// Ceiling of the entries of the RLS factor `D`: `1e29 / delta`, at most `1 / MIN_POSITIVE`.
+    ceiling: T,
 }
 
 impl<T: Scalar> Config<T> {
@@ -97,7 +107,16 @@ impl<T: Scalar> Config<T> {
     /// regularisation `delta > 0` and sample interval `dt` (s). The running mean is removed.
     ///
     /// `delta` only shapes the first few `1/(1 - lambda)` samples; `0.01..1` times the expected
-    /// variance of the input is a good choice.
+    /// variance of the input is a good choice. It also sets the scale of the estimators' only
+    /// absolute safeguards (the energy floor `delta EPSILON^2` and the RLS ceiling
+    /// `1e29 / delta`): with `delta` in the data's units squared, data in other units (scaled
+    /// by `s`, `delta` by `s^2`) gives the same coefficients as far as the scalar's exponent
+    /// range allows.
+    ///
+    /// `delta` must lie in `[MIN_POSITIVE / EPSILON, EPSILON / MIN_POSITIVE]` of the scalar
+    /// (about `1e-31..1e31` in `f32`, `1e-292..1e292` in `f64`): a smaller one (a subnormal,
+    /// say) makes the initial energies `delta lambda^k` lose their precision or their
+    /// reciprocals overflow, so that the recursion breaks down on every sample.
     ///
     /// # Errors
     ///
@@ -106,18 +125,28 @@ impl<T: Scalar> Config<T> {
         if !(lambda.is_finite() && lambda > T::ZERO && lambda <= T::ONE) {
             return Err(ConfigError::Lambda);
         }
-        if !(delta.is_finite() && delta > T::ZERO) {
+        let (low, high) = (T::MIN_POSITIVE / T::EPSILON, T::EPSILON / T::MIN_POSITIVE);
+        if !(delta.is_finite() && delta >= low && delta <= high) {
             return Err(ConfigError::Delta);
         }
         if !(dt.is_finite() && dt > T::ZERO) {
             return Err(ConfigError::Interval);
         }
+        let relative = delta * T::EPSILON * T::EPSILON;
+        let floor = if relative > T::MIN_POSITIVE {
+            relative
+        } else {
+            T::MIN_POSITIVE
+        };
+        let ceiling = (1e29 / delta.to_f64()).min(1.0 / T::MIN_POSITIVE.to_f64());
         Ok(Self {
             lambda,
             delta,
             dt,
             demean: true,
             saturation: None,
+            floor,
+            ceiling: T::from_f64(ceiling),
         })
     }
 
@@ -170,9 +199,21 @@ impl<T: Scalar> Config<T> {
     }
 
     /// Effective sample size `(1 + lambda) / (1 - lambda)` (variance-equivalent), or `None`
-    /// for `lambda = 1` (growing memory).
+    /// for `lambda = 1` (growing memory: there the effective sample size is the number of
+    /// samples, which only the estimator knows; see [`Lattice::weight`]).
     pub fn effective_samples(&self) -> Option<T> {
         (self.lambda < T::ONE).then(|| (T::ONE + self.lambda) / (T::ONE - self.lambda))
+    }
+
+    /// The energy floor of the float estimators, `delta EPSILON^2` (at least the smallest
+    /// normal value).
+    pub(crate) fn floor(&self) -> T {
+        self.floor
+    }
+
+    /// The ceiling of the RLS factor `D`, `1e29 / delta` (at most `1 / MIN_POSITIVE`).
+    pub(crate) fn ceiling(&self) -> T {
+        self.ceiling
     }
 
     /// Classifies a raw sample: `Ok` when it may enter the estimator.
@@ -244,16 +285,33 @@ impl<T: Scalar> WeightSum<T> {
 }
 
 /// What every float estimator keeps around its recursion: the running mean, the weight sum,
-/// the health counters, and the published model held through a restart.
+/// the health counters, and the last good model, held through a restart.
+///
+/// The estimator refreshes the snapshot itself ([`Shell::refresh`]) every
+/// [`snapshot_interval`] accepted samples while no restart is settling, so that the model held
+/// after a restart does not depend on when, or whether, the caller asked for one.
 #[derive(Clone, Copy, Debug)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub(crate) struct Shell<T, const P: usize> {
     pub(crate) mean: RunningMean<T>,
     pub(crate) weight: WeightSum<T>,
     pub(crate) health: Health,
-    published: Option<crate::ArModel<T, P>>,
+    /// The last good model, held while a restarted estimator settles.
+    snapshot: Option<crate::ArModel<T, P>>,
     /// Samples to go before a restarted estimator publishes again.
     hold: u32,
+}
+
+/// Accepted samples between two snapshots of the model an order-`P` float estimator holds
+/// through a restart: `4 P^2`, at least 32, rounded up to a power of two (so that the test on
+/// the sample count is a mask). Making the lattice's coefficients costs `O(P^3/3)`, so the
+/// snapshot adds `O(P/12)` operations per sample on average (with the test, 1 to 7
+/// instructions per stage of the `f32` lattice on a Cortex-M4F, `cargo qemu bench`); for
+/// [`Rls`] and [`Sftf`] it is a copy of `P` coefficients, and no measurable cost.
+pub const fn snapshot_interval(p: usize) -> u64 {
+    let quadratic = 4 * (p as u64) * (p as u64);
+    let at_least = if quadratic > 32 { quadratic } else { 32 };
+    at_least.next_power_of_two()
 }
 
 impl<T: Scalar, const P: usize> Shell<T, P> {
@@ -262,7 +320,7 @@ impl<T: Scalar, const P: usize> Shell<T, P> {
             mean: RunningMean::new(),
             weight: WeightSum(T::ZERO),
             health: Health::default(),
-            published: None,
+            snapshot: None,
             hold: 0,
         }
     }
@@ -287,8 +345,8 @@ impl<T: Scalar, const P: usize> Shell<T, P> {
         Some(y)
     }
 
-    /// Counts a restart, forgets the mean and the weight, and holds the published model for
-    /// `3/(1 - lambda)` samples.
+    /// Counts a restart, forgets the mean and the weight, and holds the snapshot for
+    /// `3/(1 - lambda)` samples, at most 30 000.
     pub(crate) fn restart(&mut self, config: &Config<T>) {
         self.health.restarts += 1;
         self.mean = RunningMean::new();
@@ -301,22 +359,48 @@ impl<T: Scalar, const P: usize> Shell<T, P> {
         (self.weight.0 > T::ZERO).then(|| energy / self.weight.0)
     }
 
-    /// The model of coefficients `a` (computed only when needed) and energy `energy`
-    /// (innovation variance `energy / W_n`), unless a restarted estimator is still settling:
-    /// then, and when no valid model can be made, the last one published.
-    pub(crate) fn model(
-        &mut self,
+    /// The model of the current state: coefficients `a` (computed only when called) and
+    /// innovation variance `energy / W_n`; `None` if it is not a valid model.
+    fn current(
+        &self,
         config: &Config<T>,
         energy: T,
         a: impl FnOnce() -> Option<[T; P]>,
     ) -> Option<crate::ArModel<T, P>> {
-        if self.hold == 0
-            && let Some(variance) = self.per_sample(energy)
-            && let Some(a) = a()
-            && let Ok(m) = crate::ArModel::new(a, variance, self.mean.mean(), config.dt())
+        let variance = self.per_sample(energy)?;
+        crate::ArModel::new(a()?, variance, self.mean.mean(), config.dt()).ok()
+    }
+
+    /// Called by the estimator after every healthy update: every [`snapshot_interval`]
+    /// accepted samples, unless a restart is settling, the current model (if valid) becomes
+    /// the one held through the next restart.
+    #[inline]
+    pub(crate) fn refresh(
+        &mut self,
+        config: &Config<T>,
+        energy: T,
+        a: impl FnOnce() -> Option<[T; P]>,
+    ) {
+        if self.health.samples & (snapshot_interval(P) - 1) == 0
+            && self.hold == 0
+            && let Some(m) = self.current(config, energy, a)
         {
-            self.published = Some(m);
+            self.snapshot = Some(m);
         }
-        self.published
+    }
+
+    /// The model of the current state, unless a restarted estimator is still settling: then,
+    /// and when the current state makes no valid model, the last snapshot.
+    pub(crate) fn model(
+        &self,
+        config: &Config<T>,
+        energy: T,
+        a: impl FnOnce() -> Option<[T; P]>,
+    ) -> Option<crate::ArModel<T, P>> {
+        if self.hold == 0 {
+            self.current(config, energy, a).or(self.snapshot)
+        } else {
+            self.snapshot
+        }
     }
 }

@@ -11,9 +11,11 @@ pub enum OrderRule {
     /// squared *a-priori* errors `Pi_k(n) = lambda Pi_k(n-1) + f_k(n)^2`. Needs no sample size
     /// or penalty: an over-fitted order predicts worse out of sample.
     Pls,
-    /// `N_eff ln s2_k + 2k` with `s2_k = F_k / W_n` and `N_eff = (1 + lambda)/(1 - lambda)`.
+    /// `N_eff ln s2_k + 2k` with `s2_k = F_k / W_n` and `N_eff = (1 + lambda)/(1 - lambda)`;
+    /// at `lambda = 1` (growing memory) `N_eff` is the number of samples,
+    /// [`Lattice::weight`].
     Aic,
-    /// `N_eff ln s2_k + k ln N_eff`.
+    /// `N_eff ln s2_k + k ln N_eff`, with `N_eff` as for [`OrderRule::Aic`].
     Bic,
 }
 
@@ -94,9 +96,12 @@ impl<T: FloatArith, const P: usize> OrderSelector<T, P> {
     }
 
     fn best(&self, config: &Config<T>, lattice: &Lattice<T, P>) -> usize {
+        // At lambda = 1 (also an f32 lambda that rounds to 1) the memory grows: the effective
+        // sample size is the number of samples since the start or the last restart.
         let n_eff = config
             .effective_samples()
-            .map_or(f64::INFINITY, |n| n.to_f64());
+            .unwrap_or_else(|| lattice.weight())
+            .to_f64();
         let score = |k: usize| -> f64 {
             match self.rule {
                 OrderRule::Pls => {
@@ -108,7 +113,7 @@ impl<T: FloatArith, const P: usize> OrderSelector<T, P> {
                 }
                 OrderRule::Aic | OrderRule::Bic => {
                     let s2 = lattice.innovation_variance(k).map_or(0.0, Scalar::to_f64);
-                    if !(s2 > 0.0 && n_eff.is_finite()) {
+                    if !(s2 > 0.0 && n_eff >= 1.0 && n_eff.is_finite()) {
                         return f64::INFINITY;
                     }
                     let penalty = match self.rule {

@@ -3,11 +3,6 @@
 use super::{Config, Health, Shell};
 use crate::{ArModel, Scalar};
 
-/// Ceiling of the entries of `D`: without excitation (a stuck sensor) `P` grows as
-/// `lambda^-n` and would overflow ("covariance wind-up"); held below this the estimator stays
-/// finite and recovers as soon as the input moves again. Far above any value of a healthy run.
-const D_MAX: f64 = 1e30;
-
 /// The initial inverse correlation matrix `P_0` of [`Rls`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -42,10 +37,11 @@ pub enum RlsInit {
 /// The innovation variance is `E_n / W_n` with `E_n = lambda E_{n-1} + e_n eps_n` (a-priori
 /// times a-posteriori error, `E_0 = delta lambda^P`) and `W_n = sum lambda^(n-i)`.
 ///
-/// Safeguards: the entries of `D` are capped at 1e30, so that a stuck sensor (no excitation,
-/// `P` growing as `lambda^-n`) cannot overflow it; a non-finite or non-positive factor
+/// Safeguards: the entries of `D` are capped at `1e29 / delta` (`1e30` for `delta = 0.1`; the
+/// cap scales with the data, as `delta` does), so that a stuck sensor (no excitation, `P`
+/// growing as `lambda^-n`) cannot overflow it; a non-finite or non-positive factor
 /// re-initialises the state (counted in [`Health::restarts`]) while [`Rls::model`] returns the
-/// last good model for `3/(1-lambda)` samples.
+/// last good model (see [`Lattice::model`](super::Lattice::model)).
 #[derive(Clone, Copy, Debug)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Rls<T, const P: usize> {
@@ -131,7 +127,11 @@ impl<T: Scalar, const P: usize> Rls<T, P> {
             }
         }
         let mut check = T::ZERO;
-        let d_max = T::from_f64(D_MAX);
+        // Without excitation (a stuck sensor) `P` grows as `lambda^-n` and would overflow
+        // ("covariance wind-up"); held below `1e29 / delta` the estimator stays finite and
+        // recovers as soon as the input moves again. Far above any value of a healthy run, and
+        // relative to `delta`, so that it scales with the data.
+        let d_max = config.ceiling();
         for ((a, d), g) in self.a.iter_mut().zip(&mut self.d).zip(&gain) {
             *a += *g / alpha * e;
             // Without excitation (a stuck sensor) D grows as lambda^-n: cap it.
@@ -151,6 +151,7 @@ impl<T: Scalar, const P: usize> Rls<T, P> {
         self.phi.copy_within(0..P - 1, 1);
         self.phi[0] = y;
         self.error = e;
+        self.shell.refresh(config, self.energy, || Some(self.a));
         Some(e)
     }
 
@@ -179,8 +180,9 @@ impl<T: Scalar, const P: usize> Rls<T, P> {
         self.shell.health
     }
 
-    /// The model after the last sample; the last good one while a restarted state settles.
-    pub fn model(&mut self, config: &Config<T>) -> Option<ArModel<T, P>> {
+    /// The model after the last sample; after a restart, the last good one (a snapshot the
+    /// estimator takes itself, as [`Lattice::model`](super::Lattice::model) describes).
+    pub fn model(&self, config: &Config<T>) -> Option<ArModel<T, P>> {
         let a = self.a;
         self.shell.model(config, self.energy, || Some(a))
     }

@@ -4,10 +4,6 @@
 use super::{Config, Health, Shell};
 use crate::{ArModel, Scalar};
 
-/// Added to both energy updates, as in the lattice: keeps `alpha` and `beta` positive (and
-/// divisible) however long the input is exactly zero.
-const FLOOR: f64 = 1e-30;
-
 /// The monitor's threshold `tau` on the disagreement of the two backward errors
 /// ([`Sftf::disagreement`]): `1e-2` in single precision, `1e-6` in double. The largest
 /// disagreement of the healthy runs of `host-tests/tests/sftf.rs` is printed in README's table
@@ -60,8 +56,8 @@ const GAMMA_MAX: f64 = 1.0 + 1e-3;
 /// * any value is not finite.
 ///
 /// The rescue zeroes the delay line and restarts from the initial state, and
-/// [`Sftf::model`] keeps returning the last model published before it for `3/(1 - lambda)`
-/// samples. Where the lattice and this filter both apply, prefer the [`Lattice`](super::Lattice):
+/// [`Sftf::model`] keeps returning the last good model (a snapshot the filter refreshes
+/// itself) for `3/(1 - lambda)` samples, at most 30 000. Where the lattice and this filter both apply, prefer the [`Lattice`](super::Lattice):
 /// it never needs rescuing; this filter is for firmware that must have `a` every sample.
 ///
 /// ```
@@ -130,7 +126,9 @@ impl<T: Scalar, const P: usize> Sftf<T, P> {
     pub fn update(&mut self, config: &Config<T>, x: T) -> Option<T> {
         let y = self.shell.intake(config, x)?;
         let lambda = config.lambda();
-        let floor = T::from_f64(FLOOR);
+        // Added to both energy updates, as in the lattice: keeps `alpha` and `beta` positive
+        // (and divisible) however long the input is exactly zero; relative to `delta`.
+        let floor = config.floor();
 
         let e = self
             .a
@@ -179,6 +177,7 @@ impl<T: Scalar, const P: usize> Sftf<T, P> {
         }
         self.error = e;
         self.backward = (r_f, r_s);
+        self.shell.refresh(config, self.alpha, || Some(self.a));
         Some(e)
     }
 
@@ -240,8 +239,10 @@ impl<T: Scalar, const P: usize> Sftf<T, P> {
         self.shell.health
     }
 
-    /// The model after the last sample; the last good one while a rescued filter settles.
-    pub fn model(&mut self, config: &Config<T>) -> Option<ArModel<T, P>> {
+    /// The model after the last sample; after a rescue, the last good one (a snapshot the
+    /// filter takes itself, whether or not this method was called, as
+    /// [`Lattice::model`](super::Lattice::model) describes).
+    pub fn model(&self, config: &Config<T>) -> Option<ArModel<T, P>> {
         let a = self.a;
         self.shell.model(config, self.alpha, || Some(a))
     }
