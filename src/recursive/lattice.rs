@@ -109,6 +109,23 @@ impl<A: Arith, const P: usize> Core<A, P> {
         &self.ring_kb[self.head % P]
     }
 
+    /// The ring slot the next sample overwrites (`kf`, `kb`): with `F_P`, all that
+    /// [`Core::rewind`] needs to restore the coefficients from before that sample.
+    pub(crate) fn next_slot(&self) -> (&[A::Coef; P], &[A::Coef; P]) {
+        let next = (self.head % P + P - 1) % P;
+        (&self.ring_kf[next], &self.ring_kb[next])
+    }
+
+    /// Undoes the last [`Core::step`] as far as [`Core::coefficients`] and `F_P` are
+    /// concerned, given what [`Core::next_slot`] returned before it and the `F_P` before it.
+    pub(crate) fn rewind(&mut self, kf: &[A::Coef; P], kb: &[A::Coef; P], f_energy_p: A::Energy) {
+        let last = self.head % P;
+        self.ring_kf[last] = *kf;
+        self.ring_kb[last] = *kb;
+        self.head = (last + 1) % P;
+        self.f_energy_p = f_energy_p;
+    }
+
     /// Forward energy of order `m` in `0..=P`.
     pub(crate) fn energy(&self, m: usize) -> Option<A::Energy> {
         if m == P {
