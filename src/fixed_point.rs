@@ -79,7 +79,8 @@ fn mul_hi(x: i32, y: i32) -> i32 {
 /// `x` is 0 (`n = 31`).
 #[inline(always)]
 fn normalise(x: i32) -> (i32, u32) {
-    let n = (x ^ (x >> 31)).leading_zeros() - 1;
+    // `x ^ (x >> 31)` is non-negative: at least one leading zero, no wrap.
+    let n = (x ^ (x >> 31)).leading_zeros().wrapping_sub(1);
     (x.wrapping_shl(n), n)
 }
 
@@ -89,7 +90,7 @@ fn sat_i32(x: i64, clip: &mut u32) -> i32 {
     match i32::try_from(x) {
         Ok(v) => v,
         Err(_) => {
-            *clip += 1;
+            *clip = clip.saturating_add(1);
             if x < 0 { i32::MIN } else { i32::MAX }
         }
     }
@@ -99,7 +100,7 @@ fn sat_i32(x: i64, clip: &mut u32) -> i32 {
 #[inline(always)]
 fn sat_add(x: i64, y: i64, clip: &mut u32) -> i64 {
     x.checked_add(y).unwrap_or_else(|| {
-        *clip += 1;
+        *clip = clip.saturating_add(1);
         if y < 0 { i64::MIN } else { i64::MAX }
     })
 }
@@ -138,8 +139,9 @@ fn reciprocal(e: i64) -> (i32, u32) {
         // `(lo >> 1) >> (31 - z)` is `lo >> (32 - z)` without a shift by 32.
         ((hi << z) | ((lo >> 1) >> (31 - z)), z)
     } else {
+        // `lo != 0` here (`e >= 1`), so `z < 32`.
         let z = lo.leading_zeros();
-        (lo << z, 32 + z)
+        (lo.wrapping_shl(z), 32 + z)
     };
     // `| 0x8000` changes nothing (the top bit is set) but proves the divisor non-zero.
     let r0 = (u32::MAX / ((m >> 16) | 0x8000)) << 13; // in (2^29, 2^30]
@@ -165,16 +167,18 @@ fn quotient(
     // q = a b r 2^(na + nb - 64), |q| <= 2^28.
     let q = mul_hi(mul_hi(an, bn), r);
     // a b / e in Q(out) = a b r 2^(lz - 53 - ab_frac + out) = q 2^shift.
-    let shift = (11 + lz + out_frac) as i32 - (ab_frac + na + nb) as i32;
+    // Every term is below 128: the sums and the difference cannot wrap.
+    let shift = (11u32.wrapping_add(lz).wrapping_add(out_frac) as i32)
+        .wrapping_sub(ab_frac.wrapping_add(na).wrapping_add(nb) as i32);
     if shift < 0 {
         // |q| <= 2^28, so anything past 30 gives 0 and the rounded sum fits in 32 bits.
         let t = shift.unsigned_abs().min(30);
-        i64::from((q + (1 << (t - 1))) >> t)
+        i64::from(q.wrapping_add(1 << (t - 1)) >> t)
     } else if shift <= 32 {
         i64::from(q) << shift
     } else {
         if q != 0 {
-            *clip += 1;
+            *clip = clip.saturating_add(1);
         }
         i64::from(q.signum()) * i64::MAX
     }
@@ -447,12 +451,12 @@ impl<const P: usize> FixedLattice<P> {
     /// `|x scale| >= 16` (counted in [`FixedLattice::health`]; the state is unchanged).
     pub fn update(&mut self, config: &FixedConfig, x: f32) -> Option<I5F27> {
         if !x.is_finite() {
-            self.health.non_finite += 1;
+            self.health.non_finite = self.health.non_finite.saturating_add(1);
             return None;
         }
         let bits = f64::from(x) * f64::from(config.scale) * (1u64 << ERR_FRAC) as f64;
         if bits.abs() >= config.limit as f64 {
-            self.health.saturated += 1;
+            self.health.saturated = self.health.saturated.saturating_add(1);
             return None;
         }
         Some(self.accept(config, libm::round(bits) as i32))
@@ -465,7 +469,7 @@ impl<const P: usize> FixedLattice<P> {
         let (lo, hi) = config.count_limit;
         let bits = i32::from(count) << 16;
         if count <= lo || count >= hi || i64::from(bits).abs() >= config.limit {
-            self.health.saturated += 1;
+            self.health.saturated = self.health.saturated.saturating_add(1);
             return None;
         }
         Some(self.accept(config, bits))

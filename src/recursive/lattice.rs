@@ -152,7 +152,7 @@ impl<A: Arith, const P: usize> Core<A, P> {
         let mut rows = [[[T::ZERO; P]; P]; 2];
         let mut alpha = [T::ZERO; P];
         for t in (0..m).rev() {
-            let slot = (self.head + t) % P;
+            let slot = (self.head % P + t) % P;
             let (kf, kb) = (&self.ring_kf[slot], &self.ring_kb[slot]);
             alpha = [T::ZERO; P];
             let (first, second) = rows.split_at_mut(1);
@@ -162,11 +162,12 @@ impl<A: Arith, const P: usize> Core<A, P> {
                 (&first[0], &mut second[0])
             };
             let stages = kf.iter().zip(kb).take(m - t);
-            for (k, (&kf_k, &kb_k)) in (1..).zip(stages) {
+            for (k, (&kf_k, &kb_k)) in (1..=P).zip(stages) {
                 let (kf_k, kb_k) = (to_t(kf_k), to_t(kb_k));
-                // B_{k-1}(n-t-1), with its trailing 1.
-                let b_prev = older.get(k - 1);
-                let b_full_prev = |i: usize| match (i + 1 == k, b_prev) {
+                // B_{k-1}(n-t-1), with its trailing 1 (`k >= 1`: no wrap).
+                let b_prev = older.get(k.wrapping_sub(1));
+                // `i < P`: `i + 1` cannot wrap.
+                let b_full_prev = |i: usize| match (i.wrapping_add(1) == k, b_prev) {
                     (true, _) => T::ONE,
                     (false, Some(row)) => row.get(i).copied().unwrap_or(T::ZERO),
                     (false, None) => T::ZERO,
