@@ -526,9 +526,10 @@ impl<const P: usize> FixedLattice<P> {
     #[inline(never)]
     fn restart_after_saturation(&mut self, config: &FixedConfig, settled: bool) {
         if settled {
-            let mut before = self.core;
-            before.rewind(&self.undo.kf, &self.undo.kb, self.undo.f_energy_p);
-            if let Some(m) = Self::model_of(&before, self.undo.weight, self.undo.mean, config) {
+            // In place (the state is re-initialised next): no copy of the state on the stack.
+            let u = self.undo;
+            self.core.rewind(&u.kf, &u.kb, u.f_energy_p);
+            if let Some(m) = Self::model_of(&self.core, u.weight, u.mean, config) {
                 self.held = Some(m);
             }
         }
