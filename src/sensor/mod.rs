@@ -236,15 +236,18 @@ const MAX_PACKET: usize = 16;
 impl FifoStats {
     /// Counts a recovery after an outage of `outage_us` microseconds at `rate_hz`.
     pub(crate) fn recovered(&mut self, outage_us: u32, rate_hz: f32) {
-        self.resets += 1;
-        self.lost += libm::round(f64::from(outage_us) * f64::from(rate_hz) * 1e-6) as u64;
+        self.resets = self.resets.saturating_add(1);
+        // `as` saturates (and maps NaN to 0).
+        let lost = libm::round(f64::from(outage_us) * f64::from(rate_hz) * 1e-6) as u64;
+        self.lost = self.lost.saturating_add(lost);
     }
 
     /// Counts an overflow whose reset lost the complete packets in `bytes` bytes of FIFO.
     pub(crate) fn overflow<E>(&mut self, bytes: u16, packet: usize) -> Error<E> {
-        let discarded = bytes / packet as u16;
-        self.overflows += 1;
-        self.discarded += u64::from(discarded);
+        // Clamped as in `drain`: never a division by zero or a truncated packet size.
+        let discarded = bytes / packet.clamp(1, MAX_PACKET) as u16;
+        self.overflows = self.overflows.saturating_add(1);
+        self.discarded = self.discarded.saturating_add(u64::from(discarded));
         Error::FifoOverflow { discarded }
     }
 
@@ -266,7 +269,7 @@ impl FifoStats {
             let n = remaining.min(CHUNK).min(out.len() - delivered);
             let bytes = &mut buf[..n * packet];
             if let Err(e) = read(bytes) {
-                self.discarded += delivered as u64;
+                self.discarded = self.discarded.saturating_add(delivered as u64);
                 return Err(e);
             }
             remaining -= n;
@@ -278,7 +281,7 @@ impl FifoStats {
                             delivered += 1;
                         }
                     }
-                    Packet::Malformed => self.malformed += 1,
+                    Packet::Malformed => self.malformed = self.malformed.saturating_add(1),
                     Packet::End => {
                         remaining = 0;
                         break;
@@ -286,7 +289,7 @@ impl FifoStats {
                 }
             }
         }
-        self.samples += delivered as u64;
+        self.samples = self.samples.saturating_add(delivered as u64);
         Ok(delivered)
     }
 }
