@@ -4,7 +4,7 @@
 //!
 //! The first byte picks the forgetting factor (1 included) and whether the mean is removed;
 //! every further 2 bytes are an `i16` sample `v`, taken as `v / 2048` internal units (the
-//! whole `i16` range, inside the format's +-16).
+//! `i16` range less its bottom value, strictly inside the format's +-16).
 #![no_main]
 
 use imu_ar_host::differential::differential;
@@ -18,7 +18,7 @@ fuzz_target!(|data: &[u8]| {
     let demean = head & 8 != 0;
     let x: Vec<f64> = data
         .chunks_exact(2)
-        .map(|b| f64::from(i16::from_le_bytes([b[0], b[1]])) / 2048.0)
+        .map(|b| f64::from(i16::from_le_bytes([b[0], b[1]]).max(-i16::MAX)) / 2048.0)
         .collect();
     if let Err(why) = differential::<3>(&x, lambda, demean) {
         panic!("lambda {lambda} demean {demean}: {why}");
