@@ -30,7 +30,7 @@ fn main() -> ! {
         |lattice, x| {
             lattice.update(&fixed, x);
         },
-        |mut lattice| lattice.model(&fixed).map_or(f32::NAN, |m| m.a()[0]),
+        |lattice| lattice.model(&fixed).map_or(f32::NAN, |m| m.a()[0]),
     )
 }
 

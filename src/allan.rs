@@ -183,10 +183,10 @@ impl<const L: usize> AllanStream<L> {
     /// returns whether the sample was taken.
     pub fn push<T: Scalar>(&mut self, x: T) -> bool {
         if !x.is_finite() {
-            self.rejected += 1;
+            self.rejected = self.rejected.saturating_add(1);
             return false;
         }
-        self.samples += 1;
+        self.samples = self.samples.saturating_add(1);
         let mut block = x.to_f64();
         let mut size = 1.0;
         for o in self.octaves.iter_mut() {
@@ -194,7 +194,7 @@ impl<const L: usize> AllanStream<L> {
             size *= 2.0;
             if let Some(prev) = o.previous {
                 o.acc += (avg - prev) * (avg - prev);
-                o.count += 1;
+                o.count = o.count.saturating_add(1);
             }
             o.previous = Some(avg);
             match o.pending.take() {

@@ -55,8 +55,8 @@ const ERR_FRAC: u32 = 27;
 const GAMMA_FRAC: u32 = 30;
 const COEF_FRAC: u32 = 29;
 const ENERGY_FRAC: u32 = 40;
-/// The running mean's offset from the first sample.
-const OFFSET_FRAC: u32 = 56;
+/// The running mean, Q56 in an `i64` (range +-128 internal units; the mean stays inside +-16).
+const MEAN_FRAC: u32 = 56;
 /// Energies are floored at 16 LSB (1.5e-11 internal units^2).
 const ENERGY_FLOOR: i64 = 16;
 const TWO_32: f64 = 4_294_967_296.0;
@@ -79,7 +79,8 @@ fn mul_hi(x: i32, y: i32) -> i32 {
 /// `x` is 0 (`n = 31`).
 #[inline(always)]
 fn normalise(x: i32) -> (i32, u32) {
-    let n = (x ^ (x >> 31)).leading_zeros() - 1;
+    // `x ^ (x >> 31)` is non-negative: at least one leading zero, no wrap.
+    let n = (x ^ (x >> 31)).leading_zeros().wrapping_sub(1);
     (x.wrapping_shl(n), n)
 }
 
@@ -89,7 +90,7 @@ fn sat_i32(x: i64, clip: &mut u32) -> i32 {
     match i32::try_from(x) {
         Ok(v) => v,
         Err(_) => {
-            *clip += 1;
+            *clip = clip.saturating_add(1);
             if x < 0 { i32::MIN } else { i32::MAX }
         }
     }
@@ -99,7 +100,7 @@ fn sat_i32(x: i64, clip: &mut u32) -> i32 {
 #[inline(always)]
 fn sat_add(x: i64, y: i64, clip: &mut u32) -> i64 {
     x.checked_add(y).unwrap_or_else(|| {
-        *clip += 1;
+        *clip = clip.saturating_add(1);
         if y < 0 { i64::MIN } else { i64::MAX }
     })
 }
@@ -111,6 +112,16 @@ fn decay(e: i64, lambda: u32) -> i64 {
     let e = e as u64;
     let low = ((e & 0xFFFF_FFFF) * u64::from(lambda) + (1 << 31)) >> 32;
     ((e >> 32) * u64::from(lambda) + low) as i64
+}
+
+/// `y / W` in Q56, for `y` in Q27 and the [`reciprocal`] of a Q40 weight `W >= 1`: one exact
+/// `SMULL` and one rounding shift (relative error about 2^-29), never out of range.
+#[inline(always)]
+fn mean_step(y: i32, (r, lz): (i32, u32)) -> i64 {
+    // y / W = y r 2^(lz - 53 - 27) real = y r 2^(lz - 24) in Q56; W >= 1 (Q40) gives lz <= 23.
+    let s = 24u32.saturating_sub(lz).clamp(1, 24);
+    // |y r| < 2^61: the product and the rounding add stay well inside `i64`.
+    (i64::from(y) * i64::from(r)).wrapping_add(1 << (s - 1)) >> s
 }
 
 /// A positive Q40 energy prepared for division: `(r, lz)` with `1/e_real = r 2^(lz - 53)`,
@@ -128,8 +139,9 @@ fn reciprocal(e: i64) -> (i32, u32) {
         // `(lo >> 1) >> (31 - z)` is `lo >> (32 - z)` without a shift by 32.
         ((hi << z) | ((lo >> 1) >> (31 - z)), z)
     } else {
+        // `lo != 0` here (`e >= 1`), so `z < 32`.
         let z = lo.leading_zeros();
-        (lo << z, 32 + z)
+        (lo.wrapping_shl(z), 32 + z)
     };
     // `| 0x8000` changes nothing (the top bit is set) but proves the divisor non-zero.
     let r0 = (u32::MAX / ((m >> 16) | 0x8000)) << 13; // in (2^29, 2^30]
@@ -155,16 +167,18 @@ fn quotient(
     // q = a b r 2^(na + nb - 64), |q| <= 2^28.
     let q = mul_hi(mul_hi(an, bn), r);
     // a b / e in Q(out) = a b r 2^(lz - 53 - ab_frac + out) = q 2^shift.
-    let shift = (11 + lz + out_frac) as i32 - (ab_frac + na + nb) as i32;
+    // Every term is below 128: the sums and the difference cannot wrap.
+    let shift = (11u32.wrapping_add(lz).wrapping_add(out_frac) as i32)
+        .wrapping_sub(ab_frac.wrapping_add(na).wrapping_add(nb) as i32);
     if shift < 0 {
         // |q| <= 2^28, so anything past 30 gives 0 and the rounded sum fits in 32 bits.
         let t = shift.unsigned_abs().min(30);
-        i64::from((q + (1 << (t - 1))) >> t)
+        i64::from(q.wrapping_add(1 << (t - 1)) >> t)
     } else if shift <= 32 {
         i64::from(q) << shift
     } else {
         if q != 0 {
-            *clip += 1;
+            *clip = clip.saturating_add(1);
         }
         i64::from(q.signum()) * i64::MAX
     }
@@ -376,16 +390,30 @@ impl FixedConfig {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct FixedLattice<const P: usize> {
     core: Core<Q, P>,
-    /// The first sample, Q27.
-    origin: i32,
-    /// Weighted mean of `x - origin`, Q56.
-    offset: i64,
+    /// The weighted running mean, Q56 (held directly: fixed point has the same resolution
+    /// everywhere in its range, so no origin is needed).
+    mean: i64,
     /// `W_n = lambda W_{n-1} + 1`, Q40.
     weight: i64,
     started: bool,
     health: Health,
-    published: Option<ArModel<f32, P>>,
+    /// What the last sample overwrote: enough to rebuild the model from before it.
+    undo: Undo<P>,
+    /// The last good model, kept by a restart: published while `hold` lasts.
+    held: Option<ArModel<f32, P>>,
     hold: u32,
+}
+
+/// The part of the state one sample overwrites that the model is built from: the oldest
+/// reflection coefficients of the ring, `F_P`, the weight and the mean.
+#[derive(Clone, Copy, Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+struct Undo<const P: usize> {
+    kf: [I3F29; P],
+    kb: [I3F29; P],
+    f_energy_p: I24F40,
+    weight: i64,
+    mean: i64,
 }
 
 impl<const P: usize> FixedLattice<P> {
@@ -394,12 +422,18 @@ impl<const P: usize> FixedLattice<P> {
         const { assert!(P > 0, "the model order P must be at least 1") };
         Self {
             core: Self::initial_core(config),
-            origin: 0,
-            offset: 0,
+            mean: 0,
             weight: 0,
             started: false,
             health: Health::default(),
-            published: None,
+            undo: Undo {
+                kf: [I3F29::ZERO; P],
+                kb: [I3F29::ZERO; P],
+                f_energy_p: I24F40::ZERO,
+                weight: 0,
+                mean: 0,
+            },
+            held: None,
             hold: 0,
         }
     }
@@ -417,12 +451,12 @@ impl<const P: usize> FixedLattice<P> {
     /// `|x scale| >= 16` (counted in [`FixedLattice::health`]; the state is unchanged).
     pub fn update(&mut self, config: &FixedConfig, x: f32) -> Option<I5F27> {
         if !x.is_finite() {
-            self.health.non_finite += 1;
+            self.health.non_finite = self.health.non_finite.saturating_add(1);
             return None;
         }
         let bits = f64::from(x) * f64::from(config.scale) * (1u64 << ERR_FRAC) as f64;
         if bits.abs() >= config.limit as f64 {
-            self.health.saturated += 1;
+            self.health.saturated = self.health.saturated.saturating_add(1);
             return None;
         }
         Some(self.accept(config, libm::round(bits) as i32))
@@ -435,30 +469,42 @@ impl<const P: usize> FixedLattice<P> {
         let (lo, hi) = config.count_limit;
         let bits = i32::from(count) << 16;
         if count <= lo || count >= hi || i64::from(bits).abs() >= config.limit {
-            self.health.saturated += 1;
+            self.health.saturated = self.health.saturated.saturating_add(1);
             return None;
         }
         Some(self.accept(config, bits))
     }
 
+    /// One in-range sample `x` (Q27). Any saturation inside (the centred input, an error, an
+    /// energy, a coefficient or the weight) invalidates the state: the lattice restarts and
+    /// keeps the model from before this sample, if it was publishing one.
     fn accept(&mut self, config: &FixedConfig, x: i32) -> I5F27 {
-        self.health.samples += 1;
+        self.health.samples = self.health.samples.saturating_add(1);
+        let settled = self.hold == 0;
         self.hold = self.hold.saturating_sub(1);
+        let (kf, kb) = self.core.next_slot();
+        self.undo = Undo {
+            kf: *kf,
+            kb: *kb,
+            f_energy_p: self.core.f_energy_p,
+            weight: self.weight,
+            mean: self.mean,
+        };
         let mut clip = 0u32;
         let weight = decay(self.weight, config.params.lambda.to_bits());
         self.weight = sat_add(weight, 1 << ENERGY_FRAC, &mut clip);
         let y = if config.demean {
             if !self.started {
-                self.origin = x;
+                self.mean = i64::from(x) << (MEAN_FRAC - ERR_FRAC);
                 self.started = true;
             }
-            let mean =
-                (self.offset + (1 << (OFFSET_FRAC - ERR_FRAC - 1))) >> (OFFSET_FRAC - ERR_FRAC);
-            let y = sat_i32(i64::from(x) - i64::from(self.origin) - mean, &mut clip);
-            // offset += y / W: y times 1 (Q30) over W.
-            let w = reciprocal(self.weight);
-            let step = quotient(y, 1 << 30, ERR_FRAC + 30, w, OFFSET_FRAC, &mut clip);
-            self.offset = sat_add(self.offset, step, &mut clip);
+            // The mean rounded to Q27: `(m / 2^28 + 1) / 2`, no sum that could overflow.
+            let mean = ((self.mean >> (MEAN_FRAC - ERR_FRAC - 1)) + 1) >> 1;
+            // |x| < 2^31 and |mean| < 2^36: the difference is exact in i64.
+            let y = sat_i32(i64::from(x) - mean, &mut clip);
+            self.mean = self
+                .mean
+                .saturating_add(mean_step(y, reciprocal(self.weight)));
             y
         } else {
             x
@@ -466,8 +512,50 @@ impl<const P: usize> FixedLattice<P> {
         let f = self
             .core
             .step(&config.params, I5F27::from_bits(y), &mut clip);
-        self.health.clipped += u64::from(clip);
+        if clip != 0 {
+            self.health.clipped = self.health.clipped.saturating_add(u64::from(clip));
+            self.restart_after_saturation(config, settled);
+        }
         f
+    }
+
+    /// A saturation in the last sample: the model from before it becomes the held one (if the
+    /// lattice was publishing; a restarted lattice still settling keeps what it holds), then a
+    /// restart.
+    #[cold]
+    #[inline(never)]
+    fn restart_after_saturation(&mut self, config: &FixedConfig, settled: bool) {
+        if settled {
+            // In place (the state is re-initialised next): no copy of the state on the stack.
+            let u = self.undo;
+            self.core.rewind(&u.kf, &u.kb, u.f_energy_p);
+            if let Some(m) = Self::model_of(&self.core, u.weight, u.mean, config) {
+                self.held = Some(m);
+            }
+        }
+        self.reset(config);
+    }
+
+    /// The model of a state, if it makes one.
+    fn model_of(
+        core: &Core<Q, P>,
+        weight: i64,
+        mean: i64,
+        config: &FixedConfig,
+    ) -> Option<ArModel<f32, P>> {
+        if weight <= 0 {
+            return None;
+        }
+        let lsb = 1.0 / (1u32 << COEF_FRAC) as f32;
+        let a = core.coefficients(P, |k| k.to_bits() as f32 * lsb)?;
+        let s = f64::from(config.scale);
+        let e = core.f_energy_p.to_bits() as f64;
+        let variance = (e / weight as f64 / (s * s)) as f32;
+        ArModel::new(a, variance, Self::mean_of(mean, config), config.dt).ok()
+    }
+
+    fn mean_of(mean: i64, config: &FixedConfig) -> f32 {
+        (mean as f64 / (1u64 << MEAN_FRAC) as f64 / f64::from(config.scale)) as f32
     }
 
     /// A-priori forward prediction errors `f_1(n)..f_P(n)` of the last accepted sample, in
@@ -509,9 +597,7 @@ impl<const P: usize> FixedLattice<P> {
 
     /// The weighted running mean, in sensor units.
     pub fn mean(&self, config: &FixedConfig) -> f32 {
-        let origin = f64::from(self.origin) / (1u64 << ERR_FRAC) as f64;
-        let offset = self.offset as f64 / (1u64 << OFFSET_FRAC) as f64;
-        ((origin + offset) / f64::from(config.scale)) as f32
+        Self::mean_of(self.mean, config)
     }
 
     /// What happened to the samples so far, including internal saturations (`clipped`).
@@ -526,28 +612,37 @@ impl<const P: usize> FixedLattice<P> {
         self.core.coefficients(m, |k| k.to_bits() as f32 * lsb)
     }
 
-    /// The order-`P` model in sensor units after the last sample (see
-    /// [`Lattice::model`](crate::recursive::Lattice::model)).
-    pub fn model(&mut self, config: &FixedConfig) -> Option<ArModel<f32, P>> {
+    /// The order-`P` model in sensor units after the last sample, or, while a restarted
+    /// lattice settles (`3/(1 - lambda)` samples), the last good model from before the
+    /// restart (`None` if there was none). A state in which anything saturated is never
+    /// published: the lattice restarts instead (see [`FixedLattice::restart`]). Calling this
+    /// changes nothing.
+    pub fn model(&self, config: &FixedConfig) -> Option<ArModel<f32, P>> {
         if self.hold == 0 {
-            let a = self.coefficients(P)?;
-            let variance = self.innovation_variance(config, P)?;
-            let dt = config.dt;
-            if let Ok(m) = ArModel::new(a, variance, self.mean(config), dt) {
-                self.published = Some(m);
-            }
+            Self::model_of(&self.core, self.weight, self.mean, config)
+        } else {
+            self.held
         }
-        self.published
     }
 
-    /// Re-initialises the state (counted as a restart); the last model stays published for
-    /// `3/(1 - lambda)` samples. Fixed-point arithmetic cannot produce a non-finite value, so
-    /// the lattice never does this by itself.
+    /// Re-initialises the state (counted as a restart); the last good model (see
+    /// [`FixedLattice::model`]) stays published for `3/(1 - lambda)` samples. The lattice
+    /// does this by itself when any internal quantity saturates (counted in
+    /// [`Health::clipped`]), keeping the model from before that sample.
     pub fn restart(&mut self, config: &FixedConfig) {
-        self.health.restarts += 1;
+        if self.hold == 0
+            && let Some(m) = Self::model_of(&self.core, self.weight, self.mean, config)
+        {
+            self.held = Some(m);
+        }
+        self.reset(config);
+    }
+
+    /// Counts a restart and re-initialises the state; `held` is left as it is.
+    fn reset(&mut self, config: &FixedConfig) {
+        self.health.restarts = self.health.restarts.saturating_add(1);
         self.core = Self::initial_core(config);
-        self.origin = 0;
-        self.offset = 0;
+        self.mean = 0;
         self.weight = 0;
         self.started = false;
         self.hold = hold_after_restart(config.lambda);

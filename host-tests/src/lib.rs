@@ -6,5 +6,6 @@
 #![deny(missing_docs)]
 
 pub mod data;
+pub mod differential;
 pub mod fixtures;
 pub mod reference;

@@ -161,9 +161,11 @@ fn full_scale_constant_and_alternating_inputs() {
         clipped_after[n / 20_000] = lattice.health().clipped;
     }
     let h = lattice.health();
-    assert_eq!((h.samples, h.saturated, h.restarts), (60_000, 3, 0));
-    // Alternating full scale drives errors past +-16 internal units: saturated and counted.
+    assert_eq!((h.samples, h.saturated), (60_000, 3));
+    // Alternating full scale drives errors past +-16 internal units: saturated, counted, and
+    // the lattice restarts (holding its last good model) rather than publish that state.
     assert!(clipped_after[1] > clipped_after[0], "{clipped_after:?}");
+    assert!(h.restarts > 0, "{h:?}");
     let model = lattice.model(&fixed).unwrap();
     assert!(
         model.a().iter().all(|a| a.is_finite() && a.abs() < 100.0),

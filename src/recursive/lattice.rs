@@ -109,6 +109,23 @@ impl<A: Arith, const P: usize> Core<A, P> {
         &self.ring_kb[self.head % P]
     }
 
+    /// The ring slot the next sample overwrites (`kf`, `kb`): with `F_P`, all that
+    /// [`Core::rewind`] needs to restore the coefficients from before that sample.
+    pub(crate) fn next_slot(&self) -> (&[A::Coef; P], &[A::Coef; P]) {
+        let next = (self.head % P + P - 1) % P;
+        (&self.ring_kf[next], &self.ring_kb[next])
+    }
+
+    /// Undoes the last [`Core::step`] as far as [`Core::coefficients`] and `F_P` are
+    /// concerned, given what [`Core::next_slot`] returned before it and the `F_P` before it.
+    pub(crate) fn rewind(&mut self, kf: &[A::Coef; P], kb: &[A::Coef; P], f_energy_p: A::Energy) {
+        let last = self.head % P;
+        self.ring_kf[last] = *kf;
+        self.ring_kb[last] = *kb;
+        self.head = (last + 1) % P;
+        self.f_energy_p = f_energy_p;
+    }
+
     /// Forward energy of order `m` in `0..=P`.
     pub(crate) fn energy(&self, m: usize) -> Option<A::Energy> {
         if m == P {
@@ -135,7 +152,7 @@ impl<A: Arith, const P: usize> Core<A, P> {
         let mut rows = [[[T::ZERO; P]; P]; 2];
         let mut alpha = [T::ZERO; P];
         for t in (0..m).rev() {
-            let slot = (self.head + t) % P;
+            let slot = (self.head % P + t) % P;
             let (kf, kb) = (&self.ring_kf[slot], &self.ring_kb[slot]);
             alpha = [T::ZERO; P];
             let (first, second) = rows.split_at_mut(1);
@@ -145,11 +162,12 @@ impl<A: Arith, const P: usize> Core<A, P> {
                 (&first[0], &mut second[0])
             };
             let stages = kf.iter().zip(kb).take(m - t);
-            for (k, (&kf_k, &kb_k)) in (1..).zip(stages) {
+            for (k, (&kf_k, &kb_k)) in (1..=P).zip(stages) {
                 let (kf_k, kb_k) = (to_t(kf_k), to_t(kb_k));
-                // B_{k-1}(n-t-1), with its trailing 1.
-                let b_prev = older.get(k - 1);
-                let b_full_prev = |i: usize| match (i + 1 == k, b_prev) {
+                // B_{k-1}(n-t-1), with its trailing 1 (`k >= 1`: no wrap).
+                let b_prev = older.get(k.wrapping_sub(1));
+                // `i < P`: `i + 1` cannot wrap.
+                let b_full_prev = |i: usize| match (i.wrapping_add(1) == k, b_prev) {
                     (true, _) => T::ONE,
                     (false, Some(row)) => row.get(i).copied().unwrap_or(T::ZERO),
                     (false, None) => T::ZERO,

@@ -17,12 +17,19 @@ use crate::Scalar;
 /// the offset (ulp(1) = 1.2e-7 against increments of 4e-7 at `lambda = 0.9999`). Measured on
 /// the ADIS16405 `az` record, order 8, `lambda = 0.9999`: the held-directly mean cost 7.4e-4 in
 /// the coefficients, this form 1.5e-6.
+///
+/// The origin is re-centred on the mean (`x_1 + c` becomes the origin, `c` becomes 0) whenever
+/// `|c|` exceeds `|x_1 + c|`, the mean itself: the offset is then no more precise than the
+/// mean held directly, so the move costs no more than `c`'s own rounding, and it leaves `c`
+/// small against the spread again. Without it a large first sample pins the grid of `c` for
+/// good (a first sample of `1e6` puts `c` on a grid of 0.0625 in `f32`, coarser than any
+/// increment `y_n / W_n`); with it, any start is forgotten as `lambda` says.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct RunningMean<T> {
-    /// `x_1`.
+    /// `x_1`, or the mean at the last re-centring.
     origin: T,
-    /// Weighted mean of `x - x_1`.
+    /// Weighted mean of `x - origin`.
     offset: T,
     weight: WeightSum<T>,
     started: bool,
@@ -62,6 +69,10 @@ impl<T: Scalar> RunningMean<T> {
         let y = (x - self.origin) - self.offset;
         self.weight.push(lambda);
         self.offset += y / self.weight.0;
+        if self.offset.abs() > (self.origin + self.offset).abs() {
+            self.origin += self.offset;
+            self.offset = T::ZERO;
+        }
         y
     }
 }

@@ -265,8 +265,8 @@ impl Health {
 
     pub(crate) fn reject(&mut self, why: Rejection) {
         match why {
-            Rejection::NonFinite => self.non_finite += 1,
-            Rejection::Saturated => self.saturated += 1,
+            Rejection::NonFinite => self.non_finite = self.non_finite.saturating_add(1),
+            Rejection::Saturated => self.saturated = self.saturated.saturating_add(1),
         }
     }
 }
@@ -333,7 +333,7 @@ impl<T: Scalar, const P: usize> Shell<T, P> {
             self.health.reject(why);
             return None;
         }
-        self.health.samples += 1;
+        self.health.samples = self.health.samples.saturating_add(1);
         self.hold = self.hold.saturating_sub(1);
         let lambda = config.lambda();
         let y = if config.demean() {
@@ -348,7 +348,7 @@ impl<T: Scalar, const P: usize> Shell<T, P> {
     /// Counts a restart, forgets the mean and the weight, and holds the snapshot for
     /// `3/(1 - lambda)` samples, at most 30 000.
     pub(crate) fn restart(&mut self, config: &Config<T>) {
-        self.health.restarts += 1;
+        self.health.restarts = self.health.restarts.saturating_add(1);
         self.mean = RunningMean::new();
         self.weight = WeightSum(T::ZERO);
         self.hold = lattice::hold_after_restart(config.lambda().to_f64());

@@ -82,7 +82,7 @@ impl<T: FloatArith, const P: usize> OrderSelector<T, P> {
             self.streak = 0;
         } else {
             self.streak = if best == self.candidate {
-                self.streak + 1
+                self.streak.saturating_add(1)
             } else {
                 1
             };

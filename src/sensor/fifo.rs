@@ -285,10 +285,10 @@ pub(crate) fn read_fifo<C: FifoChip>(
         }
     }
     let stats = &mut chip.state().stats;
-    stats.samples += delivered as u64;
-    stats.invalid += invalid;
-    stats.malformed += malformed;
-    stats.clipped += clipped;
+    stats.samples = stats.samples.saturating_add(delivered as u64);
+    stats.invalid = stats.invalid.saturating_add(invalid);
+    stats.malformed = stats.malformed.saturating_add(malformed);
+    stats.clipped = stats.clipped.saturating_add(clipped);
     Ok(delivered)
 }
 
@@ -349,12 +349,12 @@ fn reset<C: FifoChip>(chip: &mut C) -> Result<(), Error<C::BusError>> {
 fn count_reset(stats: &mut FifoStats, p: PendingReset, packet: usize) -> u16 {
     let bytes = p.consumed.saturating_add(u32::from(p.held));
     let discarded = bytes / u32::try_from(packet.max(1)).unwrap_or(1);
-    stats.discarded += u64::from(discarded);
-    stats.discarded_bytes += u64::from(bytes);
+    stats.discarded = stats.discarded.saturating_add(u64::from(discarded));
+    stats.discarded_bytes = stats.discarded_bytes.saturating_add(u64::from(bytes));
     if p.overflow {
-        stats.overflows += 1;
+        stats.overflows = stats.overflows.saturating_add(1);
     } else if p.resync {
-        stats.resyncs += 1;
+        stats.resyncs = stats.resyncs.saturating_add(1);
     }
     u16::try_from(discarded).unwrap_or(u16::MAX)
 }

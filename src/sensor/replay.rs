@@ -84,8 +84,11 @@ impl ImuReader for Replay<'_> {
         let n = rest.len().min(out.len());
         out[..n].copy_from_slice(&rest[..n]);
         self.next += n;
-        self.stats.samples += n as u64;
-        self.stats.clipped += out[..n].iter().filter(|s| s.clipped()).count() as u64;
+        self.stats.samples = self.stats.samples.saturating_add(n as u64);
+        self.stats.clipped = self
+            .stats
+            .clipped
+            .saturating_add(out[..n].iter().filter(|s| s.clipped()).count() as u64);
         Ok(n)
     }
 
