@@ -36,8 +36,8 @@ pub enum ModelError {
     InvalidGaussMarkov,
     /// The scalar type cannot represent the AR(1) sampling of a Gauss-Markov process: `dt` is
     /// so small against the correlation time that the coefficient nearest to
-    /// `exp(-dt / T_c)` misses `1 - exp(-dt / T_c)` by more than 1 % (see
-    /// [`GaussMarkov::to_ar1`]).
+    /// `exp(-dt / T_c)` misses `1 - exp(-dt / T_c)` by more than 1 %, or the noise variance
+    /// underflows to 0 or overflows (see [`GaussMarkov::to_ar1`]).
     Unrepresentable,
 }
 
@@ -58,7 +58,8 @@ impl fmt::Display for ModelError {
                 f.write_str("Gauss-Markov correlation time and sigma must be positive and finite")
             }
             Self::Unrepresentable => f.write_str(
-                "sample interval too short against the correlation time for this number type",
+                "Gauss-Markov process not representable in this number type (sample interval \
+                 too short against the correlation time, or noise variance out of range)",
             ),
         }
     }
@@ -191,8 +192,12 @@ impl<T: Scalar, const P: usize> ArModel<T, P> {
     ///
     /// # Errors
     ///
-    /// [`ModelError::Unstable`] when the model is not stationary ([`ArModel::is_stable`]).
+    /// [`ModelError::Unstable`] when the model is not stationary ([`ArModel::is_stable`]);
+    /// [`ModelError::NonFinite`] for a NaN or infinite frequency.
     pub fn psd(&self, f: T) -> Result<T, ModelError> {
+        if !f.is_finite() {
+            return Err(ModelError::NonFinite);
+        }
         step_down(&self.a_f64())?;
         let dt = self.dt.to_f64();
         let w = 2.0 * core::f64::consts::PI * f.to_f64() * dt;
@@ -363,7 +368,9 @@ impl<T: Scalar> GaussMarkov<T> {
     ///
     /// [`ModelError::NonPositiveInterval`] or [`ModelError::NonFinite`] for a bad `dt` or `mean`;
     /// [`ModelError::Unrepresentable`] where `T` cannot represent the process, as above
-    /// (including `phi` rounding to 1, which would be a random walk, not this process).
+    /// (including `phi` rounding to 1, which would be a random walk, not this process), and
+    /// where the noise variance `sigma^2 (1 - phi^2)` underflows to 0 or overflows in `T`
+    /// (in `f32`, `sigma` below about `1e-19` or above about `1e19`).
     pub fn to_ar1(&self, dt: T, mean: T) -> Result<ArModel<T, 1>, ModelError> {
         if !dt.is_finite() || !mean.is_finite() {
             return Err(ModelError::NonFinite);
@@ -383,12 +390,13 @@ impl<T: Scalar> GaussMarkov<T> {
             return Err(ModelError::Unrepresentable);
         }
         let s = self.sigma.to_f64();
-        ArModel::new(
-            [phi],
-            T::from_f64(s * s * one_minus * (1.0 + phi.to_f64())),
-            mean,
-            dt,
-        )
+        // The noise variance must be a positive, finite `T`: one that underflows to 0 would
+        // make a noise-free model (stationary variance 0), one that overflows no model.
+        let variance = T::from_f64(s * s * one_minus * (1.0 + phi.to_f64()));
+        if !(variance.is_finite() && variance > T::ZERO) {
+            return Err(ModelError::Unrepresentable);
+        }
+        ArModel::new([phi], variance, mean, dt)
     }
 }
 

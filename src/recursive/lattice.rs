@@ -192,6 +192,21 @@ impl<A: Arith, const P: usize> Core<A, P> {
     }
 }
 
+impl<T: FloatArith, const P: usize> Core<T, P> {
+    /// Halves every energy (the weight of every past sample), keeping the reflection
+    /// coefficients: see [`Shell::weight_full`](super::Shell::weight_full).
+    fn halve_energies(&mut self) {
+        let half = T::from_f64(0.5);
+        self.f_energy_p *= half;
+        for e in self.f_energy.iter_mut().chain(&mut self.b_energy) {
+            *e *= half;
+        }
+        for (r, &b) in self.b_recip.iter_mut().zip(&self.b_energy) {
+            *r = T::recip(b);
+        }
+    }
+}
+
 /// Exponentially weighted least-squares AR estimator of all orders `0..=P` at `O(P)` cost: the
 /// a-priori lattice with error feedback of Ling, Manolakis & Proakis (1986, IEEE Trans. ASSP
 /// 34(4):837-845), as written in numerics.md section 2.1.
@@ -293,6 +308,10 @@ impl<T: FloatArith, const P: usize> Lattice<T, P> {
             self.core = Self::initial_core(config);
             return None;
         }
+        if self.shell.weight_full() {
+            self.core.halve_energies();
+            self.shell.halve_weight();
+        }
         let core = &self.core;
         self.shell
             .refresh(config, core.f_energy_p, || core.coefficients(P, |k| k));
@@ -340,6 +359,8 @@ impl<T: FloatArith, const P: usize> Lattice<T, P> {
 
     /// The weighted number of samples since the start or the last restart,
     /// `W_n = sum_{i<=n} lambda^(n-i)`: `n` at `lambda = 1`, `(1 - lambda^n)/(1 - lambda)` below.
+    /// It stays below `1/(4 EPSILON)` (`2^21` in `f32`): there it is halved with the energies,
+    /// so that both keep their precision (the memory stops growing).
     pub fn weight(&self) -> T {
         self.shell.weight.0
     }

@@ -116,7 +116,12 @@ impl<T: Scalar> Config<T> {
     /// `delta` must lie in `[MIN_POSITIVE / EPSILON, EPSILON / MIN_POSITIVE]` of the scalar
     /// (about `1e-31..1e31` in `f32`, `1e-292..1e292` in `f64`): a smaller one (a subnormal,
     /// say) makes the initial energies `delta lambda^k` lose their precision or their
-    /// reciprocals overflow, so that the recursion breaks down on every sample.
+    /// reciprocals overflow, so that the recursion breaks down on every sample. For the same
+    /// reason the initial energies `delta lambda^k` (`k` up to the order `P`) are held at or
+    /// above that smallest `delta`: a small `delta` with a small `lambda` and a high order
+    /// (`delta lambda^P` below `1e-31` in `f32`) starts from a slightly stronger
+    /// regularisation of the highest lags instead of breaking down. Above it (every
+    /// practical `f64` configuration) the start is exactly the problem's.
     ///
     /// # Errors
     ///
@@ -228,9 +233,14 @@ impl<T: Scalar> Config<T> {
         }
     }
 
-    /// `delta lambda^k`, by `k` multiplications.
+    /// `delta lambda^k`, by `k` multiplications, held at or above `MIN_POSITIVE / EPSILON`
+    /// (the smallest accepted `delta`; see [`Config::new`]).
     pub(crate) fn delta_lambda_pow(&self, k: usize) -> T {
-        (0..k).fold(self.delta, |acc, _| acc * self.lambda)
+        let low = T::MIN_POSITIVE / T::EPSILON;
+        (0..k).fold(self.delta, |acc, _| {
+            let next = acc * self.lambda;
+            if next > low { next } else { low }
+        })
     }
 }
 
@@ -302,16 +312,30 @@ pub(crate) struct Shell<T, const P: usize> {
     hold: u32,
 }
 
+/// The largest weight `W_n` a float estimator lets grow: `1/(4 EPSILON)`, `2^21` in `f32`
+/// (`2^50` in `f64`, never reached). Beyond it `W_n + 1` and `E + e^2` lose their precision
+/// (`W_n` stops at `2^24` in `f32` while the energy keeps growing), so at the limit the weight
+/// and the energies are halved together: the memory of an `f32` estimator at `lambda = 1` stops
+/// growing at about two million samples, and its innovation variance stays right.
+fn weight_limit<T: Scalar>() -> T {
+    T::ONE / (T::from_f64(4.0) * T::EPSILON)
+}
+
 /// Accepted samples between two snapshots of the model an order-`P` float estimator holds
 /// through a restart: `4 P^2`, at least 32, rounded up to a power of two (so that the test on
 /// the sample count is a mask). Making the lattice's coefficients costs `O(P^3/3)`, so the
 /// snapshot adds `O(P/12)` operations per sample on average (with the test, 1 to 7
 /// instructions per stage of the `f32` lattice on a Cortex-M4F, `cargo qemu bench`); for
 /// [`Rls`] and [`Sftf`] it is a copy of `P` coefficients, and no measurable cost.
+/// Saturates for orders too large for the product (`2^63` at most), no panic.
 pub const fn snapshot_interval(p: usize) -> u64 {
-    let quadratic = 4 * (p as u64) * (p as u64);
+    let p = p as u64;
+    let quadratic = p.saturating_mul(p).saturating_mul(4);
     let at_least = if quadratic > 32 { quadratic } else { 32 };
-    at_least.next_power_of_two()
+    match at_least.checked_next_power_of_two() {
+        Some(interval) => interval,
+        None => 1 << 63,
+    }
 }
 
 impl<T: Scalar, const P: usize> Shell<T, P> {
@@ -346,12 +370,29 @@ impl<T: Scalar, const P: usize> Shell<T, P> {
     }
 
     /// Counts a restart, forgets the mean and the weight, and holds the snapshot for
-    /// `3/(1 - lambda)` samples, at most 30 000.
+    /// `3/(1 - lambda)` samples, at most 30 000. A restart while a hold runs does not extend
+    /// it: an estimator restarted again and again (the SFTF on data it cannot follow) still
+    /// publishes its own model, and refreshes its snapshot, once the first hold is over.
     pub(crate) fn restart(&mut self, config: &Config<T>) {
         self.health.restarts = self.health.restarts.saturating_add(1);
         self.mean = RunningMean::new();
         self.weight = WeightSum(T::ZERO);
-        self.hold = lattice::hold_after_restart(config.lambda().to_f64());
+        if self.hold == 0 {
+            self.hold = lattice::hold_after_restart(config.lambda().to_f64());
+        }
+    }
+
+    /// Whether the weight has reached [`weight_limit`]: then the estimator halves its
+    /// energies and calls [`Shell::halve_weight`], so that energy and weight keep growing
+    /// together (at `lambda = 1`, or a `lambda` within `1/weight_limit` of 1).
+    #[inline]
+    pub(crate) fn weight_full(&self) -> bool {
+        self.weight.0 >= weight_limit::<T>()
+    }
+
+    /// Halves the weight `W_n` (with the estimator's energies: see [`Shell::weight_full`]).
+    pub(crate) fn halve_weight(&mut self) {
+        self.weight.0 *= T::from_f64(0.5);
     }
 
     /// `E / W_n`, the innovation variance of an energy; `None` before the first sample.

@@ -77,6 +77,16 @@ impl<T: FloatArith, const P: usize> OrderSelector<T, P> {
             return self.selected;
         }
         self.countdown = self.interval;
+        // One huge sample the lattice accepted (it restarts and recovers) can make a sum
+        // infinite, and `lambda inf` stays infinite: every score would be infinite for good.
+        // Start the sums afresh instead, keeping the selected order.
+        let total = self.pls.iter().fold(self.pls0, |s, &p| s + p);
+        if !total.is_finite() {
+            self.pls = [T::ZERO; P];
+            self.pls0 = T::ZERO;
+            self.streak = 0;
+            return self.selected;
+        }
         let best = self.best(config, lattice);
         if best == self.selected {
             self.streak = 0;

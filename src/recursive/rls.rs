@@ -141,12 +141,23 @@ impl<T: Scalar, const P: usize> Rls<T, P> {
             check += *a + *d;
         }
         // a-posteriori error eps = e lambda / alpha
-        self.energy = lambda * self.energy + e * (e * lambda / alpha);
+        // The same floor as the lattice's and the SFTF's: a stuck sensor keeps a positive
+        // energy instead of one that decays as lambda^n to 0.
+        self.energy = lambda * self.energy + e * (e * lambda / alpha) + config.floor();
         check += self.energy;
         if !(healthy && check.is_finite()) {
             self.shell.restart(config);
             self.initialise(config);
             return None;
+        }
+        if self.shell.weight_full() {
+            // Halving the weight of every past sample halves the energy and doubles `P`.
+            self.energy *= T::from_f64(0.5);
+            for d in &mut self.d {
+                let doubled = *d + *d;
+                *d = if doubled > d_max { d_max } else { doubled };
+            }
+            self.shell.halve_weight();
         }
         self.phi.copy_within(0..P - 1, 1);
         self.phi[0] = y;

@@ -175,6 +175,18 @@ impl<T: Scalar, const P: usize> Sftf<T, P> {
             };
             return None;
         }
+        if self.shell.weight_full() {
+            // Halving the weight of every past sample halves the energies and doubles the
+            // gain `g = R^-1 phi / lambda`, so `1/gamma - 1 = g^T phi` doubles.
+            let half = T::from_f64(0.5);
+            self.alpha *= half;
+            self.beta *= half;
+            for g in &mut self.g {
+                *g = *g + *g;
+            }
+            self.gamma = self.gamma / (T::from_f64(2.0) - self.gamma);
+            self.shell.halve_weight();
+        }
         self.error = e;
         self.backward = (r_f, r_s);
         self.shell.refresh(config, self.alpha, || Some(self.a));
