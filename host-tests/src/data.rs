@@ -90,11 +90,8 @@ fn line_at(source: impl Read, byte: u64) -> Option<u64> {
         after_cr = b == b'\r';
     }
     // Skip the empty and comment lines before the record.
-    loop {
-        let b = match bytes.next() {
-            Some(b) => b.ok()?,
-            None => break,
-        };
+    while let Some(b) = bytes.next() {
+        let b = b.ok()?;
         if b == b'\n' && after_cr {
             after_cr = false;
             continue;
