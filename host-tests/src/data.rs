@@ -2,7 +2,7 @@
 
 use std::fmt;
 use std::fs::File;
-use std::io::{BufRead, BufReader, IsTerminal, Read, Write};
+use std::io::{BufReader, IsTerminal, Read, Write};
 use std::path::{Path, PathBuf};
 
 /// A problem with an input file, for a one-line message `FILE[:LINE]: problem`.
@@ -69,41 +69,85 @@ pub fn parse_column(label: &Path, bytes: &[u8], column: &str) -> Result<Vec<f64>
 }
 
 /// The 1-based line of the record that starts at `byte` of `source` (or at the first line
-/// after it that is neither blank nor a `#` comment): a record's own line, whatever the line
-/// endings (`\r\n` too) and however many blank lines come before it.
+/// after it that is neither empty nor a comment): a record's own line, however many empty or
+/// comment lines come before it.
+///
+/// Lines are counted as the CSV reader ends records: at `\n`, `\r\n` or a lone `\r`; and, as
+/// for the reader, a comment is a line whose first byte is `#` (an indented `#` is a record).
 fn line_at(source: impl Read, byte: u64) -> Option<u64> {
-    let mut reader = BufReader::new(source);
-    let mut head = (&mut reader).take(byte);
-    let mut newlines = 0u64;
-    let mut buf = [0u8; 1 << 16];
-    loop {
-        let n = head.read(&mut buf).ok()?;
-        if n == 0 {
-            break;
+    let mut bytes = BufReader::new(source).bytes();
+    let mut line = 1u64;
+    // Whether the last byte was a '\r' (so that a '\n' after it ends no second line).
+    let mut after_cr = false;
+    for _ in 0..byte {
+        let Some(b) = bytes.next() else {
+            return Some(line);
+        };
+        let b = b.ok()?;
+        if b == b'\r' || (b == b'\n' && !after_cr) {
+            line += 1;
         }
-        newlines += buf[..n].iter().filter(|&&b| b == b'\n').count() as u64;
+        after_cr = b == b'\r';
     }
-    let mut line = Vec::new();
-    loop {
-        line.clear();
-        if reader.read_until(b'\n', &mut line).ok()? == 0 {
-            break;
+    // Skip the empty and comment lines before the record.
+    while let Some(b) = bytes.next() {
+        let b = b.ok()?;
+        if b == b'\n' && after_cr {
+            after_cr = false;
+            continue;
         }
-        let text = line.trim_ascii();
-        if !(text.is_empty() || text.starts_with(b"#")) || !line.ends_with(b"\n") {
-            break;
+        after_cr = false;
+        match b {
+            b'\r' | b'\n' => {
+                after_cr = b == b'\r';
+                line += 1;
+            }
+            b'#' => {
+                // The reader's comment runs to the next '\n' (over any lone '\r', each a
+                // line of its own); a comment without one is no line before a record.
+                let mut ended = false;
+                for c in bytes.by_ref() {
+                    let c = c.ok()?;
+                    if c == b'\r' || (c == b'\n' && !after_cr) {
+                        line += 1;
+                    }
+                    after_cr = c == b'\r';
+                    if c == b'\n' {
+                        ended = true;
+                        break;
+                    }
+                }
+                after_cr = false;
+                if !ended {
+                    break;
+                }
+            }
+            _ => break,
         }
-        newlines += 1;
     }
-    Some(newlines + 1)
+    Some(line)
+}
+
+/// `text` with every control character escaped (`\n`, `\r`, `\t`, `\u{..}`), so that echoed
+/// input keeps an error message on one line.
+pub fn escaped(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        if c.is_control() {
+            out.extend(c.escape_default());
+        } else {
+            out.push(c);
+        }
+    }
+    out
 }
 
 /// A cell as shown in an error: cut to its first 40 characters when it is longer.
 fn shown(cell: &str) -> String {
     const KEEP: usize = 40;
     match cell.char_indices().nth(KEEP) {
-        Some((end, _)) => format!("{}... ({} bytes)", &cell[..end], cell.len()),
-        None => cell.to_string(),
+        Some((end, _)) => format!("{}... ({} bytes)", escaped(&cell[..end]), cell.len()),
+        None => escaped(cell),
     }
 }
 
@@ -166,11 +210,15 @@ fn read_source<T>(
         return Err(error(path, None, "empty file (no header row)"));
     }
     let Some(index) = headers.iter().position(|h| h == column) else {
-        let names: Vec<&str> = headers.iter().collect();
+        let names: Vec<String> = headers.iter().map(shown).collect();
         return Err(error(
             path,
             None,
-            format!("no column '{column}' (columns: {})", names.join(", ")),
+            format!(
+                "no column '{}' (columns: {})",
+                escaped(column),
+                names.join(", ")
+            ),
         ));
     };
     let copies = headers.iter().filter(|h| *h == column).count();

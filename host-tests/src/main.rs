@@ -23,7 +23,7 @@ use std::io::{BufWriter, Write};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use clap::{Args, Parser, Subcommand, ValueEnum};
+use clap::{Args, CommandFactory, Parser, Subcommand, ValueEnum};
 use imu_ar::ArModel;
 use imu_ar::allan::overlapping_avar;
 use imu_ar::batch::criteria::Criterion;
@@ -324,10 +324,11 @@ impl Record {
     fn load(&self, decimate: usize) -> Result<Vec<f64>, Fail> {
         check_order("--order", self.order)?;
         check_decimate(decimate)?;
-        Ok(block_average(
+        decimated(
+            &self.files,
             &read_column(&self.files, &self.column)?,
             decimate,
-        ))
+        )
     }
 }
 
@@ -382,33 +383,93 @@ fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) if !e.use_stderr() => {
-            print!("{e}");
-            return ExitCode::SUCCESS;
+            // Help and version: a closed pipe is a normal end.
+            return write_stdout(&e.to_string());
         }
         Err(e) => {
-            let text = e.to_string();
-            let first = text.lines().next().unwrap_or("invalid arguments");
-            eprintln!("imu-ar: {}", first.trim_start_matches("error: "));
+            let msg = match e.kind() {
+                // The help shown for no arguments at all.
+                clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+                    let command = Cli::command();
+                    let names: Vec<&str> =
+                        command.get_subcommands().map(|c| c.get_name()).collect();
+                    format!(
+                        "a subcommand is required ({}); see imu-ar --help",
+                        names.join(", ")
+                    )
+                }
+                _ => clap_message(&e.to_string()),
+            };
+            eprintln!("imu-ar: {}", one_line(&msg));
             return ExitCode::from(2);
         }
     };
     match run(cli.command) {
-        Ok(out) => {
-            let mut stdout = BufWriter::new(std::io::stdout().lock());
-            if stdout
-                .write_all(out.as_bytes())
-                .and_then(|_| stdout.flush())
-                .is_err()
-            {
-                return ExitCode::FAILURE;
-            }
-            ExitCode::SUCCESS
-        }
+        Ok(out) => write_stdout(&out),
         Err(Fail(msg)) => {
-            eprintln!("imu-ar: {msg}");
+            eprintln!("imu-ar: {}", one_line(&msg));
             ExitCode::from(2)
         }
     }
+}
+
+/// Writes `out` to stdout; a reader that closed the pipe early (`| head`) ends the run
+/// normally (status 0), any other write error is status 1.
+fn write_stdout(out: &str) -> ExitCode {
+    let mut stdout = BufWriter::new(std::io::stdout().lock());
+    match stdout
+        .write_all(out.as_bytes())
+        .and_then(|_| stdout.flush())
+    {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("imu-ar: cannot write to stdout: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// A clap error as one line: its message and details (the missing arguments, a tip), without
+/// the usage and the pointer to `--help`.
+fn clap_message(text: &str) -> String {
+    let mut msg = String::new();
+    // Whether the lines are the items of a list ("...not provided:" and the arguments).
+    let mut list = false;
+    for line in text.lines() {
+        let line = line.trim();
+        if line.starts_with("Usage:") {
+            break;
+        }
+        if line.is_empty() {
+            list = false;
+            continue;
+        }
+        if line.starts_with("For more information") {
+            continue;
+        }
+        let line = line.trim_start_matches("error: ");
+        if msg.ends_with(':') {
+            msg += " ";
+            list = true;
+        } else if list {
+            msg += ", ";
+        } else if !msg.is_empty() {
+            msg += "; ";
+        }
+        msg += line;
+    }
+    if msg.is_empty() {
+        "invalid arguments".into()
+    } else {
+        msg
+    }
+}
+
+/// `text` with its control characters (a newline in an echoed cell, say) escaped, so that an
+/// error stays on one line.
+pub(crate) fn one_line(text: &str) -> String {
+    imu_ar_host::data::escaped(text)
 }
 
 /// Runs a command and returns everything it prints, so that a failure prints nothing.
@@ -448,7 +509,10 @@ fn run(command: Command) -> Result<String, Fail> {
             if let Some(d) = delta {
                 check_delta(d)?;
             }
-            let x = block_average(&read_column(&files, &column)?, decimate);
+            let x = decimated(&files, &read_column(&files, &column)?, decimate)?;
+            if let Some(r) = rate {
+                check_span("--rate", r * decimate as f64, x.len() * decimate)?;
+            }
             let fit = if method.recursive() {
                 let default = delta.is_none();
                 let delta = match delta {
@@ -520,7 +584,7 @@ fn run(command: Command) -> Result<String, Fail> {
                     v["lattice_mse"],
                     v["sftf_mse"],
                     v["sftf_restarts"],
-                    reduction_text(v["reduction_percent"].as_f64().unwrap_or(f64::NAN))
+                    reduction_text(v["reduction_percent"].as_f64())
                 )
             })
         }
@@ -537,6 +601,11 @@ fn run(command: Command) -> Result<String, Fail> {
                 None => None,
             };
             let (x, delta) = run.load()?;
+            check_span(
+                "--rate",
+                rate * run.decimate.max(1) as f64,
+                x.len() * run.decimate.max(1),
+            )?;
             let r = report::Report {
                 x: &x,
                 rate,
@@ -575,6 +644,7 @@ fn run(command: Command) -> Result<String, Fail> {
                 None => rate,
             };
             let x = record.load(decimate)?;
+            check_span("--rate", rate * decimate as f64, x.len() * decimate)?;
             let v = with_order!(record.order, handoff(method, &x, rate, filter_rate))
                 .map_err(|Fail(e)| with_file(&record.files, e))?;
             Ok(if json {
@@ -622,6 +692,7 @@ fn run(command: Command) -> Result<String, Fail> {
                     format!("{} sample(s), at least 2 needed", x.len()),
                 ));
             }
+            check_span("--rate", rate, x.len())?;
             let (mut tau, mut avar) = (Vec::new(), Vec::new());
             let mut m = 1usize;
             while x.len() / 2 >= m {
@@ -656,6 +727,7 @@ fn run(command: Command) -> Result<String, Fail> {
         } => {
             check_order("--a (number of coefficients)", a.len())?;
             let rate = check_rate(rate)?;
+            check_span("--rate", rate, n)?;
             if !(sigma.is_finite() && sigma >= 0.0) {
                 return Err(Fail(format!("--sigma {sigma}: must be finite and >= 0")));
             }
@@ -734,13 +806,39 @@ fn check_lambda(lambda: f64) -> Result<(), Fail> {
     Ok(())
 }
 
+/// A `--delta` that the f64 estimators can carry (the library's range check).
 fn check_delta(delta: f64) -> Result<(), Fail> {
-    if !(delta.is_finite() && delta > 0.0) {
+    Config::<f64>::new(DEFAULT_LAMBDA, delta, 1.0)
+        .map(|_| ())
+        .map_err(|e| Fail(format!("--delta {delta}: {e}")))
+}
+
+/// `rate` (Hz, `flag`) gives finite times over `samples` samples: their span `samples / rate`
+/// and the interval `1 / rate` do not overflow f64.
+fn check_span(flag: &str, rate: f64, samples: usize) -> Result<(), Fail> {
+    let span = samples.max(1) as f64 / rate;
+    if !(span.is_finite() && (1.0 / rate).is_finite()) {
         return Err(Fail(format!(
-            "--delta {delta}: must be positive and finite"
+            "{flag} {rate}: too small, the time of {samples} samples overflows f64"
         )));
     }
     Ok(())
+}
+
+/// `x` averaged in blocks of `m` samples; an error when no sample is left.
+fn decimated(files: &[PathBuf], x: &[f64], m: usize) -> Result<Vec<f64>, Fail> {
+    let y = block_average(x, m);
+    if y.is_empty() {
+        return Err(with_file(
+            files,
+            format!(
+                "--decimate {m}: the record has {} samples, no sample is left after averaging \
+                 blocks of {m}",
+                x.len()
+            ),
+        ));
+    }
+    Ok(y)
 }
 
 /// 0.1 x the variance of the first 1000 samples (what firmware sees at start-up), or 1 when
@@ -773,8 +871,12 @@ fn centre(x: &[f64], demean: bool) -> f64 {
     if n == 0 { 0.0 } else { sum / n as f64 }
 }
 
-/// "x % lower" or "x % higher" for a reduction in percent.
-fn reduction_text(percent: f64) -> String {
+/// "x % lower" or "x % higher" for a reduction in percent ("undefined" without one: a batch
+/// MSE of 0).
+fn reduction_text(percent: Option<f64>) -> String {
+    let Some(percent) = percent else {
+        return "undefined (batch MSE 0)".into();
+    };
     if percent < 0.0 {
         format!("{:.1} % higher", -percent)
     } else {
@@ -1027,6 +1129,17 @@ fn compare<const P: usize>(x: &[f64], lambda: f64, delta: f64, train: f64) -> Re
     }
     let m = n_eval as f64;
     let (batch_mse, rls_mse, lattice_mse) = (batch_se / m, rls_se / m, lattice_se / m);
+    for (name, mse) in [
+        ("batch LS", batch_mse),
+        ("RLS", rls_mse),
+        ("lattice", lattice_mse),
+    ] {
+        if !mse.is_finite() {
+            return Err(Fail(format!(
+                "{name} gives no finite model (no finite prediction error on the evaluation part)"
+            )));
+        }
+    }
     Ok(json!({
         "order": P,
         "lambda": lambda,
@@ -1035,9 +1148,9 @@ fn compare<const P: usize>(x: &[f64], lambda: f64, delta: f64, train: f64) -> Re
         "batch_mse": batch_mse,
         "rls_mse": rls_mse,
         "lattice_mse": lattice_mse,
-        "sftf_mse": sftf_se / sftf_n as f64,
+        "sftf_mse": finite_or_null(sftf_se / sftf_n as f64),
         "sftf_restarts": sftf.health().restarts,
-        "reduction_percent": 100.0 * (batch_mse - lattice_mse) / batch_mse,
+        "reduction_percent": finite_or_null(100.0 * (batch_mse - lattice_mse) / batch_mse),
     }))
 }
 
@@ -1194,14 +1307,25 @@ fn simulate<const P: usize>(sim: &Simulation) -> Result<String, Fail> {
     let at =
         |f: f64| -> [f64; P] { core::array::from_fn(|k| sim.a[k] + f * (sim.a_end[k] - sim.a[k])) };
     // Stationary along the path (checked at 101 points).
+    let mut gain = 1.0f64;
     for i in 0..=100 {
-        let model = ArModel::new(at(i as f64 / 100.0), 1.0, 0.0, 1.0)?;
+        let a = at(i as f64 / 100.0);
+        let model = ArModel::new(a, 1.0, 0.0, 1.0)?;
         if !model.is_stable() {
             return Err(Fail(format!(
                 "--a {:?} / --a-end {:?}: the model is not stationary (a pole on or outside the unit circle)",
                 sim.a, sim.a_end
             )));
         }
+        gain = gain.max(impulse_l1(&a));
+    }
+    // |x| <= sigma x max |w| x sum |h_k|; the polar method's variates stay below 13 in
+    // magnitude, and a margin of 1e3 covers the drift between the checked points.
+    if !(sim.sigma * 13.0 * gain * 1e3).is_finite() {
+        return Err(Fail(format!(
+            "--sigma {}: too large, the simulated process would overflow f64",
+            sim.sigma
+        )));
     }
     let mut rng = ChaCha8Rng::seed_from_u64(sim.seed);
     let mut normal = StandardNormal::new();
@@ -1225,14 +1349,42 @@ fn simulate<const P: usize>(sim: &Simulation) -> Result<String, Fail> {
         out.write_all(b"t_s,x\n")?;
         for i in 0..sim.n {
             let x = step(&at(i as f64 / span), &mut rng);
+            if !x.is_finite() {
+                return Err(std::io::Error::other(format!(
+                    "--sigma {}: too large, the simulated process overflows f64 at sample {i}",
+                    sim.sigma
+                )));
+            }
             writeln!(out, "{},{}", i as f64 / sim.rate, x)?;
         }
         out.flush()
     };
     match write() {
         Ok(()) => Ok(String::new()),
+        Err(e) if e.kind() == std::io::ErrorKind::Other => Err(Fail(e.to_string())),
         // A closed pipe (`| head`) ends the run quietly.
         Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(String::new()),
         Err(e) => Err(Fail(format!("cannot write to stdout: {e}"))),
     }
+}
+
+/// `sum |h_k|` of the impulse response of `x[n] = sum a_k x[n-k] + w[n]` (a stable model),
+/// over its first 100,000 terms.
+fn impulse_l1<const P: usize>(a: &[f64; P]) -> f64 {
+    let mut past = [0.0f64; P];
+    let mut sum = 0.0;
+    for n in 0..100_000 {
+        let h = if n == 0 {
+            1.0
+        } else {
+            a.iter().zip(&past).map(|(a, p)| a * p).sum()
+        };
+        past.rotate_right(1);
+        past[0] = h;
+        sum += f64::abs(h);
+        if n > 10 * P && past.iter().all(|p| p.abs() < 1e-17 * sum) {
+            break;
+        }
+    }
+    sum
 }

@@ -76,9 +76,13 @@ pub fn report<const P: usize>(r: &Report) -> Result<Value, Fail> {
     let mut se = [vec![], vec![], vec![]];
     let mut block = [0.0; 3];
     let mut eval = [0.0; 3];
+    let mut missing = 0usize;
     for (n, &v) in x.iter().enumerate() {
-        let e_rls = rls.update(&config, v).unwrap_or(0.0);
-        let e_lattice = lattice.update(&config, v).unwrap_or(0.0);
+        let (e_rls, e_lattice) = (rls.update(&config, v), lattice.update(&config, v));
+        if n >= n_train && (e_rls.is_none() || e_lattice.is_none()) {
+            missing += 1;
+        }
+        let (e_rls, e_lattice) = (e_rls.unwrap_or(0.0), e_lattice.unwrap_or(0.0));
         let e_batch = if n >= P {
             let past: [f64; P] = core::array::from_fn(|k| x[n - 1 - k]);
             v - train_fit.predict(&past)
@@ -104,6 +108,16 @@ pub fn report<const P: usize>(r: &Report) -> Result<Value, Fail> {
     }
     let m = (x.len() - n_train) as f64;
     let mse = eval.map(|s| s / m);
+    // An estimator that broke down (no error, counted as 0 above, on most samples) is no
+    // result.
+    let finite = rls.model(&config).is_some() && lattice.model(&config).is_some();
+    if !finite || mse.iter().any(|v| !v.is_finite()) || 2 * missing > x.len() - n_train {
+        return Err(Fail(
+            "RLS or the lattice gives no finite model (no finite prediction error on the \
+             evaluation part)"
+                .into(),
+        ));
+    }
 
     let files = [
         coefficients_png::<P>(r, &coef, &train_fit)?,
