@@ -99,6 +99,10 @@ pub struct SimImu {
     len: usize,
     overflow: bool,
     latest: [u8; 14],
+    /// USER_CTRL and PWR_MGMT_1 as last written (the reader reads them back to detect a chip
+    /// reset).
+    user_ctrl: u8,
+    pwr_mgmt_1: u8,
 }
 
 impl SimImu {
@@ -148,6 +152,9 @@ impl SimImu {
             len: 0,
             overflow: false,
             latest: [0; 14],
+            user_ctrl: 0,
+            // Power-on value: SLEEP set, internal oscillator.
+            pwr_mgmt_1: 0x40,
         };
         // Start each drift from its stationary distribution.
         for i in 0..AXES {
@@ -242,18 +249,32 @@ impl SimImu {
                 self.len -= 1;
                 b
             }
+            0x6A => self.user_ctrl,
+            0x6B => self.pwr_mgmt_1,
             0x75 => 0x68,
             _ => 0,
         }
     }
 
     fn write_reg(&mut self, reg: u8, value: u8) {
-        if reg == 0x6A {
-            if value & 0x04 != 0 {
-                self.head = 0;
-                self.len = 0;
+        match reg {
+            0x6A => {
+                if value & 0x04 != 0 {
+                    self.head = 0;
+                    self.len = 0;
+                }
+                self.fifo_enabled = value & 0x40 != 0;
+                // FIFO_RESET clears itself.
+                self.user_ctrl = value & !0x04;
             }
-            self.fifo_enabled = value & 0x40 != 0;
+            // DEVICE_RESET puts the registers at their power-on values (asleep).
+            0x6B if value & 0x80 != 0 => {
+                self.pwr_mgmt_1 = 0x40;
+                self.user_ctrl = 0;
+                self.fifo_enabled = false;
+            }
+            0x6B => self.pwr_mgmt_1 = value,
+            _ => {}
         }
     }
 }
