@@ -60,6 +60,13 @@ const MEAN_FRAC: u32 = 56;
 /// Energies are floored at 16 LSB (1.5e-11 internal units^2).
 const ENERGY_FLOOR: i64 = 16;
 const TWO_32: f64 = 4_294_967_296.0;
+/// The smallest forgetting factor of the fixed-point lattice: below it, a memory of a few
+/// samples at high orders leaves the formats' precision (the differential tests cover
+/// `[0.9, 1]`).
+const FIXED_LAMBDA_MIN: f32 = 0.9;
+/// The largest forgetting factor, `1 - 2^-22` in U0F32: a memory of 4.2 million samples. The
+/// weight `W < 1/(1 - lambda) = 2^22` then fits I24F40 (which holds less than `2^23`).
+const FIXED_LAMBDA_MAX_BITS: u32 = u32::MAX - (1 << 10) + 1;
 
 /// `x y / 2^s` rounded to nearest (ties up), for a constant `s` in `1..=62`: one `SMULL` and
 /// a rounding shift.
@@ -293,7 +300,10 @@ impl FixedConfig {
     /// # Errors
     ///
     /// [`ConfigError::Scale`] unless `scale` is positive and finite and `delta scale^2` is at
-    /// least 1e-9 internal units^2 (far above the energy format's resolution).
+    /// least 1e-9 internal units^2 (far above the energy format's resolution);
+    /// [`ConfigError::FixedLambda`] for `lambda` below 0.9. A `lambda` above `1 - 2^-22`
+    /// (`lambda = 1` included) is taken as `1 - 2^-22`, a memory of 4.2 million samples, so
+    /// that the weight stays inside its format ([`FixedConfig::lambda`] gives the value used).
     ///
     /// ```
     /// use imu_ar::fixed_point::FixedConfig;
@@ -313,8 +323,14 @@ impl FixedConfig {
         if !(1e-9..1e6).contains(&delta) {
             return Err(ConfigError::Scale);
         }
-        // By hand rather than `saturating_from_num`, which has a panic path (for NaN).
-        let lambda = U0F32::from_bits(libm::round(f64::from(config.lambda()) * TWO_32) as u32);
+        if config.lambda() < FIXED_LAMBDA_MIN {
+            return Err(ConfigError::FixedLambda);
+        }
+        // By hand rather than `saturating_from_num`, which has a panic path (for NaN); at most
+        // `1 - 2^-22`, so that the Q40 weight, below `1/(1 - lambda)`, stays inside I24F40.
+        let lambda = U0F32::from_bits(
+            (libm::round(f64::from(config.lambda()) * TWO_32) as u32).min(FIXED_LAMBDA_MAX_BITS),
+        );
         let user_limit = config.saturation().map_or(f64::INFINITY, |l| {
             f64::from(l) * s * (1u64 << ERR_FRAC) as f64
         });
@@ -645,6 +661,9 @@ impl<const P: usize> FixedLattice<P> {
         self.mean = 0;
         self.weight = 0;
         self.started = false;
-        self.hold = hold_after_restart(config.lambda);
+        // A restart during a hold does not extend it (as for the float estimators).
+        if self.hold == 0 {
+            self.hold = hold_after_restart(config.lambda);
+        }
     }
 }

@@ -1,5 +1,5 @@
-//! Edge cases of the fixed-point lattice (issue 22's rework) that break a stated guarantee.
-//! Each test is the minimal failing case of one defect; built in the test profile (overflow
+//! Edge cases of the fixed-point lattice: the hold, the weight at `lambda = 1`, small `lambda`.
+//! Each test is the minimal case of a former defect; built in the test profile (overflow
 //! checks on).
 
 use imu_ar::fixed_point::{FixedConfig, FixedLattice};
@@ -7,7 +7,7 @@ use imu_ar::recursive::Config;
 use imu_ar_host::differential::differential;
 use imu_ar_host::fixtures::ar;
 
-/// Defect: a restart during a hold extends the hold. README ("Reliability"/bad samples, "for
+/// Former defect: a restart during a hold extends the hold. README ("Reliability"/bad samples, "for
 /// every estimator"): "A restart during a hold does not extend it, so an estimator restarted
 /// again and again still publishes a current model once the first hold is over." The fixed
 /// lattice's `reset` sets `hold = 3/(1 - lambda)` on every restart, so saturating again inside
@@ -42,11 +42,14 @@ fn fixed_restart_during_hold_does_not_extend_it() {
     // `if self.hold == 0` keeps it; `FixedLattice::reset` sets it again).
     let now = f.model(&fc).map(|m| *m.a());
     let current = f.coefficients(2);
-    assert_ne!(now, held, "still publishing the held model 40 samples after the first restart");
+    assert_ne!(
+        now, held,
+        "still publishing the held model 40 samples after the first restart"
+    );
     assert_eq!(now, current);
 }
 
-/// Defect: at `lambda = 1` (and any `lambda > 1 - 2^-23`) the Q40 weight `W` saturates after
+/// Former defect: at `lambda = 1` (and any `lambda > 1 - 2^-23`) the Q40 weight `W` saturates after
 /// 2^23 = 8,388,608 samples (I24F40 holds < 8.4e6) whatever the data and the scale: benign,
 /// low-variance data (mean 3, noise 1e-3) restart the lattice (counted as `clipped` and a
 /// restart) every ~8.4M samples (2.3 h at 1 kHz). Nothing documents it (the f32 lattice halves
@@ -69,17 +72,22 @@ fn fixed_lambda_1_weight_does_not_saturate_on_benign_data() {
     assert_eq!((h.clipped, h.restarts), (0, 0), "{h:?}");
 }
 
-/// Defect: `lambda = 0.5` (accepted by `Config`), order 8, no mean removal: 5,000 zeros then
-/// a step to 8 with noise. At sample 5,007 the fixed coefficients are 0.13 from the f64
-/// lattice's (a1 0.994 against 1.122) with no saturation and no restart: a silently wrong
-/// model, against README's "within 0.01 of the f64 lattice, or a counted restart".
-/// (With mean removal the same record is 0.015 off at sample 5,005.)
-/// Expected: within 0.01 or a counted restart.
+/// Former defect: `lambda = 0.5` (accepted by `Config`), order 8, no mean removal: 5,000
+/// zeros then a step to 8 with noise. At sample 5,007 the fixed coefficients were 0.13 from
+/// the f64 lattice's (a1 0.994 against 1.122) with no saturation and no restart.
+/// Now: `FixedConfig` refuses `lambda` below 0.9 (`ConfigError::FixedLambda`), and at the
+/// bottom of its range the same record agrees with the f64 lattice or restarts.
 #[test]
-fn fixed_lambda_half_order_8_matches_f64_or_restarts() {
+fn fixed_small_lambda_is_refused_and_the_range_matches_f64_or_restarts() {
+    let config = Config::new(0.5f32, 0.01, 0.01).unwrap();
+    assert_eq!(
+        FixedConfig::new(&config, 1.0).map(|_| ()),
+        Err(imu_ar::recursive::ConfigError::FixedLambda)
+    );
     let noise = ar([0.5], 1.0, 3000, 7);
     let mut x = vec![0.0; 5000];
     x.extend(noise.iter().map(|v| v * 0.1 + 8.0));
-    assert_eq!(differential::<8>(&x, 0.5, false).map(|_| ()), Ok(()));
+    for demean in [false, true] {
+        assert_eq!(differential::<8>(&x, 0.9, demean).map(|_| ()), Ok(()));
+    }
 }
-

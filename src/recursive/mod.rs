@@ -58,6 +58,8 @@ pub enum ConfigError {
     /// The fixed-point scale is not positive and finite, or makes `delta` vanish in the
     /// energy format.
     Scale,
+    /// The forgetting factor is below the fixed-point lattice's range, `[0.9, 1]`.
+    FixedLambda,
 }
 
 impl fmt::Display for ConfigError {
@@ -71,6 +73,7 @@ impl fmt::Display for ConfigError {
             Self::Interval => "sample interval must be positive and finite",
             Self::Saturation => "saturation limit must be positive",
             Self::Scale => "fixed-point scale must be positive and keep delta representable",
+            Self::FixedLambda => "the fixed-point lattice needs lambda in [0.9, 1]",
         })
     }
 }
