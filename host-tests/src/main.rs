@@ -29,7 +29,7 @@ use imu_ar::allan::overlapping_avar;
 use imu_ar::batch::criteria::Criterion;
 use imu_ar::batch::{BatchConfig, BatchError, Fit, burg, covariance, yule_walker};
 use imu_ar::fixed_point::{FixedConfig, FixedLattice};
-use imu_ar::recursive::{Config, FloatArith, Lattice, Rls, RlsInit, Sftf};
+use imu_ar::recursive::{Config, ConfigError, FloatArith, Lattice, Rls, RlsInit, Sftf};
 use imu_ar::sim::StandardNormal;
 use imu_ar_host::data::{block_average, read_column};
 use kalman::handoff;
@@ -1024,6 +1024,9 @@ fn fixed_fit<const P: usize>(x: &[f64], r: &Recursive, scale: Scale) -> Result<V
     };
     let fixed = FixedConfig::new(&config, scale_value as f32).map_err(|e| {
         let product = r.delta * scale_value * scale_value;
+        if e == ConfigError::FixedLambda {
+            return Fail(format!("--lambda {}: {e}", r.lambda));
+        }
         match scale {
             Scale::Given(s) => Fail(format!(
                 "--scale {s}: {e} (delta x scale^2 = {product:e} must be in [1e-9, 1e6))"

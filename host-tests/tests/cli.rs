@@ -1029,3 +1029,18 @@ fn a_duplicate_column_name_is_an_error() {
     );
     std::fs::remove_file(file).unwrap();
 }
+
+/// The fixed-point lattice's range of `lambda` is `[0.9, 1]`: below it, the error names
+/// `--lambda`, not the scale.
+#[test]
+fn fixed_fit_refuses_a_lambda_below_its_range() {
+    let file = simulated("fixed-lambda.csv", "0.7,-0.2", "2000", "5");
+    let f = file.to_str().unwrap();
+    misused(
+        &[
+            "fit", f, "--column", "x", "--method", "lattice", "--scalar", "fixed", "--order", "2",
+            "--lambda", "0.5",
+        ],
+        "--lambda 0.5: the fixed-point lattice needs lambda in [0.9, 1]",
+    );
+}
