@@ -20,6 +20,20 @@ fn temp_bytes(name: &str, contents: &[u8]) -> PathBuf {
     path
 }
 
+/// `imu-ar fit FILE --column x --method burg --order 1`.
+fn fit_burg(file: &std::path::Path) -> Output {
+    imu_ar(&[
+        "fit",
+        file.to_str().unwrap(),
+        "--column",
+        "x",
+        "--method",
+        "burg",
+        "--order",
+        "1",
+    ])
+}
+
 fn stderr(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()
 }
@@ -57,11 +71,11 @@ fn ar2(name: &str) -> PathBuf {
     temp_bytes(name, &out.stdout)
 }
 
-// Defect: `simulate --sigma 1e308` passes the `--sigma` check (finite) but every sample
+// Formerly: `simulate --sigma 1e308` passes the `--sigma` check (finite) but every sample
 // overflows; it prints `NaN` samples and exits 0. Expected: status 2 naming --sigma (or
 // finite samples).
 #[test]
-fn simulate_huge_sigma_prints_nan() {
+fn simulate_refuses_a_sigma_that_overflows() {
     let out = imu_ar(&[
         "simulate", "--a", "0.9", "--sigma", "1e308", "--n", "5", "--seed", "1",
     ]);
@@ -72,10 +86,10 @@ fn simulate_huge_sigma_prints_nan() {
     }
 }
 
-// Defect: `simulate --rate 1e-320` (subnormal) is accepted; `t_s` becomes `inf` from the second
+// Formerly: `simulate --rate 1e-320` (subnormal) is accepted; `t_s` becomes `inf` from the second
 // row on. Expected: status 2 naming --rate, or finite times.
 #[test]
-fn simulate_subnormal_rate_prints_inf() {
+fn simulate_refuses_a_subnormal_rate() {
     let out = imu_ar(&[
         "simulate", "--a", "0.9", "--sigma", "1", "--n", "3", "--seed", "1", "--rate", "1e-320",
     ]);
@@ -86,11 +100,11 @@ fn simulate_subnormal_rate_prints_inf() {
     }
 }
 
-// Defect: `adev --rate 1e-320` is accepted and every `tau_s` is infinite, printed as `null`
+// Formerly: `adev --rate 1e-320` is accepted and every `tau_s` is infinite, printed as `null`
 // in JSON (and `kalman --rate 1e-308` prints `null` taus and a wrong Allan check). Expected:
 // status 2 naming --rate, or finite taus.
 #[test]
-fn adev_subnormal_rate_gives_infinite_taus() {
+fn adev_refuses_a_subnormal_rate() {
     let file = ar2("adev-rate.csv");
     let out = imu_ar(&[
         "adev",
@@ -111,67 +125,40 @@ fn adev_subnormal_rate_gives_infinite_taus() {
     }
 }
 
-// Defect: CSV errors count only '\n'; with classic Mac '\r' line endings (which the csv
+// Formerly: CSV errors count only '\n'; with classic Mac '\r' line endings (which the csv
 // reader accepts as record terminators) every error says line 1. 'abc' is on line 4.
 #[test]
-fn csv_error_line_with_cr_only_endings() {
+fn csv_error_line_with_cr_only_endings_is_right() {
     let file = temp_bytes("cr.csv", b"x\r1\r2\rabc\r5\r");
-    let out = imu_ar(&[
-        "fit",
-        file.to_str().unwrap(),
-        "--column",
-        "x",
-        "--method",
-        "burg",
-        "--order",
-        "1",
-    ]);
+    let out = fit_burg(&file);
     assert_one_line_failure(&out);
     assert!(stderr(&out).contains("cr.csv:4:"), "{}", stderr(&out));
 }
 
-// Defect: a line whose first non-blank character is '#' but that does not start with '#' is
+// Formerly: a line whose first non-blank character is '#' but that does not start with '#' is
 // a record to the csv reader (only a leading '#' is a comment), but the line locator skips it
 // as a comment and names the next line. '  #c' is on line 3; the error says line 4.
 #[test]
-fn csv_error_line_of_indented_hash_cell() {
+fn csv_error_line_of_an_indented_hash_cell_is_right() {
     let file = temp_bytes("hash.csv", b"x\n1\n  #c\n3\n4\n5\n");
-    let out = imu_ar(&[
-        "fit",
-        file.to_str().unwrap(),
-        "--column",
-        "x",
-        "--method",
-        "burg",
-        "--order",
-        "1",
-    ]);
+    let out = fit_burg(&file);
     assert_one_line_failure(&out);
     assert!(stderr(&out).contains("hash.csv:3:"), "{}", stderr(&out));
 }
 
-// Defect: a quoted cell holding a newline is echoed verbatim, so the error is two lines.
+// Formerly: a quoted cell holding a newline is echoed verbatim, so the error is two lines.
 // Expected: one line (escape or cut the cell).
 #[test]
-fn csv_error_quoted_newline_cell_is_multiline() {
+fn csv_error_with_a_quoted_newline_is_one_line() {
     let file = temp_bytes("qnl.csv", b"x\n\"1\n2\"\n3\n");
-    let out = imu_ar(&[
-        "fit",
-        file.to_str().unwrap(),
-        "--column",
-        "x",
-        "--method",
-        "burg",
-        "--order",
-        "1",
-    ]);
+    let out = fit_burg(&file);
     assert_one_line_failure(&out);
 }
 
-// Defect: "no column" lists the header's names verbatim; a quoted header name with a newline
+// Formerly: "no column" lists the header's names verbatim; a quoted header name with a newline
 // makes the error two lines. Expected: one line.
 #[test]
-fn csv_error_header_with_newline_is_multiline() {
+fn csv_error_with_a_newline_in_the_header_is_one_line() {
     let file = temp_bytes("hnl.csv", b"a,\"x\ny\"\n1,2\n");
     let out = imu_ar(&[
         "fit",
@@ -186,11 +173,11 @@ fn csv_error_header_with_newline_is_multiline() {
     assert_one_line_failure(&out);
 }
 
-// Defect: `compare --delta 1e-320`: RLS and the lattice give no MSE, and the text output says
+// Formerly: `compare --delta 1e-320`: RLS and the lattice give no MSE, and the text output says
 // "lattice against batch: NaN % lower", exit 0. Expected: status 2 (as `fit` says "no finite
 // model"), or no NaN in the output.
 #[test]
-fn compare_tiny_delta_prints_nan() {
+fn compare_refuses_a_tiny_delta() {
     let file = ar2("cmp-delta.csv");
     let out = imu_ar(&[
         "compare",
@@ -209,12 +196,12 @@ fn compare_tiny_delta_prints_nan() {
     }
 }
 
-// Defect: `report --delta 1e-320` exits 0 claiming lattice_mse 0.0, rls_mse 0.0,
+// Formerly: `report --delta 1e-320` exits 0 claiming lattice_mse 0.0, rls_mse 0.0,
 // reduction_percent 100 and lattice_a [-0.0] (a perfect lattice), where `fit` with the same
 // delta says "no finite model". A wrong result that looks fine. Expected: status 2, or MSEs
 // that are not better than the batch fit's on this stationary record.
 #[test]
-fn report_tiny_delta_claims_perfect_lattice() {
+fn report_refuses_a_tiny_delta() {
     let file = ar2("rep-delta.csv");
     let dir = std::env::temp_dir().join(format!("imu-ar-edges-{}-rep", std::process::id()));
     let out = imu_ar(&[
@@ -244,12 +231,12 @@ fn report_tiny_delta_claims_perfect_lattice() {
     }
 }
 
-// Defect: `--decimate` larger than the record leaves 0 samples; the recursive methods then
+// Formerly: `--decimate` larger than the record leaves 0 samples; the recursive methods then
 // say "the variance of the first 1000 samples ... overflows f64 (values of about 1e154 or
 // more)", which is false (the mean of no samples is NaN). Expected: an error about too few
 // samples (as burg says "0 samples given").
 #[test]
-fn decimate_beyond_record_blames_overflow() {
+fn decimate_beyond_the_record_blames_no_overflow() {
     let file = ar2("dec.csv");
     let out = imu_ar(&[
         "fit",
@@ -271,11 +258,11 @@ fn decimate_beyond_record_blames_overflow() {
     );
 }
 
-// Defect: a missing required argument prints only clap's first line, "the following required
+// Formerly: a missing required argument prints only clap's first line, "the following required
 // arguments were not provided:", dropping the names of the arguments. Expected: one line that
 // names the missing argument (--method).
 #[test]
-fn missing_argument_error_names_nothing() {
+fn missing_argument_error_names_the_argument() {
     let file = ar2("miss.csv");
     let out = imu_ar(&[
         "fit",
@@ -289,11 +276,11 @@ fn missing_argument_error_names_nothing() {
     assert!(stderr(&out).contains("--method"), "{}", stderr(&out));
 }
 
-// Defect: `simulate` into a pipe closed early (`| head -c 100`) exits with status 1, though
+// Formerly: `simulate` into a pipe closed early (`| head -c 100`) exits with status 1, though
 // the code means a closed pipe to end the run quietly (status 0): simulate swallows
 // BrokenPipe, then main's flush of the leftover stdout buffer fails.
 #[test]
-fn simulate_closed_pipe_exits_nonzero() {
+fn simulate_into_a_closed_pipe_exits_zero() {
     let mut child = Command::new(env!("CARGO_BIN_EXE_imu-ar"))
         .args([
             "simulate", "--a", "0.5", "--sigma", "1", "--n", "1000000", "--seed", "1",
@@ -329,16 +316,7 @@ fn csv_error_line_with_mixed_endings() {
     ];
     for (name, contents, line) in cases {
         let file = temp_bytes(&format!("{name}.csv"), contents);
-        let out = imu_ar(&[
-            "fit",
-            file.to_str().unwrap(),
-            "--column",
-            "x",
-            "--method",
-            "burg",
-            "--order",
-            "1",
-        ]);
+        let out = fit_burg(&file);
         assert_one_line_failure(&out);
         let expected = format!("{name}.csv:{line}:");
         assert!(stderr(&out).contains(&expected), "{name}: {}", stderr(&out));
