@@ -133,7 +133,7 @@ impl<T: Scalar> Config<T> {
         if !(lambda.is_finite() && lambda > T::ZERO && lambda <= T::ONE) {
             return Err(ConfigError::Lambda);
         }
-        let (low, high) = (T::MIN_POSITIVE / T::EPSILON, T::EPSILON / T::MIN_POSITIVE);
+        let (low, high) = (min_delta::<T>(), T::EPSILON / T::MIN_POSITIVE);
         if !(delta.is_finite() && delta >= low && delta <= high) {
             return Err(ConfigError::Delta);
         }
@@ -239,7 +239,7 @@ impl<T: Scalar> Config<T> {
     /// `delta lambda^k`, by `k` multiplications, held at or above `MIN_POSITIVE / EPSILON`
     /// (the smallest accepted `delta`; see [`Config::new`]).
     pub(crate) fn delta_lambda_pow(&self, k: usize) -> T {
-        let low = T::MIN_POSITIVE / T::EPSILON;
+        let low = min_delta::<T>();
         (0..k).fold(self.delta, |acc, _| {
             let next = acc * self.lambda;
             if next > low { next } else { low }
@@ -313,6 +313,12 @@ pub(crate) struct Shell<T, const P: usize> {
     snapshot: Option<crate::ArModel<T, P>>,
     /// Samples to go before a restarted estimator publishes again.
     hold: u32,
+}
+
+/// The smallest `delta` [`Config::new`] accepts, `MIN_POSITIVE / EPSILON`, and the floor of
+/// the initial energies `delta lambda^k`.
+fn min_delta<T: Scalar>() -> T {
+    T::MIN_POSITIVE / T::EPSILON
 }
 
 /// The largest weight `W_n` a float estimator lets grow: `1/(4 EPSILON)`, `2^21` in `f32`
