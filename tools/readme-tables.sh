@@ -10,6 +10,8 @@
 #
 #   tools/readme-tables.sh            all of them (about 3 minutes)
 #   tools/readme-tables.sh accuracy   one group: accuracy | demo | compare | sftf
+#   tools/readme-tables.sh check-demo FILE   exit 1 when the README's demo-output block differs
+#                                            from the demo output in FILE (CI)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 only=${1:-all}
@@ -62,12 +64,22 @@ if [ "$only" = all ] || [ "$only" = accuracy ]; then
     test_tables fixed "| process |=fixed-accuracy" "| record |=fixed-real"
 fi
 
+# demo_block: the README's demo-output block from the demo's output on stdin.
+demo_block() {
+    echo '```text'
+    grep -E 't=120\.0s|^INFO  check|demo:'
+    echo '```'
+}
+
+if [ "$only" = check-demo ]; then
+    # CI: fail when the block differs from what the demo prints (its output in file $2).
+    demo_block < "${2:?usage: tools/readme-tables.sh check-demo DEMO_OUTPUT}" > "$tmp/demo-output.md"
+    python3 tools/readme.py check demo-output "$tmp/demo-output.md"
+    exit
+fi
+
 if [ "$only" = all ] || [ "$only" = demo ]; then
-    {
-        echo '```text'
-        cargo qemu demo 2>/dev/null | grep -E 't=120\.0s|^INFO  check|demo:'
-        echo '```'
-    } > "$tmp/demo-output.md"
+    cargo qemu demo 2>/dev/null | demo_block > "$tmp/demo-output.md"
     replace demo-output "$tmp/demo-output.md"
     tools/footprint.sh demo > "$tmp/footprint.md"
     replace footprint "$tmp/footprint.md"
