@@ -53,7 +53,7 @@ fn recover_that_fails_part_way_is_finished_by_the_next_one() {
         Err(Error::Bus(_))
     ));
     assert_eq!(imu.read_fifo(&mut out), Err(Error::FifoNotRunning));
-    assert_eq!(imu.recover(&mut NoDelay, 20_000), Ok(()));
+    assert_eq!(imu.recover(&mut NoDelay, 20_000), Ok(0x47));
     sim.borrow_mut().tick(u64::from(icm::GYRO_STARTUP));
     assert_eq!(imu.read_fifo(&mut out), Ok(0));
     expect_samples(&sim, &mut imu, 7);
@@ -159,7 +159,7 @@ fn random_bus_faults_lose_nothing_uncounted() {
     let figures = sim::fault_run(
         &sim,
         &mut imu,
-        |imu, us| imu.recover(&mut NoDelay, us),
+        |imu, us| imu.recover(&mut NoDelay, us).map(|_| ()),
         12,
         0.01,
         100_000,

@@ -13,6 +13,8 @@
 //! Units are typed ([`GyroUnit`], [`AccelUnit`]); the conversion factors are the datasheet
 //! sensitivities of the configured full-scale range.
 
+mod chip;
+mod driver;
 mod fifo;
 mod icm42688;
 mod mpu6050;
@@ -20,8 +22,9 @@ mod replay;
 
 use core::fmt;
 
-pub use icm42688::{Icm42688, Icm42688Config, IcmAccelRange, IcmGyroRange, Odr};
-pub use mpu6050::{AccelRange, Dlpf, GyroRange, Mpu6050, Mpu6050Config};
+pub use driver::Driver;
+pub use icm42688::{Icm42688, Icm42688Bus, Icm42688Config, IcmAccelRange, IcmGyroRange, Odr};
+pub use mpu6050::{AccelRange, Dlpf, GyroRange, Mpu6050, Mpu6050Bus, Mpu6050Config};
 pub use replay::Replay;
 
 /// One six-axis reading in raw counts, in the sensor's axes.
@@ -335,19 +338,6 @@ fn be_i16(b: &[u8], i: usize) -> i16 {
 #[inline]
 fn be_i16x3(b: &[u8], i: usize) -> [i16; 3] {
     [be_i16(b, i), be_i16(b, i + 2), be_i16(b, i + 4)]
-}
-
-/// What a FIFO packet turned out to be.
-pub(crate) enum Packet {
-    /// A sample.
-    Sample(RawSample),
-    /// A packet the chip marked invalid: skipped and counted.
-    Invalid,
-    /// A packet of the wrong layout: skipped and counted.
-    Malformed,
-    /// The chip's "FIFO empty" marker: inside the counted bytes, a damaged header (counted as
-    /// malformed); the batch ends with it.
-    End,
 }
 
 impl FifoStats {
