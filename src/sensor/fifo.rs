@@ -119,11 +119,18 @@ impl FifoState {
         });
     }
 
-    /// A recovery has succeeded after an outage of `outage_us` at `hz / div` samples per
-    /// second.
+    /// A recovery has succeeded after an outage of `outage_us` microseconds at `hz / div`
+    /// samples per second: counts the samples of the outage, rounded to the nearest, and the
+    /// chip reset when one was reported ([`Error::SensorReset`]).
     pub(crate) fn recovered(&mut self, outage_us: u64, hz: u32, div: u32) {
         let chip_reset = core::mem::take(&mut self.reset_seen);
-        self.stats.recovered(chip_reset, outage_us, hz, div);
+        let den = 1_000_000u128 * u128::from(div.max(1));
+        let lost = (u128::from(outage_us) * u128::from(hz) + den / 2) / den;
+        let stats = &mut self.stats;
+        stats.resets = stats.resets.saturating_add(u64::from(chip_reset));
+        stats.lost = stats
+            .lost
+            .saturating_add(u64::try_from(lost).unwrap_or(u64::MAX));
     }
 
     fn mark_overflow(&mut self) {
