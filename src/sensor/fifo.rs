@@ -1,9 +1,9 @@
 //! The FIFO routine shared by the chip readers: overflow detection and handling, whole-packet
 //! reads, and the FIFO reset that realigns the packets after a failed read.
 //!
-//! Each reader implements [`FifoChip`] (its registers) and keeps a [`FifoState`]; the routine
-//! below is the same for every chip. It is written so that a bus error at any transfer leaves
-//! a state from which the next call carries on:
+//! Each chip describes its FIFO registers ([`Chip`], [`Map`](super::chip::Map)) and each reader
+//! keeps a [`FifoState`]; the routine below is the same for every chip. It is written so that a
+//! bus error at any transfer leaves a state from which the next call carries on:
 //!
 //! - "the FIFO should be on" ([`FifoState::wanted`]) is kept apart from "the FIFO is on"
 //!   ([`FifoState::running`]): a recovery or `enable_fifo` that fails part-way leaves the second
@@ -15,7 +15,8 @@
 //!   empties the FIFO: what it drops is counted exactly, and an empty FIFO is first checked
 //!   against a chip reset, so that starting the FIFO again never hides one.
 
-use super::{Error, FifoStats, Packet, RawSample};
+use super::chip::{Chip, Packet};
+use super::{Error, FifoStats, RawSample};
 
 /// Packets read per bus transfer.
 const CHUNK: usize = 8;
@@ -118,11 +119,18 @@ impl FifoState {
         });
     }
 
-    /// A recovery has succeeded after an outage of `outage_us` at `hz / div` samples per
-    /// second.
+    /// A recovery has succeeded after an outage of `outage_us` microseconds at `hz / div`
+    /// samples per second: counts the samples of the outage, rounded to the nearest, and the
+    /// chip reset when one was reported ([`Error::SensorReset`]).
     pub(crate) fn recovered(&mut self, outage_us: u64, hz: u32, div: u32) {
         let chip_reset = core::mem::take(&mut self.reset_seen);
-        self.stats.recovered(chip_reset, outage_us, hz, div);
+        let den = 1_000_000u128 * u128::from(div.max(1));
+        let lost = (u128::from(outage_us) * u128::from(hz) + den / 2) / den;
+        let stats = &mut self.stats;
+        stats.resets = stats.resets.saturating_add(u64::from(chip_reset));
+        stats.lost = stats
+            .lost
+            .saturating_add(u64::try_from(lost).unwrap_or(u64::MAX));
     }
 
     fn mark_overflow(&mut self) {
@@ -132,176 +140,166 @@ impl FifoState {
     }
 }
 
-/// The registers of one chip, as the FIFO routine needs them.
-pub(crate) trait FifoChip {
-    /// The bus's error type.
-    type BusError;
-    /// Bytes per FIFO packet (at most [`MAX_PACKET`]).
-    const PACKET: usize;
-    /// The FIFO's size in bytes: a count at it is an overflow, a count above it no count.
-    const FIFO_BYTES: u16;
-    /// FIFO_COUNT is read a second time before data are read, and the smaller count is used:
-    /// for packets without a header, whose data cannot show a count that was wrong.
-    const CONFIRM_COUNT: bool;
-
-    /// The reader's FIFO bookkeeping.
-    fn state(&mut self) -> &mut FifoState;
-    /// Reads the interrupt status (which clears it): `true` on a FIFO overflow.
-    fn overflow_flag(&mut self) -> Result<bool, Error<Self::BusError>>;
-    /// Reads FIFO_COUNT, in bytes.
-    fn fifo_count(&mut self) -> Result<u16, Error<Self::BusError>>;
-    /// Reads back the FIFO mode after an empty count: `false` when the chip has reset itself.
-    fn fifo_configured(&mut self) -> Result<bool, Error<Self::BusError>>;
-    /// Reads back a register of the chip's configuration that no FIFO reset writes: `true`
-    /// when the chip has reset itself.
-    fn chip_reset(&mut self) -> Result<bool, Error<Self::BusError>>;
-    /// The first write of `enable_fifo`, before the FIFO reset.
-    fn prepare_fifo(&mut self) -> Result<(), Error<Self::BusError>>;
-    /// Takes the channels off the FIFO (and, where needed, the FIFO itself).
-    fn stop_fifo(&mut self) -> Result<(), Error<Self::BusError>>;
-    /// Empties the FIFO, its channels off.
-    fn empty_fifo(&mut self) -> Result<(), Error<Self::BusError>>;
-    /// Starts the FIFO and its channels.
-    fn start_fifo(&mut self) -> Result<(), Error<Self::BusError>>;
-    /// Reads `buf.len()` bytes from the FIFO data register.
-    fn read_data(&mut self, buf: &mut [u8]) -> Result<(), Error<Self::BusError>>;
-    /// Classifies one packet.
-    fn parse(packet: &[u8]) -> Packet;
+/// Bytes per FIFO packet of `C`, kept within 1 ..= [`MAX_PACKET`].
+fn packet<C: Chip>() -> usize {
+    C::MAP.packet.clamp(1, MAX_PACKET)
 }
 
 /// Reads FIFO_COUNT; a count above the FIFO's size is [`Error::BadFifoCount`].
-fn count<C: FifoChip>(chip: &mut C) -> Result<u16, Error<C::BusError>> {
+fn count<C: Chip>(chip: &mut C) -> Result<u16, Error<C::BusError>> {
     let count = chip.fifo_count()?;
-    if count > C::FIFO_BYTES {
+    if count > C::MAP.fifo_bytes {
         return Err(Error::BadFifoCount { count });
     }
     Ok(count)
 }
 
 /// A count read while a reset is pending.
-fn observe<C: FifoChip>(chip: &mut C, count: u16) {
-    let packet = C::PACKET.clamp(1, MAX_PACKET);
-    if let Some(p) = chip.state().pending.as_mut() {
-        p.observe(count, packet);
+fn observe<C: Chip>(state: &mut FifoState, count: u16) {
+    if let Some(p) = state.pending.as_mut() {
+        p.observe(count, packet::<C>());
     }
 }
 
 /// `enable_fifo` of every chip: the chip's first write, then a FIFO reset. A FIFO that an
 /// earlier attempt left running is emptied by it: its samples are counted as discarded, and a
 /// reset still pending (an overflow, a failed read) is counted as done.
-pub(crate) fn enable<C: FifoChip>(chip: &mut C) -> Result<(), Error<C::BusError>> {
-    let state = chip.state();
+pub(crate) fn enable<C: Chip>(
+    chip: &mut C,
+    state: &mut FifoState,
+) -> Result<(), Error<C::BusError>> {
     if !state.initialised {
         return Err(Error::NotInitialised);
     }
     state.wanted = true;
     state.running = false;
     state.pending.get_or_insert_with(PendingReset::default);
-    chip.prepare_fifo()?;
-    reset(chip)?;
-    let state = chip.state();
+    chip.write_all(C::MAP.fifo_prepare)?;
+    reset(chip, state)?;
     state.running = true;
     if let Some(p) = state.pending.take() {
-        count_reset(&mut state.stats, p, C::PACKET.clamp(1, MAX_PACKET));
+        count_reset(&mut state.stats, p, packet::<C>());
     }
     Ok(())
 }
 
 /// `ImuReader::read_fifo` of every chip; see the readers' documentation.
-pub(crate) fn read_fifo<C: FifoChip>(
+pub(crate) fn read_fifo<C: Chip>(
     chip: &mut C,
+    state: &mut FifoState,
     out: &mut [RawSample],
 ) -> Result<usize, Error<C::BusError>> {
-    let packet = C::PACKET.clamp(1, MAX_PACKET);
-    let state = chip.state();
+    let packet = packet::<C>();
     if !state.wanted {
         return Err(Error::FifoDisabled);
     }
     if !state.running {
         return Err(Error::FifoNotRunning);
     }
-    if chip.overflow_flag()? {
-        chip.state().mark_overflow();
+    if chip.read_u8(C::MAP.int_status)? & C::MAP.int_fifo_overflow != 0 {
+        state.mark_overflow();
     }
     let first = count(chip)?;
-    observe(chip, first);
+    observe::<C>(state, first);
     // The count the data are read by, and the latest count, which the bytes of a failed read
     // are reckoned from.
     let (mut readable, mut latest) = (first, first);
-    if C::CONFIRM_COUNT && usize::from(first) >= packet && chip.state().pending.is_none() {
+    if C::MAP.confirm_count && usize::from(first) >= packet && state.pending.is_none() {
         latest = count(chip)?;
         readable = readable.min(latest);
     }
-    if latest >= C::FIFO_BYTES {
+    if latest >= C::MAP.fifo_bytes {
         // A full FIFO overwrites its oldest bytes: its packets are no longer aligned.
-        chip.state().mark_overflow();
+        state.mark_overflow();
     }
-    if chip.state().pending.is_some() {
-        return finish_reset(chip);
+    if state.pending.is_some() {
+        return finish_reset(chip, state);
     }
     let available = usize::from(readable) / packet;
     if available == 0 {
         // An empty FIFO may be a chip that reset itself: its FIFO is then off.
-        return if chip.fifo_configured()? {
+        return if chip.check(C::MAP.fifo_on)? {
             Ok(0)
         } else {
-            chip.state().reset_seen = true;
+            state.reset_seen = true;
             Err(Error::SensorReset)
         };
     }
     let mut buf = [0u8; MAX_PACKET * CHUNK];
-    let (mut remaining, mut delivered) = (available, 0usize);
-    let (mut taken, mut invalid, mut malformed, mut clipped) = (0usize, 0u64, 0u64, 0u64);
-    while remaining > 0 && delivered < out.len() {
-        let n = remaining.min(CHUNK).min(out.len() - delivered);
+    let mut batch = Batch::default();
+    let (mut remaining, mut taken) = (available, 0usize);
+    while remaining > 0 && batch.delivered < out.len() {
+        let n = remaining.min(CHUNK).min(out.len() - batch.delivered);
         let bytes = &mut buf[..n * packet];
-        if let Err(e) = chip.read_data(bytes) {
-            resync(chip, latest, taken, n * packet);
-            return match finish_reset(chip) {
-                Err(Error::Bus(_)) => Err(e),
+        if let Err(e) = chip.read(C::MAP.fifo_data, bytes) {
+            resync(chip, state, latest, taken, n * packet);
+            return match finish_reset(chip, state) {
+                Err(Error::Bus(_)) => Err(Error::Bus(e)),
                 other => other,
             };
         }
         taken += n * packet;
         remaining -= n;
-        for p in bytes.chunks_exact(packet) {
+        if batch.parse::<C>(bytes, out) {
+            remaining = 0;
+        }
+    }
+    batch.count(&mut state.stats);
+    Ok(batch.delivered)
+}
+
+/// The packets of one `read_fifo`.
+#[derive(Default)]
+struct Batch {
+    delivered: usize,
+    invalid: u64,
+    malformed: u64,
+    clipped: u64,
+}
+
+impl Batch {
+    /// Parses the packets in `bytes` into `out`, after the samples already delivered. Returns
+    /// `true` when one of them ends the batch.
+    fn parse<C: Chip>(&mut self, bytes: &[u8], out: &mut [RawSample]) -> bool {
+        let mut end = false;
+        for p in bytes.chunks_exact(packet::<C>()) {
             match C::parse(p) {
                 Packet::Sample(s) => {
-                    if let Some(slot) = out.get_mut(delivered) {
-                        clipped += u64::from(s.clipped());
+                    if let Some(slot) = out.get_mut(self.delivered) {
+                        self.clipped += u64::from(s.clipped());
                         *slot = s;
-                        delivered += 1;
+                        self.delivered += 1;
                     }
                 }
-                Packet::Invalid => invalid += 1,
-                Packet::Malformed => malformed += 1,
+                Packet::Invalid => self.invalid += 1,
+                Packet::Malformed => self.malformed += 1,
                 Packet::End => {
                     // The "FIFO empty" marker inside the counted bytes: a damaged header. The
                     // packets after it in this transfer are parsed; the batch ends with it.
-                    malformed += 1;
-                    remaining = 0;
+                    self.malformed += 1;
+                    end = true;
                 }
             }
         }
+        end
     }
-    let stats = &mut chip.state().stats;
-    stats.samples = stats.samples.saturating_add(delivered as u64);
-    stats.invalid = stats.invalid.saturating_add(invalid);
-    stats.malformed = stats.malformed.saturating_add(malformed);
-    stats.clipped = stats.clipped.saturating_add(clipped);
-    Ok(delivered)
+
+    /// Adds the batch to `stats`.
+    fn count(&self, stats: &mut FifoStats) {
+        stats.samples = stats.samples.saturating_add(self.delivered as u64);
+        stats.invalid = stats.invalid.saturating_add(self.invalid);
+        stats.malformed = stats.malformed.saturating_add(self.malformed);
+        stats.clipped = stats.clipped.saturating_add(self.clipped);
+    }
 }
 
 /// A data read of `len` bytes failed with `latest` bytes in the FIFO at the last count and
 /// `taken` of them read before: decides a reset, and learns from FIFO_COUNT how many bytes the
 /// failed transfer clocked out. Without a count, the first count read later (before the FIFO
 /// is emptied) settles it.
-fn resync<C: FifoChip>(chip: &mut C, latest: u16, taken: usize, len: usize) {
+fn resync<C: Chip>(chip: &mut C, state: &mut FifoState, latest: u16, taken: usize, len: usize) {
     let taken = u16::try_from(taken).unwrap_or(u16::MAX).min(latest);
-    let pending = chip
-        .state()
-        .pending
-        .get_or_insert_with(PendingReset::default);
+    let pending = state.pending.get_or_insert_with(PendingReset::default);
     pending.resync = true;
     pending.consumed = pending.consumed.saturating_add(u32::from(taken));
     pending.unresolved = Some(Unresolved {
@@ -311,7 +309,7 @@ fn resync<C: FifoChip>(chip: &mut C, latest: u16, taken: usize, len: usize) {
     for _ in 0..COUNT_TRIES {
         match count(chip) {
             Ok(c) => {
-                observe(chip, c);
+                observe::<C>(state, c);
                 break;
             }
             Err(Error::BadFifoCount { .. }) => break,
@@ -323,25 +321,25 @@ fn resync<C: FifoChip>(chip: &mut C, latest: u16, taken: usize, len: usize) {
 /// The FIFO reset: channels off, the count of what it drops (stable now), a check that the
 /// chip has not reset itself when the FIFO is empty, then empty and start. Every step can be
 /// repeated: after a failure the whole sequence is simply run again.
-fn reset<C: FifoChip>(chip: &mut C) -> Result<(), Error<C::BusError>> {
-    chip.stop_fifo()?;
+fn reset<C: Chip>(chip: &mut C, state: &mut FifoState) -> Result<(), Error<C::BusError>> {
+    chip.write_all(C::MAP.fifo_stop)?;
     let held = count(chip)?;
-    observe(chip, held);
-    if held == 0 && chip.chip_reset()? {
+    observe::<C>(state, held);
+    if held == 0 && !chip.check(C::MAP.configured)? {
         // A chip that reset itself: starting its FIFO would hide the reset (the FIFO would
         // look configured, and stay empty).
-        chip.state().reset_seen = true;
+        state.reset_seen = true;
         return Err(Error::SensorReset);
     }
-    let emptied = chip.empty_fifo();
+    let emptied = chip.write_all(C::MAP.fifo_empty);
     if emptied.is_ok()
-        && let Some(p) = chip.state().pending.as_mut()
+        && let Some(p) = state.pending.as_mut()
     {
         p.consumed = p.consumed.saturating_add(u32::from(p.held));
         p.held = 0;
     }
     emptied?;
-    chip.start_fifo()
+    chip.write_all(C::MAP.fifo_start)
 }
 
 /// Counts a reset that has been carried out: its bytes as discarded, its cause. Returns the
@@ -361,14 +359,12 @@ fn count_reset(stats: &mut FifoStats, p: PendingReset, packet: usize) -> u16 {
 
 /// Carries out the pending reset and counts it: [`Error::FifoOverflow`] or
 /// [`Error::FifoResync`]; a bus error keeps it pending.
-fn finish_reset<C: FifoChip>(chip: &mut C) -> Result<usize, Error<C::BusError>> {
-    let packet = C::PACKET.clamp(1, MAX_PACKET);
-    reset(chip)?;
-    let state = chip.state();
+fn finish_reset<C: Chip>(chip: &mut C, state: &mut FifoState) -> Result<usize, Error<C::BusError>> {
+    reset(chip, state)?;
     let Some(p) = state.pending.take() else {
         return Ok(0);
     };
-    let discarded = count_reset(&mut state.stats, p, packet);
+    let discarded = count_reset(&mut state.stats, p, packet::<C>());
     if p.overflow {
         Err(Error::FifoOverflow { discarded })
     } else {

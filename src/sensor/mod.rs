@@ -12,7 +12,14 @@
 //!
 //! Units are typed ([`GyroUnit`], [`AccelUnit`]); the conversion factors are the datasheet
 //! sensitivities of the configured full-scale range.
+//!
+//! The two chip readers are one [`Driver`]: [`Mpu6050`] and [`Icm42688`] name it over each
+//! chip on its bus ([`Mpu6050Bus`], [`Icm42688Bus`]), whose registers, write sequences and
+//! packet layout are all that differs. `init`, `recover`, `enable_fifo` and the FIFO routine
+//! (overflow, resync after a failed read, chip-reset detection) are written once.
 
+mod chip;
+mod driver;
 mod fifo;
 mod icm42688;
 mod mpu6050;
@@ -20,8 +27,9 @@ mod replay;
 
 use core::fmt;
 
-pub use icm42688::{Icm42688, Icm42688Config, IcmAccelRange, IcmGyroRange, Odr};
-pub use mpu6050::{AccelRange, Dlpf, GyroRange, Mpu6050, Mpu6050Config};
+pub use driver::Driver;
+pub use icm42688::{Icm42688, Icm42688Bus, Icm42688Config, IcmAccelRange, IcmGyroRange, Odr};
+pub use mpu6050::{AccelRange, Dlpf, GyroRange, Mpu6050, Mpu6050Bus, Mpu6050Config};
 pub use replay::Replay;
 
 /// One six-axis reading in raw counts, in the sensor's axes.
@@ -335,31 +343,4 @@ fn be_i16(b: &[u8], i: usize) -> i16 {
 #[inline]
 fn be_i16x3(b: &[u8], i: usize) -> [i16; 3] {
     [be_i16(b, i), be_i16(b, i + 2), be_i16(b, i + 4)]
-}
-
-/// What a FIFO packet turned out to be.
-pub(crate) enum Packet {
-    /// A sample.
-    Sample(RawSample),
-    /// A packet the chip marked invalid: skipped and counted.
-    Invalid,
-    /// A packet of the wrong layout: skipped and counted.
-    Malformed,
-    /// The chip's "FIFO empty" marker: inside the counted bytes, a damaged header (counted as
-    /// malformed); the batch ends with it.
-    End,
-}
-
-impl FifoStats {
-    /// Counts a recovery after an outage of `outage_us` microseconds at `hz / div` samples per
-    /// second, rounded to the nearest sample; `chip_reset` when it followed
-    /// [`Error::SensorReset`].
-    pub(crate) fn recovered(&mut self, chip_reset: bool, outage_us: u64, hz: u32, div: u32) {
-        let den = 1_000_000u128 * u128::from(div.max(1));
-        let lost = (u128::from(outage_us) * u128::from(hz) + den / 2) / den;
-        self.resets = self.resets.saturating_add(u64::from(chip_reset));
-        self.lost = self
-            .lost
-            .saturating_add(u64::try_from(lost).unwrap_or(u64::MAX));
-    }
 }

@@ -1,78 +1,138 @@
 //! InvenSense MPU-6050 over I2C. The MPU-6500 and MPU-9250 answer the same protocol but differ
 //! in their temperature formula, in how SMPLRT_DIV applies with the 260 Hz filter and in their
 //! accelerometer filter register (ACCEL_CONFIG2, 0x1D): they are rejected with
-//! [`Error::UnsupportedDevice`] rather than handled with MPU-6050 formulas.
+//! [`Error::UnsupportedDevice`](super::Error::UnsupportedDevice) rather than handled with
+//! MPU-6050 formulas.
 //!
 //! Registers, bits and scale factors from "MPU-6000 and MPU-6050 Register Map and
 //! Descriptions", RM-MPU-6000A-00 revision 4.2 (register numbers below), and "MPU-6000 and
 //! MPU-6050 Product Specification", PS-MPU-6000A-00 revision 3.4, sections 6.1 (gyro
 //! sensitivity) and 6.2 (accelerometer sensitivity).
 
-use embedded_hal::delay::DelayNs;
 use embedded_hal::i2c::I2c;
 
-use super::fifo::{self, FifoChip, FifoState};
-use super::{Error, FifoStats, ImuReader, Packet, RawSample, Scale, be_i16, be_i16x3};
+use super::chip::{Check, Chip, Map, Packet, Write};
+use super::driver::Driver;
+use super::{RawSample, Scale, be_i16, be_i16x3};
 
 /// Register 25, SMPLRT_DIV: sample rate = gyro output rate / (1 + SMPLRT_DIV).
 const SMPLRT_DIV: u8 = 0x19;
-/// Register 26, CONFIG: DLPF_CFG in bits 2:0.
+
+/// Register 26, CONFIG: DLPF_CFG in bits 2:0 ([`Dlpf::dlpf_cfg`]).
 const CONFIG: u8 = 0x1A;
-/// Register 27, GYRO_CONFIG: FS_SEL in bits 4:3.
+
+/// Register 27, GYRO_CONFIG.
 const GYRO_CONFIG: u8 = 0x1B;
-/// Register 28, ACCEL_CONFIG: AFS_SEL in bits 4:3.
+/// GYRO_CONFIG: FS_SEL in bits 4:3 ([`GyroRange::fs_sel`]).
+const FS_SEL_SHIFT: u8 = 3;
+
+/// Register 28, ACCEL_CONFIG.
 const ACCEL_CONFIG: u8 = 0x1C;
-/// Register 35, FIFO_EN: XG (6), YG (5), ZG (4), ACCEL (3).
+/// ACCEL_CONFIG: AFS_SEL in bits 4:3 ([`AccelRange::afs_sel`]).
+const AFS_SEL_SHIFT: u8 = 3;
+
+/// Register 35, FIFO_EN: the channels written into the FIFO.
 const FIFO_EN: u8 = 0x23;
-/// Register 56, INT_ENABLE: FIFO_OFLOW_EN in bit 4.
+/// FIFO_EN: XG_FIFO_EN, bit 6.
+const XG_FIFO_EN: u8 = 0x40;
+/// FIFO_EN: YG_FIFO_EN, bit 5.
+const YG_FIFO_EN: u8 = 0x20;
+/// FIFO_EN: ZG_FIFO_EN, bit 4.
+const ZG_FIFO_EN: u8 = 0x10;
+/// FIFO_EN: ACCEL_FIFO_EN, bit 3.
+const ACCEL_FIFO_EN: u8 = 0x08;
+/// Each FIFO packet is accel x, y, z then gyro x, y, z (register order).
+const ACCEL_GYRO_FIFO_EN: u8 = XG_FIFO_EN | YG_FIFO_EN | ZG_FIFO_EN | ACCEL_FIFO_EN;
+
+/// Register 56, INT_ENABLE.
 const INT_ENABLE: u8 = 0x38;
-/// Register 58, INT_STATUS: FIFO_OFLOW_INT in bit 4, cleared by reading.
+/// INT_ENABLE: FIFO_OFLOW_EN, bit 4.
+const FIFO_OFLOW_EN: u8 = 0x10;
+
+/// Register 58, INT_STATUS, cleared by reading.
 const INT_STATUS: u8 = 0x3A;
+/// INT_STATUS: FIFO_OFLOW_INT, bit 4.
+const FIFO_OFLOW_INT: u8 = 0x10;
+
 /// Registers 59-72: ACCEL_XOUT_H .. GYRO_ZOUT_L, big-endian, temperature at 65-66.
 const ACCEL_XOUT_H: u8 = 0x3B;
-/// Register 106, USER_CTRL: FIFO_EN (6), FIFO_RESET (2).
+
+/// Register 106, USER_CTRL.
 const USER_CTRL: u8 = 0x6A;
-/// Register 107, PWR_MGMT_1: DEVICE_RESET (7), SLEEP (6), CLKSEL (2:0).
+/// USER_CTRL: FIFO_EN, bit 6.
+const USER_CTRL_FIFO_EN: u8 = 0x40;
+/// USER_CTRL: FIFO_RESET, bit 2 (self-clearing; resets the FIFO "while FIFO_EN equals 0").
+const FIFO_RESET: u8 = 0x04;
+
+/// Register 107, PWR_MGMT_1.
 const PWR_MGMT_1: u8 = 0x6B;
+/// PWR_MGMT_1: DEVICE_RESET, bit 7.
+const DEVICE_RESET: u8 = 0x80;
+/// PWR_MGMT_1: SLEEP, bit 6 (set at power-on).
+const SLEEP: u8 = 0x40;
+/// PWR_MGMT_1: CLKSEL, bits 2:0 (0 at power-on: the internal oscillator).
+const CLKSEL: u8 = 0x07;
+/// PWR_MGMT_1: CLKSEL = 1, the PLL with the X-gyro reference (and SLEEP clear: awake).
+const CLKSEL_PLL_XGYRO: u8 = 0x01;
+
 /// Registers 114-115, FIFO_COUNTH/L: bytes in the FIFO, big-endian.
 const FIFO_COUNTH: u8 = 0x72;
+
 /// Register 116, FIFO_R_W.
 const FIFO_R_W: u8 = 0x74;
+
 /// Register 117, WHO_AM_I.
 const WHO_AM_I: u8 = 0x75;
+/// WHO_AM_I of the MPU-6050.
+const MPU6050_ID: u8 = 0x68;
+/// WHO_AM_I of the MPU-6500 and MPU-9250: recognised, and rejected.
+const MPU6500_MPU9250_IDS: [u8; 2] = [0x70, 0x71];
 
-/// INT_STATUS and INT_ENABLE: FIFO_OFLOW_INT / FIFO_OFLOW_EN.
-const INT_FIFO_OFLOW: u8 = 1 << 4;
-/// USER_CTRL: FIFO_EN.
-const USER_CTRL_FIFO_EN: u8 = 1 << 6;
-/// USER_CTRL: FIFO_RESET (self-clearing; resets the FIFO "while FIFO_EN equals 0").
-const USER_CTRL_FIFO_RESET: u8 = 1 << 2;
-/// PWR_MGMT_1: DEVICE_RESET.
-const PWR_DEVICE_RESET: u8 = 1 << 7;
-/// PWR_MGMT_1: awake (SLEEP clear), clock from the X-gyro PLL (CLKSEL = 1).
-const PWR_CLK_PLL_X: u8 = 0x01;
-/// PWR_MGMT_1: SLEEP and CLKSEL, compared with [`PWR_CLK_PLL_X`] to detect a chip reset (its
-/// power-on value is SLEEP set, CLKSEL 0).
-const PWR_SLEEP_CLKSEL: u8 = 0x47;
-/// FIFO_EN: XG_FIFO_EN.
-const FIFO_EN_XG: u8 = 1 << 6;
-/// FIFO_EN: YG_FIFO_EN.
-const FIFO_EN_YG: u8 = 1 << 5;
-/// FIFO_EN: ZG_FIFO_EN.
-const FIFO_EN_ZG: u8 = 1 << 4;
-/// FIFO_EN: ACCEL_FIFO_EN.
-const FIFO_EN_ACCEL: u8 = 1 << 3;
-/// Each FIFO packet is accel x, y, z then gyro x, y, z (register order).
-const FIFO_EN_ACCEL_GYRO: u8 = FIFO_EN_XG | FIFO_EN_YG | FIFO_EN_ZG | FIFO_EN_ACCEL;
 /// Bytes per FIFO packet with accelerometer and gyro enabled.
 const PACKET: usize = 12;
 /// FIFO size (register map, FIFO_COUNT: 1024 bytes).
 const FIFO_BYTES: u16 = 1024;
+/// The wait after DEVICE_RESET (the register map's reset sequence waits 100 ms).
+const RESET_MS: u32 = 100;
 
-/// WHO_AM_I of the MPU-6050.
-const MPU6050_ID: u8 = 0x68;
-/// WHO_AM_I of the MPU-6500 and MPU-9250: recognised, and rejected.
-const UNSUPPORTED_IDS: [u8; 2] = [0x70, 0x71];
+/// The chip reset.
+const CHIP_RESET: Write = (PWR_MGMT_1, DEVICE_RESET);
+/// The configuration writes need no wait.
+const NO_SETTLE: u32 = 0;
+
+/// `enable_fifo` first enables the overflow flag.
+const OVERFLOW_FLAG_ON: &[Write] = &[(INT_ENABLE, FIFO_OFLOW_EN)];
+/// The channels are taken off the FIFO before it is reset, as ArduPilot does
+/// (libraries/AP_InertialSensor/AP_InertialSensor_Invensense.cpp,
+/// `AP_InertialSensor_Invensense::_fifo_reset`: FIFO_EN = 0, USER_CTRL without FIFO_EN,
+/// USER_CTRL | FIFO_RESET, USER_CTRL | FIFO_EN, then the FIFO_EN channels), and as the
+/// register map requires of USER_CTRL (FIFO_RESET "resets the FIFO buffer when set to 1 while
+/// FIFO_EN equals 0"). With the channels off first, nothing enters the FIFO between the count
+/// read after this step and the reset, which makes the count of discarded samples exact.
+const FIFO_STOP: &[Write] = &[(FIFO_EN, 0), (USER_CTRL, 0)];
+/// The FIFO reset, with FIFO_EN clear.
+const FIFO_EMPTY: &[Write] = &[(USER_CTRL, FIFO_RESET)];
+/// The FIFO on, then its channels.
+const FIFO_START: &[Write] = &[
+    (USER_CTRL, USER_CTRL_FIFO_EN),
+    (FIFO_EN, ACCEL_GYRO_FIFO_EN),
+];
+
+/// The FIFO on and the chip awake on its PLL clock: USER_CTRL and PWR_MGMT_1 in one read (a
+/// chip reset leaves it asleep; `enable_fifo` could have set USER_CTRL.FIFO_EN on it).
+const FIFO_ON: Check = Check {
+    reg: USER_CTRL,
+    fields: &[
+        (USER_CTRL_FIFO_EN, USER_CTRL_FIFO_EN),
+        (SLEEP | CLKSEL, CLKSEL_PLL_XGYRO),
+    ],
+};
+
+/// PWR_MGMT_1: awake, on the PLL clock (a chip reset leaves it asleep on the oscillator).
+const AWAKE_ON_PLL: Check = Check {
+    reg: PWR_MGMT_1,
+    fields: &[(SLEEP | CLKSEL, CLKSEL_PLL_XGYRO)],
+};
 
 /// Gyro full-scale range (FS_SEL).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -80,13 +140,13 @@ const UNSUPPORTED_IDS: [u8; 2] = [0x70, 0x71];
 pub enum GyroRange {
     /// +-250 deg/s, 131 counts per deg/s.
     #[default]
-    Dps250 = 0,
+    Dps250,
     /// +-500 deg/s, 65.5 counts per deg/s.
-    Dps500 = 1,
+    Dps500,
     /// +-1000 deg/s, 32.8 counts per deg/s.
-    Dps1000 = 2,
+    Dps1000,
     /// +-2000 deg/s, 16.4 counts per deg/s.
-    Dps2000 = 3,
+    Dps2000,
 }
 
 impl GyroRange {
@@ -99,6 +159,16 @@ impl GyroRange {
             Self::Dps2000 => 16.4,
         }
     }
+
+    /// FS_SEL (GYRO_CONFIG, register 27).
+    fn fs_sel(self) -> u8 {
+        match self {
+            Self::Dps250 => 0,
+            Self::Dps500 => 1,
+            Self::Dps1000 => 2,
+            Self::Dps2000 => 3,
+        }
+    }
 }
 
 /// Accelerometer full-scale range (AFS_SEL).
@@ -107,13 +177,13 @@ impl GyroRange {
 pub enum AccelRange {
     /// +-2 g, 16384 counts per g.
     #[default]
-    G2 = 0,
+    G2,
     /// +-4 g, 8192 counts per g.
-    G4 = 1,
+    G4,
     /// +-8 g, 4096 counts per g.
-    G8 = 2,
+    G8,
     /// +-16 g, 2048 counts per g.
-    G16 = 3,
+    G16,
 }
 
 impl AccelRange {
@@ -126,6 +196,16 @@ impl AccelRange {
             Self::G16 => 2048.0,
         }
     }
+
+    /// AFS_SEL (ACCEL_CONFIG, register 28).
+    fn afs_sel(self) -> u8 {
+        match self {
+            Self::G2 => 0,
+            Self::G4 => 1,
+            Self::G8 => 2,
+            Self::G16 => 3,
+        }
+    }
 }
 
 /// Digital low-pass filter (DLPF_CFG); the accelerometer bandwidth is given.
@@ -133,23 +213,43 @@ impl AccelRange {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Dlpf {
     /// 260 Hz, gyro output rate 8 kHz.
-    Hz260 = 0,
+    Hz260,
     /// 184 Hz.
-    Hz184 = 1,
+    Hz184,
     /// 94 Hz.
-    Hz94 = 2,
+    Hz94,
     /// 44 Hz.
     #[default]
-    Hz44 = 3,
+    Hz44,
     /// 21 Hz.
-    Hz21 = 4,
+    Hz21,
     /// 10 Hz.
-    Hz10 = 5,
+    Hz10,
     /// 5 Hz.
-    Hz5 = 6,
+    Hz5,
 }
 
-/// Configuration written by [`Mpu6050::init`].
+impl Dlpf {
+    /// The gyro output rate in Hz: 8 kHz with [`Dlpf::Hz260`], otherwise 1 kHz.
+    fn gyro_rate_hz(self) -> u32 {
+        if self == Self::Hz260 { 8000 } else { 1000 }
+    }
+
+    /// DLPF_CFG (CONFIG, register 26).
+    fn dlpf_cfg(self) -> u8 {
+        match self {
+            Self::Hz260 => 0,
+            Self::Hz184 => 1,
+            Self::Hz94 => 2,
+            Self::Hz44 => 3,
+            Self::Hz21 => 4,
+            Self::Hz10 => 5,
+            Self::Hz5 => 6,
+        }
+    }
+}
+
+/// Configuration written by [`Driver::init`] of an [`Mpu6050`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Mpu6050Config {
@@ -161,13 +261,6 @@ pub struct Mpu6050Config {
     pub dlpf: Dlpf,
     /// Sample rate = gyro output rate (1 kHz, or 8 kHz with [`Dlpf::Hz260`]) / (1 + this).
     pub sample_rate_divider: u8,
-}
-
-impl Dlpf {
-    /// The gyro output rate in Hz: 8 kHz with [`Dlpf::Hz260`], otherwise 1 kHz.
-    fn gyro_rate_hz(self) -> u32 {
-        if self == Self::Hz260 { 8000 } else { 1000 }
-    }
 }
 
 impl Default for Mpu6050Config {
@@ -197,7 +290,21 @@ impl Mpu6050Config {
     }
 }
 
-/// An MPU-6050 on an I2C bus.
+/// An MPU-6050 on an I2C bus: the [`Driver`] of an [`Mpu6050Bus`].
+///
+/// - `init` probes WHO_AM_I (0x68; the MPU-6500 and MPU-9250 are rejected), resets the chip
+///   (PWR_MGMT_1.DEVICE_RESET, then 100 ms), wakes it on the X-gyro PLL clock and writes
+///   SMPLRT_DIV, CONFIG, GYRO_CONFIG and ACCEL_CONFIG. It returns WHO_AM_I, as `recover`
+///   does; pass `recover` the 100 ms of the reset in its outage.
+/// - `read` is one burst read of registers 59-72 (accelerometer, temperature, gyro).
+/// - `enable_fifo` enables FIFO_OFLOW_INT and the FIFO with accelerometer and gyro samples
+///   (12 bytes each, no header). `read_fifo` reads FIFO_COUNT twice and takes the smaller
+///   (a count corrupted on the wire would otherwise have the reader read past the FIFO's end
+///   and deliver its repeated last byte as samples); its FIFO holds 1024 bytes. A FIFO reset
+///   takes the channels off (FIFO_EN, USER_CTRL), reads FIFO_COUNT, then sets
+///   USER_CTRL.FIFO_RESET and starts the FIFO and its channels again. An empty FIFO is
+///   checked against USER_CTRL and PWR_MGMT_1 (a chip that has reset itself has its FIFO off
+///   and is asleep); a FIFO reset that finds the FIFO empty checks PWR_MGMT_1.
 ///
 /// ```
 /// # use embedded_hal::i2c::{ErrorType, I2c, Operation};
@@ -215,7 +322,7 @@ impl Mpu6050Config {
 /// use imu_ar::sensor::{GyroUnit, ImuReader, Mpu6050, Mpu6050Config};
 ///
 /// let mut imu = Mpu6050::new(Bus, 0x68);
-/// imu.init(&mut Delay, Mpu6050Config::default())?;
+/// assert_eq!(imu.init(&mut Delay, Mpu6050Config::default())?, 0x68);
 /// let config = Config::new(0.999f32, 1e-4, 0.01).unwrap();
 /// let mut axes = [Lattice::<f32, 4>::new(&config); 6];
 /// let sample = imu.read()?;
@@ -227,148 +334,17 @@ impl Mpu6050Config {
 /// let bus: Bus = imu.destroy();
 /// # Ok::<(), imu_ar::sensor::Error<core::convert::Infallible>>(())
 /// ```
-#[derive(Debug)]
-pub struct Mpu6050<I2C> {
-    i2c: I2C,
-    address: u8,
-    config: Mpu6050Config,
-    fifo: FifoState,
-}
+pub type Mpu6050<I2C> = Driver<Mpu6050Bus<I2C>>;
 
 impl<I2C: I2c> Mpu6050<I2C> {
     /// A reader at `address` (0x68, or 0x69 with AD0 high); no bus traffic until `init`.
     pub fn new(i2c: I2C, address: u8) -> Self {
-        Self {
-            i2c,
-            address,
-            config: Mpu6050Config::default(),
-            fifo: FifoState::default(),
-        }
+        Driver::with_chip(Mpu6050Bus { i2c, address })
     }
 
     /// Gives the bus back.
     pub fn destroy(self) -> I2C {
-        self.i2c
-    }
-
-    fn write(&mut self, reg: u8, value: u8) -> Result<(), Error<I2C::Error>> {
-        self.i2c.write(self.address, &[reg, value])?;
-        Ok(())
-    }
-
-    fn read_regs(&mut self, reg: u8, buf: &mut [u8]) -> Result<(), Error<I2C::Error>> {
-        self.i2c.write_read(self.address, &[reg], buf)?;
-        Ok(())
-    }
-
-    /// WHO_AM_I (register 117).
-    ///
-    /// # Errors
-    ///
-    /// [`Error::Bus`].
-    pub fn who_am_i(&mut self) -> Result<u8, Error<I2C::Error>> {
-        let mut id = [0];
-        self.read_regs(WHO_AM_I, &mut id)?;
-        Ok(id[0])
-    }
-
-    /// Probes WHO_AM_I, resets the chip (DEVICE_RESET, then 100 ms), wakes it on the X-gyro
-    /// PLL clock and writes `config`. Returns the WHO_AM_I value, 0x68. The FIFO is off
-    /// afterwards. `enable_fifo` and `recover` need a successful `init` first.
-    ///
-    /// # Errors
-    ///
-    /// [`Error::UnsupportedDevice`] for an MPU-6500 or MPU-9250 (0x70, 0x71),
-    /// [`Error::WrongDevice`] for anything else, or [`Error::Bus`]; after a bus error `init`
-    /// can simply be called again.
-    pub fn init(
-        &mut self,
-        delay: &mut impl DelayNs,
-        config: Mpu6050Config,
-    ) -> Result<u8, Error<I2C::Error>> {
-        self.fifo.off();
-        let id = self.configure(delay, config)?;
-        self.fifo.initialised = true;
-        Ok(id)
-    }
-
-    fn configure(
-        &mut self,
-        delay: &mut impl DelayNs,
-        config: Mpu6050Config,
-    ) -> Result<u8, Error<I2C::Error>> {
-        let id = self.who_am_i()?;
-        if UNSUPPORTED_IDS.contains(&id) {
-            return Err(Error::UnsupportedDevice { found: id });
-        }
-        if id != MPU6050_ID {
-            return Err(Error::WrongDevice { found: id });
-        }
-        self.write(PWR_MGMT_1, PWR_DEVICE_RESET)?;
-        delay.delay_ms(100);
-        self.write(PWR_MGMT_1, PWR_CLK_PLL_X)?;
-        self.write(SMPLRT_DIV, config.sample_rate_divider)?;
-        self.write(CONFIG, config.dlpf as u8)?;
-        self.write(GYRO_CONFIG, (config.gyro_range as u8) << 3)?;
-        self.write(ACCEL_CONFIG, (config.accel_range as u8) << 3)?;
-        self.config = config;
-        Ok(id)
-    }
-
-    /// Brings the chip back after [`Error::SensorReset`], [`Error::FifoNotRunning`] (or any
-    /// suspected glitch): probes WHO_AM_I, writes the last configuration again and re-enables
-    /// the FIFO if `enable_fifo` was called since `init`. `outage_us` is the time in
-    /// microseconds from the last `read_fifo` that accounted for the FIFO (see
-    /// [`FifoStats::lost`]) to the FIFO running again, by the caller's clock: the time of the
-    /// call plus the 100 ms of the chip reset (the caller cannot read its clock after
-    /// `recover` and still count on it); the samples the chip produced in it are counted in
-    /// [`FifoStats::lost`]. A recovery after [`Error::SensorReset`] is counted in
-    /// [`FifoStats::resets`]. A FIFO reset still pending (an overflow, a failed read) is
-    /// replaced by the recovery and counted as done; its samples are inside the outage.
-    /// Returns WHO_AM_I.
-    ///
-    /// # Errors
-    ///
-    /// [`Error::NotInitialised`] before `init`; otherwise as [`Mpu6050::init`]; nothing is
-    /// counted until the recovery succeeds, and until then `read_fifo` returns
-    /// [`Error::FifoNotRunning`]: it can simply be called again.
-    pub fn recover(
-        &mut self,
-        delay: &mut impl DelayNs,
-        outage_us: u64,
-    ) -> Result<u8, Error<I2C::Error>> {
-        if !self.fifo.initialised {
-            return Err(Error::NotInitialised);
-        }
-        self.fifo.recovering();
-        let id = self.configure(delay, self.config)?;
-        if self.fifo.wanted {
-            self.enable_fifo()?;
-        }
-        self.fifo.recovered(
-            outage_us,
-            self.config.dlpf.gyro_rate_hz(),
-            1 + u32::from(self.config.sample_rate_divider),
-        );
-        Ok(id)
-    }
-
-    /// The configuration written by the last `init`.
-    pub fn config(&self) -> &Mpu6050Config {
-        &self.config
-    }
-
-    /// Enables the overflow flag and resets and enables the FIFO with accelerometer and gyro
-    /// samples (12 bytes each). Samples in the FIFO (one left running by an earlier call that
-    /// failed part-way) are counted in [`FifoStats::discarded`].
-    ///
-    /// # Errors
-    ///
-    /// [`Error::NotInitialised`] before `init`; [`Error::SensorReset`] when the chip has
-    /// reset itself (call `recover`); [`Error::Bus`] (or [`Error::BadFifoCount`]): until a
-    /// later call (or `recover`) succeeds, `read_fifo` returns [`Error::FifoNotRunning`].
-    pub fn enable_fifo(&mut self) -> Result<(), Error<I2C::Error>> {
-        fifo::enable(self)
+        self.into_chip().i2c
     }
 
     /// Temperature in deg C from the raw value: `raw / 340 + 36.53` (register map, registers
@@ -376,128 +352,86 @@ impl<I2C: I2c> Mpu6050<I2C> {
     pub fn temperature_celsius(raw: i16) -> f32 {
         f32::from(raw) / 340.0 + 36.53
     }
-
-    fn fifo_count(&mut self) -> Result<u16, Error<I2C::Error>> {
-        let mut b = [0; 2];
-        self.read_regs(FIFO_COUNTH, &mut b)?;
-        Ok(u16::from_be_bytes(b))
-    }
 }
 
-impl<I2C: I2c> FifoChip for Mpu6050<I2C> {
+/// The registers the shared driver uses.
+const MAP: Map = Map {
+    who_am_i: WHO_AM_I,
+    id: MPU6050_ID,
+    unsupported: &MPU6500_MPU9250_IDS,
+    reset: CHIP_RESET,
+    reset_ms: RESET_MS,
+    settle_ms: NO_SETTLE,
+    data: ACCEL_XOUT_H,
+    int_status: INT_STATUS,
+    int_fifo_overflow: FIFO_OFLOW_INT,
+    fifo_count: FIFO_COUNTH,
+    fifo_data: FIFO_R_W,
+    packet: PACKET,
+    fifo_bytes: FIFO_BYTES,
+    confirm_count: true,
+    fifo_prepare: OVERFLOW_FLAG_ON,
+    fifo_stop: FIFO_STOP,
+    fifo_empty: FIFO_EMPTY,
+    fifo_start: FIFO_START,
+    fifo_on: FIFO_ON,
+    configured: AWAKE_ON_PLL,
+};
+
+/// The MPU-6050 at its address on an I2C bus: the chip that an [`Mpu6050`] drives.
+#[derive(Debug)]
+pub struct Mpu6050Bus<I2C> {
+    i2c: I2C,
+    address: u8,
+}
+
+impl<I2C: I2c> Chip for Mpu6050Bus<I2C> {
     type BusError = I2C::Error;
-    const PACKET: usize = PACKET;
-    const FIFO_BYTES: u16 = FIFO_BYTES;
-    const CONFIRM_COUNT: bool = true;
+    type Config = Mpu6050Config;
+    const MAP: Map = MAP;
 
-    fn state(&mut self) -> &mut FifoState {
-        &mut self.fifo
+    fn write(&mut self, reg: u8, value: u8) -> Result<(), I2C::Error> {
+        self.i2c.write(self.address, &[reg, value])
     }
 
-    fn overflow_flag(&mut self) -> Result<bool, Error<I2C::Error>> {
-        let mut status = [0];
-        self.read_regs(INT_STATUS, &mut status)?;
-        Ok(status[0] & INT_FIFO_OFLOW != 0)
+    fn read(&mut self, reg: u8, buf: &mut [u8]) -> Result<(), I2C::Error> {
+        self.i2c.write_read(self.address, &[reg], buf)
     }
 
-    fn fifo_count(&mut self) -> Result<u16, Error<I2C::Error>> {
-        Mpu6050::fifo_count(self)
+    /// Awake on the X-gyro PLL clock, then rate, filter and ranges.
+    fn setup(c: &Mpu6050Config) -> impl IntoIterator<Item = Write> {
+        [
+            (PWR_MGMT_1, CLKSEL_PLL_XGYRO),
+            (SMPLRT_DIV, c.sample_rate_divider),
+            (CONFIG, c.dlpf.dlpf_cfg()),
+            (GYRO_CONFIG, c.gyro_range.fs_sel() << FS_SEL_SHIFT),
+            (ACCEL_CONFIG, c.accel_range.afs_sel() << AFS_SEL_SHIFT),
+        ]
     }
 
-    /// USER_CTRL and PWR_MGMT_1 in one read: the FIFO on, and the chip awake on its PLL clock
-    /// (a chip reset leaves it asleep; `enable_fifo` could have set USER_CTRL.FIFO_EN on it).
-    fn fifo_configured(&mut self) -> Result<bool, Error<I2C::Error>> {
-        let mut b = [0; 2];
-        self.read_regs(USER_CTRL, &mut b)?;
-        Ok(b[0] & USER_CTRL_FIFO_EN != 0 && b[1] & PWR_SLEEP_CLKSEL == PWR_CLK_PLL_X)
+    fn scale(c: &Mpu6050Config) -> Scale {
+        c.scale()
     }
 
-    /// PWR_MGMT_1: asleep, or not on the PLL clock.
-    fn chip_reset(&mut self) -> Result<bool, Error<I2C::Error>> {
-        let mut pwr = [0];
-        self.read_regs(PWR_MGMT_1, &mut pwr)?;
-        Ok(pwr[0] & PWR_SLEEP_CLKSEL != PWR_CLK_PLL_X)
+    fn rate(c: &Mpu6050Config) -> (u32, u32) {
+        (c.dlpf.gyro_rate_hz(), 1 + u32::from(c.sample_rate_divider))
     }
 
-    fn prepare_fifo(&mut self) -> Result<(), Error<I2C::Error>> {
-        self.write(INT_ENABLE, INT_FIFO_OFLOW)
+    /// Registers 59-72: accelerometer, temperature, gyro.
+    fn sample(b: &[u8; 14]) -> Option<RawSample> {
+        Some(RawSample {
+            accel: be_i16x3(b, 0),
+            temperature: Some(be_i16(b, 6)),
+            gyro: be_i16x3(b, 8),
+        })
     }
 
-    /// The channels are taken off the FIFO before it is reset, as ArduPilot does
-    /// (libraries/AP_InertialSensor/AP_InertialSensor_Invensense.cpp,
-    /// `AP_InertialSensor_Invensense::_fifo_reset`: FIFO_EN = 0, USER_CTRL without FIFO_EN,
-    /// USER_CTRL | FIFO_RESET, USER_CTRL | FIFO_EN, then the FIFO_EN channels), and as the
-    /// register map requires of USER_CTRL (FIFO_RESET "resets the FIFO buffer when set to 1
-    /// while FIFO_EN equals 0"). With the channels off first, nothing enters the FIFO between
-    /// the count read after this step and the reset, which makes the count of discarded
-    /// samples exact.
-    fn stop_fifo(&mut self) -> Result<(), Error<I2C::Error>> {
-        self.write(FIFO_EN, 0)?;
-        self.write(USER_CTRL, 0)
-    }
-
-    fn empty_fifo(&mut self) -> Result<(), Error<I2C::Error>> {
-        self.write(USER_CTRL, USER_CTRL_FIFO_RESET)
-    }
-
-    fn start_fifo(&mut self) -> Result<(), Error<I2C::Error>> {
-        self.write(USER_CTRL, USER_CTRL_FIFO_EN)?;
-        self.write(FIFO_EN, FIFO_EN_ACCEL_GYRO)
-    }
-
-    fn read_data(&mut self, buf: &mut [u8]) -> Result<(), Error<I2C::Error>> {
-        self.read_regs(FIFO_R_W, buf)
-    }
-
+    /// Accelerometer then gyro, no header: every packet is a sample.
     fn parse(p: &[u8]) -> Packet {
         Packet::Sample(RawSample {
             accel: be_i16x3(p, 0),
             gyro: be_i16x3(p, 6),
             temperature: None,
         })
-    }
-}
-
-impl<I2C: I2c> ImuReader for Mpu6050<I2C> {
-    type BusError = I2C::Error;
-
-    fn scale(&self) -> Scale {
-        self.config.scale()
-    }
-
-    /// One burst read of registers 59-72.
-    fn read(&mut self) -> Result<RawSample, Error<I2C::Error>> {
-        let mut b = [0u8; 14];
-        self.read_regs(ACCEL_XOUT_H, &mut b)?;
-        Ok(RawSample {
-            accel: be_i16x3(&b, 0),
-            temperature: Some(be_i16(&b, 6)),
-            gyro: be_i16x3(&b, 8),
-        })
-    }
-
-    /// Reads INT_STATUS and FIFO_COUNT first; a non-empty count is read a second time and the
-    /// smaller taken (the packets have no header: a count corrupted on the wire would
-    /// otherwise have the reader read past the FIFO's end and deliver its repeated last byte
-    /// as samples). A count above the FIFO's 1024 bytes is no count ([`Error::BadFifoCount`],
-    /// nothing read). On FIFO_OFLOW_INT, or a count of 1024 bytes, the FIFO is reset (its
-    /// complete packets are counted as discarded) and [`Error::FifoOverflow`] is returned. An
-    /// empty FIFO is checked against USER_CTRL and PWR_MGMT_1: a chip that has reset itself
-    /// has its FIFO off and is asleep, and [`Error::SensorReset`] is returned (see
-    /// [`Mpu6050::recover`]); a FIFO reset finds such a chip by PWR_MGMT_1, and returns the
-    /// same. Otherwise the whole packets in the FIFO (up to `out.len()`) are read, 8 per I2C
-    /// transfer; a partial packet stays in the FIFO for the next call.
-    ///
-    /// MPU packets have no header: a read that fails part-way would leave the FIFO misaligned
-    /// for good. So, as TDK's drivers do, the FIFO is then reset: the samples of the call and
-    /// those left in the FIFO are counted as discarded and [`Error::FifoResync`] is returned.
-    /// A reset that meets a bus error itself is remembered and finished by the next call, so
-    /// an overflow, whose flag is cleared by reading it, is never lost.
-    fn read_fifo(&mut self, out: &mut [RawSample]) -> Result<usize, Error<I2C::Error>> {
-        fifo::read_fifo(self, out)
-    }
-
-    fn fifo_stats(&self) -> FifoStats {
-        self.fifo.stats
     }
 }

@@ -12,16 +12,23 @@
 //! Time advances only through [`Sim::tick`], one sample period per tick, between reader calls.
 //! Each tick's sample carries its tick number, so every delivered sample can be checked
 //! against what the chip produced ([`decode`]).
+//!
+//! This module is the chip-independent part; each chip's registers, register side effects,
+//! FIFO packet and bus are in its own module ([`mpu6050`], [`icm42688`]); buses that act at a
+//! chosen transfer are in [`hooks`], and the run with random bus faults is in [`run`].
 
 #![allow(dead_code)]
+
+pub mod hooks;
+pub mod icm42688;
+pub mod mpu6050;
+pub mod run;
 
 use std::cell::RefCell;
 use std::collections::{BTreeMap, VecDeque};
 use std::rc::Rc;
 
-use embedded_hal::i2c::{self, I2c};
-use embedded_hal::spi::{self, Operation, SpiDevice};
-use imu_ar::sensor::{Error, FifoStats, ImuReader, RawSample};
+use imu_ar::sensor::RawSample;
 use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
 
@@ -32,6 +39,44 @@ pub enum Model {
     Mpu6050,
     /// ICM-42688-P on SPI.
     Icm42688,
+}
+
+impl Model {
+    fn chip(self) -> &'static Chip {
+        match self {
+            Model::Mpu6050 => &mpu6050::CHIP,
+            Model::Icm42688 => &icm42688::CHIP,
+        }
+    }
+}
+
+/// What differs between the simulated chips.
+pub struct Chip {
+    /// WHO_AM_I's answer.
+    id: u8,
+    /// Bytes per FIFO packet.
+    packet: usize,
+    /// FIFO size in bytes.
+    fifo_bytes: usize,
+    /// INT_STATUS, FIFO_COUNTH, WHO_AM_I and the FIFO data register.
+    int_status: u8,
+    fifo_counth: u8,
+    who_am_i: u8,
+    fifo_data: u8,
+    /// INT_STATUS bits set when the full FIFO overwrites a byte, and when it becomes full.
+    overwrite_flag: u8,
+    full_flag: u8,
+    /// The register and bit that reset the chip.
+    reset: (u8, u8),
+    /// Sets the registers that are not 0 at power-on.
+    power_on: fn(&mut [u8; 128]),
+    /// Whether the FIFO takes samples, by the registers.
+    accepting: fn(&[u8; 128]) -> bool,
+    /// The FIFO packet of tick `seq` with these accelerometer and gyro values.
+    packet_of: fn(&mut Sim, u64, [i16; 3], [i16; 3]) -> Vec<u8>,
+    /// What a register write other than the reset does besides storing its value: returns
+    /// the value stored, if any.
+    write: fn(&mut Sim, u8, u8) -> Option<u8>,
 }
 
 /// A kind of bus transfer: a write to a register, or a read starting at one.
@@ -55,36 +100,6 @@ struct Rule {
 struct Fault {
     clock_out: usize,
     apply: bool,
-}
-
-/// MPU-6050 registers (RM-MPU-6000A-00).
-pub mod mpu {
-    pub const FIFO_EN: u8 = 0x23;
-    pub const INT_STATUS: u8 = 0x3A;
-    pub const USER_CTRL: u8 = 0x6A;
-    pub const PWR_MGMT_1: u8 = 0x6B;
-    pub const FIFO_COUNTH: u8 = 0x72;
-    pub const FIFO_R_W: u8 = 0x74;
-    pub const WHO_AM_I: u8 = 0x75;
-    pub const PACKET: usize = 12;
-    pub const FIFO_BYTES: usize = 1024;
-}
-
-/// ICM-42688-P registers (DS-000347, bank 0).
-pub mod icm {
-    pub const DEVICE_CONFIG: u8 = 0x11;
-    pub const FIFO_CONFIG: u8 = 0x16;
-    pub const INT_STATUS: u8 = 0x2D;
-    pub const FIFO_COUNTH: u8 = 0x2E;
-    pub const FIFO_DATA: u8 = 0x30;
-    pub const SIGNAL_PATH_RESET: u8 = 0x4B;
-    pub const PWR_MGMT0: u8 = 0x4E;
-    pub const FIFO_CONFIG1: u8 = 0x5F;
-    pub const WHO_AM_I: u8 = 0x75;
-    pub const PACKET: usize = 16;
-    pub const FIFO_BYTES: usize = 2048;
-    /// Samples with the invalid gyro marker after the gyro is switched on (30 ms at 1 kHz).
-    pub const GYRO_STARTUP: u32 = 30;
 }
 
 /// The simulated chip and its bus.
@@ -158,10 +173,7 @@ impl Sim {
             rules: Vec::new(),
             rate: 0.0,
             stuck_high: false,
-            who_am_i: match model {
-                Model::Mpu6050 => 0x68,
-                Model::Icm42688 => 0x47,
-            },
+            who_am_i: model.chip().id,
             transfers: BTreeMap::new(),
             injected: BTreeMap::new(),
             ticks: 0,
@@ -176,24 +188,16 @@ impl Sim {
     }
 
     fn packet_len(&self) -> usize {
-        match self.model {
-            Model::Mpu6050 => mpu::PACKET,
-            Model::Icm42688 => icm::PACKET,
-        }
+        self.model.chip().packet
     }
 
     fn capacity(&self) -> usize {
-        match self.model {
-            Model::Mpu6050 => mpu::FIFO_BYTES,
-            Model::Icm42688 => icm::FIFO_BYTES,
-        }
+        self.model.chip().fifo_bytes
     }
 
     fn power_on_registers(&mut self) {
         self.regs = [0; 128];
-        if self.model == Model::Mpu6050 {
-            self.regs[usize::from(mpu::PWR_MGMT_1)] = 0x40; // SLEEP
-        }
+        (self.model.chip().power_on)(&mut self.regs);
         self.int_status = 0;
         self.gyro_startup = 0;
         self.clear_fifo();
@@ -250,19 +254,7 @@ impl Sim {
 
     /// Whether the FIFO takes samples now.
     fn accepting(&self) -> bool {
-        let r = |a: u8| self.regs[usize::from(a)];
-        match self.model {
-            Model::Mpu6050 => {
-                r(mpu::PWR_MGMT_1) & 0x40 == 0
-                    && r(mpu::USER_CTRL) & 0x40 != 0
-                    && r(mpu::FIFO_EN) & 0x78 == 0x78
-            }
-            Model::Icm42688 => {
-                r(icm::FIFO_CONFIG) == 0x40
-                    && r(icm::FIFO_CONFIG1) & 0x03 == 0x03
-                    && r(icm::PWR_MGMT0) & 0x0F == 0x0F
-            }
-        }
+        (self.model.chip().accepting)(&self.regs)
     }
 
     /// `n` sample periods: each writes a sample into the FIFO if it is on.
@@ -274,23 +266,8 @@ impl Sim {
                 self.paused.push(seq);
                 continue;
             }
-            let (a, mut g) = sample(seq);
-            let mut bytes = Vec::with_capacity(16);
-            match self.model {
-                Model::Mpu6050 => {
-                    bytes.extend(a.iter().chain(&g).flat_map(|v| v.to_be_bytes()));
-                }
-                Model::Icm42688 => {
-                    if self.gyro_startup > 0 {
-                        self.gyro_startup -= 1;
-                        g = [i16::MIN; 3];
-                    }
-                    bytes.push(0x68);
-                    bytes.extend(a.iter().chain(&g).flat_map(|v| v.to_be_bytes()));
-                    bytes.push(20);
-                    bytes.extend((seq as u16).to_be_bytes());
-                }
-            }
+            let (a, g) = sample(seq);
+            let bytes = (self.model.chip().packet_of)(self, seq, a, g);
             self.produced += 1;
             for b in bytes {
                 self.push(b);
@@ -307,13 +284,11 @@ impl Sim {
             }
             self.head = (self.head + 1) % p;
             self.overflowed = true;
-            if self.model == Model::Mpu6050 {
-                self.int_status |= 0x10;
-            }
+            self.int_status |= self.model.chip().overwrite_flag;
         }
         self.fifo.push_back(b);
-        if self.model == Model::Icm42688 && self.fifo.len() == cap {
-            self.int_status |= 0x02;
+        if self.fifo.len() == cap {
+            self.int_status |= self.model.chip().full_flag;
         }
     }
 
@@ -356,20 +331,15 @@ impl Sim {
     }
 
     fn is_fifo_data(&self, reg: u8) -> bool {
-        match self.model {
-            Model::Mpu6050 => reg == mpu::FIFO_R_W,
-            Model::Icm42688 => reg == icm::FIFO_DATA,
-        }
+        reg == self.model.chip().fifo_data
     }
 
     fn read_reg(&mut self, reg: u8, count: u16) -> u8 {
         if self.stuck_high {
             return 0xFF;
         }
-        let (status, counth, who) = match self.model {
-            Model::Mpu6050 => (mpu::INT_STATUS, mpu::FIFO_COUNTH, mpu::WHO_AM_I),
-            Model::Icm42688 => (icm::INT_STATUS, icm::FIFO_COUNTH, icm::WHO_AM_I),
-        };
+        let chip = self.model.chip();
+        let (status, counth, who) = (chip.int_status, chip.fifo_counth, chip.who_am_i);
         if reg == status {
             std::mem::take(&mut self.int_status)
         } else if reg == counth {
@@ -399,33 +369,12 @@ impl Sim {
     }
 
     fn write(&mut self, reg: u8, value: u8) {
-        let i = usize::from(reg & 0x7F);
-        match (self.model, reg) {
-            (Model::Mpu6050, mpu::PWR_MGMT_1) if value & 0x80 != 0 => self.power_on_registers(),
-            (Model::Mpu6050, mpu::USER_CTRL) => {
-                if value & 0x04 != 0 {
-                    if value & 0x40 != 0 || self.regs[usize::from(mpu::FIFO_EN)] != 0 {
-                        self.resets_with_channels_on += 1;
-                    }
-                    self.clear_fifo();
-                }
-                self.regs[i] = value & !0x04;
-            }
-            (Model::Icm42688, icm::DEVICE_CONFIG) if value & 0x01 != 0 => {
-                self.power_on_registers();
-            }
-            (Model::Icm42688, icm::SIGNAL_PATH_RESET) => {
-                if value & 0x02 != 0 {
-                    self.clear_fifo();
-                }
-            }
-            (Model::Icm42688, icm::PWR_MGMT0) => {
-                if value & 0x0C == 0x0C && self.regs[i] & 0x0C != 0x0C {
-                    self.gyro_startup = icm::GYRO_STARTUP;
-                }
-                self.regs[i] = value;
-            }
-            _ => self.regs[i] = value,
+        let chip = self.model.chip();
+        let (reset, bit) = chip.reset;
+        if reg == reset && value & bit != 0 {
+            self.power_on_registers();
+        } else if let Some(v) = (chip.write)(self, reg, value) {
+            self.regs[usize::from(reg & 0x7F)] = v;
         }
     }
 
@@ -463,264 +412,9 @@ impl Sim {
     }
 }
 
-/// The I2C bus of a simulated MPU-6050.
-pub struct SimI2c(pub Rc<RefCell<Sim>>);
-
-impl i2c::ErrorType for SimI2c {
-    type Error = i2c::ErrorKind;
-}
-
-impl I2c for SimI2c {
-    fn transaction(
-        &mut self,
-        address: u8,
-        ops: &mut [i2c::Operation<'_>],
-    ) -> Result<(), Self::Error> {
-        let fail = i2c::ErrorKind::ArbitrationLoss;
-        if address != 0x68 {
-            return Err(i2c::ErrorKind::NoAcknowledge(
-                i2c::NoAcknowledgeSource::Address,
-            ));
-        }
-        let mut sim = self.0.borrow_mut();
-        match ops {
-            [i2c::Operation::Write(w)] if w.len() == 2 => {
-                let mut v = [w[1]];
-                sim.transfer(Kind::Write(w[0]), &mut v).map_err(|()| fail)
-            }
-            [i2c::Operation::Write(w), i2c::Operation::Read(r)] if w.len() == 1 => {
-                sim.transfer(Kind::Read(w[0]), r).map_err(|()| fail)
-            }
-            _ => panic!("unexpected I2C transaction"),
-        }
-    }
-}
-
-/// The SPI device of a simulated ICM-42688-P.
-pub struct SimSpi(pub Rc<RefCell<Sim>>);
-
-impl spi::ErrorType for SimSpi {
-    type Error = spi::ErrorKind;
-}
-
-impl SpiDevice for SimSpi {
-    fn transaction(&mut self, ops: &mut [Operation<'_, u8>]) -> Result<(), Self::Error> {
-        let mut sim = self.0.borrow_mut();
-        let fail = spi::ErrorKind::Overrun;
-        match ops {
-            [Operation::Write(w)] if w.len() == 2 => {
-                let mut v = [w[1]];
-                sim.transfer(Kind::Write(w[0]), &mut v).map_err(|()| fail)
-            }
-            [Operation::Write(w), Operation::Read(r)] if w.len() == 1 && w[0] & 0x80 != 0 => {
-                sim.transfer(Kind::Read(w[0] & 0x7F), r).map_err(|()| fail)
-            }
-            _ => panic!("unexpected SPI transaction"),
-        }
-    }
-}
-
 /// No delay: the simulator's time advances only by [`Sim::tick`].
 pub struct NoDelay;
 
 impl embedded_hal::delay::DelayNs for NoDelay {
     fn delay_ns(&mut self, _: u32) {}
-}
-
-/// Checks delivered samples: each exactly one the chip produced, in order.
-fn accept(out: &[RawSample], last_seq: &mut Option<u64>) -> u64 {
-    for s in out {
-        let seq = decode(s).unwrap_or_else(|| panic!("a malformed sample delivered: {s:?}"));
-        assert!(last_seq.is_none_or(|l| l < seq), "out of order: {seq}");
-        *last_seq = Some(seq);
-    }
-    out.len() as u64
-}
-
-/// What a run with random bus faults did.
-#[derive(Debug)]
-pub struct Figures {
-    pub ticks: u64,
-    pub produced: u64,
-    pub delivered: u64,
-    pub stats: FifoStats,
-    pub dropped_by_chip: u64,
-    pub paused_outside_outages: u64,
-    pub left_in_fifo: u64,
-    pub transfers: u64,
-    pub faults: u64,
-    pub kinds: usize,
-    pub recoveries: u64,
-    pub failed_recoveries: u64,
-    pub overflows_forced: u64,
-}
-
-/// Runs `reader` on `sim` with faults at `rate` on every transfer until `target` samples were
-/// delivered, calling `recover` the way a board loop does; then stops the faults, recovers
-/// once and checks that samples flow. Every delivered sample is checked against the chip's,
-/// in order; at the end every tick is accounted for:
-///
-/// `ticks = delivered + discarded + invalid + malformed + lost + dropped by the chip while
-/// full + ticks with the FIFO's channels off outside an outage + left in the FIFO`.
-pub fn fault_run<R: ImuReader>(
-    sim: &Rc<RefCell<Sim>>,
-    reader: &mut R,
-    mut recover: impl FnMut(&mut R, u64) -> Result<(), Error<R::BusError>>,
-    seed: u64,
-    rate: f64,
-    target: u64,
-) -> Figures
-where
-    R::BusError: std::fmt::Debug,
-{
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let mut out = vec![RawSample::default(); 256];
-    let mut last_accounted = sim.borrow().ticks;
-    let mut dropped_at_accounting = sim.borrow().dropped;
-    let mut last_seq: Option<u64> = None;
-    let mut outages: Vec<(u64, u64)> = Vec::new();
-    let (mut delivered, mut recoveries, mut failed, mut forced) = (0u64, 0, 0, 0);
-    let capacity = sim.borrow().capacity() / sim.borrow().packet_len();
-    sim.borrow_mut().rate = rate;
-
-    let mut try_recover = |reader: &mut R,
-                           last_accounted: &mut u64,
-                           dropped_at: &mut u64,
-                           outages: &mut Vec<(u64, u64)>|
-     -> bool {
-        let now = sim.borrow().ticks;
-        match recover(reader, (now - *last_accounted) * 1000) {
-            Ok(()) => {
-                assert_eq!(
-                    sim.borrow().dropped,
-                    *dropped_at,
-                    "an overflow inside an outage would be counted twice"
-                );
-                outages.push((*last_accounted, now));
-                *last_accounted = now;
-                true
-            }
-            Err(Error::Bus(_)) => false,
-            Err(e) => panic!("recover: {e:?}"),
-        }
-    };
-
-    while delivered < target {
-        let n = if rng.next_u32() % 1000 < 3 {
-            forced += 1;
-            capacity as u64 + 20
-        } else {
-            u64::from(rng.next_u32() % 13)
-        };
-        sim.borrow_mut().tick(n);
-        let now = sim.borrow().ticks;
-        let res = reader.read_fifo(&mut out);
-        match res {
-            Ok(k) => {
-                delivered += accept(&out[..k], &mut last_seq);
-                last_accounted = now;
-                dropped_at_accounting = sim.borrow().dropped;
-                if rng.next_u32() % 20 == 0 {
-                    // A suspected glitch: recover anyway, a few samples later.
-                    sim.borrow_mut().tick(u64::from(rng.next_u32() % 13));
-                    if try_recover(
-                        reader,
-                        &mut last_accounted,
-                        &mut dropped_at_accounting,
-                        &mut outages,
-                    ) {
-                        recoveries += 1;
-                    } else {
-                        failed += 1;
-                    }
-                }
-            }
-            Err(Error::FifoOverflow { .. } | Error::FifoResync { .. }) => {
-                last_accounted = now;
-                dropped_at_accounting = sim.borrow().dropped;
-            }
-            Err(Error::Bus(_)) => {}
-            Err(Error::FifoNotRunning | Error::SensorReset) => {
-                if try_recover(
-                    reader,
-                    &mut last_accounted,
-                    &mut dropped_at_accounting,
-                    &mut outages,
-                ) {
-                    recoveries += 1;
-                } else {
-                    failed += 1;
-                }
-            }
-            Err(e) => panic!("read_fifo: {e:?}"),
-        }
-    }
-
-    // The faults stop: one recovery, and samples flow again.
-    sim.borrow_mut().rate = 0.0;
-    sim.borrow_mut().tick(5);
-    assert!(
-        try_recover(
-            reader,
-            &mut last_accounted,
-            &mut dropped_at_accounting,
-            &mut outages
-        ),
-        "recover after the faults stopped"
-    );
-    recoveries += 1;
-    sim.borrow_mut().tick(50);
-    let k = reader
-        .read_fifo(&mut out)
-        .expect("samples after one recover");
-    assert!(k > 0, "no samples after one recover");
-    delivered += accept(&out[..k], &mut last_seq);
-
-    let sim = sim.borrow();
-    let paused_outside = sim
-        .paused
-        .iter()
-        .filter(|&&t| !outages.iter().any(|&(a, b)| (a..b).contains(&t)))
-        .count() as u64;
-    let stats = reader.fifo_stats();
-    let figures = Figures {
-        ticks: sim.ticks,
-        produced: sim.produced,
-        delivered,
-        stats,
-        dropped_by_chip: sim.dropped,
-        paused_outside_outages: paused_outside,
-        left_in_fifo: sim.fifo_packets(),
-        transfers: sim.transfers.values().sum(),
-        faults: sim.injected.values().sum(),
-        kinds: sim.transfers.len(),
-        recoveries,
-        failed_recoveries: failed,
-        overflows_forced: forced,
-    };
-    assert_eq!(stats.samples, delivered);
-    let fault_rate = figures.faults as f64 / figures.transfers as f64;
-    assert!(
-        (0.8 * rate..1.2 * rate).contains(&fault_rate),
-        "fault rate {fault_rate}"
-    );
-    for kind in sim.transfers.keys() {
-        assert!(
-            sim.injected.get(kind).copied().unwrap_or(0) > 0,
-            "no fault at {kind:?}: {figures:#?}"
-        );
-    }
-    assert_eq!(
-        figures.ticks,
-        delivered
-            + stats.discarded
-            + stats.invalid
-            + stats.malformed
-            + stats.lost
-            + figures.dropped_by_chip
-            + paused_outside
-            + figures.left_in_fifo,
-        "every tick accounted for: {figures:#?}"
-    );
-    figures
 }

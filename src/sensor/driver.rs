@@ -1,0 +1,199 @@
+//! The driver shared by the chip readers: probe, reset and configure, recover after a chip
+//! reset, and the FIFO routine (`fifo.rs`), over the chip's registers ([`Chip`]).
+
+use embedded_hal::delay::DelayNs;
+
+use super::chip::{CHECK_REGS, Chip};
+use super::fifo::{self, FifoState, MAX_PACKET};
+use super::{Error, FifoStats, ImuReader, RawSample, Scale};
+
+/// A six-axis reader of the chip `C` on its bus: [`Mpu6050`](super::Mpu6050) (I2C) and
+/// [`Icm42688`](super::Icm42688) (SPI) are this driver over their chips, and every method
+/// below works the same for both. `new` and `destroy` are the chips' own (they take and give
+/// back the bus); the register sequences, delays and packet layouts of each chip are listed
+/// on its type.
+///
+/// `init` and `recover` both return the WHO_AM_I value that identified the chip (0x68 for the
+/// MPU-6050, 0x47 for the ICM-42688-P).
+#[derive(Debug)]
+pub struct Driver<C: Chip> {
+    chip: C,
+    config: C::Config,
+    fifo: FifoState,
+}
+
+impl<C: Chip> Driver<C> {
+    /// A reader of `chip` with the default configuration; no bus traffic until `init`.
+    pub(crate) fn with_chip(chip: C) -> Self {
+        const {
+            assert!(C::MAP.packet > 0 && C::MAP.packet <= MAX_PACKET);
+            assert!(C::MAP.fifo_on.fields.len() <= CHECK_REGS);
+            assert!(C::MAP.configured.fields.len() <= CHECK_REGS);
+        }
+        Self {
+            chip,
+            config: C::Config::default(),
+            fifo: FifoState::default(),
+        }
+    }
+
+    /// The chip, for `destroy` to give its bus back.
+    pub(crate) fn into_chip(self) -> C {
+        self.chip
+    }
+
+    /// Reads WHO_AM_I.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::Bus`].
+    pub fn who_am_i(&mut self) -> Result<u8, Error<C::BusError>> {
+        self.chip.read_u8(C::MAP.who_am_i)
+    }
+
+    /// Probes WHO_AM_I, resets the chip (and waits for the reset to complete), writes
+    /// `config` and returns the WHO_AM_I value. The FIFO is off afterwards. `enable_fifo` and
+    /// `recover` need a successful `init` first.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::UnsupportedDevice`] for a related chip that this reader rejects (the MPU-6500
+    /// and MPU-9250, 0x70 and 0x71, for [`Mpu6050`](super::Mpu6050)),
+    /// [`Error::WrongDevice`] for any other WHO_AM_I, or [`Error::Bus`]; after a bus error
+    /// `init` can simply be called again.
+    pub fn init(
+        &mut self,
+        delay: &mut impl DelayNs,
+        config: C::Config,
+    ) -> Result<u8, Error<C::BusError>> {
+        self.fifo.off();
+        let id = self.configure(delay, config)?;
+        self.fifo.initialised = true;
+        Ok(id)
+    }
+
+    fn configure(
+        &mut self,
+        delay: &mut impl DelayNs,
+        config: C::Config,
+    ) -> Result<u8, Error<C::BusError>> {
+        let map = C::MAP;
+        let id = self.who_am_i()?;
+        if map.unsupported.contains(&id) {
+            return Err(Error::UnsupportedDevice { found: id });
+        }
+        if id != map.id {
+            return Err(Error::WrongDevice { found: id });
+        }
+        let (reg, value) = map.reset;
+        self.chip.write(reg, value)?;
+        delay.delay_ms(map.reset_ms);
+        for (reg, value) in C::setup(&config) {
+            self.chip.write(reg, value)?;
+        }
+        if map.settle_ms > 0 {
+            delay.delay_ms(map.settle_ms);
+        }
+        self.config = config;
+        Ok(id)
+    }
+
+    /// Brings the chip back after [`Error::SensorReset`], [`Error::FifoNotRunning`] (or any
+    /// suspected glitch): probes WHO_AM_I, resets the chip and writes the last configuration
+    /// again as `init` does, and re-enables the FIFO if `enable_fifo` was called since `init`.
+    /// Returns WHO_AM_I.
+    ///
+    /// `outage_us` is the time in microseconds from the last `read_fifo` that accounted for
+    /// the FIFO (see [`FifoStats::lost`]) to the FIFO running again, by the caller's clock:
+    /// the time of the call plus the delays of the chip's reset and start (100 ms on the
+    /// MPU-6050, 2 ms on the ICM-42688-P), since the caller cannot read its clock after
+    /// `recover` and still count on it. The samples the chip produced in it are counted in
+    /// [`FifoStats::lost`]. A recovery after [`Error::SensorReset`] is counted in
+    /// [`FifoStats::resets`]. A FIFO reset still pending (an overflow, a failed read) is
+    /// replaced by the recovery and counted as done; its samples are inside the outage.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::NotInitialised`] before `init`; otherwise as [`Driver::init`] and
+    /// [`Driver::enable_fifo`]. Nothing is counted until the recovery succeeds, and until then
+    /// `read_fifo` returns [`Error::FifoNotRunning`]: `recover` can simply be called again.
+    pub fn recover(
+        &mut self,
+        delay: &mut impl DelayNs,
+        outage_us: u64,
+    ) -> Result<u8, Error<C::BusError>> {
+        if !self.fifo.initialised {
+            return Err(Error::NotInitialised);
+        }
+        self.fifo.recovering();
+        let id = self.configure(delay, self.config)?;
+        if self.fifo.wanted {
+            self.enable_fifo()?;
+        }
+        let (hz, div) = C::rate(&self.config);
+        self.fifo.recovered(outage_us, hz, div);
+        Ok(id)
+    }
+
+    /// The configuration written by the last `init`.
+    pub fn config(&self) -> &C::Config {
+        &self.config
+    }
+
+    /// Enables the FIFO (with the chip's overflow flag, in the chip's packet layout), and
+    /// resets it. Samples in the FIFO (one left running by an earlier call that failed
+    /// part-way) are counted in [`FifoStats::discarded`].
+    ///
+    /// # Errors
+    ///
+    /// [`Error::NotInitialised`] before `init`; [`Error::SensorReset`] when the chip has
+    /// reset itself (call `recover`); [`Error::Bus`] (or [`Error::BadFifoCount`]): until a
+    /// later call (or `recover`) succeeds, `read_fifo` returns [`Error::FifoNotRunning`].
+    pub fn enable_fifo(&mut self) -> Result<(), Error<C::BusError>> {
+        fifo::enable(&mut self.chip, &mut self.fifo)
+    }
+}
+
+impl<C: Chip> ImuReader for Driver<C> {
+    type BusError = C::BusError;
+
+    fn scale(&self) -> Scale {
+        C::scale(&self.config)
+    }
+
+    /// One burst read of the 14 bytes of the data registers. Registers holding the chip's
+    /// invalid-data marker (the ICM-42688-P's -32768, while a sensor is starting) give
+    /// [`Error::NoData`]; they are no FIFO packet, and are not counted in
+    /// [`FifoStats::invalid`].
+    fn read(&mut self) -> Result<RawSample, Error<C::BusError>> {
+        let mut b = [0u8; 14];
+        self.chip.read(C::MAP.data, &mut b)?;
+        C::sample(&b).ok_or(Error::NoData)
+    }
+
+    /// Reads INT_STATUS and FIFO_COUNT first. A count above the FIFO's size is no count
+    /// ([`Error::BadFifoCount`], nothing read). On the FIFO overflow flag, or a count at the
+    /// FIFO's size (a full FIFO overwrites its oldest bytes, so its packets are misaligned),
+    /// the FIFO is reset (its complete packets are counted as discarded) and
+    /// [`Error::FifoOverflow`] is returned. An empty FIFO is checked against a chip reset (the
+    /// chip's FIFO configuration read back): a chip that has reset itself has its FIFO off,
+    /// and [`Error::SensorReset`] is returned (see [`Driver::recover`]); a FIFO reset finds
+    /// such a chip by its power mode, and returns the same. Otherwise the whole packets in the
+    /// FIFO (up to `out.len()`) are read, 8 per bus transfer; a partial packet stays in the
+    /// FIFO for the next call. Packets are parsed as the chip's type describes: skipped
+    /// packets are counted in [`FifoStats::malformed`] or [`FifoStats::invalid`].
+    ///
+    /// A read that fails part-way would leave the FIFO misaligned for good (the MPU-6050's
+    /// packets have no header). So, as TDK's drivers do, the FIFO is then reset: the samples
+    /// of the call and those left in the FIFO are counted as discarded and
+    /// [`Error::FifoResync`] is returned. A reset that meets a bus error itself is remembered
+    /// and finished by the next call, so an overflow, whose flag is cleared by reading it, is
+    /// never lost.
+    fn read_fifo(&mut self, out: &mut [RawSample]) -> Result<usize, Error<C::BusError>> {
+        fifo::read_fifo(&mut self.chip, &mut self.fifo, out)
+    }
+
+    fn fifo_stats(&self) -> FifoStats {
+        self.fifo.stats
+    }
+}
