@@ -5,6 +5,7 @@
 //! algebra from `nalgebra`), never the library's own recursion instantiated at `f64`.
 #![deny(missing_docs)]
 
+pub mod composite;
 pub mod data;
 pub mod differential;
 pub mod fixtures;

@@ -1,0 +1,108 @@
+//! The composite noise model a navigation filter needs: quantisation, white noise, a sum of
+//! first-order Gauss-Markov terms, random walk and rate ramp, with an optional AR(p) part for
+//! the sensor's short-term colouring, fitted to the Allan variance and checked against it at
+//! every averaging time.
+//!
+//! The components are independent, so the Allan variance of the sum is the sum of theirs, and
+//! each is linear in its variance parameter ([`component`] gives the exact discrete-time
+//! curves). A model is therefore fitted by non-negative least squares ([`nnls`]) on the octave
+//! Allan variances ([`Octaves`]), each row weighted by the inverse variance of its estimate,
+//! over a fixed log-spaced grid of Gauss-Markov correlation times; the terms are then reduced
+//! to the caller's budget of Kalman states. See [`NoiseModel::fit`] for the procedure and
+//! [`NoiseModel::kalman`] for the hand-off.
+//!
+//! Units: `u` is the sensor's unit (deg/s, rad/s, g, m/s^2). `Q` is in u s, `N` in u/sqrt(Hz)
+//! (u s^(1/2)), `K` in u/s/sqrt(Hz) (u s^(-1/2)), `R` in u/s, Gauss-Markov `sigma` in u and
+//! correlation times in s. For a gyro in deg/s, `N` in deg/sqrt(h) is `60 N`.
+//!
+//! Everything here runs in `f64`, on the host and on the device alike, allocation-free: the fit
+//! is not per-sample work. It needs about `4 L^2` `f64` of stack for `L` octaves (12.8 KiB for
+//! `L = 20`).
+
+use core::fmt;
+
+use crate::model::ModelError;
+
+pub mod component;
+mod fit;
+mod model;
+pub mod nnls;
+mod octaves;
+
+pub use fit::FitConfig;
+pub use model::{AllanRow, Check, GmTerm, Ieee952, KalmanForm, NoiseModel};
+pub use nnls::NnlsError;
+pub use octaves::{Estimator, NoiseType, Octaves};
+
+/// Why a noise model could not be fitted or used.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum NoiseError {
+    /// The sample interval (or the filter's step) is not positive and finite.
+    Interval,
+    /// A sample or an Allan variance at this index is NaN, infinite or negative.
+    NonFinite {
+        /// Index into the input.
+        index: usize,
+    },
+    /// Fewer octaves than the fit needs (2).
+    TooFewOctaves {
+        /// The octaves given.
+        given: usize,
+    },
+    /// More octaves than the capacity `L`.
+    TooManyOctaves {
+        /// The capacity.
+        capacity: usize,
+    },
+    /// Every Allan variance is zero: a constant (or stuck) input has no noise to model.
+    Constant,
+    /// More Gauss-Markov states asked for than the model's capacity `G`.
+    Budget {
+        /// States asked for.
+        requested: usize,
+        /// The capacity.
+        capacity: usize,
+    },
+    /// The grid spacing is not in [0.5, 8] octaves.
+    Spacing,
+    /// The AR part is not a stationary model.
+    Ar(ModelError),
+    /// The least-squares solve failed.
+    Nnls(NnlsError),
+}
+
+impl fmt::Display for NoiseError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Self::Interval => f.write_str("sample interval must be positive and finite"),
+            Self::NonFinite { index } => write!(f, "value {index} is NaN, infinite or negative"),
+            Self::TooFewOctaves { given } => write!(
+                f,
+                "{given} Allan octave(s), at least 2 needed (a record of at least 4 samples)"
+            ),
+            Self::TooManyOctaves { capacity } => {
+                write!(f, "more than {capacity} Allan octaves")
+            }
+            Self::Constant => f.write_str("the input is constant: every Allan variance is zero"),
+            Self::Budget {
+                requested,
+                capacity,
+            } => write!(
+                f,
+                "{requested} Gauss-Markov states asked for, at most {capacity} held"
+            ),
+            Self::Spacing => f.write_str("grid spacing must be in [0.5, 8] octaves"),
+            Self::Ar(e) => write!(f, "AR part: {e}"),
+            Self::Nnls(e) => write!(f, "least squares: {e:?}"),
+        }
+    }
+}
+
+impl core::error::Error for NoiseError {}
+
+impl From<NnlsError> for NoiseError {
+    fn from(e: NnlsError) -> Self {
+        Self::Nnls(e)
+    }
+}

@@ -1,0 +1,345 @@
+//! The fitted composite model: its Allan variance, its IEEE 952 readings, its Kalman filter
+//! form and its Allan check.
+
+use crate::model::ArModel;
+
+use super::component;
+use super::{NoiseError, NoiseType, Octaves};
+
+/// One first-order Gauss-Markov term: `dx/dt = -x / T + u`, stationary standard deviation
+/// `sigma`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct GmTerm {
+    /// Stationary standard deviation, in u.
+    pub sigma: f64,
+    /// Correlation time `T`, in s.
+    pub correlation_time: f64,
+}
+
+/// The composite noise model of one sensor axis, with at most `G` Gauss-Markov terms and an
+/// optional AR(`P`) part; see the [module docs](super) for the components and units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct NoiseModel<const P: usize, const G: usize> {
+    pub(super) dt: f64,
+    pub(super) quantization: f64,
+    pub(super) white: f64,
+    pub(super) random_walk: f64,
+    pub(super) ramp: f64,
+    pub(super) gm: [GmTerm; G],
+    pub(super) gm_len: usize,
+    pub(super) ar: Option<ArModel<f64, P>>,
+}
+
+/// The IEEE Std 952-1997 (Annex C) readings of a model and the data it was fitted to.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Ieee952 {
+    /// Angle (velocity) random walk `N` of the whole model, u/sqrt(Hz): the white term and the
+    /// AR part's white equivalent at long `tau`, `sqrt(N_w^2 + N_ar^2)`.
+    pub white_noise: f64,
+    /// `N` read as the data's Allan deviation at `tau = 1 s` (interpolated log-log between
+    /// octaves), the reading of Kalibr and allan_variance_ros users; `None` when the data do
+    /// not reach 1 s.
+    pub white_noise_at_1s: Option<f64>,
+    /// Quantisation `Q`, u s.
+    pub quantization: f64,
+    /// Rate random walk `K`, u/s/sqrt(Hz).
+    pub random_walk: f64,
+    /// Rate ramp `R`, u/s.
+    pub ramp: f64,
+    /// Bias instability `B = min ADEV / 0.664` of the data, u, and the `tau` of that minimum, s.
+    pub bias_instability: (f64, f64),
+}
+
+/// One filter state of a Gauss-Markov term at the filter's step `Dt`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct GmState {
+    /// `Phi = exp(-Dt / T)`.
+    pub phi: f64,
+    /// `Qd = sigma^2 (1 - exp(-2 Dt / T))`, u^2.
+    pub q: f64,
+    /// Stationary `P0 = sigma^2`, u^2.
+    pub p0: f64,
+}
+
+/// The model as a Kalman filter stepping every `Dt` takes it: one state per Gauss-Markov term,
+/// one random-walk state, and the white part as measurement noise or as a process-noise
+/// density. The AR part, if any, is folded into the white part (its equivalent at long `tau`):
+/// a filter that needs its short-term colouring takes [`NoiseModel::ar`] in companion form
+/// ([`ArModel::discretize`]) instead.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct KalmanForm<const G: usize> {
+    /// The filter's step `Dt`, s.
+    pub dt: f64,
+    /// The Gauss-Markov states, `[..gm_len]`.
+    pub gm: [GmState; G],
+    /// How many Gauss-Markov states.
+    pub gm_len: usize,
+    /// The random-walk state (`Phi = 1`, `Qd = K^2 Dt`, `P0` the turn-on bias variance the
+    /// caller gave), or `None` when the model has no random walk.
+    pub random_walk: Option<GmState>,
+    /// Variance of the sensor averaged over one step `Dt` (a filter that uses it as a
+    /// measurement): `N^2 / Dt + 2 Q^2 / Dt^2`, u^2.
+    pub measurement_variance: f64,
+    /// Two-sided PSD of the white part, `N^2`, u^2/Hz (u^2 s): the process noise density of the
+    /// integrated angle or velocity in a strapdown filter.
+    pub white_psd: f64,
+}
+
+/// One row of the Allan check.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct AllanRow {
+    /// `tau`, s.
+    pub tau: f64,
+    /// The data's Allan deviation, u.
+    pub data_adev: f64,
+    /// The model's Allan deviation, u.
+    pub model_adev: f64,
+    /// Two standard errors of the measured deviation, `2 / sqrt(2 nu)`, or 0.1 where that is
+    /// larger, as a fraction.
+    pub tolerance: f64,
+    /// `|data / model - 1| <= tolerance`.
+    pub agrees: bool,
+}
+
+/// The Allan check of a model against the octaves it describes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Check<const L: usize> {
+    rows: [AllanRow; L],
+    len: usize,
+}
+
+impl<const L: usize> Check<L> {
+    /// The rows, one per octave.
+    pub fn rows(&self) -> &[AllanRow] {
+        &self.rows[..self.len]
+    }
+
+    /// The largest `tau` up to which every row agrees, or `None` when the first does not.
+    pub fn explained_up_to(&self) -> Option<f64> {
+        self.rows()
+            .iter()
+            .take_while(|r| r.agrees)
+            .last()
+            .map(|r| r.tau)
+    }
+
+    /// Whether every row agrees.
+    pub fn holds(&self) -> bool {
+        self.rows().iter().all(|r| r.agrees)
+    }
+}
+
+impl<const P: usize, const G: usize> NoiseModel<P, G> {
+    /// The data's sample interval, s.
+    pub fn dt(&self) -> f64 {
+        self.dt
+    }
+
+    /// Quantisation `Q`, u s.
+    pub fn quantization(&self) -> f64 {
+        self.quantization
+    }
+
+    /// `N` of the white term alone, u/sqrt(Hz).
+    pub fn white_term(&self) -> f64 {
+        self.white
+    }
+
+    /// `N` of the whole model, u/sqrt(Hz): the white term and the AR part's white equivalent
+    /// at long `tau`, `N_ar^2 = sigma_w^2 dt / (1 - sum a_k)^2`.
+    pub fn white_noise(&self) -> f64 {
+        libm::sqrt(self.white * self.white + self.ar_white_psd())
+    }
+
+    /// Rate random walk `K`, u/s/sqrt(Hz).
+    pub fn random_walk(&self) -> f64 {
+        self.random_walk
+    }
+
+    /// Rate ramp `R`, u/s.
+    pub fn ramp(&self) -> f64 {
+        self.ramp
+    }
+
+    /// The Gauss-Markov terms, by increasing correlation time.
+    pub fn gauss_markov(&self) -> &[GmTerm] {
+        &self.gm[..self.gm_len]
+    }
+
+    /// The AR part, with the noise variance the fit scaled it to.
+    pub fn ar(&self) -> Option<&ArModel<f64, P>> {
+        self.ar.as_ref()
+    }
+
+    fn ar_white_psd(&self) -> f64 {
+        self.ar.as_ref().map_or(0.0, |ar| {
+            let gain = 1.0 - ar.a().iter().sum::<f64>();
+            ar.noise_variance() * self.dt / (gain * gain)
+        })
+    }
+
+    /// The model's Allan variance at `tau = 2^j dt` for `j < out.len()`, in u^2.
+    ///
+    /// # Errors
+    ///
+    /// [`NoiseError::Ar`] when the AR part is not stationary (a fitted model's always is).
+    pub fn avar_octaves(&self, out: &mut [f64]) -> Result<(), NoiseError> {
+        match &self.ar {
+            Some(ar) => component::ar_octaves(ar, out).map_err(NoiseError::Ar)?,
+            None => out.fill(0.0),
+        }
+        for (j, v) in out.iter_mut().enumerate() {
+            let (_, total) = self.dominant(1u64 << j.min(63));
+            *v += total;
+        }
+        Ok(())
+    }
+
+    /// The noise type that dominates the model's Allan variance at `m` (the AR part counts as
+    /// white), and the Allan variance of every component but the AR part.
+    pub(super) fn dominant(&self, m: u64) -> (NoiseType, f64) {
+        let dt = self.dt;
+        let tau = m as f64 * dt;
+        let sq = |v: f64| v * v;
+        let mut parts = [
+            (
+                NoiseType::WhitePhase,
+                sq(self.quantization) * component::quantization(dt, m),
+            ),
+            (
+                NoiseType::WhiteFrequency,
+                (sq(self.white) + self.ar_white_psd()) * component::white(dt, m),
+            ),
+            (
+                NoiseType::RandomWalkFrequency,
+                sq(self.random_walk) * component::random_walk(dt, m)
+                    + sq(self.ramp) * component::ramp(dt, m),
+            ),
+            (NoiseType::FlickerFrequency, 0.0),
+        ];
+        let mut total = parts[0].1 + parts[2].1 + sq(self.white) * component::white(dt, m);
+        for t in self.gauss_markov() {
+            let v = sq(t.sigma) * component::gauss_markov(dt, t.correlation_time, m);
+            total += v;
+            let kind = match tau / t.correlation_time {
+                r if r < 0.5 => 2,
+                r if r > 4.0 => 1,
+                _ => 3,
+            };
+            parts[kind].1 += v;
+        }
+        let kind = parts
+            .iter()
+            .max_by(|p, q| p.1.total_cmp(&q.1))
+            .map_or(NoiseType::WhiteFrequency, |p| p.0);
+        (kind, total)
+    }
+
+    /// The Allan check against `octaves` (the data the model describes): at every octave, the
+    /// model's deviation must be within two standard errors of the measured one, or within
+    /// 10 %, whichever is larger (`noise-model.md` section 4). The standard error is that of
+    /// the estimator that measured the octaves, with the degrees of freedom of the noise type
+    /// that dominates the model there ([`super::Estimator::edf`]).
+    ///
+    /// # Errors
+    ///
+    /// [`NoiseError::Ar`] when the AR part is not stationary.
+    pub fn check<const L: usize>(&self, octaves: &Octaves<L>) -> Result<Check<L>, NoiseError> {
+        let mut model = [0.0; L];
+        self.avar_octaves(&mut model)?;
+        let mut rows = [AllanRow::default(); L];
+        let data = octaves.avar();
+        for (j, (row, d)) in rows.iter_mut().zip(data).enumerate() {
+            let m = 1u64 << j.min(63);
+            let nu = octaves.estimator().edf(m, self.dominant(m).0);
+            let (data_adev, model_adev) = (libm::sqrt(*d), libm::sqrt(model[j]));
+            let tolerance = (2.0 / libm::sqrt(2.0 * nu)).max(0.1);
+            *row = AllanRow {
+                tau: octaves.tau(j),
+                data_adev,
+                model_adev,
+                tolerance,
+                agrees: libm::fabs(data_adev / model_adev - 1.0) <= tolerance,
+            };
+        }
+        Ok(Check {
+            rows,
+            len: data.len(),
+        })
+    }
+
+    /// The IEEE 952 readings of the model, with `B` and the 1 s reading of `N` taken from the
+    /// data `octaves`.
+    pub fn ieee952<const L: usize>(&self, octaves: &Octaves<L>) -> Ieee952 {
+        let adev = |j: usize| libm::sqrt(octaves.avar()[j]);
+        let lowest = (0..octaves.avar().len())
+            .min_by(|&p, &q| adev(p).total_cmp(&adev(q)))
+            .map_or((0.0, 0.0), |j| (adev(j) / 0.664, octaves.tau(j)));
+        // Log-log interpolation between the octaves around 1 s.
+        let at_1s = (1..octaves.avar().len())
+            .find(|&j| octaves.tau(j - 1) <= 1.0 && octaves.tau(j) >= 1.0)
+            .map(|j| {
+                let (t0, t1) = (octaves.tau(j - 1), octaves.tau(j));
+                let f = libm::log(1.0 / t0) / libm::log(t1 / t0);
+                libm::exp(libm::log(adev(j - 1)) * (1.0 - f) + libm::log(adev(j)) * f)
+            });
+        Ieee952 {
+            white_noise: self.white_noise(),
+            white_noise_at_1s: at_1s,
+            quantization: self.quantization,
+            random_walk: self.random_walk,
+            ramp: self.ramp,
+            bias_instability: lowest,
+        }
+    }
+
+    /// The model as a Kalman filter stepping every `dt_filter` seconds takes it (see
+    /// [`KalmanForm`]); `random_walk_p0` is the random-walk state's initial variance (the
+    /// turn-on bias uncertainty, which one recording cannot give), u^2.
+    ///
+    /// Gauss-Markov terms and the random walk are continuous-time processes, sampled exactly
+    /// at any step.
+    ///
+    /// # Errors
+    ///
+    /// [`NoiseError::Interval`] for a step that is not positive and finite, or a negative or
+    /// non-finite `random_walk_p0`.
+    pub fn kalman(&self, dt_filter: f64, random_walk_p0: f64) -> Result<KalmanForm<G>, NoiseError> {
+        let step_ok = dt_filter.is_finite() && dt_filter > 0.0;
+        let p0_ok = random_walk_p0.is_finite() && random_walk_p0 >= 0.0;
+        if !(step_ok && p0_ok) {
+            return Err(NoiseError::Interval);
+        }
+        let mut gm = [GmState::default(); G];
+        for (state, t) in gm.iter_mut().zip(self.gauss_markov()) {
+            let s2 = t.sigma * t.sigma;
+            *state = GmState {
+                phi: libm::exp(-dt_filter / t.correlation_time),
+                q: -s2 * libm::expm1(-2.0 * dt_filter / t.correlation_time),
+                p0: s2,
+            };
+        }
+        let k2 = self.random_walk * self.random_walk;
+        let n2 = self.white_noise() * self.white_noise();
+        let q2 = self.quantization * self.quantization;
+        Ok(KalmanForm {
+            dt: dt_filter,
+            gm,
+            gm_len: self.gm_len,
+            random_walk: (k2 > 0.0).then_some(GmState {
+                phi: 1.0,
+                q: k2 * dt_filter,
+                p0: random_walk_p0,
+            }),
+            measurement_variance: n2 / dt_filter + 2.0 * q2 / (dt_filter * dt_filter),
+            white_psd: n2,
+        })
+    }
+}

@@ -1,0 +1,207 @@
+//! The measured Allan variances at `tau = 2^j dt` that a noise model is fitted to, with the
+//! equivalent degrees of freedom of each.
+
+use crate::Scalar;
+use crate::allan::{AllanStream, overlapping_avar};
+
+use super::NoiseError;
+
+/// Which estimator measured the Allan variances: it sets their equivalent degrees of freedom.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Estimator {
+    /// The overlapping estimator over `n` samples ([`overlapping_avar`], the host).
+    Overlapping {
+        /// Samples in the record.
+        n: u64,
+    },
+    /// The non-overlapping estimator ([`AllanStream`], the device) over `n` samples.
+    NonOverlapping {
+        /// Samples taken.
+        n: u64,
+    },
+}
+
+/// The noise type that dominates an Allan estimate, which decides its degrees of freedom.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum NoiseType {
+    /// White phase noise: quantisation, `AVAR ~ tau^-2`.
+    WhitePhase,
+    /// White frequency noise: angle or velocity random walk, `AVAR ~ tau^-1`.
+    WhiteFrequency,
+    /// Flicker frequency noise: bias instability, flat `AVAR`.
+    FlickerFrequency,
+    /// Random-walk frequency noise: rate random walk, `AVAR ~ tau`.
+    RandomWalkFrequency,
+}
+
+impl Estimator {
+    /// Samples in the record.
+    pub fn samples(&self) -> u64 {
+        match *self {
+            Self::Overlapping { n } | Self::NonOverlapping { n } => n,
+        }
+    }
+
+    /// Equivalent degrees of freedom `nu` of the Allan variance at `m` samples per cluster
+    /// when `noise` dominates: the estimate is distributed as `AVAR chi^2_nu / nu`, so its
+    /// relative standard error is `sqrt(2 / nu)` (and the deviation's `1 / sqrt(2 nu)`).
+    ///
+    /// - Non-overlapping: the number of differences, `floor(n/m) - 1`, whatever the noise
+    ///   (exact for white frequency noise, whose differences are independent).
+    /// - Overlapping: the simple formulas of W. J. Riley, *Handbook of Frequency Stability
+    ///   Analysis*, NIST SP 1065 (2008), table 5 (after Howe, Allan and Barnes 1981), with
+    ///   `N = n + 1` phase points.
+    ///
+    /// At least 1; 0 when fewer than two clusters fit (no estimate).
+    pub fn edf(&self, m: u64, noise: NoiseType) -> f64 {
+        let n = self.samples();
+        if m == 0 || n / m < 2 {
+            return 0.0;
+        }
+        let nu = match *self {
+            Self::NonOverlapping { .. } => (n / m - 1) as f64,
+            Self::Overlapping { .. } => {
+                let (big, m) = (n as f64 + 1.0, m as f64);
+                match noise {
+                    NoiseType::WhitePhase => (big + 1.0) * (big - 2.0 * m) / (2.0 * (big - m)),
+                    NoiseType::WhiteFrequency => {
+                        (3.0 * (big - 1.0) / (2.0 * m) - 2.0 * (big - 2.0) / big) * 4.0 * m * m
+                            / (4.0 * m * m + 5.0)
+                    }
+                    NoiseType::FlickerFrequency if m < 2.0 => 2.0 * (big - 2.0) / (2.3 * big - 4.9),
+                    NoiseType::FlickerFrequency => 5.0 * big * big / (4.0 * m * (big + 3.0 * m)),
+                    NoiseType::RandomWalkFrequency => {
+                        let b1 = big - 1.0;
+                        (big - 2.0) / m * (b1 * b1 - 3.0 * m * b1 + 4.0 * m * m)
+                            / ((big - 3.0) * (big - 3.0))
+                    }
+                }
+            }
+        };
+        nu.max(1.0)
+    }
+}
+
+/// Allan variances at `tau = 2^j dt`, `j = 0..len`, with the estimator that measured them.
+///
+/// `L` is the capacity in octaves.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Octaves<const L: usize> {
+    dt: f64,
+    avar: [f64; L],
+    len: usize,
+    estimator: Estimator,
+}
+
+impl<const L: usize> Octaves<L> {
+    /// The octaves of a streaming estimator sampled every `dt` seconds: every level with at
+    /// least one difference.
+    ///
+    /// # Errors
+    ///
+    /// [`NoiseError::Interval`] for a `dt` that is not positive and finite.
+    pub fn from_stream(stream: &AllanStream<L>, dt: f64) -> Result<Self, NoiseError> {
+        check_dt(dt)?;
+        let mut avar = [0.0; L];
+        let mut len = 0;
+        while let Some(v) = stream.avar(len) {
+            avar[len] = v;
+            len += 1;
+        }
+        Ok(Self {
+            dt,
+            avar,
+            len,
+            estimator: Estimator::NonOverlapping {
+                n: stream.samples(),
+            },
+        })
+    }
+
+    /// The overlapping Allan variances of `x`, sampled every `dt` seconds, at every octave
+    /// with at least two clusters (`2m <= n`), up to `L`. `O(n L)` operations.
+    ///
+    /// # Errors
+    ///
+    /// [`NoiseError::Interval`] for a bad `dt`; [`NoiseError::NonFinite`] for a NaN or
+    /// infinite sample.
+    pub fn overlapping<T: Scalar>(x: &[T], dt: f64) -> Result<Self, NoiseError> {
+        check_dt(dt)?;
+        if let Some(index) = x.iter().position(|v| !v.is_finite()) {
+            return Err(NoiseError::NonFinite { index });
+        }
+        let mut avar = [0.0; L];
+        let mut len = 0;
+        for (j, slot) in avar.iter_mut().enumerate() {
+            let m = 1usize << j.min(63);
+            if j >= 63 || x.len() / 2 < m {
+                break;
+            }
+            // m >= 1, 2m <= n and every sample finite: the estimate exists.
+            let Ok(v) = overlapping_avar(x, m) else { break };
+            *slot = v.to_f64();
+            len += 1;
+        }
+        Ok(Self {
+            dt,
+            avar,
+            len,
+            estimator: Estimator::Overlapping { n: x.len() as u64 },
+        })
+    }
+
+    /// Octaves given directly: `avar[j]` at `tau = 2^j dt`, measured by `estimator`.
+    ///
+    /// # Errors
+    ///
+    /// [`NoiseError::Interval`] for a bad `dt`, [`NoiseError::TooFewOctaves`] for more than `L`
+    /// values, [`NoiseError::NonFinite`] for a NaN, infinite or negative value.
+    pub fn new(dt: f64, avar: &[f64], estimator: Estimator) -> Result<Self, NoiseError> {
+        check_dt(dt)?;
+        if avar.len() > L {
+            return Err(NoiseError::TooManyOctaves { capacity: L });
+        }
+        if let Some(index) = avar.iter().position(|v| !(v.is_finite() && *v >= 0.0)) {
+            return Err(NoiseError::NonFinite { index });
+        }
+        let mut out = [0.0; L];
+        out[..avar.len()].copy_from_slice(avar);
+        Ok(Self {
+            dt,
+            avar: out,
+            len: avar.len(),
+            estimator,
+        })
+    }
+
+    /// The sample interval, in seconds.
+    pub fn dt(&self) -> f64 {
+        self.dt
+    }
+
+    /// The Allan variances, `[j]` at `tau = 2^j dt`, in units^2.
+    pub fn avar(&self) -> &[f64] {
+        &self.avar[..self.len]
+    }
+
+    /// The estimator that measured them.
+    pub fn estimator(&self) -> Estimator {
+        self.estimator
+    }
+
+    /// `tau = 2^j dt`, in seconds.
+    pub fn tau(&self, j: usize) -> f64 {
+        self.dt * (1u64 << j.min(63)) as f64
+    }
+}
+
+fn check_dt(dt: f64) -> Result<(), NoiseError> {
+    if dt.is_finite() && dt > 0.0 {
+        Ok(())
+    } else {
+        Err(NoiseError::Interval)
+    }
+}
