@@ -32,6 +32,8 @@ pub enum AllanError {
         /// Index into the input slice.
         index: usize,
     },
+    /// A forgetting horizon below one sample, or not finite.
+    Horizon,
 }
 
 impl fmt::Display for AllanError {
@@ -42,6 +44,7 @@ impl fmt::Display for AllanError {
                 write!(f, "{given} samples given, at least {needed} needed")
             }
             Self::NonFinite { index } => write!(f, "sample {index} is NaN or infinite"),
+            Self::Horizon => f.write_str("forgetting horizon must be at least 1 sample"),
         }
     }
 }
@@ -124,20 +127,28 @@ struct Octave {
     pending: Option<f64>,
     /// Average of the previous block.
     previous: Option<f64>,
-    /// Sum of squared differences of consecutive block averages.
+    /// Weighted sum of squared differences of consecutive block averages.
     acc: f64,
-    /// Number of differences in `acc`.
-    count: u64,
+    /// Sum of the weights of the differences in `acc` (their number without forgetting).
+    weight: f64,
+    /// Sum of the squared weights (for the effective number of differences).
+    weight2: f64,
 }
 
-/// Streaming Allan variance at `m = 1, 2, 4, .., 2^(L-1)` in fixed memory.
+/// Streaming Allan variance at `m = 1, 2, 4, .., 2^(L-1)` in fixed memory, optionally
+/// forgetting.
 ///
-/// Each octave keeps the pending block sum, the previous block average, a sum of squares and a
-/// count (40 bytes an octave: 800 bytes for `L = 20`), so one sample costs `O(1)` amortised
-/// (two octave updates on average). The estimate is the **non-overlapping** Allan variance
+/// Each octave keeps the pending block sum, the previous block average, a weighted sum of
+/// squares and two weight sums (56 bytes an octave), so one sample costs `O(1)` amortised (two
+/// octave updates on average). The estimate is the **non-overlapping** Allan variance
 /// `sum_k (ybar_{k+1} - ybar_k)^2 / (2 K)` over consecutive blocks of `m` samples: it has the same
 /// expectation as [`overlapping_avar`] but uses `N/m - 1` differences instead of `N - 2m + 1`,
 /// so its variance is larger (by up to about 2x at large `m`). Accumulates in `f64`.
+///
+/// A stream made by [`AllanStream::forgetting`] weights each difference by `exp(-age / H)`,
+/// its age in samples against the horizon `H`, so that it follows a sensor whose noise
+/// changes; [`AllanStream::differences`] gives the effective number of differences
+/// `(sum w)^2 / sum w^2` of each octave, which sets the estimate's standard error.
 ///
 /// ```
 /// use imu_ar::allan::AllanStream;
@@ -154,6 +165,8 @@ struct Octave {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct AllanStream<const L: usize> {
     octaves: [Octave; L],
+    /// Per-sample decay `exp(-1 / H)`; 1 without forgetting.
+    decay: f64,
     samples: u64,
     rejected: u64,
 }
@@ -165,18 +178,52 @@ impl<const L: usize> Default for AllanStream<L> {
 }
 
 impl<const L: usize> AllanStream<L> {
-    /// An empty estimator.
+    /// An empty estimator that never forgets.
     pub const fn new() -> Self {
         Self {
             octaves: [Octave {
                 pending: None,
                 previous: None,
                 acc: 0.0,
-                count: 0,
+                weight: 0.0,
+                weight2: 0.0,
             }; L],
+            decay: 1.0,
             samples: 0,
             rejected: 0,
         }
+    }
+
+    /// An empty estimator that forgets with a horizon of `horizon` samples: a difference
+    /// `k` samples old weighs `exp(-k / horizon)`. Octave `j` then has about
+    /// `2 horizon / 2^j` effective differences, so the horizon should be many times the
+    /// longest averaging time of interest. An octave follows a step change of the noise
+    /// exponentially with time constant `horizon` samples, whatever its `m`.
+    ///
+    /// ```
+    /// use imu_ar::allan::AllanStream;
+    ///
+    /// let mut s = AllanStream::<4>::forgetting(100.0).unwrap();
+    /// for n in 0..2000 {
+    ///     // Alternating +-1, then +-3 for the last 1,000 samples.
+    ///     let level = if n < 1000 { 1.0 } else { 3.0 };
+    ///     s.push(if n % 2 == 0 { level } else { -level });
+    /// }
+    /// // AVAR(1) = 2 level^2: the first 1,000 samples weigh exp(-10) by now.
+    /// assert!((s.avar(0).unwrap() / 18.0 - 1.0).abs() < 1e-3);
+    /// ```
+    ///
+    /// # Errors
+    ///
+    /// [`AllanError::Horizon`] unless `horizon` is at least 1 and finite.
+    pub fn forgetting(horizon: f64) -> Result<Self, AllanError> {
+        if !(horizon.is_finite() && horizon >= 1.0) {
+            return Err(AllanError::Horizon);
+        }
+        Ok(Self {
+            decay: libm::exp(-1.0 / horizon),
+            ..Self::new()
+        })
     }
 
     /// Adds one sample. A NaN or infinite sample is rejected, counted and changes nothing else;
@@ -189,12 +236,15 @@ impl<const L: usize> AllanStream<L> {
         self.samples = self.samples.saturating_add(1);
         let mut block = x.to_f64();
         let mut size = 1.0;
+        // exp(-m / H): the decay between two differences of the octave of m.
+        let mut decay = self.decay;
         for o in self.octaves.iter_mut() {
             let avg = block / size;
             size *= 2.0;
             if let Some(prev) = o.previous {
-                o.acc += (avg - prev) * (avg - prev);
-                o.count = o.count.saturating_add(1);
+                o.acc = decay * o.acc + (avg - prev) * (avg - prev);
+                o.weight = decay * o.weight + 1.0;
+                o.weight2 = decay * decay * o.weight2 + 1.0;
             }
             o.previous = Some(avg);
             match o.pending.take() {
@@ -204,6 +254,7 @@ impl<const L: usize> AllanStream<L> {
                     break;
                 }
             }
+            decay *= decay;
         }
         true
     }
@@ -211,7 +262,17 @@ impl<const L: usize> AllanStream<L> {
     /// Allan variance at `m = 2^level`, or `None` before two blocks of that size were seen.
     pub fn avar(&self, level: usize) -> Option<f64> {
         let o = self.octaves.get(level)?;
-        (o.count > 0).then(|| o.acc / (2.0 * o.count as f64))
+        (o.weight > 0.0).then(|| o.acc / (2.0 * o.weight))
+    }
+
+    /// The effective number of differences behind [`AllanStream::avar`] at `level`,
+    /// `(sum w)^2 / sum w^2`: without forgetting, their number `floor(N / m) - 1`. 0 before the
+    /// first.
+    pub fn differences(&self, level: usize) -> f64 {
+        self.octaves
+            .get(level)
+            .filter(|o| o.weight2 > 0.0)
+            .map_or(0.0, |o| o.weight * o.weight / o.weight2)
     }
 
     /// Samples taken.

@@ -126,3 +126,93 @@ fn white_and_quantization() {
         assert!(q.abs() < 0.03, "seed {seed}: Q off by {q}");
     }
 }
+
+/// A forgetting `AllanStream` fed a record whose noise steps up at `switch`, fitted every
+/// `horizon` samples after it: the fitted `N` or Gauss-Markov sigma against the new truth.
+fn track(before: &Composite, after: &Composite, horizon: f64) -> Vec<NoiseModel<1, 4>> {
+    use imu_ar::allan::AllanStream;
+    let h = horizon as usize;
+    let (first, second) = (before.simulate(10 * h, 7), after.simulate(5 * h, 8));
+    let mut stream = AllanStream::<14>::forgetting(horizon).unwrap();
+    first.iter().for_each(|&x| {
+        stream.push(x);
+    });
+    second
+        .chunks(h)
+        .map(|chunk| {
+            chunk.iter().for_each(|&x| {
+                stream.push(x);
+            });
+            let octaves = Octaves::from_stream(&stream, after.dt).unwrap();
+            NoiseModel::<1, 4>::fit(&octaves, None, &FitConfig::new(1)).unwrap()
+        })
+        .collect()
+}
+
+#[test]
+fn a_forgetting_stream_follows_a_step_of_white_noise() {
+    let before = Composite {
+        dt: 0.01,
+        white: 0.01,
+        quantization: 0.0,
+        gm: vec![],
+        random_walk: 0.0,
+    };
+    let after = Composite {
+        white: 0.02,
+        ..before.clone()
+    };
+    // A horizon of 30,000 samples (300 s). N^2 follows exponentially with that time
+    // constant: N / N_after = sqrt(1 - 0.75 exp(-t / H)), 0.86 after one horizon, 0.98
+    // after three.
+    let fits = track(&before, &after, 30_000.0);
+    let ratios: Vec<f64> = fits.iter().map(|m| m.white_noise() / 0.02).collect();
+    println!("N / N_after one to five horizons after the step: {ratios:.3?}");
+    for (k, r) in ratios.iter().enumerate() {
+        let expected = (1.0 - 0.75 * (-(k as f64 + 1.0)).exp()).sqrt();
+        assert!(
+            (r - expected).abs() < 0.03,
+            "{} horizons: {r} vs {expected}",
+            k + 1
+        );
+    }
+}
+
+#[test]
+fn a_forgetting_stream_follows_a_step_of_gauss_markov_sigma() {
+    let before = Composite {
+        dt: 0.01,
+        white: 0.002,
+        quantization: 0.0,
+        gm: vec![(2e-3, 2.0)],
+        random_walk: 0.0,
+    };
+    let after = Composite {
+        gm: vec![(4e-3, 2.0)],
+        ..before.clone()
+    };
+    let fits = track(&before, &after, 30_000.0);
+    // sigma against T is poorly determined by one bump; its height is not: the model's Allan
+    // deviation at 2.56 s and 5.12 s (the bump's peak is near 1.89 T = 3.8 s) against the
+    // new truth's. Its square follows as N^2 does.
+    let ratios: Vec<[f64; 2]> = fits
+        .iter()
+        .map(|m| {
+            let mut avar = [0.0; 10];
+            m.avar_octaves(&mut avar).unwrap();
+            [8, 9].map(|j| (avar[j] / after.avar(1 << j)).sqrt())
+        })
+        .collect();
+    println!("model / truth ADEV at 2.56 s and 5.12 s, one to five horizons after: {ratios:.3?}");
+    for (k, r) in ratios.iter().enumerate() {
+        for (v, j) in r.iter().zip([8, 9]) {
+            let old = before.avar(1 << j) / after.avar(1 << j);
+            let expected = (1.0 - (1.0 - old) * (-(k as f64 + 1.0)).exp()).sqrt();
+            assert!(
+                (v - expected).abs() < 0.1,
+                "{} horizons: {v} vs {expected}",
+                k + 1
+            );
+        }
+    }
+}

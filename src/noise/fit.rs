@@ -263,7 +263,7 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
                 Some(model) if curve[j] > 0.0 => (model.dominant(m).0, curve[j]),
                 _ => (NoiseType::WhiteFrequency, d.max(floor)),
             };
-            let nu = self.octaves.estimator().edf(m, kind);
+            let nu = self.octaves.edf(j, kind);
             self.weight[j] = libm::sqrt(nu) / reference;
         }
     }

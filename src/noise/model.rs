@@ -258,7 +258,7 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
         let data = octaves.avar();
         for (j, (row, d)) in rows.iter_mut().zip(data).enumerate() {
             let m = 1u64 << j.min(63);
-            let nu = octaves.estimator().edf(m, self.dominant(m).0);
+            let nu = octaves.edf(j, self.dominant(m).0);
             let (data_adev, model_adev) = (libm::sqrt(*d), libm::sqrt(model[j]));
             let tolerance = (2.0 / libm::sqrt(2.0 * nu)).max(0.1);
             *row = AllanRow {

@@ -15,7 +15,9 @@ pub enum Estimator {
         /// Samples in the record.
         n: u64,
     },
-    /// The non-overlapping estimator ([`AllanStream`], the device) over `n` samples.
+    /// The non-overlapping estimator ([`AllanStream`], the device) over `n` samples (a
+    /// forgetting stream: its effective number of differences per octave instead, see
+    /// [`Octaves::from_stream`]).
     NonOverlapping {
         /// Samples taken.
         n: u64,
@@ -60,27 +62,27 @@ impl Estimator {
         if m == 0 || n / m < 2 {
             return 0.0;
         }
-        let nu = match *self {
+        match *self {
             Self::NonOverlapping { .. } => (n / m - 1) as f64,
-            Self::Overlapping { .. } => {
-                let (big, m) = (n as f64 + 1.0, m as f64);
-                match noise {
-                    NoiseType::WhitePhase => (big + 1.0) * (big - 2.0 * m) / (2.0 * (big - m)),
-                    NoiseType::WhiteFrequency => {
-                        (3.0 * (big - 1.0) / (2.0 * m) - 2.0 * (big - 2.0) / big) * 4.0 * m * m
-                            / (4.0 * m * m + 5.0)
-                    }
-                    NoiseType::FlickerFrequency if m < 2.0 => 2.0 * (big - 2.0) / (2.3 * big - 4.9),
-                    NoiseType::FlickerFrequency => 5.0 * big * big / (4.0 * m * (big + 3.0 * m)),
-                    NoiseType::RandomWalkFrequency => {
-                        let b1 = big - 1.0;
-                        (big - 2.0) / m * (b1 * b1 - 3.0 * m * b1 + 4.0 * m * m)
-                            / ((big - 3.0) * (big - 3.0))
-                    }
-                }
-            }
-        };
-        nu.max(1.0)
+            Self::Overlapping { .. } => overlapping_edf(n as f64 + 1.0, m as f64, noise).max(1.0),
+        }
+    }
+}
+
+/// Riley's table 5 for `big` phase points and `m` samples per cluster.
+fn overlapping_edf(big: f64, m: f64, noise: NoiseType) -> f64 {
+    match noise {
+        NoiseType::WhitePhase => (big + 1.0) * (big - 2.0 * m) / (2.0 * (big - m)),
+        NoiseType::WhiteFrequency => {
+            (3.0 * (big - 1.0) / (2.0 * m) - 2.0 * (big - 2.0) / big) * 4.0 * m * m
+                / (4.0 * m * m + 5.0)
+        }
+        NoiseType::FlickerFrequency if m < 2.0 => 2.0 * (big - 2.0) / (2.3 * big - 4.9),
+        NoiseType::FlickerFrequency => 5.0 * big * big / (4.0 * m * (big + 3.0 * m)),
+        NoiseType::RandomWalkFrequency => {
+            let b1 = big - 1.0;
+            (big - 2.0) / m * (b1 * b1 - 3.0 * m * b1 + 4.0 * m * m) / ((big - 3.0) * (big - 3.0))
+        }
     }
 }
 
@@ -92,13 +94,16 @@ impl Estimator {
 pub struct Octaves<const L: usize> {
     dt: f64,
     avar: [f64; L],
+    /// A stream's effective number of differences per octave; empty otherwise.
+    differences: Option<[f64; L]>,
     len: usize,
     estimator: Estimator,
 }
 
 impl<const L: usize> Octaves<L> {
     /// The octaves of a streaming estimator sampled every `dt` seconds: every level with at
-    /// least one difference.
+    /// least one difference, each with the stream's effective number of differences as its
+    /// degrees of freedom (for a forgetting stream, fewer than `floor(n/m) - 1`).
     ///
     /// # Errors
     ///
@@ -106,14 +111,17 @@ impl<const L: usize> Octaves<L> {
     pub fn from_stream(stream: &AllanStream<L>, dt: f64) -> Result<Self, NoiseError> {
         check_dt(dt)?;
         let mut avar = [0.0; L];
+        let mut differences = [0.0; L];
         let mut len = 0;
         while let Some(v) = stream.avar(len) {
             avar[len] = v;
+            differences[len] = stream.differences(len);
             len += 1;
         }
         Ok(Self {
             dt,
             avar,
+            differences: Some(differences),
             len,
             estimator: Estimator::NonOverlapping {
                 n: stream.samples(),
@@ -148,6 +156,7 @@ impl<const L: usize> Octaves<L> {
         Ok(Self {
             dt,
             avar,
+            differences: None,
             len,
             estimator: Estimator::Overlapping { n: x.len() as u64 },
         })
@@ -172,6 +181,7 @@ impl<const L: usize> Octaves<L> {
         Ok(Self {
             dt,
             avar: out,
+            differences: None,
             len: avar.len(),
             estimator,
         })
@@ -190,6 +200,15 @@ impl<const L: usize> Octaves<L> {
     /// The estimator that measured them.
     pub fn estimator(&self) -> Estimator {
         self.estimator
+    }
+
+    /// The degrees of freedom of octave `j` when `noise` dominates it: a stream's effective
+    /// number of differences (at least 1), or [`Estimator::edf`].
+    pub fn edf(&self, j: usize, noise: NoiseType) -> f64 {
+        match &self.differences {
+            Some(d) => d.get(j).map_or(0.0, |v| v.max(1.0)),
+            None => self.estimator.edf(1u64 << j.min(63), noise),
+        }
     }
 
     /// `tau = 2^j dt`, in seconds.
