@@ -216,3 +216,44 @@ fn a_forgetting_stream_follows_a_step_of_gauss_markov_sigma() {
         }
     }
 }
+
+#[test]
+#[ignore]
+fn explore_real() {
+    use imu_ar::batch::{BatchConfig, covariance};
+    use imu_ar_host::data::read_column;
+    use std::path::PathBuf;
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/imu");
+    let adis = [
+        dir.join("adis16405_imu1_part1.csv"),
+        dir.join("adis16405_imu1_part2.csv"),
+    ];
+    for c in ["ax", "ay", "az", "gx"] {
+        let x = read_column(&adis, c).unwrap();
+        let octaves = Octaves::<24>::overlapping(&x, 0.01).unwrap();
+        let ar = covariance::<f64, 8>(&x, &BatchConfig::new(0.01).unwrap())
+            .unwrap()
+            .model;
+        for osc in [false, true] {
+            let model = NoiseModel::<8, 6>::fit(
+                &octaves,
+                Some(&ar),
+                &FitConfig::new(5).with_oscillators(osc),
+            )
+            .unwrap();
+            let check = model.check(&octaves).unwrap();
+            let fails: Vec<String> = check
+                .rows()
+                .iter()
+                .filter(|r| !r.agrees)
+                .map(|r| format!("{}:{:.2}", r.tau, r.data_adev / r.model_adev))
+                .collect();
+            println!(
+                "{c} osc {osc}: gm {:?} osc {:?} up to {:?} fails {fails:?}",
+                model.gauss_markov().len(),
+                model.oscillators(),
+                check.explained_up_to()
+            );
+        }
+    }
+}

@@ -72,6 +72,26 @@ fn g(x: f64) -> f64 {
     sum
 }
 
+/// `AVAR` at `m = 2^j` of a second-order Gauss-Markov process (a damped oscillator) of unit
+/// variance, centre frequency `frequency` (Hz) and decay time `t` (s), sampled every `dt`: the
+/// AR(2) with poles `exp(-dt/t) exp(+-i 2 pi f dt)`, `a = [2 r cos(theta), -r^2]`. Its Allan
+/// deviation has the bump of a spectral line, at `tau` near `0.37 / f`.
+///
+/// # Errors
+///
+/// [`ModelError::Unstable`] for `t` not positive (a pole on the unit circle);
+/// [`ModelError::NonFinite`] for a non-finite parameter.
+pub fn oscillator(dt: f64, frequency: f64, t: f64, j: usize) -> Result<f64, ModelError> {
+    let r = libm::exp(-dt / t);
+    let theta = 2.0 * core::f64::consts::PI * frequency * dt;
+    let ar = ArModel::new([2.0 * r * libm::cos(theta), -r * r], 1.0, 0.0, dt)?;
+    let r0 = ar.autocovariances()?.next().unwrap_or(1.0);
+    let mut out = [0.0; 64];
+    let out = &mut out[..=j.min(63)];
+    ar_octaves(&ar, out)?;
+    Ok(out[out.len() - 1] / r0)
+}
+
 /// The Allan variances of a stationary AR model at `m = 1, 2, 4, .., 2^(L-1)` into `out`.
 ///
 /// With the autocovariances `r_k`, `Var S_m = m (2 A_m - r_0) - 2 B_m` where

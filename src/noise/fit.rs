@@ -2,7 +2,7 @@
 
 use crate::model::ArModel;
 
-use super::model::{GmTerm, NoiseModel};
+use super::model::{GmTerm, NoiseModel, Oscillator};
 use super::{NoiseError, NoiseType, Octaves, component, nnls};
 
 /// How to fit a [`NoiseModel`].
@@ -20,6 +20,7 @@ pub struct FitConfig {
     spacing: f64,
     quantization: bool,
     ramp: bool,
+    oscillators: bool,
 }
 
 impl FitConfig {
@@ -31,6 +32,7 @@ impl FitConfig {
             spacing: 1.0,
             quantization: true,
             ramp: false,
+            oscillators: false,
         }
     }
 
@@ -64,11 +66,29 @@ impl FitConfig {
         Self { ramp: on, ..self }
     }
 
+    /// Whether the model may have second-order Gauss-Markov terms (damped oscillators, two
+    /// states each; default: no), for a spectral line below the AR part's reach: candidates
+    /// at `f = 0.371 / tau` for every octave from `8 dt`, down to [`OSCILLATOR_MIN_HZ`],
+    /// decaying over [`OSCILLATOR_CYCLES`] periods.
+    pub const fn with_oscillators(self, on: bool) -> Self {
+        Self {
+            oscillators: on,
+            ..self
+        }
+    }
+
     /// The budget of Gauss-Markov terms.
     pub const fn gm_states(&self) -> usize {
         self.gm_states
     }
 }
+
+/// The decay time of a candidate oscillator, in periods: `T = OSCILLATOR_CYCLES / f`.
+pub const OSCILLATOR_CYCLES: f64 = 10.0;
+
+/// The lowest candidate oscillator frequency, Hz: a slower line is a bump that Gauss-Markov
+/// terms fit as well within a record's reach, for one state instead of two.
+pub const OSCILLATOR_MIN_HZ: f64 = 0.1;
 
 /// A column of the fit: a component of unit parameter.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -80,6 +100,7 @@ enum Column {
     Ramp,
     Ar,
     GaussMarkov(f64),
+    Oscillator(f64),
 }
 
 /// Weighted solves before and after the reduction to the state budget.
@@ -191,6 +212,13 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
             n += 1;
             t *= libm::exp2(config.spacing);
         }
+        for j in (3..data.len()).filter(|_| config.oscillators) {
+            if n == capacity || 0.371 / octaves.tau(j) < OSCILLATOR_MIN_HZ {
+                break;
+            }
+            columns[n] = Column::Oscillator(0.371 / octaves.tau(j));
+            n += 1;
+        }
 
         let fit = problem.refine(&columns[..n], None)?;
         n = compact(&mut columns[..n], &fit.1);
@@ -213,6 +241,8 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
         );
         model.gm_len = full.gm_len.min(G);
         model.gm[..model.gm_len].copy_from_slice(&full.gm[..model.gm_len]);
+        model.osc_len = full.osc_len.min(G);
+        model.osc[..model.osc_len].copy_from_slice(&full.osc[..model.osc_len]);
         Ok(model)
     }
 
@@ -225,6 +255,8 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
             ramp: 0.0,
             gm: [GmTerm::default(); G],
             gm_len: 0,
+            osc: [Oscillator::default(); G],
+            osc_len: 0,
             ar: None,
         }
     }
@@ -241,6 +273,10 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
             Column::Ramp => component::ramp(dt, m),
             Column::Ar => self.ar_curve[j],
             Column::GaussMarkov(t) => component::gauss_markov(dt, t, m),
+            // The candidates' poles are inside the unit circle by construction.
+            Column::Oscillator(f) => {
+                component::oscillator(dt, f, OSCILLATOR_CYCLES / f, j).unwrap_or(0.0)
+            }
         }
     }
 
@@ -311,7 +347,15 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
                     };
                     model.gm_len += 1;
                 }
-                Column::GaussMarkov(_) => {}
+                Column::Oscillator(f) if v > 0.0 => {
+                    model.osc[model.osc_len] = Oscillator {
+                        sigma: root,
+                        frequency: f,
+                        decay_time: OSCILLATOR_CYCLES / f,
+                    };
+                    model.osc_len += 1;
+                }
+                Column::GaussMarkov(_) | Column::Oscillator(_) => {}
             }
         }
         model.gm[..model.gm_len]
@@ -362,7 +406,7 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
         mut n: usize,
         budget: usize,
     ) -> Result<usize, NoiseError> {
-        while n - fixed > budget {
+        while states(&columns[fixed..n]) > budget {
             let (x, _) = self.nnls(&columns[..n])?;
             let mut best: Option<(f64, usize, Option<f64>)> = None;
             let mut trial = [[Column::default(); L]; 2];
@@ -399,13 +443,26 @@ const MAX: usize = nnls::MAX_COLUMNS;
 fn compact(columns: &mut [Column], x: &[f64]) -> usize {
     let mut kept = 0;
     for c in 0..columns.len() {
-        let zero_term = matches!(columns[c], Column::GaussMarkov(_)) && x[c] <= 0.0;
+        let term = matches!(columns[c], Column::GaussMarkov(_) | Column::Oscillator(_));
+        let zero_term = term && x[c] <= 0.0;
         if !zero_term {
             columns[kept] = columns[c];
             kept += 1;
         }
     }
     kept
+}
+
+/// Kalman states of the terms `columns`: one per Gauss-Markov term, two per oscillator.
+fn states(columns: &[Column]) -> usize {
+    columns
+        .iter()
+        .map(|c| match c {
+            Column::GaussMarkov(_) => 1,
+            Column::Oscillator(_) => 2,
+            _ => 0,
+        })
+        .sum()
 }
 
 /// The term replacing Gauss-Markov columns `p` and `q` of variances `vp` and `vq`: their

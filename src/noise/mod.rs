@@ -29,8 +29,10 @@ mod model;
 pub mod nnls;
 mod octaves;
 
-pub use fit::FitConfig;
-pub use model::{AllanRow, Check, GmTerm, Ieee952, KalmanForm, NoiseModel};
+pub use fit::{FitConfig, OSCILLATOR_CYCLES, OSCILLATOR_MIN_HZ};
+pub use model::{
+    AllanRow, Check, GmState, GmTerm, Ieee952, KalmanForm, NoiseModel, Oscillator, OscillatorState,
+};
 pub use nnls::NnlsError;
 pub use octaves::{Estimator, NoiseType, Octaves};
 

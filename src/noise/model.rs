@@ -17,6 +17,19 @@ pub struct GmTerm {
     pub correlation_time: f64,
 }
 
+/// One second-order Gauss-Markov term (a damped oscillator, two Kalman states): the stationary
+/// process with poles `-1/T +- i 2 pi f`, variance `sigma^2`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Oscillator {
+    /// Stationary standard deviation, in u.
+    pub sigma: f64,
+    /// Centre frequency `f`, Hz.
+    pub frequency: f64,
+    /// Decay time `T`, s.
+    pub decay_time: f64,
+}
+
 /// The composite noise model of one sensor axis, with at most `G` Gauss-Markov terms and an
 /// optional AR(`P`) part; see the [module docs](super) for the components and units.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -29,6 +42,8 @@ pub struct NoiseModel<const P: usize, const G: usize> {
     pub(super) ramp: f64,
     pub(super) gm: [GmTerm; G],
     pub(super) gm_len: usize,
+    pub(super) osc: [Oscillator; G],
+    pub(super) osc_len: usize,
     pub(super) ar: Option<ArModel<f64, P>>,
 }
 
@@ -65,8 +80,58 @@ pub struct GmState {
     pub p0: f64,
 }
 
+/// The two filter states `[x, dx/dt]` of an oscillator at the filter's step `Dt`: the
+/// continuous-time process `x'' + 2 x' / T + (w^2 + 1/T^2) x = noise` (`w = 2 pi f`) with the
+/// oscillator's poles and variance, sampled exactly: `Phi = exp(A Dt)` and, for a stationary
+/// process, `Qd = P0 - Phi P0 Phi^T` with `P0 = diag(sigma^2, (w^2 + 1/T^2) sigma^2)`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct OscillatorState {
+    /// `Phi`, row-major.
+    pub phi: [[f64; 2]; 2],
+    /// `Qd`, u^2 and u^2/s^2.
+    pub q: [[f64; 2]; 2],
+    /// Stationary `P0`.
+    pub p0: [[f64; 2]; 2],
+}
+
+impl OscillatorState {
+    fn new(o: &Oscillator, dt: f64) -> Self {
+        let (alpha, w) = (
+            1.0 / o.decay_time,
+            2.0 * core::f64::consts::PI * o.frequency,
+        );
+        let wn2 = w * w + alpha * alpha;
+        // exp(A t) = exp(-alpha t) [cos(w t) I + sin(w t) / w (A + alpha I)],
+        // A = [[0, 1], [-wn^2, -2 alpha]].
+        let (e, c, sn) = (
+            libm::exp(-alpha * dt),
+            libm::cos(w * dt),
+            libm::sin(w * dt) / w,
+        );
+        let phi = [
+            [e * (c + sn * alpha), e * sn],
+            [-e * sn * wn2, e * (c - sn * alpha)],
+        ];
+        let s2 = o.sigma * o.sigma;
+        let p = [s2, wn2 * s2];
+        let mut q = [[0.0; 2]; 2];
+        for (i, row) in q.iter_mut().enumerate() {
+            for (k, v) in row.iter_mut().enumerate() {
+                let fpf: f64 = (0..2).map(|l| phi[i][l] * p[l] * phi[k][l]).sum();
+                *v = if i == k { p[i] } else { 0.0 } - fpf;
+            }
+        }
+        Self {
+            phi,
+            q,
+            p0: [[p[0], 0.0], [0.0, p[1]]],
+        }
+    }
+}
+
 /// The model as a Kalman filter stepping every `Dt` takes it: one state per Gauss-Markov term,
-/// one random-walk state, and the white part as measurement noise or as a process-noise
+/// two per oscillator, one random-walk state, and the white part as measurement noise or as a process-noise
 /// density. The AR part, if any, is folded into the white part (its equivalent at long `tau`):
 /// a filter that needs its short-term colouring takes [`NoiseModel::ar`] in companion form
 /// ([`ArModel::discretize`]) instead.
@@ -79,6 +144,10 @@ pub struct KalmanForm<const G: usize> {
     pub gm: [GmState; G],
     /// How many Gauss-Markov states.
     pub gm_len: usize,
+    /// The oscillators' state pairs, `[..osc_len]`.
+    pub osc: [OscillatorState; G],
+    /// How many oscillators.
+    pub osc_len: usize,
     /// The random-walk state (`Phi = 1`, `Qd = K^2 Dt`, `P0` the turn-on bias variance the
     /// caller gave), or `None` when the model has no random walk.
     pub random_walk: Option<GmState>,
@@ -173,6 +242,11 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
         &self.gm[..self.gm_len]
     }
 
+    /// The second-order Gauss-Markov terms (two Kalman states each), by increasing frequency.
+    pub fn oscillators(&self) -> &[Oscillator] {
+        &self.osc[..self.osc_len]
+    }
+
     /// The AR part, with the noise variance the fit scaled it to.
     pub fn ar(&self) -> Option<&ArModel<f64, P>> {
         self.ar.as_ref()
@@ -198,12 +272,18 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
         for (j, v) in out.iter_mut().enumerate() {
             let (_, total) = self.dominant(1u64 << j.min(63));
             *v += total;
+            for o in self.oscillators() {
+                let unit = component::oscillator(self.dt, o.frequency, o.decay_time, j)
+                    .map_err(NoiseError::Ar)?;
+                *v += o.sigma * o.sigma * unit;
+            }
         }
         Ok(())
     }
 
     /// The noise type that dominates the model's Allan variance at `m` (the AR part counts as
-    /// white), and the Allan variance of every component but the AR part.
+    /// white, oscillators do not count), and the Allan variance of every component but the AR
+    /// part and the oscillators.
     pub(super) fn dominant(&self, m: u64) -> (NoiseType, f64) {
         let dt = self.dt;
         let tau = m as f64 * dt;
@@ -326,6 +406,10 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
                 p0: s2,
             };
         }
+        let mut osc = [OscillatorState::default(); G];
+        for (state, o) in osc.iter_mut().zip(self.oscillators()) {
+            *state = OscillatorState::new(o, dt_filter);
+        }
         let k2 = self.random_walk * self.random_walk;
         let n2 = self.white_noise() * self.white_noise();
         let q2 = self.quantization * self.quantization;
@@ -333,6 +417,8 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
             dt: dt_filter,
             gm,
             gm_len: self.gm_len,
+            osc,
+            osc_len: self.osc_len,
             random_walk: (k2 > 0.0).then_some(GmState {
                 phi: 1.0,
                 q: k2 * dt_filter,
