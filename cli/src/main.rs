@@ -31,7 +31,7 @@ use imu_ar::batch::{BatchConfig, BatchError, Fit, burg, covariance, yule_walker}
 use imu_ar::fixed_point::{FixedConfig, FixedLattice};
 use imu_ar::recursive::{Config, ConfigError, FloatArith, Lattice, Rls, RlsInit, Sftf};
 use imu_ar::sim::StandardNormal;
-use imu_ar_host::data::{block_average, read_column};
+use imu_ar_cli::data::{block_average, read_column};
 use kalman::handoff;
 use rand_chacha::ChaCha8Rng;
 use rand_core::SeedableRng;
@@ -469,7 +469,7 @@ fn clap_message(text: &str) -> String {
 /// `text` with its control characters (a newline in an echoed cell, say) escaped, so that an
 /// error stays on one line.
 pub(crate) fn one_line(text: &str) -> String {
-    imu_ar_host::data::escaped(text)
+    imu_ar_cli::data::escaped(text)
 }
 
 /// Runs a command and returns everything it prints, so that a failure prints nothing.
@@ -765,7 +765,7 @@ fn check_order(flag: &str, p: usize) -> Result<(), Fail> {
 /// `(tau_s, adev)` of `channel` from a published Allan table.
 fn read_reference(path: &std::path::Path, channel: &str) -> Result<Vec<(f64, f64)>, Fail> {
     let files = [path.to_path_buf()];
-    let channels = imu_ar_host::data::read_text_column(&files, "channel")?;
+    let channels = imu_ar_cli::data::read_text_column(&files, "channel")?;
     let tau = read_column(&files, "tau_s")?;
     let adev = read_column(&files, "adev")?;
     let rows: Vec<(f64, f64)> = channels
