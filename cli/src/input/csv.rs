@@ -5,6 +5,8 @@ use std::fs::File;
 use std::io::{BufReader, IsTerminal, Read, Write};
 use std::path::{Path, PathBuf};
 
+use crate::error::escaped;
+
 /// A problem with an input file, for a one-line message `FILE[:LINE]: problem`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DataError {
@@ -128,20 +130,6 @@ fn line_at(source: impl Read, byte: u64) -> Option<u64> {
     Some(line)
 }
 
-/// `text` with every control character escaped (`\n`, `\r`, `\t`, `\u{..}`), so that echoed
-/// input keeps an error message on one line.
-pub fn escaped(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    for c in text.chars() {
-        if c.is_control() {
-            out.extend(c.escape_default());
-        } else {
-            out.push(c);
-        }
-    }
-    out
-}
-
 /// A cell as shown in an error: cut to its first 40 characters when it is longer.
 fn shown(cell: &str) -> String {
     const KEEP: usize = 40;
@@ -197,9 +185,9 @@ fn read_source<T>(
     progress: bool,
     locate: &dyn Fn(u64) -> Option<u64>,
 ) -> Result<(), DataError> {
-    let mut reader = csv::ReaderBuilder::new()
+    let mut reader = ::csv::ReaderBuilder::new()
         .comment(Some(b'#'))
-        .trim(csv::Trim::All)
+        .trim(::csv::Trim::All)
         .flexible(true)
         .from_reader(source);
     let headers = reader
@@ -230,7 +218,7 @@ fn read_source<T>(
         ));
     }
     let start = out.len();
-    let mut record = csv::StringRecord::new();
+    let mut record = ::csv::StringRecord::new();
     loop {
         match reader.read_record(&mut record) {
             Ok(false) => break,
@@ -258,20 +246,4 @@ fn read_source<T>(
         return Err(error(path, None, "no data rows"));
     }
     Ok(())
-}
-
-/// Averages of consecutive blocks of `m` samples (a last, incomplete block is dropped): the
-/// record at `1/m` of its rate, as sensor drift is usually modelled. `m = 1` returns `x`.
-///
-/// Block averaging is a low-pass filter: it keeps the slow (correlated) part of the error and
-/// divides the white part's variance by `m`, so a model fitted to averaged data describes the
-/// averaged sensor, not the raw one (numerics.md section 6).
-pub fn block_average(x: &[f64], m: usize) -> Vec<f64> {
-    match m {
-        0 | 1 => x.to_vec(),
-        _ => x
-            .chunks_exact(m)
-            .map(|block| block.iter().sum::<f64>() / m as f64)
-            .collect(),
-    }
 }
