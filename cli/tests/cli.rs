@@ -576,6 +576,31 @@ fn report_writes_four_pngs_and_a_summary() {
     );
 }
 
+/// `report` summarises the comparison of `compare` on the record, the SFTF's included.
+#[test]
+fn report_and_compare_agree_on_the_sftf() {
+    let file = drift_record("report-sftf.csv", "20000");
+    let out = std::env::temp_dir().join(format!("imu-ar-cli-{}-sftf", std::process::id()));
+    let (f, o) = (file.to_str().unwrap(), out.to_str().unwrap());
+    let common = ["--column", "x", "--order", "2", "--lambda", "0.99"];
+    let report = json(&imu_ar(
+        &[&["report", f, "--rate", "100", "--out", o], &common[..]].concat(),
+    ));
+    let compare = json(&imu_ar(&[&["compare", f, "--json"], &common[..]].concat()));
+    for key in [
+        "batch_mse",
+        "rls_mse",
+        "lattice_mse",
+        "sftf_mse",
+        "sftf_restarts",
+    ] {
+        assert_eq!(report[key], compare[key], "{key}");
+    }
+    assert!(report["sftf_mse"].is_number(), "{report}");
+    std::fs::remove_dir_all(out).unwrap();
+    std::fs::remove_file(file).unwrap();
+}
+
 /// `imu-ar kalman FILE --column x ARGS.. --json`.
 fn kalman(file: &Path, args: &[&str]) -> Output {
     let mut all = vec!["kalman", file.to_str().unwrap(), "--column", "x"];

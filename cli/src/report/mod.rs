@@ -11,6 +11,7 @@ use serde::Serialize;
 use crate::error::Fail;
 use crate::input::{check_rate, check_span, csv};
 use crate::method::with_order;
+use crate::output::finite;
 use crate::predict::{Comparison, predict};
 use plot::{adev_png, coefficients_png, error_png, font, psd_png};
 
@@ -55,6 +56,10 @@ pub struct Summary {
     pub rls_mse: f64,
     /// The lattice's.
     pub lattice_mse: f64,
+    /// The SFTF's, over the samples it returned an error for (all but its rescues).
+    pub sftf_mse: Option<f64>,
+    /// The SFTF's rescues.
+    pub sftf_restarts: u64,
     /// The lattice's MSE below the batch model's, in percent.
     pub reduction_percent: f64,
     /// The batch model's coefficients.
@@ -188,8 +193,8 @@ fn report<const P: usize>(r: &Report) -> Result<Summary, Fail> {
     // An estimator that broke down (no error, counted as 0 above, on most samples) is no
     // result.
     let (rls, lattice) = (&mut eval.estimators.rls, &mut eval.estimators.lattice);
-    let finite = rls.model(&config).is_some() && lattice.model(&config).is_some();
-    if !finite || mse.iter().any(|v| !v.is_finite()) || 2 * missing > x.len() - n_train {
+    let modelled = rls.model(&config).is_some() && lattice.model(&config).is_some();
+    if !modelled || mse.iter().any(|v| !v.is_finite()) || 2 * missing > x.len() - n_train {
         return Err(Fail(
             "RLS or the lattice gives no finite model (no finite prediction error on the \
              evaluation part)"
@@ -212,6 +217,8 @@ fn report<const P: usize>(r: &Report) -> Result<Summary, Fail> {
         batch_mse: mse[0],
         rls_mse: mse[1],
         lattice_mse: mse[2],
+        sftf_mse: finite(eval.sftf.mean(eval.sftf.count)),
+        sftf_restarts: eval.estimators.sftf.health().restarts,
         reduction_percent: 100.0 * (mse[0] - mse[2]) / mse[0],
         batch_a: train_fit.a().to_vec(),
         lattice_a: lattice.coefficients(P).map(|a| a.to_vec()),
