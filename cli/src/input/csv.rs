@@ -1,9 +1,11 @@
-//! Reading one column of CSV sensor logs, with errors that name the file and the line.
+//! Reading one column of CSV sensor logs, with errors that name the file and the line. The file
+//! name `-` is standard input.
 
 use std::fmt;
 use std::fs::File;
 use std::io::{BufReader, IsTerminal, Read, Write};
 use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
 
 use crate::error::escaped;
 
@@ -38,9 +40,15 @@ fn error(file: &Path, line: Option<u64>, problem: impl Into<String>) -> DataErro
     }
 }
 
+/// The file name that stands for standard input.
+pub const STDIN: &str = "-";
+
 /// Reads column `column` of each file in turn (a record split over several files is joined in
 /// order). Files are CSV with a header row; lines starting with `#` are ignored. The files are
 /// streamed row by row; on a terminal, progress goes to stderr every 100,000 rows.
+///
+/// The file [`STDIN`] (`-`) is standard input, read to its end first (so that an error can
+/// name its line); wherever it is named again it gives the same bytes.
 ///
 /// Every cell must be a finite number: a missing column, an empty or non-numeric cell, NaN or
 /// infinity is an error naming the file and line, and so is a file without data rows.
@@ -163,6 +171,12 @@ fn read_cells<T>(
     let progress = std::io::stderr().is_terminal();
     let mut out = Vec::new();
     for path in files {
+        if path.as_os_str() == STDIN {
+            let bytes = stdin().map_err(|e| error(path, None, format!("cannot read: {e}")))?;
+            let locate = |byte| line_at(bytes, byte);
+            read_source(path, bytes, column, &parse, &mut out, progress, &locate)?;
+            continue;
+        }
         let file = File::open(path).map_err(|e| error(path, None, format!("cannot open: {e}")))?;
         let source = BufReader::with_capacity(1 << 16, file);
         let locate = |byte| line_at(File::open(path).ok()?, byte);
@@ -172,6 +186,21 @@ fn read_cells<T>(
         eprintln!("\rread {} rows", out.len());
     }
     Ok(out)
+}
+
+/// All of standard input, read once.
+fn stdin() -> Result<&'static [u8], &'static str> {
+    static BYTES: OnceLock<Result<Vec<u8>, String>> = OnceLock::new();
+    BYTES
+        .get_or_init(|| {
+            let mut bytes = Vec::new();
+            match std::io::stdin().lock().read_to_end(&mut bytes) {
+                Ok(_) => Ok(bytes),
+                Err(e) => Err(e.to_string()),
+            }
+        })
+        .as_deref()
+        .map_err(String::as_str)
 }
 
 /// Appends the cells of `column` of one CSV source (named `path` in errors) to `out`;

@@ -13,7 +13,7 @@ use crate::method::{DEFAULT_LAMBDA, MAX_ORDER};
 /// One column of a record.
 #[derive(clap::Args)]
 pub struct Input {
-    /// CSV files with a header row, read as one record.
+    /// CSV files with a header row, read as one record (`-` is standard input).
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
     /// Column name.

@@ -28,7 +28,7 @@ pub struct Args {
     #[arg(long, default_value = "units")]
     unit: String,
     /// A published Allan table to draw too: CSV with `channel`, `tau_s` and `adev`
-    /// columns; the rows of channel `--column` are used.
+    /// columns (`-` is standard input); the rows of channel `--column` are used.
     #[arg(long)]
     reference: Option<PathBuf>,
     /// Directory for the PNG files (created if needed).
