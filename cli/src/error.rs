@@ -1,5 +1,6 @@
 //! The tool's errors: one line on stderr, and status 2.
 
+use std::ffi::OsString;
 use std::fmt::Display;
 use std::path::PathBuf;
 
@@ -34,10 +35,10 @@ pub fn escaped(text: &str) -> String {
     out
 }
 
-/// A command-line error of `command` as one line: clap's message and details (the missing
-/// arguments, a tip) without the usage and the pointer to `--help`; for no arguments at all,
-/// the subcommands.
-pub fn clap_error(e: &clap::Error, command: &clap::Command) -> String {
+/// A command-line error of `command`, parsed from `args`, as one line: clap's message and
+/// details (the missing arguments, a tip) without the usage and the pointer to `--help`;
+/// for no arguments at all, the subcommands; for an argument that is not UTF-8, which one.
+pub fn clap_error(e: &clap::Error, command: &clap::Command, args: &[OsString]) -> String {
     let msg = match e.kind() {
         // The help shown for no arguments at all.
         ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
@@ -47,6 +48,7 @@ pub fn clap_error(e: &clap::Error, command: &clap::Command) -> String {
                 names.join(", ")
             )
         }
+        ErrorKind::InvalidUtf8 => clap_message(&e.to_string()) + &not_utf8(args),
         _ => clap_message(&e.to_string()),
     };
     escaped(&msg)
@@ -85,5 +87,22 @@ fn clap_message(text: &str) -> String {
         "invalid arguments".into()
     } else {
         msg
+    }
+}
+
+/// Which of `args` (the program's name first) is not UTF-8, for clap's error that does not
+/// say: `: argument 4 ('g�x', after '--column')` (`�` for the bytes that are not UTF-8).
+fn not_utf8(args: &[OsString]) -> String {
+    let Some(i) = args.iter().skip(1).position(|a| a.to_str().is_none()) else {
+        return String::new();
+    };
+    let shown = args[i + 1].to_string_lossy();
+    match i {
+        0 => format!(": argument 1 ('{shown}')"),
+        _ => format!(
+            ": argument {} ('{shown}', after '{}')",
+            i + 1,
+            args[i].to_string_lossy()
+        ),
     }
 }

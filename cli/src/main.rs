@@ -20,6 +20,7 @@
 //! on stderr naming the file, line and problem; nothing is written to stdout. The commands
 //! are the modules of the library `imu_ar_cli`; this file parses and dispatches.
 
+use std::ffi::OsString;
 use std::io::{BufWriter, Write};
 use std::process::ExitCode;
 
@@ -67,11 +68,12 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    let cli = match Cli::try_parse() {
+    let args: Vec<OsString> = std::env::args_os().collect();
+    let cli = match Cli::try_parse_from(&args) {
         Ok(cli) => cli,
         // Help and version: a closed pipe is a normal end.
         Err(e) if !e.use_stderr() => return write_stdout(&e.to_string()),
-        Err(e) => return fail(&clap_error(&e, &Cli::command())),
+        Err(e) => return fail(&clap_error(&e, &Cli::command(), &args)),
     };
     match run(cli.command) {
         Ok(out) => write_stdout(&out),

@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{ar2, assert_one_line_failure, imu_ar, stderr, stdout};
+use common::{ar2, assert_one_line_failure, command, imu_ar, misused, stderr, stdout};
 
 // Formerly: a missing required argument prints only clap's first line, "the following required
 // arguments were not provided:", dropping the names of the arguments. Expected: one line that
@@ -107,4 +107,58 @@ fn help_and_version_exit_zero() {
     let out = imu_ar(&["--version"]);
     assert_eq!(out.status.code(), Some(0));
     assert!(stdout(&out).starts_with("imu-ar "), "{}", stdout(&out));
+}
+
+/// Every other kind of command-line error is one line that names the argument and what is
+/// wrong with it, an argument that is not UTF-8 included.
+#[test]
+fn every_kind_of_argument_error_is_one_informative_line() {
+    let file = ar2("kinds.csv");
+    let f = file.to_str().unwrap();
+    let fit = |extra: &[&'static str]| {
+        let mut args = vec!["fit", f, "--column", "x", "--method", "ls", "--order", "1"];
+        args.extend_from_slice(extra);
+        args
+    };
+    let simulate = ["simulate", "--sigma", "1", "--n", "3", "--seed", "1", "--a"];
+    for (args, expected) in [
+        (fit(&["--json=yes"]), "unexpected value 'yes' for '--json'"),
+        (fit(&["--rate"]), "a value is required for '--rate <RATE>'"),
+        (
+            fit(&["--scalar", "f16"]),
+            "invalid value 'f16' for '--scalar <SCALAR>'",
+        ),
+        (
+            [&simulate[..], &["0.5,"]].concat(),
+            "invalid value '' for '--a <A>'",
+        ),
+        (vec!["parity", "extra"], "unexpected argument 'extra'"),
+        (
+            vec!["help", "frobnicate"],
+            "unrecognized subcommand 'frobnicate'",
+        ),
+    ] {
+        misused(&args, expected);
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        let out = command()
+            .args(["fit", f, "--column"])
+            .arg(std::ffi::OsStr::from_bytes(b"g\xffx"))
+            .args(["--method", "ls", "--order", "1"])
+            .output()
+            .unwrap();
+        assert_one_line_failure(&out);
+        assert!(
+            stderr(&out).contains("invalid UTF-8") && stderr(&out).contains("argument 4 ("),
+            "{}",
+            stderr(&out)
+        );
+        assert!(
+            stderr(&out).contains("after '--column'"),
+            "{}",
+            stderr(&out)
+        );
+    }
 }
