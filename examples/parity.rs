@@ -3,7 +3,7 @@
 //!
 //! ```text
 //! cargo qemu parity
-//! cargo run -p imu-ar-host --bin imu-ar -- parity
+//! cargo run -p imu-ar-cli --bin imu-ar -- parity
 //! ```
 //!
 //! Both print `parity f32 <hex> fixed <hex>`; `.ci/run` fails when the two lines differ.

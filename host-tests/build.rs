@@ -2,6 +2,9 @@
 //! by `IMU_AR_DATA`, relative to the repository root) and, when they are there, sets
 //! `cfg(imu_ar_data)` and `IMU_AR_DATA_DIR` for the tests. Without them the tests that read
 //! the records are ignored, so `cargo test` reports them as ignored rather than passed.
+//!
+//! The build script of `imu-ar-host` and of `imu-ar-cli` (whose manifest names this file): both
+//! sit one folder below the repository root.
 
 use std::path::{Path, PathBuf};
 

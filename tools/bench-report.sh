@@ -97,7 +97,7 @@ PY
 fi
 
 if [ "$only" = all ] || [ "$only" = wall ]; then
-    cargo build --release -q -p imu-ar-host
+    cargo build --release -q -p imu-ar-cli
     python3 - "$data" > "$tmp/perf-wall.md" <<'PY'
 import subprocess, sys, time
 data = sys.argv[1]

@@ -86,7 +86,7 @@ if [ "$only" = all ] || [ "$only" = demo ]; then
 fi
 
 if [ "$only" = all ] || [ "$only" = compare ]; then
-    cargo build --release -q -p imu-ar-host
+    cargo build --release -q -p imu-ar-cli
     tool=target/release/imu-ar
     "$tool" simulate --a 1.5,-0.7 --a-end 1.0,-0.7 --sigma 1 --n 100000 --seed 4 --rate 100 \
         > "$tmp/drift.csv"

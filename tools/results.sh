@@ -14,7 +14,7 @@ cd "$(dirname "$0")/.."
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 data=${IMU_AR_DATA:-../shared/data/imu}
-cargo build --release -q -p imu-ar-host
+cargo build --release -q -p imu-ar-cli
 tool=target/release/imu-ar
 
 # replace SECTION FILE: put FILE's contents between the section's markers in README.md.

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use imu_ar_host::data::parse_column;
+use imu_ar_cli::input::csv::parse_column;
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {

@@ -1,12 +1,11 @@
-//! Host companion of `imu-ar`: the independent f64 reference every core is tested against, the
-//! CSV reader and the command-line tool `imu-ar`.
+//! Host companion of `imu-ar`: the independent f64 reference every core is tested against,
+//! the seeded and real test records, and the differential check of the fixed-point lattice.
 //!
 //! The reference is a direct solve of the problem an estimator claims to solve (dense linear
 //! algebra from `nalgebra`), never the library's own recursion instantiated at `f64`.
 #![deny(missing_docs)]
 
 pub mod composite;
-pub mod data;
 pub mod differential;
 pub mod fixtures;
 pub mod reference;

@@ -4,7 +4,7 @@
 
 use imu_ar::fixed_point::{FixedConfig, FixedLattice};
 use imu_ar::recursive::Config;
-use imu_ar_host::data::read_column;
+use imu_ar_cli::input::csv::read_column;
 use imu_ar_host::fixtures::{AXES, add, ar, real_records};
 use imu_ar_host::reference::{Regularisation, Section0, running_mean_removed};
 

@@ -3,7 +3,7 @@
 //! `tools/accuracy-table.sh` puts into README.md.
 
 use imu_ar::recursive::{Config, Lattice, Rls, RlsInit, Sftf};
-use imu_ar_host::data::read_column;
+use imu_ar_cli::input::csv::read_column;
 use imu_ar_host::fixtures::{AXES, add, ar, real_records};
 use imu_ar_host::reference::{Regularisation, Section0, running_mean_removed};
 

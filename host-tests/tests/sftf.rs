@@ -6,7 +6,7 @@
 
 use imu_ar::ArModel;
 use imu_ar::recursive::{Config, FloatArith, Lattice, Rls, RlsInit, Sftf, snapshot_interval};
-use imu_ar_host::data::read_column;
+use imu_ar_cli::input::csv::read_column;
 use imu_ar_host::fixtures::{AXES, add, ar, real_records};
 use imu_ar_host::reference::{Regularisation, Section0};
 

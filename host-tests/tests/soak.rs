@@ -8,7 +8,7 @@
 //! ```
 
 use imu_ar::recursive::{Config, Lattice};
-use imu_ar_host::data::read_column;
+use imu_ar_cli::input::csv::read_column;
 use imu_ar_host::fixtures::real_records;
 use imu_ar_host::reference::{Regularisation, Section0};
 use rand_chacha::ChaCha8Rng;

@@ -1,144 +1,25 @@
-//! `imu-ar report`: the paper's comparison on one record, in four PNG plots.
+//! The four PNG plots of `imu-ar report`.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use imu_ar::ArModel;
 use imu_ar::allan::overlapping_avar;
-use imu_ar::batch::{BatchConfig, covariance};
-use imu_ar::recursive::{Config, Lattice, Rls, RlsInit};
 use plotters::prelude::*;
 use rustfft::{FftPlanner, num_complex::Complex};
-use serde_json::{Value, json};
 
-use crate::Fail;
-
-/// What the report shows and where it goes.
-pub struct Report<'a> {
-    /// The record (already decimated), in sensor units.
-    pub x: &'a [f64],
-    /// Sample rate of `x` in Hz.
-    pub rate: f64,
-    pub lambda: f64,
-    pub delta: f64,
-    /// Fraction of the record the batch model is fitted on.
-    pub train: f64,
-    /// The sensor unit, for the axis labels.
-    pub unit: &'a str,
-    /// Published Allan deviations `(tau_s, adev)` to draw with the data's.
-    pub reference: Option<Vec<(f64, f64)>>,
-    pub out: &'a Path,
-}
+use super::{Report, Track};
+use crate::error::Fail;
 
 const SIZE: (u32, u32) = (960, 600);
-/// Fewest samples a report is drawn from: enough for a periodogram of 8-sample segments.
-const MIN_SAMPLES: usize = 64;
-
-/// Coefficients `a_1..a_P` at sampled times (s).
-type Track<const P: usize> = Vec<(f64, [f64; P])>;
-/// Points per drawn time series: the plots stay small and readable for any record length.
-const POINTS: usize = 400;
 
 /// Registers the embedded DejaVu Sans as the plots' font (no system fonts needed).
-fn font() -> Result<(), Fail> {
+pub(super) fn font() -> Result<(), Fail> {
     plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular())
         .map_err(|_| Fail("cannot load the embedded font".into()))
 }
 
 fn draw_err(e: impl std::fmt::Debug) -> Fail {
     Fail(format!("drawing failed: {e:?}"))
-}
-
-/// Writes the four PNGs and returns a JSON summary.
-pub fn report<const P: usize>(r: &Report) -> Result<Value, Fail> {
-    let x = r.x;
-    if x.len() < MIN_SAMPLES {
-        return Err(Fail(format!(
-            "report needs at least {MIN_SAMPLES} samples (after --decimate), not {}",
-            x.len()
-        )));
-    }
-    font()?;
-    let dt = 1.0 / r.rate;
-    let n_train = (r.train * x.len() as f64) as usize;
-    let batch_config = BatchConfig::new(dt)?;
-    let train_fit = covariance::<f64, P>(&x[..n_train], &batch_config)?.model;
-    let whole_fit = covariance::<f64, P>(x, &batch_config)?.model;
-
-    // The recursive estimators over the whole record; their errors and coefficients sampled.
-    let config = Config::new(r.lambda, r.delta, dt)?;
-    // Only once the input has passed every check.
-    std::fs::create_dir_all(r.out)
-        .map_err(|e| Fail(format!("{}: cannot create: {e}", r.out.display())))?;
-    let mut rls = Rls::<f64, P>::new(&config, RlsInit::ShiftConsistent);
-    let mut lattice = Lattice::<f64, P>::new(&config);
-    let stride = (x.len() / POINTS).max(1);
-    let mut coef = (Vec::new(), Vec::new());
-    let mut se = [vec![], vec![], vec![]];
-    let mut block = [0.0; 3];
-    let mut eval = [0.0; 3];
-    let mut missing = 0usize;
-    for (n, &v) in x.iter().enumerate() {
-        let (e_rls, e_lattice) = (rls.update(&config, v), lattice.update(&config, v));
-        if n >= n_train && (e_rls.is_none() || e_lattice.is_none()) {
-            missing += 1;
-        }
-        let (e_rls, e_lattice) = (e_rls.unwrap_or(0.0), e_lattice.unwrap_or(0.0));
-        let e_batch = if n >= P {
-            let past: [f64; P] = core::array::from_fn(|k| x[n - 1 - k]);
-            v - train_fit.predict(&past)
-        } else {
-            0.0
-        };
-        for (k, e) in [e_batch, e_rls, e_lattice].into_iter().enumerate() {
-            block[k] += e * e;
-            if n >= n_train {
-                eval[k] += e * e;
-            }
-        }
-        if (n + 1) % stride == 0 {
-            let t = (n + 1) as f64 * dt;
-            for (k, b) in block.iter_mut().enumerate() {
-                se[k].push((t, *b / stride as f64));
-                *b = 0.0;
-            }
-            let a_lattice = lattice.coefficients(P).unwrap_or([f64::NAN; P]);
-            coef.0.push((t, *rls.coefficients()));
-            coef.1.push((t, a_lattice));
-        }
-    }
-    let m = (x.len() - n_train) as f64;
-    let mse = eval.map(|s| s / m);
-    // An estimator that broke down (no error, counted as 0 above, on most samples) is no
-    // result.
-    let finite = rls.model(&config).is_some() && lattice.model(&config).is_some();
-    if !finite || mse.iter().any(|v| !v.is_finite()) || 2 * missing > x.len() - n_train {
-        return Err(Fail(
-            "RLS or the lattice gives no finite model (no finite prediction error on the \
-             evaluation part)"
-                .into(),
-        ));
-    }
-
-    let files = [
-        coefficients_png::<P>(r, &coef, &train_fit)?,
-        error_png(r, &se, &mse, n_train as f64 * dt)?,
-        psd_png(r, &whole_fit)?,
-        adev_png(r, &whole_fit)?,
-    ];
-    Ok(json!({
-        "order": P,
-        "lambda": r.lambda,
-        "rate_hz": r.rate,
-        "n": x.len(),
-        "n_train": n_train,
-        "batch_mse": mse[0],
-        "rls_mse": mse[1],
-        "lattice_mse": mse[2],
-        "reduction_percent": 100.0 * (mse[0] - mse[2]) / mse[0],
-        "batch_a": train_fit.a().to_vec(),
-        "lattice_a": lattice.coefficients(P).map(|a| a.to_vec()),
-        "files": files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>(),
-    }))
 }
 
 /// A chart on `root` with the report's caption, margins and label areas.
@@ -212,7 +93,7 @@ fn span(values: impl Iterator<Item = f64>) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
-fn coefficients_png<const P: usize>(
+pub(super) fn coefficients_png<const P: usize>(
     r: &Report,
     coef: &(Track<P>, Track<P>),
     batch: &ArModel<f64, P>,
@@ -287,7 +168,7 @@ fn coefficients_png<const P: usize>(
     Ok(path.clone())
 }
 
-fn error_png(
+pub(super) fn error_png(
     r: &Report,
     se: &[Vec<(f64, f64)>; 3],
     mse: &[f64; 3],
@@ -383,7 +264,10 @@ fn welch(x: &[f64], rate: f64) -> Vec<(f64, f64)> {
         .collect()
 }
 
-fn psd_png<const P: usize>(r: &Report, model: &ArModel<f64, P>) -> Result<PathBuf, Fail> {
+pub(super) fn psd_png<const P: usize>(
+    r: &Report,
+    model: &ArModel<f64, P>,
+) -> Result<PathBuf, Fail> {
     let path = r.out.join("psd.png");
     let data = welch(r.x, r.rate);
     let psd = |f: f64| {
@@ -431,7 +315,10 @@ fn psd_png<const P: usize>(r: &Report, model: &ArModel<f64, P>) -> Result<PathBu
     Ok(path.clone())
 }
 
-fn adev_png<const P: usize>(r: &Report, model: &ArModel<f64, P>) -> Result<PathBuf, Fail> {
+pub(super) fn adev_png<const P: usize>(
+    r: &Report,
+    model: &ArModel<f64, P>,
+) -> Result<PathBuf, Fail> {
     let path = r.out.join("adev.png");
     let dt = 1.0 / r.rate;
     let ms: Vec<usize> = (0..)

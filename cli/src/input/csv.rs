@@ -1,9 +1,13 @@
-//! Reading one column of CSV sensor logs, with errors that name the file and the line.
+//! Reading one column of CSV sensor logs, with errors that name the file and the line. The file
+//! name `-` is standard input.
 
 use std::fmt;
 use std::fs::File;
 use std::io::{BufReader, IsTerminal, Read, Write};
 use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use crate::error::escaped;
 
 /// A problem with an input file, for a one-line message `FILE[:LINE]: problem`.
 #[derive(Debug, Clone, PartialEq)]
@@ -36,9 +40,15 @@ fn error(file: &Path, line: Option<u64>, problem: impl Into<String>) -> DataErro
     }
 }
 
+/// The file name that stands for standard input.
+pub const STDIN: &str = "-";
+
 /// Reads column `column` of each file in turn (a record split over several files is joined in
 /// order). Files are CSV with a header row; lines starting with `#` are ignored. The files are
 /// streamed row by row; on a terminal, progress goes to stderr every 100,000 rows.
+///
+/// The file [`STDIN`] (`-`) is standard input, read to its end first (so that an error can
+/// name its line); wherever it is named again it gives the same bytes.
 ///
 /// Every cell must be a finite number: a missing column, an empty or non-numeric cell, NaN or
 /// infinity is an error naming the file and line, and so is a file without data rows.
@@ -128,20 +138,6 @@ fn line_at(source: impl Read, byte: u64) -> Option<u64> {
     Some(line)
 }
 
-/// `text` with every control character escaped (`\n`, `\r`, `\t`, `\u{..}`), so that echoed
-/// input keeps an error message on one line.
-pub fn escaped(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    for c in text.chars() {
-        if c.is_control() {
-            out.extend(c.escape_default());
-        } else {
-            out.push(c);
-        }
-    }
-    out
-}
-
 /// A cell as shown in an error: cut to its first 40 characters when it is longer.
 fn shown(cell: &str) -> String {
     const KEEP: usize = 40;
@@ -175,6 +171,12 @@ fn read_cells<T>(
     let progress = std::io::stderr().is_terminal();
     let mut out = Vec::new();
     for path in files {
+        if path.as_os_str() == STDIN {
+            let bytes = stdin().map_err(|e| error(path, None, format!("cannot read: {e}")))?;
+            let locate = |byte| line_at(bytes, byte);
+            read_source(path, bytes, column, &parse, &mut out, progress, &locate)?;
+            continue;
+        }
         let file = File::open(path).map_err(|e| error(path, None, format!("cannot open: {e}")))?;
         let source = BufReader::with_capacity(1 << 16, file);
         let locate = |byte| line_at(File::open(path).ok()?, byte);
@@ -184,6 +186,21 @@ fn read_cells<T>(
         eprintln!("\rread {} rows", out.len());
     }
     Ok(out)
+}
+
+/// All of standard input, read once.
+fn stdin() -> Result<&'static [u8], &'static str> {
+    static BYTES: OnceLock<Result<Vec<u8>, String>> = OnceLock::new();
+    BYTES
+        .get_or_init(|| {
+            let mut bytes = Vec::new();
+            match std::io::stdin().lock().read_to_end(&mut bytes) {
+                Ok(_) => Ok(bytes),
+                Err(e) => Err(e.to_string()),
+            }
+        })
+        .as_deref()
+        .map_err(String::as_str)
 }
 
 /// Appends the cells of `column` of one CSV source (named `path` in errors) to `out`;
@@ -197,9 +214,9 @@ fn read_source<T>(
     progress: bool,
     locate: &dyn Fn(u64) -> Option<u64>,
 ) -> Result<(), DataError> {
-    let mut reader = csv::ReaderBuilder::new()
+    let mut reader = ::csv::ReaderBuilder::new()
         .comment(Some(b'#'))
-        .trim(csv::Trim::All)
+        .trim(::csv::Trim::All)
         .flexible(true)
         .from_reader(source);
     let headers = reader
@@ -230,7 +247,7 @@ fn read_source<T>(
         ));
     }
     let start = out.len();
-    let mut record = csv::StringRecord::new();
+    let mut record = ::csv::StringRecord::new();
     loop {
         match reader.read_record(&mut record) {
             Ok(false) => break,
@@ -258,20 +275,4 @@ fn read_source<T>(
         return Err(error(path, None, "no data rows"));
     }
     Ok(())
-}
-
-/// Averages of consecutive blocks of `m` samples (a last, incomplete block is dropped): the
-/// record at `1/m` of its rate, as sensor drift is usually modelled. `m = 1` returns `x`.
-///
-/// Block averaging is a low-pass filter: it keeps the slow (correlated) part of the error and
-/// divides the white part's variance by `m`, so a model fitted to averaged data describes the
-/// averaged sensor, not the raw one (numerics.md section 6).
-pub fn block_average(x: &[f64], m: usize) -> Vec<f64> {
-    match m {
-        0 | 1 => x.to_vec(),
-        _ => x
-            .chunks_exact(m)
-            .map(|block| block.iter().sum::<f64>() / m as f64)
-            .collect(),
-    }
 }

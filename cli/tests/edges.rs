@@ -1,75 +1,13 @@
-//! Edge inputs to the `imu-ar` tool: extreme settings, unusual CSV line endings and cells,
-//! missing arguments and a closed pipe. The contract (architecture.md): bad input exits with
-//! status 2 and ONE line on stderr naming file, line and problem, nothing on stdout; no NaN or
-//! infinity in any output; no result that is wrong but looks fine.
+//! Edge inputs to the `imu-ar` tool: extreme settings, unusual CSV line endings and cells. The
+//! contract (architecture.md): bad input exits with status 2 and ONE line on stderr naming file,
+//! line and problem, nothing on stdout; no NaN or infinity in any output; no result that is
+//! wrong but looks fine.
 
-use std::io::Read;
-use std::path::PathBuf;
-use std::process::{Command, Output, Stdio};
+mod common;
 
-fn imu_ar(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_imu-ar"))
-        .args(args)
-        .output()
-        .expect("run imu-ar")
-}
-
-fn temp_bytes(name: &str, contents: &[u8]) -> PathBuf {
-    let path = std::env::temp_dir().join(format!("imu-ar-edges-{}-{name}", std::process::id()));
-    std::fs::write(&path, contents).unwrap();
-    path
-}
-
-/// `imu-ar fit FILE --column x --method burg --order 1`.
-fn fit_burg(file: &std::path::Path) -> Output {
-    imu_ar(&[
-        "fit",
-        file.to_str().unwrap(),
-        "--column",
-        "x",
-        "--method",
-        "burg",
-        "--order",
-        "1",
-    ])
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
-
-fn stdout(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-/// Status 2, nothing on stdout, exactly one line on stderr.
-fn assert_one_line_failure(out: &Output) {
-    assert_eq!(out.status.code(), Some(2), "stderr: {}", stderr(out));
-    assert!(out.stdout.is_empty(), "stdout: {}", stdout(out));
-    assert_eq!(
-        stderr(out).trim_end_matches('\n').lines().count(),
-        1,
-        "not one line: {:?}",
-        stderr(out)
-    );
-}
-
-fn no_nan_inf(text: &str) {
-    let lower = text.to_ascii_lowercase();
-    assert!(
-        !lower.contains("nan") && !lower.contains("inf"),
-        "NaN/inf in output: {text}"
-    );
-}
-
-/// A 5000-sample AR(2) record (column `x`).
-fn ar2(name: &str) -> PathBuf {
-    let out = imu_ar(&[
-        "simulate", "--a", "0.7,-0.2", "--sigma", "1", "--n", "5000", "--seed", "5",
-    ]);
-    assert!(out.status.success());
-    temp_bytes(name, &out.stdout)
-}
+use common::{
+    ar2, assert_one_line_failure, fit_burg, imu_ar, no_nan_inf, stderr, stdout, temp_file,
+};
 
 // Formerly: `simulate --sigma 1e308` passes the `--sigma` check (finite) but every sample
 // overflows; it prints `NaN` samples and exits 0. Expected: status 2 naming --sigma (or
@@ -129,7 +67,7 @@ fn adev_refuses_a_subnormal_rate() {
 // reader accepts as record terminators) every error says line 1. 'abc' is on line 4.
 #[test]
 fn csv_error_line_with_cr_only_endings_is_right() {
-    let file = temp_bytes("cr.csv", b"x\r1\r2\rabc\r5\r");
+    let file = temp_file("cr.csv", b"x\r1\r2\rabc\r5\r");
     let out = fit_burg(&file);
     assert_one_line_failure(&out);
     assert!(stderr(&out).contains("cr.csv:4:"), "{}", stderr(&out));
@@ -140,7 +78,7 @@ fn csv_error_line_with_cr_only_endings_is_right() {
 // as a comment and names the next line. '  #c' is on line 3; the error says line 4.
 #[test]
 fn csv_error_line_of_an_indented_hash_cell_is_right() {
-    let file = temp_bytes("hash.csv", b"x\n1\n  #c\n3\n4\n5\n");
+    let file = temp_file("hash.csv", b"x\n1\n  #c\n3\n4\n5\n");
     let out = fit_burg(&file);
     assert_one_line_failure(&out);
     assert!(stderr(&out).contains("hash.csv:3:"), "{}", stderr(&out));
@@ -150,7 +88,7 @@ fn csv_error_line_of_an_indented_hash_cell_is_right() {
 // Expected: one line (escape or cut the cell).
 #[test]
 fn csv_error_with_a_quoted_newline_is_one_line() {
-    let file = temp_bytes("qnl.csv", b"x\n\"1\n2\"\n3\n");
+    let file = temp_file("qnl.csv", b"x\n\"1\n2\"\n3\n");
     let out = fit_burg(&file);
     assert_one_line_failure(&out);
 }
@@ -159,7 +97,7 @@ fn csv_error_with_a_quoted_newline_is_one_line() {
 // makes the error two lines. Expected: one line.
 #[test]
 fn csv_error_with_a_newline_in_the_header_is_one_line() {
-    let file = temp_bytes("hnl.csv", b"a,\"x\ny\"\n1,2\n");
+    let file = temp_file("hnl.csv", b"a,\"x\ny\"\n1,2\n");
     let out = imu_ar(&[
         "fit",
         file.to_str().unwrap(),
@@ -258,49 +196,6 @@ fn decimate_beyond_the_record_blames_no_overflow() {
     );
 }
 
-// Formerly: a missing required argument prints only clap's first line, "the following required
-// arguments were not provided:", dropping the names of the arguments. Expected: one line that
-// names the missing argument (--method).
-#[test]
-fn missing_argument_error_names_the_argument() {
-    let file = ar2("miss.csv");
-    let out = imu_ar(&[
-        "fit",
-        file.to_str().unwrap(),
-        "--column",
-        "x",
-        "--order",
-        "1",
-    ]);
-    assert_one_line_failure(&out);
-    assert!(stderr(&out).contains("--method"), "{}", stderr(&out));
-}
-
-// Formerly: `simulate` into a pipe closed early (`| head -c 100`) exits with status 1, though
-// the code means a closed pipe to end the run quietly (status 0): simulate swallows
-// BrokenPipe, then main's flush of the leftover stdout buffer fails.
-#[test]
-fn simulate_into_a_closed_pipe_exits_zero() {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_imu-ar"))
-        .args([
-            "simulate", "--a", "0.5", "--sigma", "1", "--n", "1000000", "--seed", "1",
-        ])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let mut head = [0u8; 100];
-    child
-        .stdout
-        .as_mut()
-        .unwrap()
-        .read_exact(&mut head)
-        .unwrap();
-    drop(child.stdout.take());
-    let status = child.wait().unwrap();
-    assert_eq!(status.code(), Some(0), "status {status:?} on a closed pipe");
-}
-
 /// The line of an error with mixed line endings (`\r\n`, lone `\r`, `\n`), comment and empty
 /// lines between records.
 #[test]
@@ -315,7 +210,7 @@ fn csv_error_line_with_mixed_endings() {
         ("indented-comment", b"x\n1\n#c\n \t#d\n", 4),
     ];
     for (name, contents, line) in cases {
-        let file = temp_bytes(&format!("{name}.csv"), contents);
+        let file = temp_file(&format!("{name}.csv"), contents);
         let out = fit_burg(&file);
         assert_one_line_failure(&out);
         let expected = format!("{name}.csv:{line}:");
@@ -326,7 +221,7 @@ fn csv_error_line_with_mixed_endings() {
 /// Echoed control characters are escaped, so the error stays on one line and shows them.
 #[test]
 fn echoed_control_characters_are_escaped() {
-    let file = temp_bytes("ctl.csv", b"a,\"x\ny\"\n1,\"2\r3\"\n");
+    let file = temp_file("ctl.csv", b"a,\"x\ny\"\n1,\"2\r3\"\n");
     let f = file.to_str().unwrap();
     let out = imu_ar(&[
         "fit", f, "--column", "z", "--method", "burg", "--order", "1",
@@ -490,116 +385,4 @@ fn decimate_beyond_record_says_no_sample_is_left() {
             stderr(&out)
         );
     }
-}
-
-/// Every subcommand's missing argument is named on the one error line.
-#[test]
-fn missing_arguments_are_named_for_every_subcommand() {
-    let file = ar2("miss-all.csv");
-    let f = file.to_str().unwrap();
-    let cases: [(Vec<&str>, &str); 8] = [
-        (
-            vec!["fit", f, "--column", "x", "--method", "ls"],
-            "--order <ORDER>",
-        ),
-        (vec!["compare", f, "--order", "1"], "--column <COLUMN>"),
-        (
-            vec!["report", f, "--column", "x", "--order", "1", "--rate", "1"],
-            "--out <OUT>",
-        ),
-        (
-            vec!["kalman", f, "--column", "x", "--order", "1"],
-            "--rate <RATE>",
-        ),
-        (
-            vec!["order", f, "--column", "x", "--method", "ls"],
-            "--max-order <MAX_ORDER>",
-        ),
-        (vec!["adev", f, "--column", "x"], "--rate <RATE>"),
-        (
-            vec!["simulate", "--a", "0.5", "--n", "3", "--seed", "1"],
-            "--sigma <SIGMA>",
-        ),
-        (vec!["adev", "--column", "x", "--rate", "1"], "<FILES>"),
-    ];
-    for (args, missing) in cases {
-        let out = imu_ar(&args);
-        assert_one_line_failure(&out);
-        assert!(stderr(&out).contains(missing), "{args:?}: {}", stderr(&out));
-    }
-    // Other argument errors keep their detail on the one line.
-    for (args, expected) in [
-        (
-            vec![
-                "fit", f, "--column", "x", "--method", "ls", "--order", "1", "--bogus",
-            ],
-            "--bogus",
-        ),
-        (vec!["frobnicate"], "frobnicate"),
-        (vec![], "subcommand"),
-        (
-            vec![
-                "fit", f, "--column", "x", "--column", "y", "--method", "ls", "--order", "1",
-            ],
-            "--column",
-        ),
-    ] {
-        let out = imu_ar(&args);
-        assert_one_line_failure(&out);
-        assert!(
-            stderr(&out).contains(expected),
-            "{args:?}: {}",
-            stderr(&out)
-        );
-    }
-}
-
-/// `-h`, `--help` and `--version` still print to stdout with status 0.
-#[test]
-fn help_and_version_exit_zero() {
-    for args in [
-        vec!["--help"],
-        vec!["-h"],
-        vec!["fit", "--help"],
-        vec!["simulate", "-h"],
-        vec!["help", "kalman"],
-    ] {
-        let out = imu_ar(&args);
-        assert_eq!(out.status.code(), Some(0), "{args:?}: {}", stderr(&out));
-        assert!(
-            stdout(&out).contains("Usage:"),
-            "{args:?}: {}",
-            stdout(&out)
-        );
-        assert!(out.stderr.is_empty(), "{args:?}: {}", stderr(&out));
-    }
-    let out = imu_ar(&["--version"]);
-    assert_eq!(out.status.code(), Some(0));
-    assert!(stdout(&out).starts_with("imu-ar "), "{}", stdout(&out));
-}
-
-/// Output cut short by a closed pipe ends with status 0 for a command that prints its result
-/// at the end too.
-#[test]
-fn closed_pipe_after_the_result_exits_zero() {
-    let file = ar2("pipe-adev.csv");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_imu-ar"))
-        .args([
-            "order",
-            file.to_str().unwrap(),
-            "--column",
-            "x",
-            "--max-order",
-            "32",
-            "--method",
-            "burg",
-        ])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    drop(child.stdout.take());
-    let out = child.wait_with_output().unwrap();
-    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
-    assert!(out.stderr.is_empty(), "{}", stderr(&out));
 }

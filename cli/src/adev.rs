@@ -1,0 +1,75 @@
+//! `imu-ar adev`: the overlapping Allan deviation at `m = 1, 2, 4, ...` samples.
+
+use imu_ar::allan::overlapping_avar;
+use serde::Serialize;
+
+use crate::error::Fail;
+use crate::input::{Input, check_rate, check_span};
+use crate::output::Output;
+
+/// The arguments of `imu-ar adev`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The column.
+    #[command(flatten)]
+    input: Input,
+    /// Sample rate in Hz.
+    #[arg(long, allow_negative_numbers = true)]
+    rate: f64,
+    /// Print one JSON object.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The Allan variance and deviation at `tau = m / rate` while `2m <= n`.
+#[derive(Serialize)]
+pub struct AdevResult {
+    /// Sample rate in Hz.
+    pub rate_hz: f64,
+    /// Averaging times in s.
+    pub tau_s: Vec<f64>,
+    /// Overlapping Allan variance at each `tau`.
+    pub avar: Vec<f64>,
+    /// Its square root.
+    pub adev: Vec<f64>,
+    /// Samples in the record.
+    pub n: usize,
+}
+
+impl Output for AdevResult {
+    fn text(&self) -> String {
+        let mut s = format!(
+            "# n = {}, rate = {} Hz\n# tau_s avar adev\n",
+            self.n, self.rate_hz
+        );
+        for ((t, v), d) in self.tau_s.iter().zip(&self.avar).zip(&self.adev) {
+            s += &format!("{t} {v:e} {d:e}\n");
+        }
+        s
+    }
+}
+
+/// Checks the rate, reads the record and computes its Allan deviation.
+pub fn run(args: &Args) -> Result<AdevResult, Fail> {
+    let rate = check_rate(args.rate)?;
+    let x = args.input.read()?;
+    if x.len() < 2 {
+        let e = format!("{} sample(s), at least 2 needed", x.len());
+        return Err(args.input.fail(e));
+    }
+    check_span("--rate", rate, x.len())?;
+    let (mut tau, mut avar) = (Vec::new(), Vec::new());
+    let mut m = 1usize;
+    while x.len() / 2 >= m {
+        tau.push(m as f64 / rate);
+        avar.push(overlapping_avar(&x, m)?);
+        m *= 2;
+    }
+    Ok(AdevResult {
+        rate_hz: rate,
+        tau_s: tau,
+        adev: avar.iter().map(|v| v.sqrt()).collect(),
+        avar,
+        n: x.len(),
+    })
+}

@@ -1,0 +1,181 @@
+//! The recursive fits of `imu-ar fit`: RLS, the lattice and the SFTF in `f64` or `f32`, and
+//! the fixed-point lattice; each reports the model after the last sample.
+
+use imu_ar::fixed_point::{FixedConfig, FixedLattice};
+use imu_ar::recursive::{Config, ConfigError, FloatArith, Lattice, Rls, RlsInit, Sftf};
+
+use super::FitResult;
+use crate::error::Fail;
+use crate::method::{Method, ScalarKind};
+
+/// The settings of a recursive fit.
+pub(super) struct Recursive {
+    pub method: Method,
+    pub scalar: ScalarKind,
+    pub lambda: f64,
+    pub delta: f64,
+    pub demean: bool,
+    pub dt: f64,
+    pub rate: Option<f64>,
+    /// Whether `delta` is the default (not given).
+    pub default_delta: bool,
+}
+
+/// The scale of `--scalar fixed`: given, or the default `8 / max |x|`.
+#[derive(Clone, Copy)]
+pub(super) enum Scale {
+    Given(f64),
+    Default(f64),
+}
+
+/// The configuration in `T`, with an error that says which setting `T` cannot carry.
+fn config_in<T: FloatArith>(r: &Recursive) -> Result<Config<T>, Fail> {
+    Config::new(
+        T::from_f64(r.lambda),
+        T::from_f64(r.delta),
+        T::from_f64(r.dt),
+    )
+    .map_err(|e| {
+        if r.default_delta {
+            Fail(format!(
+                "{e}: the default --delta (0.1 x the variance of the first 1000 samples) is {}, \
+                 which --scalar {} cannot carry; give --delta",
+                r.delta,
+                r.scalar.name()
+            ))
+        } else {
+            Fail(e.to_string())
+        }
+    })
+}
+
+/// The offset removed in f64 before a fit in f32 or fixed point: the mean of the samples that
+/// f32 can hold when the mean is removed (so that rounding to f32 does not erase a small
+/// signal on a large offset), else 0.
+pub(super) fn centre(x: &[f64], demean: bool) -> f64 {
+    if !demean {
+        return 0.0;
+    }
+    let (sum, n) = x
+        .iter()
+        .filter(|v| v.abs() <= f64::from(f32::MAX))
+        .fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    if n == 0 { 0.0 } else { sum / n as f64 }
+}
+
+/// Runs RLS, the lattice or the SFTF in `T` over `x` and reports the model after the last sample.
+///
+/// In f32 the mean (of the samples f32 can hold) is removed in f64 first and added back to
+/// the reported mean, so that rounding to f32 does not erase a small signal on a large offset.
+pub(super) fn recursive_fit<T: FloatArith, const P: usize>(
+    x: &[f64],
+    r: &Recursive,
+) -> Result<FitResult, Fail> {
+    let config = config_in::<T>(r)?.with_demean(r.demean);
+    let offset = if core::mem::size_of::<T>() < 8 {
+        centre(x, r.demean)
+    } else {
+        0.0
+    };
+    let (model, health, reflection) = match r.method {
+        Method::Rls => {
+            let mut rls = Rls::<T, P>::new(&config, RlsInit::ShiftConsistent);
+            for &v in x {
+                rls.update(&config, T::from_f64(v - offset));
+            }
+            (rls.model(&config), rls.health(), None)
+        }
+        Method::Sftf => {
+            let mut sftf = Sftf::<T, P>::new(&config);
+            for &v in x {
+                sftf.update(&config, T::from_f64(v - offset));
+            }
+            (sftf.model(&config), sftf.health(), None)
+        }
+        _ => {
+            let mut lattice = Lattice::<T, P>::new(&config);
+            for &v in x {
+                lattice.update(&config, T::from_f64(v - offset));
+            }
+            let model = lattice.model(&config);
+            let k = model.and_then(|m| m.reflection().ok());
+            (model, lattice.health(), k)
+        }
+    };
+    let model = model.ok_or_else(|| Fail("no finite model".into()))?;
+    let a: Vec<f64> = model.a().iter().map(|v| v.to_f64()).collect();
+    let mean = model.mean().to_f64() + offset;
+    let noise_variance = model.noise_variance().to_f64();
+    Ok(FitResult {
+        reflection: reflection.map(|k| k.iter().map(|v| v.to_f64()).collect()),
+        lambda: Some(r.lambda),
+        delta: Some(r.delta),
+        restarts: Some(health.restarts),
+        non_finite: Some(health.non_finite),
+        ..FitResult::new(
+            r.method.name(),
+            r.scalar.name(),
+            x.len(),
+            mean,
+            a,
+            noise_variance,
+        )
+    }
+    .with_rate(r.rate, r.dt))
+}
+
+/// Runs the fixed-point lattice over `x` (in sensor units, scaled by `scale`); the mean is
+/// removed in f64 first, as for f32.
+pub(super) fn fixed_fit<const P: usize>(
+    x: &[f64],
+    r: &Recursive,
+    scale: Scale,
+) -> Result<FitResult, Fail> {
+    let config = config_in::<f32>(r)?.with_demean(r.demean);
+    let scale_value = match scale {
+        Scale::Given(s) | Scale::Default(s) => s,
+    };
+    let fixed = FixedConfig::new(&config, scale_value as f32).map_err(|e| {
+        let product = r.delta * scale_value * scale_value;
+        if e == ConfigError::FixedLambda {
+            return Fail(format!("--lambda {}: {e}", r.lambda));
+        }
+        match scale {
+            Scale::Given(s) => Fail(format!(
+                "--scale {s}: {e} (delta x scale^2 = {product:e} must be in [1e-9, 1e6))"
+            )),
+            Scale::Default(s) => Fail(format!(
+                "{e}: the default --scale 8 / max |x - mean| = {s:e} and delta {} give \
+                 delta x scale^2 = {product:e}, outside [1e-9, 1e6); give --scale or --delta",
+                r.delta
+            )),
+        }
+    })?;
+    let offset = centre(x, r.demean);
+    let mut lattice = FixedLattice::<P>::new(&fixed);
+    for &v in x {
+        lattice.update(&fixed, (v - offset) as f32);
+    }
+    let health = lattice.health();
+    let model = lattice
+        .model(&fixed)
+        .ok_or_else(|| Fail("no finite model".into()))?;
+    let a: Vec<f64> = model.a().iter().map(|&v| f64::from(v)).collect();
+    let mean = f64::from(model.mean()) + offset;
+    let noise_variance = f64::from(model.noise_variance());
+    Ok(FitResult {
+        reflection: model
+            .reflection()
+            .ok()
+            .map(|k| k.iter().map(|&v| f64::from(v)).collect()),
+        lambda: Some(fixed.lambda()),
+        delta: Some(r.delta),
+        scale: Some(f64::from(fixed.scale())),
+        restarts: Some(health.restarts),
+        saturated: Some(health.saturated),
+        clipped: Some(health.clipped),
+        non_finite: Some(health.non_finite),
+        ..FitResult::new("lattice", "fixed", x.len(), mean, a, noise_variance)
+    }
+    .with_rate(r.rate, r.dt))
+}

@@ -1,0 +1,24 @@
+//! The `imu-ar` command-line tool: AR models, order criteria, Allan deviation and the Kalman
+//! hand-off of recorded sensor logs, computed by the estimators of the `imu-ar` library.
+//!
+//! One module per command ([`fit`], [`order`], [`adev`], [`compare`], [`report`], [`kalman`],
+//! [`parity`], [`simulate`]), each with its arguments (`Args`), a `run` that checks them and
+//! returns a typed result, and that result's text. What the commands share: [`input`] reads a
+//! record ([`input::csv`] is the CSV reader), [`method`] names the estimators, [`predict`] runs
+//! them for `compare` and `report`, [`output`] prints a result as JSON or text, [`error`] is
+//! the one-line error. The binary (`src/main.rs`) parses the command line and dispatches.
+#![deny(missing_docs)]
+
+pub mod adev;
+pub mod compare;
+pub mod error;
+pub mod fit;
+pub mod input;
+pub mod kalman;
+pub mod method;
+pub mod order;
+pub mod output;
+pub mod parity;
+pub mod predict;
+pub mod report;
+pub mod simulate;

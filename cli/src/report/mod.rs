@@ -1,0 +1,227 @@
+//! `imu-ar report`: the paper's comparison on one record, in four PNG plots and a JSON summary.
+
+mod plot;
+
+use std::path::{Path, PathBuf};
+
+use imu_ar::batch::{BatchConfig, covariance};
+use imu_ar::recursive::Config;
+use serde::Serialize;
+
+use crate::error::Fail;
+use crate::input::{check_rate, check_span, csv};
+use crate::method::with_order;
+use crate::output::finite;
+use crate::predict::{Comparison, predict};
+use plot::{adev_png, coefficients_png, error_png, font, psd_png};
+
+/// The arguments of `imu-ar report`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The record and the settings.
+    #[command(flatten)]
+    run: Comparison,
+    /// Sample rate in Hz of the raw record.
+    #[arg(long, allow_negative_numbers = true)]
+    rate: f64,
+    /// The column's unit, for the axis labels.
+    #[arg(long, default_value = "units")]
+    unit: String,
+    /// A published Allan table to draw too: CSV with `channel`, `tau_s` and `adev`
+    /// columns (`-` is standard input); the rows of channel `--column` are used.
+    #[arg(long)]
+    reference: Option<PathBuf>,
+    /// Directory for the PNG files (created if needed).
+    #[arg(long)]
+    out: PathBuf,
+}
+
+/// The summary of a report, printed as JSON: the comparison of `compare` on the record, and
+/// the plots written.
+#[derive(Serialize)]
+pub struct Summary {
+    /// The model order.
+    pub order: usize,
+    /// The forgetting factor of the recursive estimators.
+    pub lambda: f64,
+    /// The rate in Hz of the record after `--decimate`.
+    pub rate_hz: f64,
+    /// Samples in the record after `--decimate`.
+    pub n: usize,
+    /// Samples in the training part.
+    pub n_train: usize,
+    /// The batch LS model's one-step prediction MSE on the evaluation part.
+    pub batch_mse: f64,
+    /// RLS's.
+    pub rls_mse: f64,
+    /// The lattice's.
+    pub lattice_mse: f64,
+    /// The SFTF's, over the samples it returned an error for (all but its rescues).
+    pub sftf_mse: Option<f64>,
+    /// The SFTF's rescues.
+    pub sftf_restarts: u64,
+    /// The lattice's MSE below the batch model's, in percent.
+    pub reduction_percent: f64,
+    /// The batch model's coefficients.
+    pub batch_a: Vec<f64>,
+    /// The lattice's after the last sample.
+    pub lattice_a: Option<Vec<f64>>,
+    /// The PNG files.
+    pub files: Vec<String>,
+}
+
+/// Checks the settings, reads the record, and writes the plots.
+pub fn run(args: &Args) -> Result<Summary, Fail> {
+    let run = &args.run;
+    let rate = check_rate(args.rate)? / run.decimate.max(1) as f64;
+    let reference = match &args.reference {
+        Some(path) => Some(read_reference(path, &run.record.input.column)?),
+        None => None,
+    };
+    let (x, delta) = run.load()?;
+    check_span(
+        "--rate",
+        rate * run.decimate.max(1) as f64,
+        x.len() * run.decimate.max(1),
+    )?;
+    let r = Report {
+        x: &x,
+        rate,
+        lambda: run.lambda,
+        delta,
+        train: run.train,
+        unit: &args.unit,
+        reference,
+        out: &args.out,
+    };
+    with_order!(run.record.order, report(&r)).map_err(|Fail(e)| run.record.input.fail(e))
+}
+
+/// `(tau_s, adev)` of `channel` from a published Allan table.
+fn read_reference(path: &Path, channel: &str) -> Result<Vec<(f64, f64)>, Fail> {
+    let files = [path.to_path_buf()];
+    let channels = csv::read_text_column(&files, "channel")?;
+    let tau = csv::read_column(&files, "tau_s")?;
+    let adev = csv::read_column(&files, "adev")?;
+    let rows: Vec<(f64, f64)> = channels
+        .iter()
+        .zip(tau.into_iter().zip(adev))
+        .filter(|(c, _)| c.as_str() == channel)
+        .map(|(_, p)| p)
+        .collect();
+    if rows.is_empty() {
+        return Err(Fail(format!(
+            "{}: no rows of channel '{channel}'",
+            path.display()
+        )));
+    }
+    Ok(rows)
+}
+
+/// What the report shows and where it goes.
+struct Report<'a> {
+    /// The record (already decimated), in sensor units.
+    x: &'a [f64],
+    /// Sample rate of `x` in Hz.
+    rate: f64,
+    lambda: f64,
+    delta: f64,
+    /// Fraction of the record the batch model is fitted on.
+    train: f64,
+    /// The sensor unit, for the axis labels.
+    unit: &'a str,
+    /// Published Allan deviations `(tau_s, adev)` to draw with the data's.
+    reference: Option<Vec<(f64, f64)>>,
+    out: &'a Path,
+}
+
+/// Fewest samples a report is drawn from: enough for a periodogram of 8-sample segments.
+const MIN_SAMPLES: usize = 64;
+
+/// Coefficients `a_1..a_P` at sampled times (s).
+type Track<const P: usize> = Vec<(f64, [f64; P])>;
+/// Points per drawn time series: the plots stay small and readable for any record length.
+const POINTS: usize = 400;
+
+/// Writes the four PNGs and returns the summary.
+fn report<const P: usize>(r: &Report) -> Result<Summary, Fail> {
+    let x = r.x;
+    if x.len() < MIN_SAMPLES {
+        return Err(Fail(format!(
+            "report needs at least {MIN_SAMPLES} samples (after --decimate), not {}",
+            x.len()
+        )));
+    }
+    font()?;
+    let dt = 1.0 / r.rate;
+    let n_train = (r.train * x.len() as f64) as usize;
+    let batch_config = BatchConfig::new(dt)?;
+    let train_fit = covariance::<f64, P>(&x[..n_train], &batch_config)?.model;
+    let whole_fit = covariance::<f64, P>(x, &batch_config)?.model;
+
+    // The recursive estimators over the whole record; their errors and coefficients sampled.
+    let config = Config::new(r.lambda, r.delta, dt)?;
+    // Only once the input has passed every check.
+    std::fs::create_dir_all(r.out)
+        .map_err(|e| Fail(format!("{}: cannot create: {e}", r.out.display())))?;
+    let stride = (x.len() / POINTS).max(1);
+    let mut coef = (Vec::new(), Vec::new());
+    let mut se = [vec![], vec![], vec![]];
+    let mut block = [0.0; 3];
+    let mut missing = 0usize;
+    let mut eval = predict(x, n_train, &train_fit, &config, |n, e, est| {
+        if n >= n_train && (e.rls.is_none() || e.lattice.is_none()) {
+            missing += 1;
+        }
+        for (k, e) in [e.batch, e.rls, e.lattice].into_iter().enumerate() {
+            let e = e.unwrap_or(0.0);
+            block[k] += e * e;
+        }
+        if (n + 1) % stride == 0 {
+            let t = (n + 1) as f64 * dt;
+            for (k, b) in block.iter_mut().enumerate() {
+                se[k].push((t, *b / stride as f64));
+                *b = 0.0;
+            }
+            let a_lattice = est.lattice.coefficients(P).unwrap_or([f64::NAN; P]);
+            coef.0.push((t, *est.rls.coefficients()));
+            coef.1.push((t, a_lattice));
+        }
+    });
+    let m = x.len() - n_train;
+    let mse = [eval.batch, eval.rls, eval.lattice].map(|s| s.mean(m));
+    // An estimator that broke down (no error, counted as 0 above, on most samples) is no
+    // result.
+    let (rls, lattice) = (&mut eval.estimators.rls, &mut eval.estimators.lattice);
+    let modelled = rls.model(&config).is_some() && lattice.model(&config).is_some();
+    if !modelled || mse.iter().any(|v| !v.is_finite()) || 2 * missing > x.len() - n_train {
+        return Err(Fail(
+            "RLS or the lattice gives no finite model (no finite prediction error on the \
+             evaluation part)"
+                .into(),
+        ));
+    }
+
+    let files = [
+        coefficients_png::<P>(r, &coef, &train_fit)?,
+        error_png(r, &se, &mse, n_train as f64 * dt)?,
+        psd_png(r, &whole_fit)?,
+        adev_png(r, &whole_fit)?,
+    ];
+    Ok(Summary {
+        order: P,
+        lambda: r.lambda,
+        rate_hz: r.rate,
+        n: x.len(),
+        n_train,
+        batch_mse: mse[0],
+        rls_mse: mse[1],
+        lattice_mse: mse[2],
+        sftf_mse: finite(eval.sftf.mean(eval.sftf.count)),
+        sftf_restarts: eval.estimators.sftf.health().restarts,
+        reduction_percent: 100.0 * (mse[0] - mse[2]) / mse[0],
+        batch_a: train_fit.a().to_vec(),
+        lattice_a: lattice.coefficients(P).map(|a| a.to_vec()),
+        files: files.iter().map(|f| f.display().to_string()).collect(),
+    })
+}
