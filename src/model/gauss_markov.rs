@@ -81,17 +81,17 @@ impl<T: Scalar> GaussMarkov<T> {
     ///
     /// # Errors
     ///
-    /// [`ModelError::NonPositiveInterval`] or [`ModelError::NonFinite`] for a bad `dt` or `mean`;
+    /// [`ModelError::Interval`] for a bad `dt`, [`ModelError::NonFinite`] for a bad `mean`;
     /// [`ModelError::Unrepresentable`] where `T` cannot represent the process, as above
     /// (including `phi` rounding to 1, which would be a random walk, not this process), and
     /// where the noise variance `sigma^2 (1 - phi^2)` underflows to 0 or overflows in `T`
     /// (in `f32`, `sigma` below about `1e-19` or above about `1e19`).
     pub fn to_ar1(&self, dt: T, mean: T) -> Result<ArModel<T, 1>, ModelError> {
-        if !dt.is_finite() || !mean.is_finite() {
-            return Err(ModelError::NonFinite);
+        if !(dt.is_finite() && dt > T::ZERO) {
+            return Err(ModelError::Interval);
         }
-        if dt <= T::ZERO {
-            return Err(ModelError::NonPositiveInterval);
+        if !mean.is_finite() {
+            return Err(ModelError::NonFinite);
         }
         let ratio = dt.to_f64() / self.correlation_time.to_f64();
         // 1 - exp(-dt/T_c), to full relative precision however small dt/T_c is.

@@ -22,12 +22,12 @@ pub type Matrix<T, const P: usize> = [[T; P]; P];
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum ModelError {
-    /// A coefficient, the variance, the mean or `dt` is NaN or infinite.
+    /// A coefficient, the variance or the mean is NaN or infinite.
     NonFinite,
     /// The innovation variance is negative.
     NegativeVariance,
-    /// The sample interval is not positive.
-    NonPositiveInterval,
+    /// The sample interval `dt` is not positive and finite.
+    Interval,
     /// The model is not stationary: the reflection coefficient of this order is not inside
     /// (-1, 1) (a pole on or outside the unit circle).
     Unstable {
@@ -50,7 +50,7 @@ impl fmt::Display for ModelError {
         match *self {
             Self::NonFinite => f.write_str("model parameter is NaN or infinite"),
             Self::NegativeVariance => f.write_str("innovation variance is negative"),
-            Self::NonPositiveInterval => f.write_str("sample interval is not positive"),
+            Self::Interval => f.write_str(INTERVAL),
             Self::Unstable { order } => write!(
                 f,
                 "model is not stationary (reflection coefficient {order} outside (-1, 1))"
@@ -70,6 +70,11 @@ impl fmt::Display for ModelError {
 }
 
 impl core::error::Error for ModelError {}
+
+/// What [`ModelError::Interval`], [`BatchError::Interval`](crate::batch::BatchError::Interval)
+/// and [`ConfigError::Interval`](crate::recursive::ConfigError::Interval) say: one check,
+/// `dt` positive and finite, everywhere a sample interval is given.
+pub(crate) const INTERVAL: &str = "sample interval must be positive and finite";
 
 /// An autoregressive model of order `P` with its innovation variance, mean and sample interval.
 ///
@@ -102,21 +107,19 @@ impl<T: Scalar, const P: usize> ArModel<T, P> {
     /// # Errors
     ///
     /// [`ModelError::NonFinite`], [`ModelError::NegativeVariance`] or
-    /// [`ModelError::NonPositiveInterval`].
+    /// [`ModelError::Interval`].
     pub fn new(a: [T; P], noise_variance: T, mean: T, dt: T) -> Result<Self, ModelError> {
         const { assert!(P > 0, "the model order P must be at least 1") };
-        let finite = a.iter().all(|v| v.is_finite())
-            && noise_variance.is_finite()
-            && mean.is_finite()
-            && dt.is_finite();
+        if !(dt.is_finite() && dt > T::ZERO) {
+            return Err(ModelError::Interval);
+        }
+        let finite =
+            a.iter().all(|v| v.is_finite()) && noise_variance.is_finite() && mean.is_finite();
         if !finite {
             return Err(ModelError::NonFinite);
         }
         if noise_variance < T::ZERO {
             return Err(ModelError::NegativeVariance);
-        }
-        if dt <= T::ZERO {
-            return Err(ModelError::NonPositiveInterval);
         }
         Ok(Self {
             a,
@@ -497,7 +500,7 @@ mod tests {
         );
         assert_eq!(
             ArModel::new([0.5f32], 1.0, 0.0, 0.0),
-            Err(ModelError::NonPositiveInterval)
+            Err(ModelError::Interval)
         );
         for phi in [0.0, -0.5, 1.0] {
             let m = ArModel::new([phi], 1.0, 0.0, 1.0).unwrap();

@@ -51,7 +51,7 @@ pub enum ConfigError {
     /// The initial regularisation `delta` is not positive and finite, or is too small or
     /// too large for the scalar to carry through the recursion (see [`Config::new`]).
     Delta,
-    /// The sample interval is not positive and finite.
+    /// The sample interval `dt` is not positive and finite.
     Interval,
     /// The saturation limit is not positive.
     Saturation,
@@ -70,7 +70,7 @@ impl fmt::Display for ConfigError {
                 "regularisation delta must be positive and finite, and within the scalar's range \
                  (about 1e-31..1e31 in f32, 1e-292..1e292 in f64)"
             }
-            Self::Interval => "sample interval must be positive and finite",
+            Self::Interval => crate::model::INTERVAL,
             Self::Saturation => "saturation limit must be positive",
             Self::Scale => "fixed-point scale must be positive and keep delta representable",
             Self::FixedLambda => "the fixed-point lattice needs lambda in [0.9, 1]",
