@@ -46,7 +46,7 @@ mod firmware {
     use embedded_hal::delay::DelayNs;
     use imu_ar::ArModel;
     use imu_ar::batch::{BatchConfig, covariance};
-    use imu_ar::recursive::{Config, Lattice, OrderRule, OrderSelector};
+    use imu_ar::recursive::{Channel, Config, Estimator, Lattice, OrderRule, OrderSelector};
     use imu_ar::sensor::{AccelUnit, GyroUnit, ImuReader, Mpu6050, Mpu6050Config, RawSample};
 
     use super::common;
@@ -87,12 +87,13 @@ mod firmware {
             common::exit(false)
         }
         let scale = imu.scale();
-        // Gyro in deg/s, accel in g; delta about 0.1 x each axis's variance.
+        // Shared by the six axes; per channel (gyro in deg/s, accel in g): delta about 0.1 x
+        // each axis's variance.
+        let config = Config::new(lambda, 1.0 / RATE).unwrap_or_else(|_| common::exit(false));
         let deltas = [2.5e-4f32, 2.5e-4, 2.5e-4, 1e-6, 1e-6, 1e-6];
-        let configs = deltas
-            .map(|d| Config::new(lambda, d, 1.0 / RATE).unwrap_or_else(|_| common::exit(false)));
+        let channels = deltas.map(|d| Channel::new(d).unwrap_or_else(|_| common::exit(false)));
         let mut lattices: [Lattice<f32, P>; 6] =
-            core::array::from_fn(|i| Lattice::new(&configs[i]));
+            core::array::from_fn(|i| Lattice::new(&config, &channels[i]));
         let mut selectors: [OrderSelector<f32, P>; 6] =
             core::array::from_fn(|_| OrderSelector::new(OrderRule::Bic, 500, 3));
         let mut windows: [Window; 6] = core::array::from_fn(|_| Window {
@@ -120,7 +121,6 @@ mod firmware {
                 let gyro = scale.gyro(s.gyro, GyroUnit::DegPerSec);
                 let accel = scale.accel(s.accel, AccelUnit::G);
                 for (axis, x) in gyro.into_iter().chain(accel).enumerate() {
-                    let config = &configs[axis];
                     let w = &mut windows[axis];
                     // Batch prediction from the previous window's model, on in-window history.
                     if let (Some(m), true) = (&batch_models[axis], w.len >= P) {
@@ -128,8 +128,8 @@ mod firmware {
                         let e = f64::from(x - m.predict(&past));
                         w.batch_se += e * e;
                     }
-                    if let Some(e) = lattices[axis].update(config, x) {
-                        selectors[axis].update(config, &lattices[axis]);
+                    if let Some(e) = lattices[axis].update(&config, x) {
+                        selectors[axis].update(&config, &lattices[axis]);
                         if w.len >= P && batch_models[axis].is_some() {
                             w.lattice_se += f64::from(e) * f64::from(e);
                             w.counted += 1;
@@ -154,8 +154,8 @@ mod firmware {
                         report(
                             t,
                             axis,
-                            &mut lattices[axis],
-                            &configs[axis],
+                            &lattices[axis],
+                            &config,
                             &selectors[axis],
                             w.counted > 0,
                             lat_mse,
@@ -179,7 +179,7 @@ mod firmware {
         for axis in 0..AXES {
             let t = &truth[axis];
             let (Some(model), Some((a_true, e_true))) =
-                (lattices[axis].model(&configs[axis]), t.ar_projection::<P>())
+                (lattices[axis].model(&config), t.ar_projection::<P>())
             else {
                 defmt::error!("{=str}: no model", NAMES[axis]);
                 ok = false;
@@ -231,7 +231,7 @@ mod firmware {
     fn report(
         t: f32,
         axis: usize,
-        lattice: &mut Lattice<f32, P>,
+        lattice: &Lattice<f32, P>,
         config: &Config<f32>,
         selector: &OrderSelector<f32, P>,
         have_batch: bool,

@@ -28,8 +28,8 @@ use imu_ar::ArModel;
 use imu_ar::allan::overlapping_avar;
 use imu_ar::batch::criteria::Criterion;
 use imu_ar::batch::{BatchConfig, BatchError, Fit, burg, covariance, yule_walker};
-use imu_ar::fixed_point::{FixedConfig, FixedLattice};
-use imu_ar::recursive::{Config, ConfigError, FloatArith, Lattice, Rls, RlsInit, Sftf};
+use imu_ar::recursive::{Channel, Config, ConfigError, Estimator, FixedChannel, FixedConfig};
+use imu_ar::recursive::{FixedLattice, FloatArith, Lattice, Rls, Sftf};
 use imu_ar::sim::StandardNormal;
 use imu_ar_host::data::{block_average, read_column};
 use kalman::handoff;
@@ -808,7 +808,7 @@ fn check_lambda(lambda: f64) -> Result<(), Fail> {
 
 /// A `--delta` that the f64 estimators can carry (the library's range check).
 fn check_delta(delta: f64) -> Result<(), Fail> {
-    Config::<f64>::new(DEFAULT_LAMBDA, delta, 1.0)
+    Channel::<f64>::new(delta)
         .map(|_| ())
         .map_err(|e| Fail(format!("--delta {delta}: {e}")))
 }
@@ -934,12 +934,14 @@ enum Scale {
 }
 
 /// The configuration in `T`, with an error that says which setting `T` cannot carry.
-fn config_in<T: FloatArith>(r: &Recursive) -> Result<Config<T>, Fail> {
-    Config::new(
-        T::from_f64(r.lambda),
-        T::from_f64(r.delta),
-        T::from_f64(r.dt),
-    )
+fn config_in<T: FloatArith>(r: &Recursive) -> Result<(Config<T>, Channel<T>), Fail> {
+    let config = Config::new(T::from_f64(r.lambda), T::from_f64(r.dt));
+    // Checked in the order lambda, delta, interval.
+    match (config, Channel::new(T::from_f64(r.delta))) {
+        (Ok(config), Ok(channel)) => Ok((config, channel)),
+        (Err(ConfigError::Lambda), _) => Err(ConfigError::Lambda),
+        (_, Err(e)) | (Err(e), _) => Err(e),
+    }
     .map_err(|e| {
         if r.default_delta {
             Fail(format!(
@@ -959,7 +961,8 @@ fn config_in<T: FloatArith>(r: &Recursive) -> Result<Config<T>, Fail> {
 /// In f32 the mean (of the samples f32 can hold) is removed in f64 first and added back to
 /// the reported mean, so that rounding to f32 does not erase a small signal on a large offset.
 fn recursive_fit<T: FloatArith, const P: usize>(x: &[f64], r: &Recursive) -> Result<Value, Fail> {
-    let config = config_in::<T>(r)?.with_demean(r.demean);
+    let (config, channel) = config_in::<T>(r)?;
+    let config = config.with_demean(r.demean);
     let offset = if core::mem::size_of::<T>() < 8 {
         centre(x, r.demean)
     } else {
@@ -967,21 +970,21 @@ fn recursive_fit<T: FloatArith, const P: usize>(x: &[f64], r: &Recursive) -> Res
     };
     let (model, health, reflection) = match r.method {
         Method::Rls => {
-            let mut rls = Rls::<T, P>::new(&config, RlsInit::ShiftConsistent);
+            let mut rls = Rls::<T, P>::new(&config, &channel);
             for &v in x {
                 rls.update(&config, T::from_f64(v - offset));
             }
             (rls.model(&config), rls.health(), None)
         }
         Method::Sftf => {
-            let mut sftf = Sftf::<T, P>::new(&config);
+            let mut sftf = Sftf::<T, P>::new(&config, &channel);
             for &v in x {
                 sftf.update(&config, T::from_f64(v - offset));
             }
             (sftf.model(&config), sftf.health(), None)
         }
         _ => {
-            let mut lattice = Lattice::<T, P>::new(&config);
+            let mut lattice = Lattice::<T, P>::new(&config, &channel);
             for &v in x {
                 lattice.update(&config, T::from_f64(v - offset));
             }
@@ -1018,11 +1021,14 @@ fn recursive_fit<T: FloatArith, const P: usize>(x: &[f64], r: &Recursive) -> Res
 /// Runs the fixed-point lattice over `x` (in sensor units, scaled by `scale`); the mean is
 /// removed in f64 first, as for f32.
 fn fixed_fit<const P: usize>(x: &[f64], r: &Recursive, scale: Scale) -> Result<Value, Fail> {
-    let config = config_in::<f32>(r)?.with_demean(r.demean);
+    let (config, channel) = config_in::<f32>(r)?;
+    let config = config.with_demean(r.demean);
     let scale_value = match scale {
         Scale::Given(s) | Scale::Default(s) => s,
     };
-    let fixed = FixedConfig::new(&config, scale_value as f32).map_err(|e| {
+    let settings = FixedChannel::new(&channel, scale_value as f32)
+        .and_then(|channel| Ok((FixedConfig::new(&config)?, channel)));
+    let (fixed, fixed_channel) = settings.map_err(|e| {
         let product = r.delta * scale_value * scale_value;
         if e == ConfigError::FixedLambda {
             return Fail(format!("--lambda {}: {e}", r.lambda));
@@ -1039,7 +1045,7 @@ fn fixed_fit<const P: usize>(x: &[f64], r: &Recursive, scale: Scale) -> Result<V
         }
     })?;
     let offset = centre(x, r.demean);
-    let mut lattice = FixedLattice::<P>::new(&fixed);
+    let mut lattice = FixedLattice::<P>::new(&fixed, &fixed_channel);
     for &v in x {
         lattice.update(&fixed, (v - offset) as f32);
     }
@@ -1058,7 +1064,7 @@ fn fixed_fit<const P: usize>(x: &[f64], r: &Recursive, scale: Scale) -> Result<V
         "noise_variance": f64::from(model.noise_variance()),
         "lambda": fixed.lambda(),
         "delta": r.delta,
-        "scale": f64::from(fixed.scale()),
+        "scale": f64::from(fixed_channel.scale()),
         "restarts": health.restarts,
         "saturated": health.saturated,
         "clipped": health.clipped,
@@ -1107,10 +1113,11 @@ fn compare<const P: usize>(x: &[f64], lambda: f64, delta: f64, train: f64) -> Re
         }
         fit => fit?.model,
     };
-    let config = Config::new(lambda, delta, 1.0)?;
-    let mut rls = Rls::<f64, P>::new(&config, RlsInit::ShiftConsistent);
-    let mut lattice = Lattice::<f64, P>::new(&config);
-    let mut sftf = Sftf::<f64, P>::new(&config);
+    let config = Config::new(lambda, 1.0)?;
+    let channel = Channel::new(delta)?;
+    let mut rls = Rls::<f64, P>::new(&config, &channel);
+    let mut lattice = Lattice::<f64, P>::new(&config, &channel);
+    let mut sftf = Sftf::<f64, P>::new(&config, &channel);
     let (mut batch_se, mut rls_se, mut lattice_se) = (0.0, 0.0, 0.0);
     let (mut sftf_se, mut sftf_n) = (0.0, 0usize);
     for (n, &v) in x.iter().enumerate() {

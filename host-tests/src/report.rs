@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use imu_ar::ArModel;
 use imu_ar::allan::overlapping_avar;
 use imu_ar::batch::{BatchConfig, covariance};
-use imu_ar::recursive::{Config, Lattice, Rls, RlsInit};
+use imu_ar::recursive::{Channel, Config, Estimator, Lattice, Rls};
 use plotters::prelude::*;
 use rustfft::{FftPlanner, num_complex::Complex};
 use serde_json::{Value, json};
@@ -65,12 +65,13 @@ pub fn report<const P: usize>(r: &Report) -> Result<Value, Fail> {
     let whole_fit = covariance::<f64, P>(x, &batch_config)?.model;
 
     // The recursive estimators over the whole record; their errors and coefficients sampled.
-    let config = Config::new(r.lambda, r.delta, dt)?;
+    let config = Config::new(r.lambda, dt)?;
+    let channel = Channel::new(r.delta)?;
     // Only once the input has passed every check.
     std::fs::create_dir_all(r.out)
         .map_err(|e| Fail(format!("{}: cannot create: {e}", r.out.display())))?;
-    let mut rls = Rls::<f64, P>::new(&config, RlsInit::ShiftConsistent);
-    let mut lattice = Lattice::<f64, P>::new(&config);
+    let mut rls = Rls::<f64, P>::new(&config, &channel);
+    let mut lattice = Lattice::<f64, P>::new(&config, &channel);
     let stride = (x.len() / POINTS).max(1);
     let mut coef = (Vec::new(), Vec::new());
     let mut se = [vec![], vec![], vec![]];

@@ -66,7 +66,8 @@ impl<T: FloatArith, const P: usize> OrderSelector<T, P> {
         self.selected
     }
 
-    /// Call after every accepted [`Lattice::update`]; returns the selected order.
+    /// Call after every accepted [`update`](super::Estimator::update) of `lattice`; returns
+    /// the selected order.
     pub fn update(&mut self, config: &Config<T>, lattice: &Lattice<T, P>) -> usize {
         let lambda = config.lambda();
         let y = lattice.input();
