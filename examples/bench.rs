@@ -27,8 +27,8 @@ mod firmware {
     use core::hint::black_box;
 
     use cortex_m::peripheral::{SYST, syst::SystClkSource};
-    use imu_ar::fixed_point::{FixedConfig, FixedLattice};
-    use imu_ar::recursive::{Config, Lattice, Rls, RlsInit, Sftf};
+    use imu_ar::recursive::{Channel, Config, Estimator, FixedChannel, FixedConfig, FixedLattice};
+    use imu_ar::recursive::{Lattice, Rls, Sftf};
 
     use super::common;
 
@@ -81,27 +81,68 @@ mod firmware {
             (full.saturating_sub(empty) * self.per_tick + BATCH as u32 / 2) / BATCH as u32
         }
 
-        fn lattice_f32<const P: usize>(&mut self) {
-            let config = Config::new(0.999f32, 0.1, 0.01).unwrap_or_else(|_| common::exit(false));
-            let mut state = Lattice::<f32, P>::new(&config);
+        /// The settings of the f32 rows.
+        fn f32_settings() -> (Config<f32>, Channel<f32>) {
+            match (Config::new(0.999f32, 0.01), Channel::new(0.1)) {
+                (Ok(config), Ok(channel)) => (config, channel),
+                _ => common::exit(false),
+            }
+        }
+
+        /// One row of an f32 estimator: instructions per `update`, then the state's size; a
+        /// restart on the benchmark record would make the count meaningless, and fails.
+        fn f32_row<E: Estimator<f32, P>, const P: usize>(
+            &mut self,
+            name: &str,
+            mut state: E,
+            config: &E::Config,
+        ) {
             let x = self.x;
             let cell = core::cell::RefCell::new(&mut state);
             let n = self.insns_per_sample(|i| {
-                black_box(cell.borrow_mut().update(&config, black_box(x[i])));
+                black_box(cell.borrow_mut().update(config, black_box(x[i])));
             });
-            defmt::info!("lattice f32 p={=usize} insns/sample={=u32}", P, n);
-            let bytes = core::mem::size_of::<Lattice<f32, P>>();
-            defmt::info!("lattice f32 p={=usize} bytes={=usize}", P, bytes);
+            defmt::info!("{=str} f32 p={=usize} insns/sample={=u32}", name, P, n);
+            let bytes = core::mem::size_of::<E>();
+            defmt::info!("{=str} f32 p={=usize} bytes={=usize}", name, P, bytes);
+            let restarts = cell.borrow().health().restarts;
+            if restarts > 0 {
+                defmt::error!("{=str} f32 p={=usize}: {=u64} restarts", name, P, restarts);
+                common::exit(false);
+            }
+        }
+
+        fn lattice_f32<const P: usize>(&mut self) {
+            let (config, channel) = Self::f32_settings();
+            self.f32_row(
+                "lattice",
+                Lattice::<f32, P>::new(&config, &channel),
+                &config,
+            );
+        }
+
+        fn rls_f32<const P: usize>(&mut self) {
+            let (config, channel) = Self::f32_settings();
+            self.f32_row("rls", Rls::<f32, P>::new(&config, &channel), &config);
+        }
+
+        fn sftf_f32<const P: usize>(&mut self) {
+            let (config, channel) = Self::f32_settings();
+            self.f32_row("sftf", Sftf::<f32, P>::new(&config, &channel), &config);
         }
 
         fn lattice_fixed<const P: usize>(&mut self) {
             // delta 0.01: at 1e-3 the reflection coefficients of this small, quantised record
             // leave the I3F29 range in the start-up of p = 16 and 32, and every such sample
             // restarts the lattice; the row would time restarts, not the recursion.
-            let config = Config::new(0.999f32, 0.01, 0.01).unwrap_or_else(|_| common::exit(false));
-            let fixed =
-                FixedConfig::for_counts(&config, 0.05).unwrap_or_else(|_| common::exit(false));
-            let mut state = FixedLattice::<P>::new(&fixed);
+            let (config, _) = Self::f32_settings();
+            let (Ok(fixed), Ok(channel)) = (
+                FixedConfig::new(&config),
+                Channel::new(0.01).and_then(|c| FixedChannel::for_counts(&c, 0.05)),
+            ) else {
+                common::exit(false)
+            };
+            let mut state = FixedLattice::<P>::new(&fixed, &channel);
             let counts = self.counts;
             let cell = core::cell::RefCell::new(&mut state);
             let n = self.insns_per_sample(|i| {
@@ -126,8 +167,8 @@ mod firmware {
 
         /// The exact transversal coefficients on request, after 1000 samples.
         fn extract_f32<const P: usize>(&mut self) {
-            let config = Config::new(0.999f32, 0.1, 0.01).unwrap_or_else(|_| common::exit(false));
-            let mut state = Lattice::<f32, P>::new(&config);
+            let (config, channel) = Self::f32_settings();
+            let mut state = Lattice::<f32, P>::new(&config, &channel);
             for &v in &self.x {
                 state.update(&config, v);
             }
@@ -139,8 +180,8 @@ mod firmware {
 
         /// One six-axis frame: six order-4 lattices, one sample each.
         fn frame6_f32(&mut self) {
-            let config = Config::new(0.999f32, 0.1, 0.01).unwrap_or_else(|_| common::exit(false));
-            let mut axes = [Lattice::<f32, 4>::new(&config); 6];
+            let (config, channel) = Self::f32_settings();
+            let mut axes = [Lattice::<f32, 4>::new(&config, &channel); 6];
             let x = self.x;
             let cell = core::cell::RefCell::new(&mut axes);
             let n = self.insns_per_sample(|i| {
@@ -149,38 +190,6 @@ mod firmware {
                 }
             });
             defmt::info!("frame6 f32 p=4 insns/sample={=u32}", n);
-        }
-
-        fn rls_f32<const P: usize>(&mut self) {
-            let config = Config::new(0.999f32, 0.1, 0.01).unwrap_or_else(|_| common::exit(false));
-            let mut state = Rls::<f32, P>::new(&config, RlsInit::ShiftConsistent);
-            let x = self.x;
-            let cell = core::cell::RefCell::new(&mut state);
-            let n = self.insns_per_sample(|i| {
-                black_box(cell.borrow_mut().update(&config, black_box(x[i])));
-            });
-            defmt::info!("rls f32 p={=usize} insns/sample={=u32}", P, n);
-            let bytes = core::mem::size_of::<Rls<f32, P>>();
-            defmt::info!("rls f32 p={=usize} bytes={=usize}", P, bytes);
-        }
-
-        fn sftf_f32<const P: usize>(&mut self) {
-            let config = Config::new(0.999f32, 0.1, 0.01).unwrap_or_else(|_| common::exit(false));
-            let mut state = Sftf::<f32, P>::new(&config);
-            let x = self.x;
-            let cell = core::cell::RefCell::new(&mut state);
-            let n = self.insns_per_sample(|i| {
-                black_box(cell.borrow_mut().update(&config, black_box(x[i])));
-            });
-            let rescues = cell.borrow().health().restarts;
-            defmt::info!("sftf f32 p={=usize} insns/sample={=u32}", P, n);
-            let bytes = core::mem::size_of::<Sftf<f32, P>>();
-            defmt::info!("sftf f32 p={=usize} bytes={=usize}", P, bytes);
-            if rescues > 0 {
-                // A rescue on the benchmark record would make the count meaningless.
-                defmt::error!("sftf f32 p={=usize}: {=u64} rescues", P, rescues);
-                common::exit(false);
-            }
         }
     }
 

@@ -9,8 +9,8 @@
 //! bias, a first-order Gauss-Markov drift whose sigma and correlation time change with a
 //! simulated temperature ramp (25 to 45 deg C), white noise, and quantisation to counts. The
 //! firmware reads it through `imu_ar::sensor::Mpu6050` (FIFO batches of 100 ms) and estimates
-//! each axis with an f32 lattice of order 4 (`lambda = 0.9995`, a 20 s memory) plus a BIC order
-//! selector. Every 10 s of sensor time it logs, per axis: `a_1..a_4`, the innovation sigma, the
+//! each axis with an f32 lattice of order 4 (`lambda = 0.9995`, a 20 s memory, shared by the six
+//! axes; `delta` and the saturation limit per channel, in deg/s or g) plus a BIC order selector. Every 10 s of sensor time it logs, per axis: `a_1..a_4`, the innovation sigma, the
 //! selected order, the Gauss-Markov correlation time and sigma of the order-1 model, and the
 //! one-step prediction MSE of the lattice and of a batch LS model fitted on the previous 10 s.
 //!
@@ -46,17 +46,17 @@ mod firmware {
     use embedded_hal::delay::DelayNs;
     use imu_ar::ArModel;
     use imu_ar::batch::{BatchConfig, covariance};
-    use imu_ar::recursive::{Config, Lattice, OrderRule, OrderSelector};
+    use imu_ar::recursive::{Channel, Config, Estimator, Lattice, OrderRule, OrderSelector};
     use imu_ar::sensor::{AccelUnit, GyroUnit, ImuReader, Mpu6050, Mpu6050Config, RawSample};
 
     use super::common;
-    use super::sim_imu::{AXES, SimImu};
+    use super::sim_imu::{AXES, AxisTruth, SimImu};
 
     const P: usize = 4;
     const RATE: f32 = 100.0;
     const WINDOW: usize = 1000; // 10 s
     const DURATION_S: u32 = 120;
-    const NAMES: [&str; 6] = ["gx", "gy", "gz", "ax", "ay", "az"];
+    const NAMES: [&str; AXES] = ["gx", "gy", "gz", "ax", "ay", "az"];
     /// Largest accepted coefficient error: about 6 standard deviations of an estimate with
     /// `(1 + lambda)/(1 - lambda) = 4000` effective samples.
     const A_TOLERANCE: f64 = 0.1;
@@ -66,13 +66,167 @@ mod firmware {
         fn delay_ns(&mut self, _: u32) {}
     }
 
-    /// Per-axis bookkeeping of one 10 s window.
-    struct Window {
+    /// One axis: its estimator and order selector, and the bookkeeping of the current 10 s
+    /// window (its samples, and the squared one-step errors of the lattice and of the batch
+    /// model fitted on the window before).
+    struct Axis {
+        name: &'static str,
+        unit: &'static str,
+        lattice: Lattice<f32, P>,
+        selector: OrderSelector<f32, P>,
         samples: [f32; WINDOW],
         len: usize,
         lattice_se: f64,
         batch_se: f64,
         counted: usize,
+        batch_model: Option<ArModel<f32, P>>,
+        /// `(lattice, batch)` prediction MSE of the last window that had a batch model.
+        last_mse: (f64, f64),
+    }
+
+    impl Axis {
+        fn new(index: usize, config: &Config<f32>, channel: &Channel<f32>) -> Self {
+            Self {
+                name: NAMES[index],
+                unit: if index < 3 { "deg/s" } else { "g" },
+                lattice: Lattice::new(config, channel),
+                selector: OrderSelector::new(OrderRule::Bic, 500, 3),
+                samples: [0.0; WINDOW],
+                len: 0,
+                lattice_se: 0.0,
+                batch_se: 0.0,
+                counted: 0,
+                batch_model: None,
+                last_mse: (0.0, 0.0),
+            }
+        }
+
+        /// One sample: the batch model's prediction error (on in-window history), the
+        /// lattice's update and error, the selector.
+        fn push(&mut self, config: &Config<f32>, x: f32) {
+            if let (Some(m), true) = (&self.batch_model, self.len >= P) {
+                let past: [f32; P] = core::array::from_fn(|k| self.samples[self.len - 1 - k]);
+                let e = f64::from(x - m.predict(&past));
+                self.batch_se += e * e;
+            }
+            if let Some(e) = self.lattice.update(config, x) {
+                self.selector.update(config, &self.lattice);
+                if self.len >= P && self.batch_model.is_some() {
+                    self.lattice_se += f64::from(e) * f64::from(e);
+                    self.counted += 1;
+                }
+            }
+            self.samples[self.len] = x;
+            self.len += 1;
+        }
+
+        /// The end of a window at `t` s: report, fit the batch model of the next window, and
+        /// start it.
+        fn end_window(&mut self, t: f32, config: &Config<f32>, batch: &BatchConfig<f32>) {
+            let counted = self.counted.max(1) as f64;
+            let mse = (self.lattice_se / counted, self.batch_se / counted);
+            if self.counted > 0 {
+                self.last_mse = mse;
+            }
+            self.batch_model = covariance::<f32, P>(&self.samples, batch)
+                .ok()
+                .map(|f| f.model);
+            self.report(t, config, (self.counted > 0).then_some(mse));
+            self.len = 0;
+            self.lattice_se = 0.0;
+            self.batch_se = 0.0;
+            self.counted = 0;
+        }
+
+        /// Logs the model, the selected order, the Gauss-Markov parameters where an AR(1)
+        /// fits, and the window's `(lattice, batch)` prediction MSE when there was a batch
+        /// model to compare with.
+        fn report(&self, t: f32, config: &Config<f32>, mse: Option<(f64, f64)>) {
+            let Some(model) = self.lattice.model(config) else {
+                return;
+            };
+            let sigma = libm::sqrtf(model.noise_variance());
+            let gm = self
+                .lattice
+                .coefficients(1)
+                .zip(self.lattice.innovation_variance(1))
+                .and_then(|(a, v)| ArModel::new([a[0]], v, model.mean(), config.dt()).ok())
+                .and_then(|m| m.to_gauss_markov().ok());
+            let order = self.selector.order();
+            // Only where an AR(1) fits: the selected order is 1.
+            let (tc, gm_sigma) = match (gm, order) {
+                (Some(g), 1) => (g.correlation_time(), g.sigma()),
+                _ => (f32::NAN, f32::NAN),
+            };
+            let a = model.a().as_slice();
+            if let Some((lattice_mse, batch_mse)) = mse {
+                defmt::info!(
+                    "t={=f32}s {=str}: a={=[?]} sigma={=f32} {=str} order={=usize} gm(tc={=f32}s sigma={=f32}) mse lattice={=f32} batch={=f32}",
+                    t,
+                    self.name,
+                    a,
+                    sigma,
+                    self.unit,
+                    order,
+                    tc,
+                    gm_sigma,
+                    lattice_mse as f32,
+                    batch_mse as f32
+                );
+            } else {
+                defmt::info!(
+                    "t={=f32}s {=str}: a={=[?]} sigma={=f32} {=str} order={=usize} gm(tc={=f32}s sigma={=f32})",
+                    t,
+                    self.name,
+                    a,
+                    sigma,
+                    self.unit,
+                    order,
+                    tc,
+                    gm_sigma
+                );
+            }
+        }
+
+        /// The truth check of the module docs; logs it and returns whether it holds.
+        fn check(&self, config: &Config<f32>, truth: &AxisTruth) -> bool {
+            let (Some(model), Some((a_true, e_true))) =
+                (self.lattice.model(config), truth.ar_projection::<P>())
+            else {
+                defmt::error!("{=str}: no model", self.name);
+                return false;
+            };
+            let mean_sd = truth.ew_mean_sd(f64::from(config.lambda()));
+            let mean_err = (f64::from(model.mean()) - truth.mean).abs();
+            let a_err = model
+                .a()
+                .iter()
+                .zip(&a_true)
+                .fold(0.0f64, |m, (a, b)| m.max((f64::from(*a) - b).abs()));
+            let var_ratio = f64::from(model.noise_variance()) / e_true;
+            let mse_ratio = self.last_mse.0 / e_true;
+            let pass_mean = mean_err <= 4.0 * mean_sd;
+            let pass_a = a_err <= A_TOLERANCE;
+            let pass_var = (0.9..=1.1).contains(&var_ratio);
+            let pass_mse = (0.75..=1.25).contains(&mse_ratio);
+            defmt::info!(
+                "check {=str}: mean {=f32} vs {=f32} (|err| {=f32} <= {=f32}) {=bool}; max|a - a_true| {=f32} <= {=f32} {=bool}; innovation variance / truth {=f32} in [0.9, 1.1] {=bool}; lattice MSE / truth {=f32} in [0.75, 1.25] {=bool}",
+                self.name,
+                model.mean(),
+                truth.mean as f32,
+                mean_err as f32,
+                (4.0 * mean_sd) as f32,
+                pass_mean,
+                a_err as f32,
+                A_TOLERANCE as f32,
+                pass_a,
+                var_ratio as f32,
+                pass_var,
+                mse_ratio as f32,
+                pass_mse
+            );
+            pass_mean && pass_a && pass_var && pass_mse
+        }
     }
 
     pub fn run() -> ! {
@@ -87,24 +241,22 @@ mod firmware {
             common::exit(false)
         }
         let scale = imu.scale();
-        // Gyro in deg/s, accel in g; delta about 0.1 x each axis's variance.
-        let deltas = [2.5e-4f32, 2.5e-4, 2.5e-4, 1e-6, 1e-6, 1e-6];
-        let configs = deltas
-            .map(|d| Config::new(lambda, d, 1.0 / RATE).unwrap_or_else(|_| common::exit(false)));
-        let mut lattices: [Lattice<f32, P>; 6] =
-            core::array::from_fn(|i| Lattice::new(&configs[i]));
-        let mut selectors: [OrderSelector<f32, P>; 6] =
-            core::array::from_fn(|_| OrderSelector::new(OrderRule::Bic, 500, 3));
-        let mut windows: [Window; 6] = core::array::from_fn(|_| Window {
-            samples: [0.0; WINDOW],
-            len: 0,
-            lattice_se: 0.0,
-            batch_se: 0.0,
-            counted: 0,
-        });
-        let mut batch_models: [Option<ArModel<f32, P>>; 6] = [None; 6];
-        let batch_config = BatchConfig::new(1.0 / RATE).unwrap_or_else(|_| common::exit(false));
-        let mut last_mse = [(0.0f64, 0.0f64); 6];
+        // What the six axes share, and what belongs to each channel: gyro in deg/s and accel
+        // in g, delta about 0.1 x each axis's variance, the saturation limit half a count
+        // below the rail of its range.
+        let settings = (
+            Config::new(lambda, 1.0 / RATE),
+            Channel::new(2.5e-4f32)
+                .and_then(|c| c.with_saturation(scale.gyro_saturation(GyroUnit::DegPerSec))),
+            Channel::new(1e-6f32)
+                .and_then(|c| c.with_saturation(scale.accel_saturation(AccelUnit::G))),
+            BatchConfig::new(1.0 / RATE),
+        );
+        let (Ok(config), Ok(gyro), Ok(accel), Ok(batch_config)) = settings else {
+            common::exit(false)
+        };
+        let mut axes: [Axis; AXES] =
+            core::array::from_fn(|i| Axis::new(i, &config, if i < 3 { &gyro } else { &accel }));
 
         let mut batch = [RawSample::default(); 32];
         let mut n = 0usize;
@@ -119,52 +271,13 @@ mod firmware {
             for s in &batch[..got] {
                 let gyro = scale.gyro(s.gyro, GyroUnit::DegPerSec);
                 let accel = scale.accel(s.accel, AccelUnit::G);
-                for (axis, x) in gyro.into_iter().chain(accel).enumerate() {
-                    let config = &configs[axis];
-                    let w = &mut windows[axis];
-                    // Batch prediction from the previous window's model, on in-window history.
-                    if let (Some(m), true) = (&batch_models[axis], w.len >= P) {
-                        let past: [f32; P] = core::array::from_fn(|k| w.samples[w.len - 1 - k]);
-                        let e = f64::from(x - m.predict(&past));
-                        w.batch_se += e * e;
-                    }
-                    if let Some(e) = lattices[axis].update(config, x) {
-                        selectors[axis].update(config, &lattices[axis]);
-                        if w.len >= P && batch_models[axis].is_some() {
-                            w.lattice_se += f64::from(e) * f64::from(e);
-                            w.counted += 1;
-                        }
-                    }
-                    w.samples[w.len] = x;
-                    w.len += 1;
+                for (axis, x) in axes.iter_mut().zip(gyro.into_iter().chain(accel)) {
+                    axis.push(&config, x);
                 }
                 n += 1;
                 if n.is_multiple_of(WINDOW) {
-                    let t = n as f32 / RATE;
-                    for axis in 0..AXES {
-                        let w = &mut windows[axis];
-                        let counted = w.counted.max(1) as f64;
-                        let (lat_mse, batch_mse) = (w.lattice_se / counted, w.batch_se / counted);
-                        if w.counted > 0 {
-                            last_mse[axis] = (lat_mse, batch_mse);
-                        }
-                        batch_models[axis] = covariance::<f32, P>(&w.samples, &batch_config)
-                            .ok()
-                            .map(|f| f.model);
-                        report(
-                            t,
-                            axis,
-                            &mut lattices[axis],
-                            &configs[axis],
-                            &selectors[axis],
-                            w.counted > 0,
-                            lat_mse,
-                            batch_mse,
-                        );
-                        w.len = 0;
-                        w.lattice_se = 0.0;
-                        w.batch_se = 0.0;
-                        w.counted = 0;
+                    for axis in &mut axes {
+                        axis.end_window(n as f32 / RATE, &config, &batch_config);
                     }
                 }
             }
@@ -175,47 +288,10 @@ mod firmware {
         // with the truth there (the parameters drift with the temperature ramp).
         let back = f64::from(lambda) / (1.0 - f64::from(lambda)) / f64::from(RATE);
         let truth = imu.destroy().truth_at(f64::from(DURATION_S) - back);
-        let mut ok = true;
-        for axis in 0..AXES {
-            let t = &truth[axis];
-            let (Some(model), Some((a_true, e_true))) =
-                (lattices[axis].model(&configs[axis]), t.ar_projection::<P>())
-            else {
-                defmt::error!("{=str}: no model", NAMES[axis]);
-                ok = false;
-                continue;
-            };
-            let mean_sd = t.ew_mean_sd(f64::from(lambda));
-            let mean_err = (f64::from(model.mean()) - t.mean).abs();
-            let a_err = model
-                .a()
-                .iter()
-                .zip(&a_true)
-                .fold(0.0f64, |m, (a, b)| m.max((f64::from(*a) - b).abs()));
-            let var_ratio = f64::from(model.noise_variance()) / e_true;
-            let mse_ratio = last_mse[axis].0 / e_true;
-            let pass_mean = mean_err <= 4.0 * mean_sd;
-            let pass_a = a_err <= A_TOLERANCE;
-            let pass_var = (0.9..=1.1).contains(&var_ratio);
-            let pass_mse = (0.75..=1.25).contains(&mse_ratio);
-            ok &= pass_mean && pass_a && pass_var && pass_mse;
-            defmt::info!(
-                "check {=str}: mean {=f32} vs {=f32} (|err| {=f32} <= {=f32}) {=bool}; max|a - a_true| {=f32} <= {=f32} {=bool}; innovation variance / truth {=f32} in [0.9, 1.1] {=bool}; lattice MSE / truth {=f32} in [0.75, 1.25] {=bool}",
-                NAMES[axis],
-                model.mean(),
-                t.mean as f32,
-                mean_err as f32,
-                (4.0 * mean_sd) as f32,
-                pass_mean,
-                a_err as f32,
-                A_TOLERANCE as f32,
-                pass_a,
-                var_ratio as f32,
-                pass_var,
-                mse_ratio as f32,
-                pass_mse
-            );
-        }
+        let ok = axes
+            .iter()
+            .zip(&truth)
+            .fold(true, |ok, (axis, t)| axis.check(&config, t) & ok);
         if ok {
             defmt::info!(
                 "demo: {=u32} s of six-axis data, every estimate within its tolerance of the simulated truth",
@@ -225,61 +301,6 @@ mod firmware {
             defmt::error!("demo: estimates far from the simulated truth");
         }
         common::exit(ok)
-    }
-
-    #[allow(clippy::too_many_arguments)]
-    fn report(
-        t: f32,
-        axis: usize,
-        lattice: &mut Lattice<f32, P>,
-        config: &Config<f32>,
-        selector: &OrderSelector<f32, P>,
-        have_batch: bool,
-        lattice_mse: f64,
-        batch_mse: f64,
-    ) {
-        let Some(model) = lattice.model(config) else {
-            return;
-        };
-        let sigma = libm::sqrtf(model.noise_variance());
-        let gm = lattice
-            .coefficients(1)
-            .zip(lattice.innovation_variance(1))
-            .and_then(|(a, v)| ArModel::new([a[0]], v, model.mean(), config.dt()).ok())
-            .and_then(|m| m.to_gauss_markov().ok());
-        // Only where an AR(1) fits: the selected order is 1.
-        let (tc, gm_sigma) = match (gm, selector.order()) {
-            (Some(g), 1) => (g.correlation_time(), g.sigma()),
-            _ => (f32::NAN, f32::NAN),
-        };
-        let unit = if axis < 3 { "deg/s" } else { "g" };
-        if have_batch {
-            defmt::info!(
-                "t={=f32}s {=str}: a={=[?]} sigma={=f32} {=str} order={=usize} gm(tc={=f32}s sigma={=f32}) mse lattice={=f32} batch={=f32}",
-                t,
-                NAMES[axis],
-                model.a().as_slice(),
-                sigma,
-                unit,
-                selector.order(),
-                tc,
-                gm_sigma,
-                lattice_mse as f32,
-                batch_mse as f32
-            );
-        } else {
-            defmt::info!(
-                "t={=f32}s {=str}: a={=[?]} sigma={=f32} {=str} order={=usize} gm(tc={=f32}s sigma={=f32})",
-                t,
-                NAMES[axis],
-                model.a().as_slice(),
-                sigma,
-                unit,
-                selector.order(),
-                tc,
-                gm_sigma
-            );
-        }
     }
 }
 

@@ -18,8 +18,8 @@ mod firmware {
     use cortex_m_rt::{ExceptionFrame, entry, exception};
     use cortex_m_semihosting::debug;
     use imu_ar::allan::AllanStream;
-    use imu_ar::fixed_point::{FixedConfig, FixedLattice};
-    use imu_ar::recursive::{Config, Lattice, OrderRule, OrderSelector, Rls, RlsInit, Sftf};
+    use imu_ar::recursive::{Channel, Config, Estimator, FixedChannel, FixedConfig};
+    use imu_ar::recursive::{FixedLattice, Lattice, OrderRule, OrderSelector, Rls, Sftf};
 
     unsafe extern "C" {
         /// Deliberately undefined: referencing it from a live panic path breaks the link.
@@ -36,55 +36,64 @@ mod firmware {
         debug_exit(false)
     }
 
-    fn exercise<const P: usize>(config: &Config<f32>, x: &[f32]) -> bool {
-        let mut lattice = Lattice::<f32, P>::new(config);
-        let mut rls = Rls::<f32, P>::new(config, RlsInit::ShiftConsistent);
-        let mut sftf = Sftf::<f32, P>::new(config);
-        let mut selector = OrderSelector::<f32, P>::new(OrderRule::Pls, 100, 3);
-        let mut allan = AllanStream::<12>::new();
-        let mut fixed = match FixedConfig::new(config, black_box(2.0)) {
-            Ok(f) => (f, FixedLattice::<P>::new(&f)),
-            Err(_) => return false,
-        };
+    /// Every sample of `x` through `update`, then the model: whether every error and the
+    /// model are finite. `on_sample` sees the estimator after each accepted sample.
+    fn run<E: Estimator<f32, P>, const P: usize>(
+        e: &mut E,
+        config: &E::Config,
+        x: &[f32],
+        mut on_sample: impl FnMut(&E),
+    ) -> bool {
         let mut finite = true;
         for &v in x {
-            let v = black_box(v);
-            if let Some(e) = lattice.update(config, v) {
-                finite &= e.is_finite();
-                selector.update(config, &lattice);
+            if let Some(err) = e.update(config, black_box(v)) {
+                finite &= err.is_finite();
+                on_sample(e);
             }
-            if let Some(e) = rls.update(config, v) {
-                finite &= e.is_finite();
-            }
-            if let Some(e) = sftf.update(config, v) {
-                finite &= e.is_finite();
-            }
-            allan.push(v);
-            black_box(fixed.1.update(&fixed.0, v));
-            black_box(fixed.1.update_counts(&fixed.0, black_box(v as i16)));
         }
-        finite &= fixed.1.model(&fixed.0).is_some();
+        finite &= e.noise_variance().is_some_and(f32::is_finite) && e.mean().is_finite();
+        finite && e.model(config).is_some_and(|m| m.a()[0].is_finite())
+    }
+
+    fn exercise<const P: usize>(config: &Config<f32>, channel: &Channel<f32>, x: &[f32]) -> bool {
+        let mut selector = OrderSelector::<f32, P>::new(OrderRule::Pls, 100, 3);
+        let mut lattice = Lattice::<f32, P>::new(config, channel);
+        let mut finite = run(&mut lattice, config, x, |l| {
+            selector.update(config, l);
+        });
+        finite &= run(&mut Rls::<f32, P>::new(config, channel), config, x, |_| {});
+        finite &= run(&mut Sftf::<f32, P>::new(config, channel), config, x, |_| {});
+        let (Ok(fixed_config), Ok(fixed_channel)) = (
+            FixedConfig::new(config),
+            FixedChannel::new(channel, black_box(2.0)),
+        ) else {
+            return false;
+        };
+        let mut fixed = FixedLattice::<P>::new(&fixed_config, &fixed_channel);
+        finite &= run(&mut fixed, &fixed_config, x, |_| {});
+        for &v in x {
+            black_box(fixed.update_counts(&fixed_config, black_box(v as i16)));
+        }
+        let mut allan = AllanStream::<12>::new();
+        for &v in x {
+            allan.push(black_box(v));
+        }
         let order = black_box(selector.order());
         finite &= order <= P;
-        match (lattice.model(config), rls.model(config), sftf.model(config)) {
-            (Some(a), Some(b), Some(c)) => {
-                finite &= a.a()[0].is_finite() && b.a()[0].is_finite() && c.a()[0].is_finite()
-            }
-            _ => finite = false,
-        }
         finite && black_box(lattice.coefficients(P)).is_some()
     }
 
     #[entry]
     fn main() -> ! {
-        let config = match Config::new(black_box(0.99f32), black_box(0.1), black_box(0.01)) {
+        let config = match Config::new(black_box(0.99f32), black_box(0.01)) {
             Ok(c) => c,
             Err(_) => debug_exit(false),
         };
-        let config = match config.with_saturation(black_box(1e3)) {
-            Ok(c) => c,
-            Err(_) => debug_exit(false),
-        };
+        let channel =
+            match Channel::new(black_box(0.1)).and_then(|c| c.with_saturation(black_box(1e3))) {
+                Ok(c) => c,
+                Err(_) => debug_exit(false),
+            };
         // A deterministic AR(1)-like record with a NaN, an infinity and a saturated sample.
         let mut x = [0.0f32; 512];
         let mut state = 0.0f32;
@@ -98,8 +107,9 @@ mod firmware {
         x[100] = f32::NAN;
         x[200] = f32::INFINITY;
         x[300] = 5e3;
-        let ok =
-            exercise::<1>(&config, &x) & exercise::<4>(&config, &x) & exercise::<8>(&config, &x);
+        let ok = exercise::<1>(&config, &channel, &x)
+            & exercise::<4>(&config, &channel, &x)
+            & exercise::<8>(&config, &channel, &x);
         debug_exit(ok)
     }
 

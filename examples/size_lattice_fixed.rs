@@ -16,17 +16,19 @@ mod size;
 #[cfg(target_os = "none")]
 #[cortex_m_rt::entry]
 fn main() -> ! {
-    use imu_ar::fixed_point::{FixedConfig, FixedLattice};
-    use imu_ar::recursive::Config;
+    use imu_ar::recursive::{Channel, Config, Estimator, FixedChannel, FixedConfig, FixedLattice};
 
-    let Ok(config) = Config::new(0.999f32, 0.1, 0.01) else {
+    let Ok(config) = Config::new(0.999f32, 0.01) else {
         common::exit(false)
     };
-    let Ok(fixed) = FixedConfig::new(&config, 4.0) else {
+    let (Ok(fixed), Ok(channel)) = (
+        FixedConfig::new(&config),
+        Channel::new(0.1).and_then(|c| FixedChannel::new(&c, 4.0)),
+    ) else {
         common::exit(false)
     };
     size::run(
-        FixedLattice::<8>::new(&fixed),
+        FixedLattice::<8>::new(&fixed, &channel),
         |lattice, x| {
             lattice.update(&fixed, x);
         },

@@ -16,13 +16,13 @@ mod size;
 #[cfg(target_os = "none")]
 #[cortex_m_rt::entry]
 fn main() -> ! {
-    use imu_ar::recursive::{Config, Rls, RlsInit};
+    use imu_ar::recursive::{Channel, Config, Estimator, Rls};
 
-    let Ok(config) = Config::new(0.999f32, 0.1, 0.01) else {
+    let (Ok(config), Ok(channel)) = (Config::new(0.999f32, 0.01), Channel::new(0.1)) else {
         common::exit(false)
     };
     size::run(
-        Rls::<f32, 8>::new(&config, RlsInit::ShiftConsistent),
+        Rls::<f32, 8>::new(&config, &channel),
         |rls, x| {
             rls.update(&config, x);
         },

@@ -5,7 +5,6 @@
 
 pub mod allan;
 pub mod batch;
-pub mod fixed_point;
 pub mod model;
 pub mod noise;
 pub mod recursive;
@@ -14,4 +13,5 @@ pub mod sensor;
 pub mod sim;
 
 pub use model::{ArModel, GaussMarkov, ModelError};
+pub use recursive::Estimator;
 pub use scalar::Scalar;

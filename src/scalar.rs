@@ -1,8 +1,10 @@
 //! The number trait every estimator is generic over.
 //!
-//! [`Scalar`] is implemented for `f32` and `f64`. It asks only for what an estimator needs and,
-//! unlike `num_traits::Num`, nothing a fixed-point type from the `fixed` crate cannot provide, so
-//! that the fixed-point cores can share code with the float ones.
+//! [`Scalar`] is implemented for `f32` and `f64`; the float estimators, the batch fits and
+//! [`ArModel`](crate::ArModel) are generic over it. It asks only for what they need (no
+//! `num_traits::Num`). The fixed-point lattice does not run in a `Scalar`: it shares the
+//! lattice recursion with the float one through a crate-private trait with one number format
+//! per quantity, and hands its models over in `f32`.
 
 use core::fmt::Debug;
 use core::ops::{Add, AddAssign, Div, Mul, MulAssign, Neg, Sub, SubAssign};

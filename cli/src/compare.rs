@@ -2,7 +2,7 @@
 //! the training part against RLS, the lattice and the SFTF running over the whole record.
 
 use imu_ar::batch::{BatchConfig, BatchError, covariance};
-use imu_ar::recursive::Config;
+use imu_ar::recursive::{Channel, Config, Estimator};
 use serde::Serialize;
 
 use crate::error::Fail;
@@ -118,8 +118,8 @@ fn compare<const P: usize>(
         }
         fit => fit?.model,
     };
-    let config = Config::new(lambda, delta, 1.0)?;
-    let eval = predict(x, n_train, &batch, &config, |_, _, _| {});
+    let (config, channel) = (Config::new(lambda, 1.0)?, Channel::new(delta)?);
+    let eval = predict(x, n_train, &batch, &config, &channel, |_, _, _| {});
     // An estimator that returned no error for a sample has no MSE.
     let mse = |s: SquaredErrors| {
         if s.count == n_eval {

@@ -3,7 +3,7 @@
 //! it; the evaluation part is the rest of the record.
 
 use imu_ar::ArModel;
-use imu_ar::recursive::{Config, Lattice, Rls, RlsInit, Sftf};
+use imu_ar::recursive::{Channel, Config, Estimator, Lattice, Rls, Sftf};
 
 use crate::error::Fail;
 use crate::input::{Record, check_delta, check_lambda, default_delta};
@@ -109,7 +109,7 @@ pub struct Evaluation<const P: usize> {
     pub sftf: SquaredErrors,
 }
 
-/// Runs RLS, the lattice and the SFTF with `config` over `x`, predicts each sample with
+/// Runs RLS, the lattice and the SFTF with `config` and `channel` over `x`, predicts each sample with
 /// `batch` from the `P` before it, calls `each(n, errors, estimators)` after every sample,
 /// and sums the squared errors from sample `n_train` on.
 pub fn predict<const P: usize>(
@@ -117,12 +117,13 @@ pub fn predict<const P: usize>(
     n_train: usize,
     batch: &ArModel<f64, P>,
     config: &Config<f64>,
+    channel: &Channel<f64>,
     mut each: impl FnMut(usize, &Errors, &Estimators<P>),
 ) -> Evaluation<P> {
     let mut estimators = Estimators {
-        rls: Rls::<f64, P>::new(config, RlsInit::ShiftConsistent),
-        lattice: Lattice::<f64, P>::new(config),
-        sftf: Sftf::<f64, P>::new(config),
+        rls: Rls::<f64, P>::new(config, channel),
+        lattice: Lattice::<f64, P>::new(config, channel),
+        sftf: Sftf::<f64, P>::new(config, channel),
     };
     let none = SquaredErrors::default();
     let [mut b, mut r, mut l, mut s] = [none; 4];

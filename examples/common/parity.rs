@@ -9,12 +9,13 @@
 //! removed; the fixed one with `scale = 2` (internal units per sensor unit).
 //!
 //! Checksum: 64-bit FNV-1a over the little-endian bit patterns of, per accepted sample, the
-//! returned error, the errors `f_1..f_P`, the energies `F_0..F_P` and the reflection
+//! order-`P` error (what the f32 `update` returns; `f_P` in internal units for the fixed
+//! point), the errors `f_1..f_P`, the energies `F_0..F_P` and the reflection
 //! coefficients `kf`, `kb`; then the final coefficients `a_1..a_P` and innovation variance.
 
 use imu_ar::ArModel;
-use imu_ar::fixed_point::{FixedConfig, FixedLattice};
-use imu_ar::recursive::{Config, Lattice};
+use imu_ar::recursive::Lattice;
+use imu_ar::recursive::{Channel, Config, Estimator, FixedChannel, FixedConfig, FixedLattice};
 use imu_ar::sim::ArSimulator;
 use rand_chacha::ChaCha8Rng;
 use rand_core::SeedableRng;
@@ -48,10 +49,12 @@ pub fn checksums() -> Option<(u64, u64)> {
     let mut rng = ChaCha8Rng::seed_from_u64(SEED);
     sim.burn_in(&mut rng, 1000);
 
-    let config = Config::new(0.999f32, 0.1, 0.01).ok()?;
-    let fixed_config = FixedConfig::new(&config, 2.0).ok()?;
-    let mut float = Lattice::<f32, P>::new(&config);
-    let mut fixed = FixedLattice::<P>::new(&fixed_config);
+    let config = Config::new(0.999f32, 0.01).ok()?;
+    let channel = Channel::new(0.1).ok()?;
+    let fixed_config = FixedConfig::new(&config).ok()?;
+    let fixed_channel = FixedChannel::new(&channel, 2.0).ok()?;
+    let mut float = Lattice::<f32, P>::new(&config, &channel);
+    let mut fixed = FixedLattice::<P>::new(&fixed_config, &fixed_channel);
     let (mut hf, mut hq) = (Fnv::new(), Fnv::new());
     for n in 0..SAMPLES {
         let x: f32 = sim.next(&mut rng);
@@ -70,8 +73,8 @@ pub fn checksums() -> Option<(u64, u64)> {
                 hf.bytes(&float.energy(m)?.to_bits().to_le_bytes());
             }
         }
-        if let Some(e) = fixed.update(&fixed_config, x) {
-            hq.bytes(&e.to_bits().to_le_bytes());
+        if fixed.update(&fixed_config, x).is_some() {
+            hq.bytes(&fixed.errors()[P - 1].to_bits().to_le_bytes());
             for v in fixed.errors() {
                 hq.bytes(&v.to_bits().to_le_bytes());
             }

@@ -11,8 +11,8 @@ use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use imu_ar::fixed_point::{FixedConfig, FixedLattice};
-use imu_ar::recursive::{Config, Lattice, Rls, RlsInit, Sftf};
+use imu_ar::recursive::{Channel, Config, Estimator, FixedChannel, FixedConfig, FixedLattice};
+use imu_ar::recursive::{Lattice, Rls, Sftf};
 use imu_ar::sim::ArSimulator;
 use imu_ar::{ArModel, Scalar};
 use rand_chacha::ChaCha8Rng;
@@ -54,22 +54,25 @@ fn bench_block<T: Copy>(
     group.finish();
 }
 
-fn config<T: Scalar>() -> Config<T> {
-    Config::new(T::from_f64(0.999), T::from_f64(0.1), T::from_f64(0.01)).unwrap()
+fn config<T: Scalar>() -> (Config<T>, Channel<T>) {
+    let config = Config::new(T::from_f64(0.999), T::from_f64(0.01)).unwrap();
+    (config, Channel::new(T::from_f64(0.1)).unwrap())
 }
 
 fn lattice<T: imu_ar::recursive::FloatArith, const P: usize>(c: &mut Criterion, name: &str) {
-    let config = config::<T>();
-    let mut state = Lattice::<T, P>::new(&config);
+    let (config, channel) = config::<T>();
+    let mut state = Lattice::<T, P>::new(&config, &channel);
     bench_block(c, name, P, &record::<T>(), |v| {
         black_box(state.update(&config, v));
     });
 }
 
 fn lattice_fixed<const P: usize>(c: &mut Criterion) {
-    let config = Config::new(0.999f32, 1e-3, 0.01).unwrap();
-    let fixed = FixedConfig::for_counts(&config, 0.05).unwrap();
-    let mut state = FixedLattice::<P>::new(&fixed);
+    let config = Config::new(0.999f32, 0.01).unwrap();
+    let channel = Channel::new(1e-3).unwrap();
+    let fixed = FixedConfig::new(&config).unwrap();
+    let fixed_channel = FixedChannel::for_counts(&channel, 0.05).unwrap();
+    let mut state = FixedLattice::<P>::new(&fixed, &fixed_channel);
     let counts: Vec<i16> = record::<f32>().iter().map(|&v| (v * 20.0) as i16).collect();
     bench_block(c, "lattice_fixed", P, &counts, |v| {
         black_box(state.update_counts(&fixed, v));
@@ -78,8 +81,8 @@ fn lattice_fixed<const P: usize>(c: &mut Criterion) {
 
 /// The exact coefficients on request, after one block.
 fn extract<const P: usize>(c: &mut Criterion) {
-    let config = config::<f32>();
-    let mut state = Lattice::<f32, P>::new(&config);
+    let (config, channel) = config::<f32>();
+    let mut state = Lattice::<f32, P>::new(&config, &channel);
     for v in record::<f32>() {
         state.update(&config, v);
     }
@@ -89,8 +92,8 @@ fn extract<const P: usize>(c: &mut Criterion) {
 }
 
 fn frame6(c: &mut Criterion) {
-    let config = config::<f32>();
-    let mut axes = [Lattice::<f32, 4>::new(&config); 6];
+    let (config, channel) = config::<f32>();
+    let mut axes = [Lattice::<f32, 4>::new(&config, &channel); 6];
     let x = record::<f32>();
     let frames: Vec<[f32; 6]> = (0..BLOCK)
         .map(|i| core::array::from_fn(|k| x[(i + k) % BLOCK]))
@@ -103,16 +106,16 @@ fn frame6(c: &mut Criterion) {
 }
 
 fn rls<T: Scalar, const P: usize>(c: &mut Criterion, name: &str) {
-    let config = config::<T>();
-    let mut state = Rls::<T, P>::new(&config, RlsInit::ShiftConsistent);
+    let (config, channel) = config::<T>();
+    let mut state = Rls::<T, P>::new(&config, &channel);
     bench_block(c, name, P, &record::<T>(), |v| {
         black_box(state.update(&config, v));
     });
 }
 
 fn sftf<T: Scalar, const P: usize>(c: &mut Criterion, name: &str) {
-    let config = config::<T>();
-    let mut state = Sftf::<T, P>::new(&config);
+    let (config, channel) = config::<T>();
+    let mut state = Sftf::<T, P>::new(&config, &channel);
     // An AR(1): the AR(2) record would make the order-1 filter under-fit and diverge, and
     // the rescues would be timed with it.
     bench_block(c, name, P, &ar_record::<T, 1>([0.9]), |v| {

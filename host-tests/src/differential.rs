@@ -8,8 +8,8 @@
 //! as long as the hold lasts. A silently wrong model fails.
 
 use imu_ar::ArModel;
-use imu_ar::fixed_point::{FixedConfig, FixedLattice};
-use imu_ar::recursive::{Config, Lattice};
+use imu_ar::recursive::Lattice;
+use imu_ar::recursive::{Channel, Config, Estimator, FixedChannel, FixedConfig, FixedLattice};
 
 /// The fixed-point tolerance against the f64 lattice, on the coefficients and on the mean (in
 /// internal units: `scale = 1`), as in issue 22's acceptance. Where the data leave the
@@ -26,12 +26,16 @@ macro_rules! ensure {
     };
 }
 
-/// The f64 lattice with the fixed lattice's own (rounded) `lambda`.
-fn reference<const P: usize>(fixed: &FixedConfig, demean: bool) -> (Lattice<f64, P>, Config<f64>) {
-    let config = Config::new(fixed.lambda(), f64::from(0.01f32), 0.01)
+/// The f64 lattice with the fixed lattice's own (rounded) `lambda`, and its settings.
+fn reference<const P: usize>(
+    fixed: &FixedConfig,
+    demean: bool,
+) -> (Lattice<f64, P>, Config<f64>, Channel<f64>) {
+    let config = Config::new(fixed.lambda(), 0.01)
         .unwrap()
         .with_demean(demean);
-    (Lattice::new(&config), config)
+    let channel = Channel::new(f64::from(0.01f32)).unwrap();
+    (Lattice::new(&config, &channel), config, channel)
 }
 
 /// The weighted second moments of the input the f64 lattice saw, `R = sum lambda^(n-i) phi_i
@@ -88,21 +92,25 @@ fn worst<const P: usize>(a: &[f32; P], b: &[f64; P]) -> f64 {
 /// fresh fixed lattice gives on the samples before it (the last good model), for as long as the
 /// hold lasts. Returns the number of restarts.
 pub fn differential<const P: usize>(x: &[f64], lambda: f32, demean: bool) -> Result<u64, String> {
-    let config = Config::new(lambda, 0.01, 0.01).unwrap().with_demean(demean);
-    let fixed_config = FixedConfig::new(&config, 1.0).unwrap();
-    let (mut float, float_config) = reference(&fixed_config, demean);
+    let config = Config::new(lambda, 0.01).unwrap().with_demean(demean);
+    let fixed_config = FixedConfig::new(&config).unwrap();
+    let fixed_channel = FixedChannel::new(&Channel::new(0.01).unwrap(), 1.0).unwrap();
+    let (mut float, float_config, float_channel) = reference(&fixed_config, demean);
     let mut moments = Moments::new(fixed_config.lambda());
-    let mut fixed = FixedLattice::<P>::new(&fixed_config);
+    let mut fixed = FixedLattice::<P>::new(&fixed_config, &fixed_channel);
     let hold = 3.0 / (1.0 - fixed_config.lambda());
     let mut segment_start = 0;
     let mut first_restart: Option<(usize, Option<ArModel<f32, P>>)> = None;
     for (n, &v) in x.iter().enumerate() {
         let before = fixed.health();
+        // `None` also for a sample that restarted the lattice: the counts say whether it
+        // was rejected.
+        fixed.update(&fixed_config, v as f32);
+        let h = fixed.health();
         ensure!(
-            fixed.update(&fixed_config, v as f32).is_some(),
+            h.rejected() == before.rejected(),
             "sample {n} ({v}) rejected"
         );
-        let h = fixed.health();
         ensure!(
             h.clipped == before.clipped || h.restarts > before.restarts,
             "sample {n}: a saturation without a restart: {h:?}"
@@ -111,7 +119,7 @@ pub fn differential<const P: usize>(x: &[f64], lambda: f32, demean: bool) -> Res
             if first_restart.is_none() {
                 // The last good model, from a lattice that never had `model` called on the
                 // way: the samples before this one.
-                let mut replay = FixedLattice::<P>::new(&fixed_config);
+                let mut replay = FixedLattice::<P>::new(&fixed_config, &fixed_channel);
                 for &u in &x[..n] {
                     replay.update(&fixed_config, u as f32);
                 }
@@ -119,7 +127,7 @@ pub fn differential<const P: usize>(x: &[f64], lambda: f32, demean: bool) -> Res
                 first_restart = Some((n, replay.model(&fixed_config)));
             }
             // The fixed lattice starts again from the next sample: so does the reference.
-            float = Lattice::new(&float_config);
+            float = Lattice::new(&float_config, &float_channel);
             moments = Moments::new(fixed_config.lambda());
             segment_start = n + 1;
             continue;
@@ -130,7 +138,7 @@ pub fn differential<const P: usize>(x: &[f64], lambda: f32, demean: bool) -> Res
             fixed.coefficients(P).unwrap(),
             float.coefficients(P).unwrap(),
         );
-        let (mean, mean_ref) = (f64::from(fixed.mean(&fixed_config)), float.mean());
+        let (mean, mean_ref) = (f64::from(fixed.mean()), float.mean());
         ensure!(
             (worst(&a, &a_ref) <= TOL || moments.predict_alike(&a, &a_ref))
                 && (mean - mean_ref).abs() <= TOL,

@@ -6,8 +6,8 @@
 //! an arithmetic overflow on the fixed-point path is a test failure here, not a silent wrap.
 //! `PROPTEST_CASES` sets the number of cases (256 unless given).
 
-use imu_ar::fixed_point::{FixedConfig, FixedLattice};
-use imu_ar::recursive::{Config, Lattice, Rls, RlsInit, Sftf};
+use imu_ar::recursive::{Channel, Config, Estimator, FixedChannel, FixedConfig, FixedLattice};
+use imu_ar::recursive::{Lattice, Rls, Sftf};
 use imu_ar_host::differential::differential;
 use imu_ar_host::fixtures::ar;
 use proptest::prelude::*;
@@ -122,15 +122,17 @@ fn fuzz_input_with_a_large_first_sample() {
     assert_eq!(x.len(), 3);
     assert!((x[0] + 11.999999).abs() < 1e-5, "{x:?}");
     // As the fuzz target runs it: order 4, `scale = 1`.
-    let config = Config::new(1.0f32, 0.01, 0.01).unwrap();
-    let fixed_config = FixedConfig::new(&config, 1.0).unwrap();
-    let mut fixed = FixedLattice::<4>::new(&fixed_config);
+    let config = Config::new(1.0f32, 0.01).unwrap();
+    let channel = Channel::new(0.01).unwrap();
+    let fixed_config = FixedConfig::new(&config).unwrap();
+    let fixed_channel = FixedChannel::new(&channel, 1.0).unwrap();
+    let mut fixed = FixedLattice::<4>::new(&fixed_config, &fixed_channel);
     for &v in &x {
         assert!(fixed.update(&fixed_config, v as f32).is_some());
     }
     let h = fixed.health();
     assert_eq!((h.samples, h.clipped, h.restarts), (3, 0, 0), "{h:?}");
-    let mean = f64::from(fixed.mean(&fixed_config));
+    let mean = f64::from(fixed.mean());
     // The weighted mean of the three samples at lambda = 1 - 2^-32: their plain mean.
     assert!((mean - (-11.999999 / 3.0)).abs() < 1e-6, "{mean}");
     // And through the differential property, at the order it uses.
@@ -160,11 +162,14 @@ fn cli_record_at_lambda_1() {
 /// The order-2 fixed and f64 lattice models (coefficients and mean) after `x`, as
 /// `imu-ar fit --method lattice` makes them (mean removal on, `delta = 0.1 Var`).
 fn fit_both(x: &[f64], lambda: f32, scale: f64) -> (([f32; 2], f32), ([f64; 2], f64)) {
-    let config = Config::new(lambda, 0.01, 0.01).unwrap();
-    let fixed_config = FixedConfig::new(&config, scale as f32).unwrap();
-    let mut fixed = FixedLattice::<2>::new(&fixed_config);
-    let float_config = Config::new(fixed_config.lambda(), f64::from(0.01f32), 0.01).unwrap();
-    let mut float = Lattice::<f64, 2>::new(&float_config);
+    let config = Config::new(lambda, 0.01).unwrap();
+    let channel = Channel::new(0.01).unwrap();
+    let fixed_config = FixedConfig::new(&config).unwrap();
+    let fixed_channel = FixedChannel::new(&channel, scale as f32).unwrap();
+    let mut fixed = FixedLattice::<2>::new(&fixed_config, &fixed_channel);
+    let float_config = Config::new(fixed_config.lambda(), 0.01).unwrap();
+    let float_config_channel = Channel::new(f64::from(0.01f32)).unwrap();
+    let mut float = Lattice::<f64, 2>::new(&float_config, &float_config_channel);
     for &v in x {
         assert!(fixed.update(&fixed_config, v as f32).is_some());
         float.update(&float_config, f64::from(v as f32));
@@ -194,12 +199,14 @@ fn close((a, mean): ([f32; 2], f32), (a_ref, mean_ref): ([f64; 2], f64)) {
 fn float_running_mean_forgets_a_large_first_sample() {
     let mut x = vec![1e6];
     x.extend(ar([0.5], 1.0, 50_000, 3));
-    let c64 = Config::new(0.999f64, 0.01, 0.01).unwrap();
-    let c32 = Config::new(0.999f32, 0.01, 0.01).unwrap();
-    let mut reference = Lattice::<f64, 2>::new(&c64);
-    let mut lattice = Lattice::<f32, 2>::new(&c32);
-    let mut rls = Rls::<f32, 2>::new(&c32, RlsInit::ShiftConsistent);
-    let mut sftf = Sftf::<f32, 2>::new(&c32);
+    let c64 = Config::new(0.999f64, 0.01).unwrap();
+    let c64_channel = Channel::new(0.01).unwrap();
+    let c32 = Config::new(0.999f32, 0.01).unwrap();
+    let c32_channel = Channel::new(0.01).unwrap();
+    let mut reference = Lattice::<f64, 2>::new(&c64, &c64_channel);
+    let mut lattice = Lattice::<f32, 2>::new(&c32, &c32_channel);
+    let mut rls = Rls::<f32, 2>::new(&c32, &c32_channel);
+    let mut sftf = Sftf::<f32, 2>::new(&c32, &c32_channel);
     for &v in &x {
         reference.update(&c64, v);
         lattice.update(&c32, v as f32);

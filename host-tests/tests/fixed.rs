@@ -2,8 +2,7 @@
 //! section-8 processes and on both real records as raw counts; and at the edges of its formats.
 //! Prints the table that `tools/readme-tables.sh` puts into README.md.
 
-use imu_ar::fixed_point::{FixedConfig, FixedLattice};
-use imu_ar::recursive::Config;
+use imu_ar::recursive::{Channel, Config, Estimator, FixedChannel, FixedConfig, FixedLattice};
 use imu_ar_cli::input::csv::read_column;
 use imu_ar_host::fixtures::{AXES, add, ar, real_records};
 use imu_ar_host::reference::{Regularisation, Section0, running_mean_removed};
@@ -13,11 +12,11 @@ use imu_ar_host::reference::{Regularisation, Section0, running_mean_removed};
 fn fixed_error<const P: usize>(x: &[f64], lambda: f64) -> f64 {
     let rms = (x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64).sqrt();
     let delta = 0.1 * rms * rms;
-    let config = Config::new(lambda as f32, delta as f32, 0.01)
-        .unwrap()
-        .with_demean(false);
-    let fixed = FixedConfig::new(&config, (1.0 / rms) as f32).unwrap();
-    let mut lattice = FixedLattice::<P>::new(&fixed);
+    let config = Config::new(lambda as f32, 0.01).unwrap().with_demean(false);
+    let channel = Channel::new(delta as f32).unwrap();
+    let fixed = FixedConfig::new(&config).unwrap();
+    let fixed_channel = FixedChannel::new(&channel, (1.0 / rms) as f32).unwrap();
+    let mut lattice = FixedLattice::<P>::new(&fixed, &fixed_channel);
     let mut reference = Section0::new(P, fixed.lambda(), f64::from(delta as f32));
     for &v in x {
         reference.push(v);
@@ -96,10 +95,12 @@ fn real_records_as_raw_counts() {
                 // delta = the record's variance: smaller values let the order-1 reflection
                 // coefficient of the first few samples pass the +-4 of its format (the LS value
                 // there is y_2 y_3 / (y_2^2 + delta)); that would be clipped and counted.
-                let config = Config::new(lambda as f32, var as f32, 0.01).unwrap();
-                let fixed = FixedConfig::for_counts(&config, lsb as f32).unwrap();
-                let mut lattice = FixedLattice::<8>::new(&fixed);
-                let delta = f64::from(config.delta());
+                let config = Config::new(lambda as f32, 0.01).unwrap();
+                let channel = Channel::new(var as f32).unwrap();
+                let fixed = FixedConfig::new(&config).unwrap();
+                let fixed_channel = FixedChannel::for_counts(&channel, lsb as f32).unwrap();
+                let mut lattice = FixedLattice::<8>::new(&fixed, &fixed_channel);
+                let delta = f64::from(channel.delta());
                 let mut reference = Section0::new(8, fixed.lambda(), delta);
                 let exact: Vec<f64> = counts.iter().map(|&c| f64::from(c) * lsb).collect();
                 for (&c, y) in counts
@@ -141,10 +142,12 @@ fn real_records_as_raw_counts() {
 
 #[test]
 fn full_scale_constant_and_alternating_inputs() {
-    let config = Config::new(0.99f32, 1.0, 0.01).unwrap();
-    let fixed = FixedConfig::for_counts(&config, 1.0).unwrap();
+    let config = Config::new(0.99f32, 0.01).unwrap();
+    let channel = Channel::new(1.0).unwrap();
+    let fixed = FixedConfig::new(&config).unwrap();
+    let fixed_channel = FixedChannel::for_counts(&channel, 1.0).unwrap();
     // Readings at the rails are rejected and counted, never wrapped.
-    let mut lattice = FixedLattice::<4>::new(&fixed);
+    let mut lattice = FixedLattice::<4>::new(&fixed, &fixed_channel);
     for c in [i16::MAX, i16::MIN, -32767] {
         assert_eq!(lattice.update_counts(&fixed, c), None);
     }
@@ -175,8 +178,9 @@ fn full_scale_constant_and_alternating_inputs() {
     assert!(model.noise_variance().is_finite());
     println!("after the edge cases: {h:?}, a = {:?}", model.a());
     // The float input: beyond +-16 internal units is saturated, NaN is non-finite.
-    let fixed = FixedConfig::new(&config, 1.0).unwrap();
-    let mut lattice = FixedLattice::<2>::new(&fixed);
+    let fixed = FixedConfig::new(&config).unwrap();
+    let fixed_channel = FixedChannel::new(&channel, 1.0).unwrap();
+    let mut lattice = FixedLattice::<2>::new(&fixed, &fixed_channel);
     assert_eq!(lattice.update(&fixed, 16.0), None);
     assert_eq!(lattice.update(&fixed, -1e30), None);
     assert_eq!(lattice.update(&fixed, f32::NAN), None);

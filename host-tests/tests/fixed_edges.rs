@@ -2,8 +2,7 @@
 //! Each test is the minimal case of a former defect; built in the test profile (overflow
 //! checks on).
 
-use imu_ar::fixed_point::{FixedConfig, FixedLattice};
-use imu_ar::recursive::Config;
+use imu_ar::recursive::{Channel, Config, Estimator, FixedChannel, FixedConfig, FixedLattice};
 use imu_ar_host::differential::differential;
 use imu_ar_host::fixtures::ar;
 
@@ -17,9 +16,11 @@ use imu_ar_host::fixtures::ar;
 /// current one (not the held one).
 #[test]
 fn fixed_restart_during_hold_does_not_extend_it() {
-    let config = Config::new(0.9f32, 0.1, 0.01).unwrap();
-    let fc = FixedConfig::new(&config, 1.0).unwrap();
-    let mut f = FixedLattice::<2>::new(&fc);
+    let config = Config::new(0.9f32, 0.01).unwrap();
+    let channel = Channel::new(0.1).unwrap();
+    let fc = FixedConfig::new(&config).unwrap();
+    let fc_channel = FixedChannel::new(&channel, 1.0).unwrap();
+    let mut f = FixedLattice::<2>::new(&fc, &fc_channel);
     let noise = ar([0.5], 0.3, 500, 9);
     for &v in &noise {
         f.update(&fc, v as f32);
@@ -57,9 +58,11 @@ fn fixed_restart_during_hold_does_not_extend_it() {
 /// Expected: no saturation and no restart on such data.
 #[test]
 fn fixed_lambda_1_weight_does_not_saturate_on_benign_data() {
-    let config = Config::new(1.0f32, 0.01, 0.01).unwrap();
-    let fc = FixedConfig::new(&config, 1.0).unwrap();
-    let mut f = FixedLattice::<1>::new(&fc);
+    let config = Config::new(1.0f32, 0.01).unwrap();
+    let channel = Channel::new(0.01).unwrap();
+    let fc = FixedConfig::new(&config).unwrap();
+    let fc_channel = FixedChannel::new(&channel, 1.0).unwrap();
+    let mut f = FixedLattice::<1>::new(&fc, &fc_channel);
     let mut s = 1u64;
     for _ in 0..8_500_000u64 {
         s ^= s << 13;
@@ -79,9 +82,9 @@ fn fixed_lambda_1_weight_does_not_saturate_on_benign_data() {
 /// bottom of its range the same record agrees with the f64 lattice or restarts.
 #[test]
 fn fixed_small_lambda_is_refused_and_the_range_matches_f64_or_restarts() {
-    let config = Config::new(0.5f32, 0.01, 0.01).unwrap();
+    let config = Config::new(0.5f32, 0.01).unwrap();
     assert_eq!(
-        FixedConfig::new(&config, 1.0).map(|_| ()),
+        FixedConfig::new(&config).map(|_| ()),
         Err(imu_ar::recursive::ConfigError::FixedLambda)
     );
     let noise = ar([0.5], 1.0, 3000, 7);

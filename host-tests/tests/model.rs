@@ -95,7 +95,7 @@ fn gauss_markov_round_trips() {
         GaussMarkov::new(0.0f64, 1.0),
         Err(ModelError::InvalidGaussMarkov)
     );
-    assert_eq!(gm.to_ar1(-1.0, 0.0), Err(ModelError::NonPositiveInterval));
+    assert_eq!(gm.to_ar1(-1.0, 0.0), Err(ModelError::Interval));
 }
 
 #[test]

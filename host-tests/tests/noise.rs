@@ -216,4 +216,3 @@ fn a_forgetting_stream_follows_a_step_of_gauss_markov_sigma() {
         }
     }
 }
-

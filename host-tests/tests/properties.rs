@@ -2,9 +2,10 @@
 //! gives finite output and consistent counters; a NaN or infinite sample is rejected, counted,
 //! and changes nothing, whatever surrounds it.
 
+use imu_ar::Scalar;
 use imu_ar::batch::{BatchConfig, BatchError, burg, covariance, yule_walker};
-use imu_ar::fixed_point::{FixedConfig, FixedLattice};
-use imu_ar::recursive::{Config, FloatArith, Health, Lattice, Rls, RlsInit, Sftf};
+use imu_ar::recursive::{Channel, Config, Estimator, FixedChannel, FixedConfig, FixedLattice};
+use imu_ar::recursive::{FloatArith, Health, Lattice, Rls, Sftf};
 use proptest::prelude::*;
 
 /// Cases per property: 256, or `PROPTEST_CASES`.
@@ -15,14 +16,36 @@ fn cases() -> u32 {
         .unwrap_or(256)
 }
 
-/// The state of one estimator behind one interface.
-trait Estimator {
-    /// One sample; the prediction error as f64.
+/// An estimator under test with its shared settings, and how to read the coefficients of its
+/// current state (the lattices compute them, `Rls` and `Sftf` keep them).
+struct Under<T: Scalar, E: Estimator<T, P>, const P: usize> {
+    state: E,
+    config: E::Config,
+    coefficients: fn(&E) -> Option<[T; P]>,
+}
+
+/// What the properties read of an estimator, in `f64`, so that one list holds them all.
+trait Probe {
+    /// One sample; the prediction error.
     fn step(&mut self, x: f64) -> Option<f64>;
     fn health(&self) -> Health;
     /// Everything the estimator publishes: order-P coefficients, then the model's
     /// coefficients and noise variance (NaN marks "none").
-    fn published(&mut self) -> Vec<f64>;
+    fn published(&self) -> Vec<f64>;
+}
+
+impl<T: Scalar, E: Estimator<T, P>, const P: usize> Probe for Under<T, E, P> {
+    fn step(&mut self, x: f64) -> Option<f64> {
+        let e = self.state.update(&self.config, T::from_f64(x));
+        e.map(Scalar::to_f64)
+    }
+    fn health(&self) -> Health {
+        self.state.health()
+    }
+    fn published(&self) -> Vec<f64> {
+        let c = (self.coefficients)(&self.state);
+        model_values(c, self.state.model(&self.config))
+    }
 }
 
 /// Values that stress a float recursion: ordinary, zero, huge, tiny and subnormal.
@@ -52,15 +75,17 @@ fn bad() -> impl Strategy<Value = f64> {
     prop_oneof![Just(f64::NAN), Just(f64::INFINITY), Just(f64::NEG_INFINITY)]
 }
 
-struct Fixed<const P: usize>(FixedLattice<P>, FixedConfig);
-
 fn config<T: FloatArith>(lambda: f64, demean: bool) -> Config<T> {
-    Config::new(T::from_f64(lambda), T::from_f64(0.01), T::from_f64(0.01))
+    Config::new(T::from_f64(lambda), T::from_f64(0.01))
         .unwrap()
         .with_demean(demean)
 }
 
-fn model_values<T: imu_ar::Scalar, const P: usize>(
+fn channel<T: FloatArith>() -> Channel<T> {
+    Channel::new(T::from_f64(0.01)).unwrap()
+}
+
+fn model_values<T: Scalar, const P: usize>(
     coefficients: Option<[T; P]>,
     model: Option<imu_ar::ArModel<T, P>>,
 ) -> Vec<f64> {
@@ -77,95 +102,72 @@ fn model_values<T: imu_ar::Scalar, const P: usize>(
     v
 }
 
-/// A float estimator `$state` with its configuration, as `$wrapper`; `$new` makes the state
-/// from the configuration `$c`, `$coefficients` reads its order-`P` coefficients from the
-/// state `$s`.
-macro_rules! float_estimator {
-    ($wrapper:ident, $state:ident, |$c:ident| $new:expr, |$s:ident| $coefficients:expr) => {
-        struct $wrapper<T: FloatArith, const P: usize>($state<T, P>, Config<T>);
-
-        impl<T: FloatArith + 'static, const P: usize> $wrapper<T, P> {
-            /// A fresh state at `lambda`, with or without mean removal.
-            fn boxed(lambda: f64, demean: bool) -> Box<dyn Estimator> {
-                let $c = &config::<T>(lambda, demean);
-                Box::new(Self($new, *$c))
-            }
-        }
-
-        impl<T: FloatArith, const P: usize> Estimator for $wrapper<T, P> {
-            fn step(&mut self, x: f64) -> Option<f64> {
-                self.0.update(&self.1, T::from_f64(x)).map(|e| e.to_f64())
-            }
-            fn health(&self) -> Health {
-                self.0.health()
-            }
-            fn published(&mut self) -> Vec<f64> {
-                let $s = &self.0;
-                let c = $coefficients;
-                model_values(c, self.0.model(&self.1))
-            }
-        }
-    };
+/// A fresh float estimator at `lambda`, with or without mean removal, made by `make`.
+fn float<T, E, const P: usize>(
+    lambda: f64,
+    demean: bool,
+    make: fn(&Config<T>, &Channel<T>) -> E,
+    coefficients: fn(&E) -> Option<[T; P]>,
+) -> Box<dyn Probe>
+where
+    T: FloatArith + 'static,
+    E: Estimator<T, P, Config = Config<T>> + 'static,
+{
+    let config = config::<T>(lambda, demean);
+    let state = make(&config, &channel());
+    Box::new(Under {
+        state,
+        config,
+        coefficients,
+    })
 }
 
-float_estimator!(FloatLattice, Lattice, |c| Lattice::new(c), |s| s
-    .coefficients(P));
-float_estimator!(
-    FloatRls,
-    Rls,
-    |c| Rls::new(c, RlsInit::ShiftConsistent),
-    |s| Some(*s.coefficients())
-);
-float_estimator!(FloatSftf, Sftf, |c| Sftf::new(c), |s| Some(
-    *s.coefficients()
-));
+fn lattice<T: FloatArith + 'static, const P: usize>(lambda: f64, demean: bool) -> Box<dyn Probe> {
+    float(lambda, demean, Lattice::<T, P>::new, |l| l.coefficients(P))
+}
 
-impl<const P: usize> Estimator for Fixed<P> {
-    fn step(&mut self, x: f64) -> Option<f64> {
-        self.0.update(&self.1, x as f32).map(f64::from)
-    }
-    fn health(&self) -> Health {
-        self.0.health()
-    }
-    fn published(&mut self) -> Vec<f64> {
-        let c = self.0.coefficients(P);
-        model_values(c, self.0.model(&self.1))
-    }
+fn rls<T: FloatArith + 'static, const P: usize>(lambda: f64, demean: bool) -> Box<dyn Probe> {
+    float(lambda, demean, Rls::<T, P>::new, |r| {
+        Some(*r.coefficients())
+    })
+}
+
+fn sftf<T: FloatArith + 'static, const P: usize>(lambda: f64, demean: bool) -> Box<dyn Probe> {
+    float(lambda, demean, Sftf::<T, P>::new, |s| {
+        Some(*s.coefficients())
+    })
+}
+
+/// A fresh order-4 fixed-point lattice at `lambda = 0.99`, `scale = 1e-3`.
+fn fixed(demean: bool) -> Box<dyn Probe> {
+    let config = FixedConfig::new(&config::<f32>(0.99, demean)).unwrap();
+    let channel = FixedChannel::new(&channel(), 1e-3).unwrap();
+    let state = FixedLattice::<4>::new(&config, &channel);
+    let coefficients = |l: &FixedLattice<4>| l.coefficients(4);
+    Box::new(Under {
+        state,
+        config,
+        coefficients,
+    })
 }
 
 /// Every estimator under test, fresh: the lattice, RLS and SFTF in f32 and f64 at orders 1, 4
 /// and 8, with and without mean removal, and the fixed-point lattice.
-fn estimators() -> Vec<(&'static str, Box<dyn Estimator>)> {
-    let fixed = |demean| {
-        let c = FixedConfig::new(&config::<f32>(0.99, demean), 1e-3).unwrap();
-        Fixed(FixedLattice::<4>::new(&c), c)
-    };
+fn estimators() -> Vec<(&'static str, Box<dyn Probe>)> {
     vec![
-        ("lattice f32 p=1", FloatLattice::<f32, 1>::boxed(0.99, true)),
-        ("lattice f32 p=4", FloatLattice::<f32, 4>::boxed(0.99, true)),
-        (
-            "lattice f32 p=8 no demean",
-            FloatLattice::<f32, 8>::boxed(0.9, false),
-        ),
-        (
-            "lattice f64 p=4",
-            FloatLattice::<f64, 4>::boxed(0.999, true),
-        ),
-        ("rls f32 p=1", FloatRls::<f32, 1>::boxed(0.99, true)),
-        ("rls f32 p=4", FloatRls::<f32, 4>::boxed(0.99, true)),
-        (
-            "rls f64 p=8 no demean",
-            FloatRls::<f64, 8>::boxed(0.9, false),
-        ),
-        ("sftf f32 p=1", FloatSftf::<f32, 1>::boxed(0.99, true)),
-        ("sftf f32 p=4", FloatSftf::<f32, 4>::boxed(0.99, true)),
+        ("lattice f32 p=1", lattice::<f32, 1>(0.99, true)),
+        ("lattice f32 p=4", lattice::<f32, 4>(0.99, true)),
+        ("lattice f32 p=8 no demean", lattice::<f32, 8>(0.9, false)),
+        ("lattice f64 p=4", lattice::<f64, 4>(0.999, true)),
+        ("rls f32 p=1", rls::<f32, 1>(0.99, true)),
+        ("rls f32 p=4", rls::<f32, 4>(0.99, true)),
+        ("rls f64 p=8 no demean", rls::<f64, 8>(0.9, false)),
+        ("sftf f32 p=1", sftf::<f32, 1>(0.99, true)),
+        ("sftf f32 p=4", sftf::<f32, 4>(0.99, true)),
         // lambda below 1 - 1/(2p): the monitor's busiest case.
-        (
-            "sftf f64 p=8 no demean",
-            FloatSftf::<f64, 8>::boxed(0.9, false),
-        ),
-        ("fixed lattice p=4", Box::new(fixed(true))),
-        ("fixed lattice p=4 no demean", Box::new(fixed(false))),
+        ("sftf f64 p=8 no demean", sftf::<f64, 8>(0.9, false)),
+        ("fixed lattice p=4", fixed(true)),
+        ("fixed lattice p=4 no demean", fixed(false)),
     ]
 }
 
@@ -242,16 +244,17 @@ proptest! {
         xs in prop::collection::vec(-1.0..1.0f64, 1..200),
         clipped in prop::collection::vec((any::<prop::sample::Index>(), prop_oneof![Just(2.0), Just(-2.0), 2.0..1e6f64]), 1..20),
     ) {
-        let limit = config::<f32>(0.99, true).with_saturation(2.0).unwrap();
+        let config = config::<f32>(0.99, true);
+        let limit = channel::<f32>().with_saturation(2.0).unwrap();
         let mut with = xs.clone();
         for (at, v) in &clipped {
             with.insert(at.index(with.len() + 1), *v);
         }
-        let mut clean = Lattice::<f32, 4>::new(&limit);
-        let mut dirty = Lattice::<f32, 4>::new(&limit);
-        let a: Vec<_> = xs.iter().map(|&x| clean.update(&limit, x as f32).map(f32::to_bits)).collect();
+        let mut clean = Lattice::<f32, 4>::new(&config, &limit);
+        let mut dirty = Lattice::<f32, 4>::new(&config, &limit);
+        let a: Vec<_> = xs.iter().map(|&x| clean.update(&config, x as f32).map(f32::to_bits)).collect();
         let b: Vec<_> = with.iter().filter_map(|&x| {
-            let e = dirty.update(&limit, x as f32);
+            let e = dirty.update(&config, x as f32);
             (x.abs() < 2.0).then_some(e.map(f32::to_bits))
         }).collect();
         prop_assert_eq!(a, b);

@@ -2,8 +2,10 @@
 //! restarts, order selection.
 
 use imu_ar::ArModel;
+use imu_ar::Scalar;
 use imu_ar::recursive::{
-    Config, ConfigError, Lattice, OrderRule, OrderSelector, Rls, RlsInit, Sftf, snapshot_interval,
+    Channel, Config, ConfigError, Estimator, FixedChannel, FixedConfig, FixedLattice, Lattice,
+    OrderRule, OrderSelector, Rls, Sftf, snapshot_interval,
 };
 use imu_ar::sim::ArSimulator;
 use imu_ar_host::reference::{Regularisation, Section0, running_mean_removed};
@@ -20,30 +22,29 @@ fn ar2(n: usize, seed: u64) -> Vec<f32> {
 
 #[test]
 fn config_rejects_out_of_range_parameters() {
-    assert_eq!(Config::new(0.0f32, 1.0, 0.01), Err(ConfigError::Lambda));
-    assert_eq!(Config::new(1.0001f32, 1.0, 0.01), Err(ConfigError::Lambda));
-    assert_eq!(Config::new(f32::NAN, 1.0, 0.01), Err(ConfigError::Lambda));
-    assert_eq!(Config::new(0.99f32, 0.0, 0.01), Err(ConfigError::Delta));
-    assert_eq!(
-        Config::new(0.99f32, f32::INFINITY, 0.01),
-        Err(ConfigError::Delta)
-    );
-    assert_eq!(Config::new(0.99f32, 1.0, -0.01), Err(ConfigError::Interval));
-    let c = Config::new(1.0f32, 1.0, 0.01).unwrap();
+    assert_eq!(Config::new(0.0f32, 0.01), Err(ConfigError::Lambda));
+    assert_eq!(Config::new(1.0001f32, 0.01), Err(ConfigError::Lambda));
+    assert_eq!(Config::new(f32::NAN, 0.01), Err(ConfigError::Lambda));
+    assert_eq!(Channel::new(0.0f32), Err(ConfigError::Delta));
+    assert_eq!(Channel::new(f32::INFINITY), Err(ConfigError::Delta));
+    assert_eq!(Config::new(0.99f32, -0.01), Err(ConfigError::Interval));
+    let c = Config::new(1.0f32, 0.01).unwrap();
+    let channel = Channel::new(1.0f32).unwrap();
     assert_eq!(c.effective_samples(), None);
-    assert_eq!(c.with_saturation(0.0), Err(ConfigError::Saturation));
-    assert_eq!(c.with_saturation(f32::NAN), Err(ConfigError::Saturation));
+    assert_eq!(channel.with_saturation(0.0), Err(ConfigError::Saturation));
+    assert_eq!(
+        channel.with_saturation(f32::NAN),
+        Err(ConfigError::Saturation)
+    );
 }
 
 #[test]
 fn rejected_samples_change_nothing_and_are_counted() {
-    let config = Config::new(0.99f32, 0.1, 0.01)
-        .unwrap()
-        .with_saturation(100.0)
-        .unwrap();
+    let config = Config::new(0.99f32, 0.01).unwrap();
+    let channel = Channel::new(0.1).unwrap().with_saturation(100.0).unwrap();
     let x = ar2(5_000, 1);
-    let mut lattice = Lattice::<f32, 4>::new(&config);
-    let mut rls = Rls::<f32, 4>::new(&config, RlsInit::ShiftConsistent);
+    let mut lattice = Lattice::<f32, 4>::new(&config, &channel);
+    let mut rls = Rls::<f32, 4>::new(&config, &channel);
     for &v in &x {
         lattice.update(&config, v);
         rls.update(&config, v);
@@ -79,10 +80,11 @@ fn stuck_sensor_then_normal_data() {
     // the direct solve of the normal data alone to 1e-2: the stuck run is forgotten.
     // The same holds for the SFTF, whose energies decay to their floor in the stuck run.
     for lambda in [0.99, 0.999] {
-        let config = Config::new(lambda as f32, 0.1, 0.01).unwrap();
-        let mut lattice = Lattice::<f32, 2>::new(&config);
-        let mut rls = Rls::<f32, 2>::new(&config, RlsInit::ShiftConsistent);
-        let mut sftf = Sftf::<f32, 2>::new(&config);
+        let config = Config::new(lambda as f32, 0.01).unwrap();
+        let channel = Channel::new(0.1).unwrap();
+        let mut lattice = Lattice::<f32, 2>::new(&config, &channel);
+        let mut rls = Rls::<f32, 2>::new(&config, &channel);
+        let mut sftf = Sftf::<f32, 2>::new(&config, &channel);
         let mut everything = Vec::new();
         for _ in 0..1_000_000 {
             assert!(lattice.update(&config, 3.25).unwrap().is_finite());
@@ -142,13 +144,11 @@ fn saturated_sensor_is_detected_and_counted() {
     // samples inside the limit.
     let full_scale = 4.0f32;
     let limit = full_scale * 0.999;
-    let config = Config::new(0.99f32, 0.1, 0.01)
-        .unwrap()
-        .with_saturation(limit)
-        .unwrap();
+    let config = Config::new(0.99f32, 0.01).unwrap();
+    let channel = Channel::new(0.1).unwrap().with_saturation(limit).unwrap();
     let x = ar2(20_000, 5);
-    let mut sensor = Lattice::<f32, 2>::new(&config);
-    let mut inside = Lattice::<f32, 2>::new(&config);
+    let mut sensor = Lattice::<f32, 2>::new(&config, &channel);
+    let mut inside = Lattice::<f32, 2>::new(&config, &channel);
     let (mut clipped, mut at_rail) = (0, 0);
     for &v in &x {
         let read = v.clamp(-full_scale, full_scale);
@@ -172,8 +172,9 @@ fn huge_input_restarts_and_keeps_publishing_the_last_good_model() {
     // A value whose square overflows f32 breaks the recursion down: the lattice restarts,
     // counts it, and hands out the model of its last snapshot (taken every
     // `snapshot_interval(P)` accepted samples) for 3/(1 - lambda) samples.
-    let config = Config::new(0.99f32, 0.1, 0.01).unwrap();
-    let mut lattice = Lattice::<f32, 2>::new(&config);
+    let config = Config::new(0.99f32, 0.01).unwrap();
+    let channel = Channel::new(0.1).unwrap();
+    let mut lattice = Lattice::<f32, 2>::new(&config, &channel);
     let x = ar2(3_000, 3);
     let mut good = None;
     for &v in &x {
@@ -214,10 +215,11 @@ fn huge_input_restarts_and_keeps_publishing_the_last_good_model() {
 
 #[test]
 fn order_selection_finds_the_true_order_without_flapping() {
-    let config = Config::new(0.999f32, 0.1, 0.01).unwrap();
+    let config = Config::new(0.999f32, 0.01).unwrap();
+    let channel = Channel::new(0.1).unwrap();
     let x = ar2(40_000, 4);
     for rule in [OrderRule::Pls, OrderRule::Aic, OrderRule::Bic] {
-        let mut lattice = Lattice::<f32, 6>::new(&config);
+        let mut lattice = Lattice::<f32, 6>::new(&config, &channel);
         let mut selector = OrderSelector::<f32, 6>::new(rule, 500, 3);
         let mut changes = 0;
         let mut last = selector.order();
@@ -243,46 +245,78 @@ fn order_selection_finds_the_true_order_without_flapping() {
     }
 }
 
+/// Runs two estimators from `make` over `x`, one asked for its model after every sample and
+/// one never, and returns the model each publishes at the end, with the restarts of one run
+/// (the same in both: the model is a pure getter).
+fn after_asking_and_not<T: Scalar, E: Estimator<T, P>, const P: usize>(
+    make: impl Fn() -> E,
+    config: &E::Config,
+    x: &[T],
+) -> (Option<ArModel<T, P>>, Option<ArModel<T, P>>, u64) {
+    let (mut asked, mut never) = (make(), make());
+    for &v in x {
+        asked.update(config, v);
+        let _ = asked.model(config);
+        never.update(config, v);
+    }
+    assert_eq!(asked.health(), never.health());
+    let restarts = never.health().restarts;
+    (asked.model(config), never.model(config), restarts)
+}
+
+/// The held model is a good one: the truth is `a = [1.2, -0.5]`.
+fn is_near_the_truth(m: Option<ArModel<f32, 2>>) -> bool {
+    m.is_some_and(|m| (m.a()[0] - 1.2).abs() < 0.1 && (m.a()[1] + 0.5).abs() < 0.1)
+}
+
 /// The model held through a restart is the estimator's own snapshot: the same whether `model`
 /// was called after every sample or never (issue 23, item 2).
 #[test]
 fn the_held_model_does_not_depend_on_calls_to_model() {
-    let config = Config::new(0.99f32, 0.1, 0.01).unwrap();
-    let x = ar2(3_000, 3);
-    let run = |ask: bool| {
-        let mut lattice = Lattice::<f32, 2>::new(&config);
-        let mut rls = Rls::<f32, 2>::new(&config, RlsInit::ShiftConsistent);
-        let mut sftf = Sftf::<f32, 2>::new(&config);
-        for &v in x.iter().chain([3e30f32].iter()).chain(&x[..100]) {
-            lattice.update(&config, v);
-            rls.update(&config, v);
-            sftf.update(&config, v);
-            if ask {
-                let _ = (
-                    lattice.model(&config),
-                    rls.model(&config),
-                    sftf.model(&config),
-                );
-            }
-        }
-        let restarts = [lattice.health(), rls.health(), sftf.health()].map(|h| h.restarts);
-        assert_eq!(restarts, [1, 1, 1]);
-        (
-            lattice.model(&config),
-            rls.model(&config),
-            sftf.model(&config),
-        )
+    let config = Config::new(0.99f32, 0.01).unwrap();
+    let channel = Channel::new(0.1).unwrap();
+    let x: Vec<f32> = {
+        let x = ar2(3_000, 3);
+        x.iter()
+            .chain(&[3e30f32])
+            .chain(&x[..100])
+            .copied()
+            .collect()
     };
-    let (asked, never) = (run(true), run(false));
-    assert!(never.0.is_some() && never.1.is_some() && never.2.is_some());
-    assert_eq!(asked, never);
-    // The held model is a good one (the truth is a = [1.2, -0.5]).
-    for a in [never.0, never.1, never.2].map(|m| *m.unwrap().a()) {
-        assert!(
-            (a[0] - 1.2).abs() < 0.1 && (a[1] + 0.5).abs() < 0.1,
-            "{a:?}"
-        );
+    let runs = [
+        after_asking_and_not(|| Lattice::<f32, 2>::new(&config, &channel), &config, &x),
+        after_asking_and_not(|| Rls::<f32, 2>::new(&config, &channel), &config, &x),
+        after_asking_and_not(|| Sftf::<f32, 2>::new(&config, &channel), &config, &x),
+    ];
+    for (asked, never, restarts) in runs {
+        assert_eq!(restarts, 1);
+        assert!(never.is_some());
+        assert_eq!(asked, never);
+        assert!(is_near_the_truth(never), "{never:?}");
     }
+}
+
+/// The same for the fixed-point lattice, whose restart comes from a saturated state: samples
+/// alternating at +-15.9 internal units drive its errors past the +-16 of their format.
+#[test]
+fn the_fixed_lattice_held_model_does_not_depend_on_calls_to_model() {
+    let config = FixedConfig::new(&Config::new(0.99f32, 0.01).unwrap()).unwrap();
+    let channel = FixedChannel::new(&Channel::new(0.1).unwrap(), 1.0).unwrap();
+    let x: Vec<f32> = {
+        let x = ar2(3_000, 3);
+        let spikes = (0..20).map(|n| if n % 2 == 0 { 15.9 } else { -15.9 });
+        x.iter()
+            .copied()
+            .chain(spikes)
+            .chain(x[..100].iter().copied())
+            .collect()
+    };
+    let make = || FixedLattice::<2>::new(&config, &channel);
+    let (asked, never, restarts) = after_asking_and_not(make, &config, &x);
+    assert!(restarts >= 1, "premise: the spikes restart the lattice");
+    // The model from just before the saturating sample (the spikes before it included).
+    assert!(never.is_some());
+    assert_eq!(asked, never);
 }
 
 /// At `lambda = 1` the memory, and `3/(1 - lambda)`, are infinite: the hold after a restart is
@@ -290,9 +324,10 @@ fn the_held_model_does_not_depend_on_calls_to_model() {
 /// item 2).
 #[test]
 fn at_lambda_one_the_hold_after_a_restart_ends() {
-    let config = Config::new(1.0f32, 0.1, 0.01).unwrap();
+    let config = Config::new(1.0f32, 0.01).unwrap();
+    let channel = Channel::new(0.1).unwrap();
     let x = ar2(40_000, 8);
-    let mut lattice = Lattice::<f32, 2>::new(&config);
+    let mut lattice = Lattice::<f32, 2>::new(&config, &channel);
     for &v in &x[..5_000] {
         lattice.update(&config, v);
     }
@@ -320,13 +355,15 @@ fn at_lambda_one_the_hold_after_a_restart_ends() {
 #[test]
 fn order_selection_at_lambda_one() {
     let x: Vec<f64> = ar2(50_000, 12).iter().map(|&v| f64::from(v)).collect();
-    let config = Config::new(1.0f64, 0.1, 0.01).unwrap();
-    let config32 = Config::new(0.999_999_99f32, 0.1, 0.01).unwrap();
+    let config = Config::new(1.0f64, 0.01).unwrap();
+    let channel = Channel::new(0.1).unwrap();
+    let config32 = Config::new(0.999_999_99f32, 0.01).unwrap();
+    let config32_channel = Channel::new(0.1).unwrap();
     assert_eq!(config32.lambda(), 1.0);
     for rule in [OrderRule::Pls, OrderRule::Aic, OrderRule::Bic] {
-        let mut lattice = Lattice::<f64, 4>::new(&config);
+        let mut lattice = Lattice::<f64, 4>::new(&config, &channel);
         let mut selector = OrderSelector::<f64, 4>::new(rule, 100, 3);
-        let mut lattice32 = Lattice::<f32, 4>::new(&config32);
+        let mut lattice32 = Lattice::<f32, 4>::new(&config32, &config32_channel);
         let mut selector32 = OrderSelector::<f32, 4>::new(rule, 100, 3);
         for &v in &x {
             if lattice.update(&config, v).is_some() {
@@ -351,17 +388,18 @@ fn order_selection_at_lambda_one() {
 /// the smallest accepted one fits without a restart.
 #[test]
 fn config_rejects_a_delta_the_scalar_cannot_carry() {
-    assert_eq!(Config::new(0.99f32, 1e-40, 0.01), Err(ConfigError::Delta));
-    assert_eq!(Config::new(0.99f32, 1e-35, 0.01), Err(ConfigError::Delta));
-    assert_eq!(Config::new(0.99f32, 1e35, 0.01), Err(ConfigError::Delta));
-    assert_eq!(Config::new(0.99f64, 1e-310, 0.01), Err(ConfigError::Delta));
-    assert_eq!(Config::new(0.99f64, 1e300, 0.01), Err(ConfigError::Delta));
+    assert_eq!(Channel::new(1e-40f32), Err(ConfigError::Delta));
+    assert_eq!(Channel::new(1e-35f32), Err(ConfigError::Delta));
+    assert_eq!(Channel::new(1e35f32), Err(ConfigError::Delta));
+    assert_eq!(Channel::new(1e-310f64), Err(ConfigError::Delta));
+    assert_eq!(Channel::new(1e300f64), Err(ConfigError::Delta));
     let x = ar2(2_000, 5);
     for delta in [1e-31f32, 1e31] {
-        let config = Config::new(0.999f32, delta, 0.01).unwrap();
-        let mut lattice = Lattice::<f32, 2>::new(&config);
-        let mut rls = Rls::<f32, 2>::new(&config, RlsInit::ShiftConsistent);
-        let mut sftf = Sftf::<f32, 2>::new(&config);
+        let config = Config::new(0.999f32, 0.01).unwrap();
+        let channel = Channel::new(delta).unwrap();
+        let mut lattice = Lattice::<f32, 2>::new(&config, &channel);
+        let mut rls = Rls::<f32, 2>::new(&config, &channel);
+        let mut sftf = Sftf::<f32, 2>::new(&config, &channel);
         for &v in &x {
             lattice.update(&config, v);
             rls.update(&config, v);

@@ -6,7 +6,7 @@
 use imu_ar::ArModel;
 use imu_ar::model::GaussMarkov;
 use imu_ar::recursive::{
-    Config, Lattice, OrderRule, OrderSelector, Rls, RlsInit, Sftf, snapshot_interval,
+    Channel, Config, Estimator, Lattice, OrderRule, OrderSelector, Rls, Sftf, snapshot_interval,
 };
 use imu_ar::sim::ArSimulator;
 use rand_chacha::ChaCha8Rng;
@@ -28,9 +28,10 @@ fn data(a: [f64; 2], n: usize, seed: u64) -> Vec<f64> {
 /// Expected: a positive innovation variance (at least the floor), as the other two give.
 #[test]
 fn rls_noise_variance_stays_positive_on_a_stuck_sensor() {
-    let config = Config::new(0.99f64, 0.1, 0.01).unwrap();
-    let mut rls = Rls::<f64, 2>::new(&config, RlsInit::ShiftConsistent);
-    let mut lattice = Lattice::<f64, 2>::new(&config);
+    let config = Config::new(0.99f64, 0.01).unwrap();
+    let channel = Channel::new(0.1).unwrap();
+    let mut rls = Rls::<f64, 2>::new(&config, &channel);
+    let mut lattice = Lattice::<f64, 2>::new(&config, &channel);
     for _ in 0..100_000 {
         rls.update(&config, 3.0);
         lattice.update(&config, 3.0);
@@ -52,8 +53,9 @@ fn rls_noise_variance_stays_positive_on_a_stuck_sensor() {
 /// Expected: such a configuration is refused (for the order used), or the estimator fits.
 #[test]
 fn accepted_delta_whose_initial_energies_underflow_still_fits() {
-    let config = Config::new(0.5f32, 1e-30, 0.01).unwrap();
-    let mut lattice = Lattice::<f32, 32>::new(&config);
+    let config = Config::new(0.5f32, 0.01).unwrap();
+    let channel = Channel::new(1e-30).unwrap();
+    let mut lattice = Lattice::<f32, 32>::new(&config, &channel);
     for &v in &data([1.2, -0.5], 5_000, 1) {
         lattice.update(&config, v as f32);
     }
@@ -77,8 +79,9 @@ fn accepted_delta_whose_initial_energies_underflow_still_fits() {
 /// has run healthily in between, e.g. a settled restarted state replaces the snapshot.
 #[test]
 fn sftf_at_lambda_one_rescued_often_publishes_a_fresh_model() {
-    let config = Config::new(1.0f32, 0.1, 0.01).unwrap();
-    let mut sftf = Sftf::<f32, 2>::new(&config);
+    let config = Config::new(1.0f32, 0.01).unwrap();
+    let channel = Channel::new(0.1).unwrap();
+    let mut sftf = Sftf::<f32, 2>::new(&config, &channel);
     let mut first_held = None;
     for &v in &data([1.78, -0.7921], 1_000_000, 5) {
         sftf.update(&config, v as f32);
@@ -106,8 +109,9 @@ fn sftf_at_lambda_one_rescued_often_publishes_a_fresh_model() {
 /// Expected: the selector recovers and selects 2 again (or drops non-finite sums).
 #[test]
 fn pls_order_selector_recovers_after_one_spike() {
-    let config = Config::new(0.999f32, 0.1, 0.01).unwrap();
-    let mut lattice = Lattice::<f32, 4>::new(&config);
+    let config = Config::new(0.999f32, 0.01).unwrap();
+    let channel = Channel::new(0.1).unwrap();
+    let mut lattice = Lattice::<f32, 4>::new(&config, &channel);
     let mut selector = OrderSelector::<f32, 4>::new(OrderRule::Pls, 100, 3);
     for (n, &v) in data([1.2, -0.5], 300_000, 4).iter().enumerate() {
         let v = if n == 5_000 { 3e18f32 } else { v as f32 };
@@ -176,8 +180,9 @@ fn f32_lattice_at_lambda_one_noise_variance_holds_past_2_pow_24_samples() {
     let truth = ArModel::new([1.2f32, -0.5], 1.0, 0.0, 0.01).unwrap();
     let mut sim = ArSimulator::new(truth);
     let mut rng = ChaCha8Rng::seed_from_u64(9);
-    let config = Config::new(1.0f32, 0.1, 0.01).unwrap();
-    let mut lattice = Lattice::<f32, 2>::new(&config);
+    let config = Config::new(1.0f32, 0.01).unwrap();
+    let channel = Channel::new(0.1).unwrap();
+    let mut lattice = Lattice::<f32, 2>::new(&config, &channel);
     for _ in 0..25_000_000u32 {
         lattice.update(&config, sim.next(&mut rng));
     }

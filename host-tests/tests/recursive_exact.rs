@@ -1,7 +1,7 @@
 //! f64 exactness of the recursive cores (lattice, RLS, SFTF) against the direct solve of numerics.md section 0.
 
 use imu_ar::ArModel;
-use imu_ar::recursive::{Config, Lattice, Rls, RlsInit, Sftf};
+use imu_ar::recursive::{Channel, Config, Estimator, Lattice, Rls, RlsInit, Sftf};
 use imu_ar::sim::ArSimulator;
 use imu_ar_host::reference::{Regularisation, Section0, running_mean_removed};
 use rand_chacha::ChaCha8Rng;
@@ -36,13 +36,12 @@ fn check<const P: usize>(
     demean: bool,
     checked: impl Fn(usize) -> bool,
 ) -> [f64; 8] {
-    let config = Config::new(lambda, DELTA, 0.01)
-        .unwrap()
-        .with_demean(demean);
-    let mut lattice = Lattice::<f64, P>::new(&config);
-    let mut rls = Rls::<f64, P>::new(&config, RlsInit::ShiftConsistent);
-    let mut ridge = Rls::<f64, P>::new(&config, RlsInit::Ridge);
-    let mut sftf = Sftf::<f64, P>::new(&config);
+    let config = Config::new(lambda, 0.01).unwrap().with_demean(demean);
+    let channel = Channel::new(DELTA).unwrap();
+    let mut lattice = Lattice::<f64, P>::new(&config, &channel);
+    let mut rls = Rls::<f64, P>::new(&config, &channel);
+    let mut ridge = Rls::<f64, P>::with_init(&config, &channel, RlsInit::Ridge);
+    let mut sftf = Sftf::<f64, P>::new(&config, &channel);
     let y = if demean {
         running_mean_removed(x, lambda)
     } else {
@@ -149,15 +148,11 @@ fn with_running_mean_removal() {
 type Fits = (Vec<[f64; 4]>, [u64; 3]);
 
 fn scaled_fits<T: imu_ar::recursive::FloatArith>(x: &[f64], s: f64, lambda: f64) -> Fits {
-    let config = Config::new(
-        T::from_f64(lambda),
-        T::from_f64(DELTA * s * s),
-        T::from_f64(0.01),
-    )
-    .unwrap();
-    let mut lattice = Lattice::<T, 4>::new(&config);
-    let mut rls = Rls::<T, 4>::new(&config, RlsInit::ShiftConsistent);
-    let mut sftf = Sftf::<T, 4>::new(&config);
+    let config = Config::new(T::from_f64(lambda), T::from_f64(0.01)).unwrap();
+    let channel = Channel::new(T::from_f64(DELTA * s * s)).unwrap();
+    let mut lattice = Lattice::<T, 4>::new(&config, &channel);
+    let mut rls = Rls::<T, 4>::new(&config, &channel);
+    let mut sftf = Sftf::<T, 4>::new(&config, &channel);
     let mut out = Vec::new();
     for (n, &v) in x.iter().enumerate() {
         let v = T::from_f64(v * s);

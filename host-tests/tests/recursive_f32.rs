@@ -2,7 +2,7 @@
 //! processes of section 8 and both real records. The test prints the table that
 //! `tools/accuracy-table.sh` puts into README.md.
 
-use imu_ar::recursive::{Config, Lattice, Rls, RlsInit, Sftf};
+use imu_ar::recursive::{Channel, Config, Estimator, Lattice, Rls, Sftf};
 use imu_ar_cli::input::csv::read_column;
 use imu_ar_host::fixtures::{AXES, add, ar, real_records};
 use imu_ar_host::reference::{Regularisation, Section0, running_mean_removed};
@@ -24,12 +24,13 @@ fn run<const P: usize>(
     demean: bool,
     orders: &[usize],
 ) -> Errors {
-    let config = Config::new(lambda as f32, delta as f32, 0.01)
+    let config = Config::new(lambda as f32, 0.01)
         .unwrap()
         .with_demean(demean);
-    let mut lattice = Lattice::<f32, P>::new(&config);
-    let mut rls = Rls::<f32, P>::new(&config, RlsInit::ShiftConsistent);
-    let mut sftf = Sftf::<f32, P>::new(&config);
+    let channel = Channel::new(delta as f32).unwrap();
+    let mut lattice = Lattice::<f32, P>::new(&config, &channel);
+    let mut rls = Rls::<f32, P>::new(&config, &channel);
+    let mut sftf = Sftf::<f32, P>::new(&config, &channel);
     let y = if demean {
         running_mean_removed(x, lambda)
     } else {
@@ -153,8 +154,12 @@ fn section_8_processes_after_two_million_samples() {
 }
 
 /// An order-`P` f32 RLS over the whole record against the order-`P` solution of `reference`.
-fn rls_error<const P: usize>(x: &[f64], config: &Config<f32>, reference: &Section0) -> f64 {
-    let mut rls = Rls::<f32, P>::new(config, RlsInit::ShiftConsistent);
+fn rls_error<const P: usize>(
+    x: &[f64],
+    (config, channel): (&Config<f32>, &Channel<f32>),
+    reference: &Section0,
+) -> f64 {
+    let mut rls = Rls::<f32, P>::new(config, channel);
     for &v in x {
         let e = rls
             .update(config, v as f32)
@@ -188,8 +193,9 @@ fn real_records_every_axis() {
             // delta = 0.1 x the record's variance (any 0.01..1 x works; it only shapes the start).
             let delta = 0.1 * var;
             for lambda in [0.99, 0.999, 0.9999] {
-                let config = Config::new(lambda as f32, delta as f32, 0.01).unwrap();
-                let mut lattice = Lattice::<f32, 8>::new(&config);
+                let config = Config::new(lambda as f32, 0.01).unwrap();
+                let channel = Channel::new(delta as f32).unwrap();
+                let mut lattice = Lattice::<f32, 8>::new(&config, &channel);
                 let mut reference = Section0::new(8, lambda, delta);
                 for (&v, y) in x.iter().zip(running_mean_removed(&x, lambda)) {
                     reference.push(y);
@@ -212,14 +218,14 @@ fn real_records_every_axis() {
                     }
                 }
                 let rls = [
-                    rls_error::<1>(&x, &config, &reference),
-                    rls_error::<2>(&x, &config, &reference),
-                    rls_error::<3>(&x, &config, &reference),
-                    rls_error::<4>(&x, &config, &reference),
-                    rls_error::<5>(&x, &config, &reference),
-                    rls_error::<6>(&x, &config, &reference),
-                    rls_error::<7>(&x, &config, &reference),
-                    rls_error::<8>(&x, &config, &reference),
+                    rls_error::<1>(&x, (&config, &channel), &reference),
+                    rls_error::<2>(&x, (&config, &channel), &reference),
+                    rls_error::<3>(&x, (&config, &channel), &reference),
+                    rls_error::<4>(&x, (&config, &channel), &reference),
+                    rls_error::<5>(&x, (&config, &channel), &reference),
+                    rls_error::<6>(&x, (&config, &channel), &reference),
+                    rls_error::<7>(&x, (&config, &channel), &reference),
+                    rls_error::<8>(&x, (&config, &channel), &reference),
                 ]
                 .into_iter()
                 .fold(0.0, f64::max);

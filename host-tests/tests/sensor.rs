@@ -35,7 +35,7 @@ fn replay_serves_the_record() {
 /// channel, and the raw-count test needs no limit at all.
 #[test]
 fn saturation_limits_from_the_scale_fire_at_the_rails() {
-    use imu_ar::recursive::{Config, Lattice};
+    use imu_ar::recursive::{Channel, Config, Estimator, Lattice};
     let scale = Scale {
         gyro_counts_per_dps: IcmGyroRange::Dps1000.counts_per_dps(),
         accel_counts_per_g: IcmAccelRange::G2.counts_per_g(),
@@ -47,7 +47,8 @@ fn saturation_limits_from_the_scale_fire_at_the_rails() {
     };
     assert!(rail.gyro_clipped() && rail.accel_clipped() && rail.clipped());
     assert!(!RawSample::default().clipped());
-    let base = Config::new(0.999f32, 1e-4, 0.001).unwrap();
+    let config = Config::new(0.999f32, 0.001).unwrap();
+    let base = Channel::new(1e-4).unwrap();
     let nominal = base.with_saturation(1000.0).unwrap();
     let gyro = base
         .with_saturation(scale.gyro_saturation(GyroUnit::DegPerSec))
@@ -57,25 +58,25 @@ fn saturation_limits_from_the_scale_fire_at_the_rails() {
         .unwrap();
     let g = scale.gyro(rail.gyro, GyroUnit::DegPerSec);
     let a = scale.accel(rail.accel, AccelUnit::G);
-    let mut l = Lattice::<f32, 2>::new(&nominal);
-    l.update(&nominal, g[0]);
+    let mut l = Lattice::<f32, 2>::new(&config, &nominal);
+    l.update(&config, g[0]);
     assert_eq!(
         l.health().saturated,
         0,
         "the nominal range lets the rail through"
     );
-    let mut l = Lattice::<f32, 2>::new(&gyro);
+    let mut l = Lattice::<f32, 2>::new(&config, &gyro);
     for x in [
         g[0],
         g[2],
         scale.gyro([i16::MAX - 1; 3], GyroUnit::DegPerSec)[0],
     ] {
-        l.update(&gyro, x);
+        l.update(&config, x);
     }
     assert_eq!((l.health().saturated, l.health().samples), (2, 1));
-    let mut l = Lattice::<f32, 2>::new(&accel);
+    let mut l = Lattice::<f32, 2>::new(&config, &accel);
     for x in [a[1], scale.accel([i16::MIN + 2; 3], AccelUnit::G)[0]] {
-        l.update(&accel, x);
+        l.update(&config, x);
     }
     assert_eq!((l.health().saturated, l.health().samples), (1, 1));
     // Per channel: the gyro's limit in g would let every clipped accel sample through.

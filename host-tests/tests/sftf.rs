@@ -5,7 +5,9 @@
 //! README.md.
 
 use imu_ar::ArModel;
-use imu_ar::recursive::{Config, FloatArith, Lattice, Rls, RlsInit, Sftf, snapshot_interval};
+use imu_ar::recursive::{
+    Channel, Config, Estimator, FloatArith, Lattice, Rls, Sftf, snapshot_interval,
+};
 use imu_ar_cli::input::csv::read_column;
 use imu_ar_host::fixtures::{AXES, add, ar, real_records};
 use imu_ar_host::reference::{Regularisation, Section0};
@@ -39,12 +41,13 @@ fn sftf_run<T: FloatArith, const P: usize>(
     delta: f64,
     demean: bool,
 ) -> Rescues {
-    let config = Config::new(T::from_f64(lambda), T::from_f64(delta), T::from_f64(0.01))
+    let config = Config::new(T::from_f64(lambda), T::from_f64(0.01))
         .unwrap()
         .with_demean(demean);
+    let channel = Channel::new(T::from_f64(delta)).unwrap();
     // The hold is 3/(1 - lambda) of lambda in T.
     let hold = (3.0 / (1.0 - config.lambda().to_f64())) as usize;
-    let mut sftf = Sftf::<T, P>::new(&config);
+    let mut sftf = Sftf::<T, P>::new(&config, &channel);
     let mut reference = (!demean).then(|| Section0::new(P, lambda, delta));
     let mut out = Rescues::default();
     // The last snapshot, with the reference's solution at its sample.
@@ -106,11 +109,12 @@ fn sftf_run<T: FloatArith, const P: usize>(
 
 /// Restarts of an order-`P` f32 lattice and f32 RLS over `x`; every returned error finite.
 fn others<const P: usize>(x: &[f64], lambda: f64, delta: f64, demean: bool) -> (u64, u64) {
-    let config = Config::new(lambda as f32, delta as f32, 0.01)
+    let config = Config::new(lambda as f32, 0.01)
         .unwrap()
         .with_demean(demean);
-    let mut lattice = Lattice::<f32, P>::new(&config);
-    let mut rls = Rls::<f32, P>::new(&config, RlsInit::ShiftConsistent);
+    let channel = Channel::new(delta as f32).unwrap();
+    let mut lattice = Lattice::<f32, P>::new(&config, &channel);
+    let mut rls = Rls::<f32, P>::new(&config, &channel);
     for &v in x {
         for e in [
             lattice.update(&config, v as f32),
@@ -325,14 +329,15 @@ fn variance(x: &[f64]) -> f64 {
 fn a_rescue_near_the_end_leaves_the_last_good_model() {
     // Order 1 under-fits this resonant AR(2): the filter is rescued now and then (section 8).
     let x = ar([1.78, -0.7921], 1.0, 18_000, 7);
-    let config = Config::new(0.99, 0.1 * variance(&x), 0.01).unwrap();
-    let mut probe = Sftf::<f64, 1>::new(&config);
+    let config = Config::new(0.99, 0.01).unwrap();
+    let channel = Channel::new(0.1 * variance(&x)).unwrap();
+    let mut probe = Sftf::<f64, 1>::new(&config, &channel);
     let late: Vec<usize> = (0..x.len())
         .filter(|&n| probe.update(&config, x[n]).is_none() && n > 1_000)
         .collect();
     assert!(!late.is_empty(), "the under-fitted case is rescued");
     for &n in &late {
-        let mut sftf = Sftf::<f64, 1>::new(&config);
+        let mut sftf = Sftf::<f64, 1>::new(&config, &channel);
         for &v in &x[..n + 10] {
             sftf.update(&config, v);
         }
@@ -352,8 +357,9 @@ fn at_lambda_one_a_rescue_leaves_the_last_good_model() {
         .iter()
         .map(|&v| v as f32)
         .collect();
-    let config = Config::new(1.0f32, 0.1, 0.01).unwrap();
-    let mut sftf = Sftf::<f32, 2>::new(&config);
+    let config = Config::new(1.0f32, 0.01).unwrap();
+    let channel = Channel::new(0.1).unwrap();
+    let mut sftf = Sftf::<f32, 2>::new(&config, &channel);
     for &v in &x[..5_000] {
         sftf.update(&config, v);
     }

@@ -7,7 +7,7 @@
 //! IMU_AR_SOAK_SAMPLES=100000000 cargo test --profile soak -p imu-ar-host --test soak -- --nocapture
 //! ```
 
-use imu_ar::recursive::{Config, Lattice};
+use imu_ar::recursive::{Channel, Config, Estimator, Lattice};
 use imu_ar_cli::input::csv::read_column;
 use imu_ar_host::fixtures::real_records;
 use imu_ar_host::reference::{Regularisation, Section0};
@@ -48,11 +48,12 @@ fn soak_real_records_with_faults() {
         }
     }
     let delta = 0.01;
-    let config = Config::new(LAMBDA as f32, delta as f32, 0.01)
+    let config = Config::new(LAMBDA as f32, 0.01).unwrap();
+    let channel = Channel::new(delta as f32)
         .unwrap()
         .with_saturation(LIMIT)
         .unwrap();
-    let mut lattice = Lattice::<f32, P>::new(&config);
+    let mut lattice = Lattice::<f32, P>::new(&config, &channel);
     let mut reference = Section0::new(P, LAMBDA, delta);
     // The running mean the lattice removes, in f64 (`running_mean_removed`, streamed).
     let (mut mean, mut weight) = (None::<f64>, 0.0f64);

@@ -40,16 +40,23 @@ impl Criterion {
     /// assert_eq!(Criterion::Fpe.value(100, 0, 2.0), 2.0 * 101.0 / 99.0);
     /// ```
     pub fn value(self, n: usize, k: usize, s2: f64) -> f64 {
-        let (nf, kf) = (n as f64, k as f64);
         if !(s2.is_finite() && s2 > 0.0) || n <= k + 2 {
             return f64::INFINITY;
         }
-        let aic = nf * libm::log(s2) + 2.0 * kf;
+        self.formula(n as f64, k as f64, s2)
+    }
+
+    /// The formula of the table above for `n` terms, `k` coefficients and variance `s2`,
+    /// without the range checks of [`Criterion::value`]: `n` may be an effective sample size
+    /// (the [`OrderSelector`](crate::recursive::OrderSelector) scores with
+    /// `(1 + lambda)/(1 - lambda)`), and the caller keeps it in range.
+    pub(crate) fn formula(self, n: f64, k: f64, s2: f64) -> f64 {
+        let fit = || n * libm::log(s2);
         match self {
-            Self::Aic => aic,
-            Self::Aicc => aic + 2.0 * (kf + 1.0) * (kf + 2.0) / (nf - kf - 2.0),
-            Self::Bic => nf * libm::log(s2) + kf * libm::log(nf),
-            Self::Fpe => s2 * (nf + kf + 1.0) / (nf - kf - 1.0),
+            Self::Aic => fit() + 2.0 * k,
+            Self::Aicc => fit() + 2.0 * k + 2.0 * (k + 1.0) * (k + 2.0) / (n - k - 2.0),
+            Self::Bic => fit() + k * libm::log(n),
+            Self::Fpe => s2 * (n + k + 1.0) / (n - k - 1.0),
         }
     }
 

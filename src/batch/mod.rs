@@ -40,10 +40,10 @@ impl<T: Scalar> BatchConfig<T> {
     ///
     /// # Errors
     ///
-    /// [`BatchError::InvalidInterval`] unless `dt` is positive and finite.
+    /// [`BatchError::Interval`] unless `dt` is positive and finite.
     pub fn new(dt: T) -> Result<Self, BatchError> {
         if !(dt.is_finite() && dt > T::ZERO) {
-            return Err(BatchError::InvalidInterval);
+            return Err(BatchError::Interval);
         }
         Ok(Self { dt, demean: true })
     }
@@ -69,8 +69,8 @@ impl<T: Scalar> BatchConfig<T> {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum BatchError {
-    /// The sample interval is not positive and finite.
-    InvalidInterval,
+    /// The sample interval `dt` is not positive and finite.
+    Interval,
     /// Too few samples for the order: every fit keeps at least one residual degree of
     /// freedom (see each estimator's bound), so that an exact fit with zero residual is never
     /// reported as a model.
@@ -101,7 +101,7 @@ pub enum BatchError {
 impl fmt::Display for BatchError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match *self {
-            Self::InvalidInterval => f.write_str("sample interval must be positive and finite"),
+            Self::Interval => f.write_str(crate::model::INTERVAL),
             Self::TooShort { needed, given } => {
                 write!(
                     f,

@@ -1,8 +1,10 @@
 //! The arithmetic of one lattice stage, per number format.
 //!
-//! The lattice recursion ([`Core`](super::lattice::Core)) is written once, in terms of the
-//! typed steps of [`Arith`]; `f32` and `f64` implement them with plain float operations, and
-//! [`Q`](crate::fixed_point::Q) with the fixed-point formats of numerics.md section 2.2.
+//! The lattice recursion (`Core` in `lattice.rs`) is written once, in terms of the typed steps
+//! of [`Arith`]; `f32` and `f64` implement them with plain float operations, and `Q`
+//! (`fixed_arith.rs`) with the fixed-point formats of numerics.md section 2.2. Both traits are
+//! sealed: [`Arith`] is unreachable from outside the crate, and [`FloatArith`] only names the
+//! float types.
 
 use core::fmt::Debug;
 
@@ -78,6 +80,7 @@ pub trait Arith: Copy + Debug {
 }
 
 /// [`Arith::Params`] of the float formats.
+// `pub` in a private module: named by `FloatArith`'s bound, reachable by no one.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct FloatParams<T> {
@@ -139,7 +142,10 @@ macro_rules! impl_arith_float {
 
 impl_arith_float!(f32, f64);
 
-/// The float types, for which every quantity of the lattice is the float itself.
+/// The float types the [`Lattice`](super::Lattice) runs in, `f32` and `f64`: every quantity of
+/// the lattice is the float itself. Sealed: it names the two types for generic code
+/// (`fn run<T: FloatArith>(lattice: &mut Lattice<T, 4>)`) and cannot be implemented outside
+/// this crate.
 pub trait FloatArith:
     Scalar + Arith<Err = Self, Gamma = Self, Coef = Self, Energy = Self, Params = FloatParams<Self>>
 {
@@ -148,11 +154,14 @@ pub trait FloatArith:
 impl FloatArith for f32 {}
 impl FloatArith for f64 {}
 
-/// The float parameters of a configuration: its forgetting factor and its energy floor
-/// (relative to `delta`, see [`Config::new`](super::Config::new)).
-pub(crate) fn float_params<T: Scalar>(config: &super::Config<T>) -> FloatParams<T> {
+/// The float parameters of a channel: the shared forgetting factor and the channel's energy
+/// floor (relative to its `delta`, see [`Channel::new`](super::Channel::new)).
+pub(crate) fn float_params<T: Scalar>(
+    config: &super::Config<T>,
+    channel: &super::Channel<T>,
+) -> FloatParams<T> {
     FloatParams {
         lambda: config.lambda(),
-        floor: config.floor(),
+        floor: channel.floor(),
     }
 }

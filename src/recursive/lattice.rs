@@ -1,18 +1,77 @@
 //! The a-priori least-squares lattice with error feedback (EF-LSL), `O(P)` per sample.
 
 use super::arith::{Arith, FloatArith, float_params};
-use super::{Config, Health, Shell};
-use crate::{ArModel, Scalar};
+use super::estimator::{Estimator, sealed::Sealed};
+use super::shell::Shell;
+use super::{Channel, Config};
+use crate::Scalar;
+
+/// The accessors both lattices have over their `core` and `shell`: the errors, energies,
+/// innovation variances and reflection coefficients of every order after the last sample, of
+/// the types `$err`, `$coef`, `$energy` and `$variance`, measured as `$units` says; `$ratio`
+/// is how the innovation variance is formed. Used in the `impl` blocks of [`Lattice`] and
+/// [`FixedLattice`](super::FixedLattice).
+macro_rules! lattice_accessors {
+    ($err:ty, $coef:ty, $energy:ty, $variance:ty, $units:literal, $ratio:literal) => {
+        #[doc = concat!(
+            "A-priori forward prediction errors `f_1(n)..f_P(n)` of the last accepted sample ",
+            "(`f_m(n) = y_n - a^(m)_{n-1}^T phi_n`), ", $units, "; `f_0(n) = y_n` is ",
+            "[`input`](Self::input)."
+        )]
+        pub fn errors(&self) -> &[$err; P] {
+            &self.core.errors
+        }
+
+        #[doc = concat!(
+            "The last accepted sample after mean removal, `y_n` (the order-0 prediction ",
+            "error), ", $units, "."
+        )]
+        pub fn input(&self) -> $err {
+            self.core.input
+        }
+
+        #[doc = concat!(
+            "Forward energy `F_m(n) = min J^(m)_n + delta lambda^(n+P)` of order `m` in ",
+            "`0..=P`, ", $units, " squared; `None` above `P`."
+        )]
+        pub fn energy(&self, m: usize) -> Option<$energy> {
+            self.core.energy(m)
+        }
+
+        #[doc = concat!(
+            "Innovation variance of order `m` in the input's units squared: ", $ratio,
+            ", `W_n = sum_{i<=n} lambda^(n-i)` (`= F_m (1 - lambda)/(1 - lambda^n)`); `None` ",
+            "above `P` or before the first sample. Order `P` is ",
+            "[`Estimator::noise_variance`](crate::recursive::Estimator::noise_variance)."
+        )]
+        pub fn innovation_variance(&self, m: usize) -> Option<$variance> {
+            self.shell.per_sample(self.energy(m)?)
+        }
+
+        /// Forward reflection coefficients `kf_1..kf_P` (lattice sign: `kf_1 = a_1` of the
+        /// order-1 model, minus the error-filter reflection coefficient).
+        pub fn forward_reflection(&self) -> &[$coef; P] {
+            self.core.forward_reflection()
+        }
+
+        /// Backward reflection coefficients `kb_1..kb_P`.
+        pub fn backward_reflection(&self) -> &[$coef; P] {
+            self.core.backward_reflection()
+        }
+    };
+}
+
+pub(crate) use lattice_accessors;
 
 /// The lattice recursion of numerics.md section 2.1, written once over the typed steps of
 /// [`Arith`]: the state of all stages, the last sample's errors, and the reflection
 /// coefficients of the last `P` samples for the exact transversal coefficients.
 ///
-/// [`Lattice`] (floats) and [`FixedLattice`](crate::fixed_point::FixedLattice) wrap it with
-/// their input handling (screening, mean removal, scaling) and outputs.
+/// [`Lattice`] (floats) and [`FixedLattice`](super::FixedLattice) wrap it with their input
+/// handling (screening, mean removal, scaling) and outputs.
 #[derive(Clone, Copy, Debug)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Core<A: Arith, const P: usize> {
+pub(crate) struct Core<A: Arith, const P: usize> {
     /// Forward energies `F_0..F_{P-1}`.
     pub(crate) f_energy: [A::Energy; P],
     /// `F_P`.
@@ -194,7 +253,7 @@ impl<A: Arith, const P: usize> Core<A, P> {
 
 impl<T: FloatArith, const P: usize> Core<T, P> {
     /// Halves every energy (the weight of every past sample), keeping the reflection
-    /// coefficients: see [`Shell::weight_full`](super::Shell::weight_full).
+    /// coefficients: see `Shell::weight_full`.
     fn halve_energies(&mut self) {
         let half = T::from_f64(0.5);
         self.f_energy_p *= half;
@@ -231,7 +290,7 @@ impl<T: FloatArith, const P: usize> Core<T, P> {
 /// the problem in the [module docs](super) (with `D_m = diag(lambda^(P-1), .., lambda^(P-m))`).
 ///
 /// The transversal coefficients `a_1..a_m` are computed on request ([`Lattice::coefficients`],
-/// [`Lattice::model`]) exactly, from the reflection coefficients of the last `P` samples
+/// [`Estimator::model`]) exactly, from the reflection coefficients of the last `P` samples
 /// (numerics.md section 1, option 1): `O(P^3/3)` operations per request, `O(P)` per sample.
 ///
 /// Safeguards: every energy update adds a tiny positive value (the floor `delta EPSILON^2`,
@@ -239,11 +298,23 @@ impl<T: FloatArith, const P: usize> Core<T, P> {
 /// which keeps the energies divisible however long the input is exactly zero. The floor is
 /// relative to `delta`, so a record in other units (with `delta` in those units) gives the
 /// same coefficients. The conversion factor is formed as a ratio that stays in `[0, 1]`; a
-/// non-finite state re-initialises the lattice (counted in [`Health::restarts`]) and
-/// [`Lattice::model`] keeps returning the last good model while the restarted lattice settles.
+/// non-finite state re-initialises the lattice (counted in
+/// [`Health::restarts`](super::Health::restarts)) and [`Estimator::model`] keeps returning the
+/// last good model while the restarted lattice settles.
+///
+/// # Stack
+///
+/// The order updates of [`Lattice::coefficients`] and [`Estimator::model`] keep two `P x P`
+/// tables of `T` on the stack, `2 P^2 size_of::<T>()` bytes, on top of the estimator's own
+/// state: for `Lattice<f32, 64>`, 32 KiB of tables. Measured on the Cortex-M4F
+/// (thumbv7em-none-eabihf, release profile, stack painted below the caller under QEMU): 33,544
+/// bytes of stack for `model()` at `P = 64`, next to a 34,656-byte `Lattice<f32, 64>`.
+/// [`update`](Estimator::update) takes its snapshot through the same code once every
+/// [`snapshot_interval`](super::snapshot_interval)`(P)` samples, so it needs that stack too.
+/// Size the stack for it at high orders.
 ///
 /// ```
-/// use imu_ar::recursive::{Config, Lattice};
+/// use imu_ar::recursive::{Channel, Config, Estimator, Lattice};
 /// use imu_ar::{ArModel, sim::ArSimulator};
 /// # struct Lcg(u64);
 /// # impl rand_core::RngCore for Lcg {
@@ -256,8 +327,8 @@ impl<T: FloatArith, const P: usize> Core<T, P> {
 /// let mut sensor = ArSimulator::new(truth);
 /// let mut rng = Lcg(7);
 ///
-/// let config = Config::new(0.999f32, 0.1, 0.01).unwrap();
-/// let mut lattice = Lattice::<f32, 2>::new(&config);
+/// let config = Config::new(0.999f32, 0.01).unwrap();
+/// let mut lattice = Lattice::<f32, 2>::new(&config, &Channel::new(0.1).unwrap());
 /// for _ in 0..20_000 {
 ///     lattice.update(&config, sensor.next(&mut rng));
 /// }
@@ -273,101 +344,32 @@ pub struct Lattice<T: FloatArith, const P: usize> {
 }
 
 impl<T: FloatArith, const P: usize> Lattice<T, P> {
-    /// A lattice at the initial state of the problem: `F_i = delta lambda^P`,
+    /// A lattice for `channel` at the initial state of the problem: `F_i = delta lambda^P`,
     /// `B_i = delta lambda^(P-i)`, zero reflection coefficients, unit conversion factors.
-    pub fn new(config: &Config<T>) -> Self {
+    pub fn new(config: &Config<T>, channel: &Channel<T>) -> Self {
         const { assert!(P > 0, "the model order P must be at least 1") };
         Self {
-            core: Self::initial_core(config),
-            shell: Shell::new(),
+            core: Self::initial_core(config, channel),
+            shell: Shell::new(*channel),
         }
     }
 
-    fn initial_core(config: &Config<T>) -> Core<T, P> {
+    fn initial_core(config: &Config<T>, channel: &Channel<T>) -> Core<T, P> {
+        let lambda = config.lambda();
         Core::new(
-            config.delta_lambda_pow(P),
-            core::array::from_fn(|i| config.delta_lambda_pow(P - i)),
+            channel.delta_lambda_pow(lambda, P),
+            core::array::from_fn(|i| channel.delta_lambda_pow(lambda, P - i)),
         )
     }
 
-    /// Takes one sample and returns the a-priori order-`P` prediction error `x_n - xhat_n`.
-    ///
-    /// Returns `None` when the sample was rejected (NaN, infinite or saturated: counted in
-    /// [`Lattice::health`], the state is unchanged) or when it broke the recursion down, which
-    /// re-initialises the lattice (counted as a restart).
-    pub fn update(&mut self, config: &Config<T>, x: T) -> Option<T> {
-        let y = self.shell.intake(config, x)?;
-        let mut clip = 0;
-        let f = self.core.step(&float_params(config), y, &mut clip);
-        // A non-finite value anywhere reaches f_P within a sample or two (the reflection
-        // coefficients feed the errors), and an overflowing input reaches F_0 and F_P at once.
-        let c = &self.core;
-        let check = f + c.f_energy_p + c.f_energy[0];
-        if !check.is_finite() {
-            self.shell.restart(config);
-            self.core = Self::initial_core(config);
-            return None;
-        }
-        if self.shell.weight_full() {
-            self.core.halve_energies();
-            self.shell.halve_weight();
-        }
-        let core = &self.core;
-        self.shell
-            .refresh(config, core.f_energy_p, || core.coefficients(P, |k| k));
-        Some(f)
-    }
-
-    /// A-priori forward prediction errors `f_1(n)..f_P(n)` of the last accepted sample
-    /// (`f_m(n) = y_n - a^(m)_{n-1}^T phi_n`); `f_0(n) = y_n` is [`Lattice::input`].
-    pub fn errors(&self) -> &[T; P] {
-        &self.core.errors
-    }
-
-    /// The last accepted sample after mean removal, `y_n` (the order-0 prediction error).
-    pub fn input(&self) -> T {
-        self.core.input
-    }
-
-    /// Forward energy `F_m(n) = min J^(m)_n + delta lambda^(n+P)` of order `m` in `0..=P`;
-    /// `None` above `P`.
-    pub fn energy(&self, m: usize) -> Option<T> {
-        self.core.energy(m)
-    }
-
-    /// Innovation variance of order `m`: `F_m(n) / W_n`, `W_n = sum_{i<=n} lambda^(n-i)`
-    /// (`= F_m (1 - lambda)/(1 - lambda^n)`); `None` above `P` or before the first sample.
-    pub fn innovation_variance(&self, m: usize) -> Option<T> {
-        self.shell.per_sample(self.energy(m)?)
-    }
-
-    /// Forward reflection coefficients `kf_1..kf_P` (lattice sign: `kf_1 = a_1` of the
-    /// order-1 model, minus the error-filter reflection coefficient).
-    pub fn forward_reflection(&self) -> &[T; P] {
-        self.core.forward_reflection()
-    }
-
-    /// Backward reflection coefficients `kb_1..kb_P`.
-    pub fn backward_reflection(&self) -> &[T; P] {
-        self.core.backward_reflection()
-    }
-
-    /// The weighted running mean removed from the input (0 without mean removal).
-    pub fn mean(&self) -> T {
-        self.shell.mean.mean()
-    }
+    lattice_accessors!(T, T, T, T, "in the input's units", "`F_m(n) / W_n`");
 
     /// The weighted number of samples since the start or the last restart,
     /// `W_n = sum_{i<=n} lambda^(n-i)`: `n` at `lambda = 1`, `(1 - lambda^n)/(1 - lambda)` below.
     /// It stays below `1/(4 EPSILON)` (`2^21` in `f32`): there it is halved with the energies,
     /// so that both keep their precision (the memory stops growing).
     pub fn weight(&self) -> T {
-        self.shell.weight.0
-    }
-
-    /// What happened to the samples so far.
-    pub fn health(&self) -> Health {
-        self.shell.health
+        self.shell.weight()
     }
 
     /// The exact least-squares coefficients `a_1..a_m` of order `m <= P` after the last
@@ -379,52 +381,53 @@ impl<T: FloatArith, const P: usize> Lattice<T, P> {
     /// B_m(n) = [0; B_{m-1}(n-1)] - kb_m(n) [A_{m-1}(n); 0]
     /// ```
     ///
-    /// with `A_m = [1, -a^(m)]`. `O(m^3/3)` operations, no allocation; `None` for `m > P`.
+    /// with `A_m = [1, -a^(m)]`. `O(m^3/3)` operations, no allocation (see the stack use in
+    /// the [type docs](Lattice)); `None` for `m > P`.
     pub fn coefficients(&self, m: usize) -> Option<[T; P]> {
         self.core.coefficients(m, |k| k)
     }
+}
 
-    /// The order-`P` model after the last sample: coefficients, innovation variance
-    /// `F_P / W_n`, the running mean and `dt` (`O(P^3/3)` operations, no state change).
-    ///
-    /// After a restart, and while the current state makes no valid model, it returns the last
-    /// good model instead: the lattice itself takes a snapshot of its model every
-    /// [`snapshot_interval`](super::snapshot_interval)`(P)` accepted samples (never while a
-    /// restart settles), whether or not this method was ever called, and returns that snapshot
-    /// for `3/(1 - lambda)` samples after a restart, at most 30 000 (so also at `lambda = 1`).
-    /// `None` before the first sample, or if no valid model has existed yet.
-    ///
-    /// # Stack
-    ///
-    /// The order updates keep two `P x P` tables of `T` on the stack, `2 P^2 size_of::<T>()`
-    /// bytes, on top of the estimator's own state: for `Lattice<f32, 64>`, 32 KiB of tables.
-    /// Measured on the Cortex-M4F (thumbv7em-none-eabihf, release profile, stack painted
-    /// below the caller under QEMU): 33,544 bytes of stack for `model()` at `P = 64`, next to
-    /// a 34,656-byte `Lattice<f32, 64>`. [`update`](Self::update) takes its snapshot through
-    /// the same code once every `snapshot_interval(P)` samples, so it needs that stack too.
-    /// Size the stack for it at high orders.
-    pub fn model(&self, config: &Config<T>) -> Option<ArModel<T, P>> {
-        let core = &self.core;
-        self.shell
-            .model(config, core.f_energy_p, || core.coefficients(P, |k| k))
+impl<T: FloatArith, const P: usize> Sealed<T, P> for Lattice<T, P> {
+    type Format = T;
+
+    fn shell(&self) -> &Shell<T, P> {
+        &self.shell
+    }
+
+    fn energy(&self) -> T {
+        self.core.f_energy_p
+    }
+
+    fn current(&self) -> Option<[T; P]> {
+        self.coefficients(P)
     }
 }
 
-/// Largest hold after a restart, in samples: three memories of `lambda = 0.9999`.
-const HOLD_MAX: f64 = 30_000.0;
+impl<T: FloatArith, const P: usize> Estimator<T, P> for Lattice<T, P> {
+    type Config = Config<T>;
 
-/// Samples for which a restarted estimator keeps publishing its last good model:
-/// `3/(1 - lambda)`, at most 30 000 (at `lambda = 1`, where the memory is unbounded, and above
-/// `lambda = 0.9999`, the restarted estimator has then seen 30 000 samples).
-pub(crate) fn hold_after_restart(lambda: f64) -> u32 {
-    let memory = if lambda < 1.0 {
-        3.0 / (1.0 - lambda)
-    } else {
-        HOLD_MAX
-    };
-    if memory < HOLD_MAX {
-        memory as u32
-    } else {
-        HOLD_MAX as u32
+    fn update(&mut self, config: &Config<T>, x: T) -> Option<T> {
+        let y = self.shell.intake(config, x)?;
+        let channel = self.shell.channel();
+        let mut clip = 0;
+        let f = self.core.step(&float_params(config, channel), y, &mut clip);
+        // A non-finite value anywhere reaches f_P within a sample or two (the reflection
+        // coefficients feed the errors), and an overflowing input reaches F_0 and F_P at once.
+        let c = &self.core;
+        let check = f + c.f_energy_p + c.f_energy[0];
+        if !check.is_finite() {
+            self.core = Self::initial_core(config, channel);
+            self.shell.restart(config.lambda().to_f64());
+            return None;
+        }
+        if self.shell.weight_full() {
+            self.core.halve_energies();
+            self.shell.halve_weight();
+        }
+        let core = &self.core;
+        self.shell
+            .refresh(config.dt(), core.f_energy_p, || core.coefficients(P, |k| k));
+        Some(f)
     }
 }

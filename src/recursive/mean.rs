@@ -1,6 +1,6 @@
 //! Exponentially weighted running mean.
 
-use super::WeightSum;
+use super::shell::WeightSum;
 use crate::Scalar;
 
 /// The exponentially weighted mean `m_n = sum lambda^(n-i) x_i / sum lambda^(n-i)`, updated as

@@ -2,6 +2,7 @@
 
 use super::{Config, FloatArith, Lattice};
 use crate::Scalar;
+use crate::batch::criteria::Criterion;
 
 /// How [`OrderSelector`] scores the orders `0..=P`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -11,11 +12,12 @@ pub enum OrderRule {
     /// squared *a-priori* errors `Pi_k(n) = lambda Pi_k(n-1) + f_k(n)^2`. Needs no sample size
     /// or penalty: an over-fitted order predicts worse out of sample.
     Pls,
-    /// `N_eff ln s2_k + 2k` with `s2_k = F_k / W_n` and `N_eff = (1 + lambda)/(1 - lambda)`;
-    /// at `lambda = 1` (growing memory) `N_eff` is the number of samples,
-    /// [`Lattice::weight`].
+    /// [`Criterion::Aic`], `N_eff ln s2_k + 2k`, with `s2_k = F_k / W_n` and
+    /// `N_eff = (1 + lambda)/(1 - lambda)`; at `lambda = 1` (growing memory) `N_eff` is the
+    /// number of samples, [`Lattice::weight`].
     Aic,
-    /// `N_eff ln s2_k + k ln N_eff`, with `N_eff` as for [`OrderRule::Aic`].
+    /// [`Criterion::Bic`], `N_eff ln s2_k + k ln N_eff`, with `N_eff` as for
+    /// [`OrderRule::Aic`].
     Bic,
 }
 
@@ -64,7 +66,8 @@ impl<T: FloatArith, const P: usize> OrderSelector<T, P> {
         self.selected
     }
 
-    /// Call after every accepted [`Lattice::update`]; returns the selected order.
+    /// Call after every accepted [`update`](super::Estimator::update) of `lattice`; returns
+    /// the selected order.
     pub fn update(&mut self, config: &Config<T>, lattice: &Lattice<T, P>) -> usize {
         let lambda = config.lambda();
         let y = lattice.input();
@@ -126,11 +129,11 @@ impl<T: FloatArith, const P: usize> OrderSelector<T, P> {
                     if !(s2 > 0.0 && n_eff >= 1.0 && n_eff.is_finite()) {
                         return f64::INFINITY;
                     }
-                    let penalty = match self.rule {
-                        OrderRule::Aic => 2.0,
-                        _ => libm::log(n_eff),
+                    let criterion = match self.rule {
+                        OrderRule::Aic => Criterion::Aic,
+                        _ => Criterion::Bic,
                     };
-                    n_eff * libm::log(s2) + penalty * k as f64
+                    criterion.formula(n_eff, k as f64, s2)
                 }
             }
         };

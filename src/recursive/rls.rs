@@ -1,7 +1,9 @@
 //! Conventional recursive least squares, `O(P^2)` per sample, in Bierman's U-D form.
 
-use super::{Config, Health, Shell};
-use crate::{ArModel, Scalar};
+use super::estimator::{Estimator, sealed::Sealed, transversal};
+use super::shell::Shell;
+use super::{Channel, Config};
+use crate::Scalar;
 
 /// The initial inverse correlation matrix `P_0` of [`Rls`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -40,11 +42,27 @@ pub enum RlsInit {
 /// Safeguards: the entries of `D` are capped at `1e29 / delta` (`1e30` for `delta = 0.1`; the
 /// cap scales with the data, as `delta` does), so that a stuck sensor (no excitation, `P`
 /// growing as `lambda^-n`) cannot overflow it; a non-finite or non-positive factor
-/// re-initialises the state (counted in [`Health::restarts`]) while [`Rls::model`] returns the
-/// last good model (see [`Lattice::model`](super::Lattice::model)).
+/// re-initialises the state (counted in [`Health::restarts`](super::Health::restarts)) while
+/// [`Estimator::model`] returns the last good model.
+///
+/// ```
+/// use imu_ar::recursive::{Channel, Config, Estimator, Rls};
+///
+/// let config = Config::new(0.999f32, 0.01)?;
+/// let mut rls = Rls::<f32, 1>::new(&config, &Channel::new(0.01)?);
+/// let (mut x, mut seed) = (0.0f32, 1u32);
+/// for _ in 0..5000 {
+///     // An AR(1) with a_1 = 0.5 and uniform innovations.
+///     seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+///     x = 0.5 * x + ((seed >> 8) as f32 / 16_777_216.0 - 0.5);
+///     rls.update(&config, x);
+/// }
+/// assert!((rls.coefficients()[0] - 0.5).abs() < 0.1);
+/// # Ok::<(), imu_ar::recursive::ConfigError>(())
+/// ```
 #[derive(Clone, Copy, Debug)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Rls<T, const P: usize> {
+pub struct Rls<T: Scalar, const P: usize> {
     a: [T; P],
     /// Strictly upper part of `U`, by columns: `ut[j][i] = U[i][j]` for `i < j`, so that the
     /// inner loops run over contiguous memory.
@@ -59,8 +77,14 @@ pub struct Rls<T, const P: usize> {
 }
 
 impl<T: Scalar, const P: usize> Rls<T, P> {
-    /// A state at `a = 0` with the chosen `P_0`.
-    pub fn new(config: &Config<T>, init: RlsInit) -> Self {
+    /// A state for `channel` at `a = 0`, with the `P_0` of the problem the lattice solves
+    /// ([`RlsInit::ShiftConsistent`]).
+    pub fn new(config: &Config<T>, channel: &Channel<T>) -> Self {
+        Self::with_init(config, channel, RlsInit::default())
+    }
+
+    /// A state for `channel` at `a = 0` with the chosen `P_0`.
+    pub fn with_init(config: &Config<T>, channel: &Channel<T>, init: RlsInit) -> Self {
         const { assert!(P > 0, "the model order P must be at least 1") };
         let mut s = Self {
             a: [T::ZERO; P],
@@ -70,31 +94,34 @@ impl<T: Scalar, const P: usize> Rls<T, P> {
             energy: T::ZERO,
             error: T::ZERO,
             init,
-            shell: Shell::new(),
+            shell: Shell::new(*channel),
         };
         s.initialise(config);
         s
     }
 
     fn initialise(&mut self, config: &Config<T>) {
+        let (lambda, channel) = (config.lambda(), self.shell.channel());
         self.a = [T::ZERO; P];
         self.ut = [[T::ZERO; P]; P];
         for (k, d) in self.d.iter_mut().enumerate() {
             *d = match self.init {
-                RlsInit::ShiftConsistent => T::ONE / config.delta_lambda_pow(P - 1 - k),
-                RlsInit::Ridge => T::ONE / config.delta(),
+                RlsInit::ShiftConsistent => T::ONE / channel.delta_lambda_pow(lambda, P - 1 - k),
+                RlsInit::Ridge => T::ONE / channel.delta(),
             };
         }
         self.phi = [T::ZERO; P];
-        self.energy = config.delta_lambda_pow(P);
+        self.energy = channel.delta_lambda_pow(lambda, P);
         self.error = T::ZERO;
     }
+}
 
-    /// Takes one sample and returns the a-priori prediction error `x_n - xhat_n`.
-    ///
-    /// Returns `None` when the sample was rejected (NaN, infinite or saturated: counted, the
-    /// state is unchanged) or broke the recursion down (re-initialised, counted as a restart).
-    pub fn update(&mut self, config: &Config<T>, x: T) -> Option<T> {
+transversal!(Rls);
+
+impl<T: Scalar, const P: usize> Estimator<T, P> for Rls<T, P> {
+    type Config = Config<T>;
+
+    fn update(&mut self, config: &Config<T>, x: T) -> Option<T> {
         let y = self.shell.intake(config, x)?;
         let lambda = config.lambda();
         let e = self
@@ -131,7 +158,7 @@ impl<T: Scalar, const P: usize> Rls<T, P> {
         // ("covariance wind-up"); held below `1e29 / delta` the estimator stays finite and
         // recovers as soon as the input moves again. Far above any value of a healthy run, and
         // relative to `delta`, so that it scales with the data.
-        let d_max = config.ceiling();
+        let d_max = self.shell.channel().ceiling();
         for ((a, d), g) in self.a.iter_mut().zip(&mut self.d).zip(&gain) {
             *a += *g / alpha * e;
             // Without excitation (a stuck sensor) D grows as lambda^-n: cap it.
@@ -143,10 +170,11 @@ impl<T: Scalar, const P: usize> Rls<T, P> {
         // a-posteriori error eps = e lambda / alpha
         // The same floor as the lattice's and the SFTF's: a stuck sensor keeps a positive
         // energy instead of one that decays as lambda^n to 0.
-        self.energy = lambda * self.energy + e * (e * lambda / alpha) + config.floor();
+        self.energy =
+            lambda * self.energy + e * (e * lambda / alpha) + self.shell.channel().floor();
         check += self.energy;
         if !(healthy && check.is_finite()) {
-            self.shell.restart(config);
+            self.shell.restart(lambda.to_f64());
             self.initialise(config);
             return None;
         }
@@ -162,40 +190,9 @@ impl<T: Scalar, const P: usize> Rls<T, P> {
         self.phi.copy_within(0..P - 1, 1);
         self.phi[0] = y;
         self.error = e;
-        self.shell.refresh(config, self.energy, || Some(self.a));
+        self.shell
+            .refresh(config.dt(), self.energy, || Some(self.a));
         Some(e)
-    }
-
-    /// The coefficients `a_1..a_P` after the last sample.
-    pub fn coefficients(&self) -> &[T; P] {
-        &self.a
-    }
-
-    /// The last a-priori prediction error.
-    pub fn error(&self) -> T {
-        self.error
-    }
-
-    /// Innovation variance `E_n / W_n`; `None` before the first sample.
-    pub fn innovation_variance(&self) -> Option<T> {
-        self.shell.per_sample(self.energy)
-    }
-
-    /// The weighted running mean removed from the input (0 without mean removal).
-    pub fn mean(&self) -> T {
-        self.shell.mean.mean()
-    }
-
-    /// What happened to the samples so far.
-    pub fn health(&self) -> Health {
-        self.shell.health
-    }
-
-    /// The model after the last sample; after a restart, the last good one (a snapshot the
-    /// estimator takes itself, as [`Lattice::model`](super::Lattice::model) describes).
-    pub fn model(&self, config: &Config<T>) -> Option<ArModel<T, P>> {
-        let a = self.a;
-        self.shell.model(config, self.energy, || Some(a))
     }
 }
 

@@ -1,8 +1,10 @@
 //! The stabilised fast transversal filter (SFTF), `O(P)` per sample, with its divergence
 //! monitor and rescue.
 
-use super::{Config, Health, Shell};
-use crate::{ArModel, Scalar};
+use super::estimator::{Estimator, sealed::Sealed, transversal};
+use super::shell::Shell;
+use super::{Channel, Config};
+use crate::Scalar;
 
 /// The monitor's threshold `tau` on the disagreement of the two backward errors
 /// ([`Sftf::disagreement`]): `1e-2` in single precision, `1e-6` in double. The largest
@@ -48,7 +50,8 @@ const GAMMA_MAX: f64 = 1.0 + 1e-3;
 /// feedback of `r_f - r_s` keeps this one stable for `lambda > 1 - 1/(2P)` on data its order
 /// describes, but not below that, and not when the order under-fits a resonant input
 /// (numerics.md section 8); there the error grows in `f64` as well as in `f32`. So every sample
-/// is checked, and the state is re-initialised (a rescue, counted in [`Health::restarts`]) when
+/// is checked, and the state is re-initialised (a rescue, counted in
+/// [`Health::restarts`](super::Health::restarts)) when
 ///
 /// * the two backward errors disagree: `|r_f - r_s| > tau (|r_f| + sqrt((1 - lambda) beta))`,
 ///   `tau = 1e-2` in `f32`, `1e-6` in `f64`;
@@ -56,12 +59,13 @@ const GAMMA_MAX: f64 = 1.0 + 1e-3;
 /// * any value is not finite.
 ///
 /// The rescue zeroes the delay line and restarts from the initial state, and
-/// [`Sftf::model`] keeps returning the last good model (a snapshot the filter refreshes
-/// itself) for `3/(1 - lambda)` samples, at most 30 000. Where the lattice and this filter both apply, prefer the [`Lattice`](super::Lattice):
-/// it never needs rescuing; this filter is for firmware that must have `a` every sample.
+/// [`Estimator::model`] keeps returning the last good model (a snapshot the filter refreshes
+/// itself) for `3/(1 - lambda)` samples, at most 30 000. Where the lattice and this filter
+/// both apply, prefer the [`Lattice`](super::Lattice): it never needs rescuing; this filter is
+/// for firmware that must have `a` every sample.
 ///
 /// ```
-/// use imu_ar::recursive::{Config, Sftf};
+/// use imu_ar::recursive::{Channel, Config, Estimator, Sftf};
 /// use imu_ar::{ArModel, sim::ArSimulator};
 /// # struct Lcg(u64);
 /// # impl rand_core::RngCore for Lcg {
@@ -74,8 +78,8 @@ const GAMMA_MAX: f64 = 1.0 + 1e-3;
 /// let mut sensor = ArSimulator::new(truth);
 /// let mut rng = Lcg(7);
 ///
-/// let config = Config::new(0.999f32, 0.1, 0.01).unwrap();
-/// let mut sftf = Sftf::<f32, 2>::new(&config);
+/// let config = Config::new(0.999f32, 0.01).unwrap();
+/// let mut sftf = Sftf::<f32, 2>::new(&config, &Channel::new(0.1).unwrap());
 /// for _ in 0..20_000 {
 ///     sftf.update(&config, sensor.next(&mut rng));
 /// }
@@ -85,13 +89,14 @@ const GAMMA_MAX: f64 = 1.0 + 1e-3;
 /// ```
 #[derive(Clone, Copy, Debug)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Sftf<T, const P: usize> {
+pub struct Sftf<T: Scalar, const P: usize> {
     a: [T; P],
     b: [T; P],
     g: [T; P],
     /// `y_{n-1} .. y_{n-P}` for the next sample.
     phi: [T; P],
-    alpha: T,
+    /// The forward energy `alpha_n`.
+    energy: T,
     beta: T,
     gamma: T,
     error: T,
@@ -101,34 +106,68 @@ pub struct Sftf<T, const P: usize> {
 }
 
 impl<T: Scalar, const P: usize> Sftf<T, P> {
-    /// A filter at the initial state of the problem.
-    pub fn new(config: &Config<T>) -> Self {
+    /// A filter for `channel` at the initial state of the problem.
+    pub fn new(config: &Config<T>, channel: &Channel<T>) -> Self {
         const { assert!(P > 0, "the model order P must be at least 1") };
         Self {
             a: [T::ZERO; P],
             b: [T::ZERO; P],
             g: [T::ZERO; P],
             phi: [T::ZERO; P],
-            alpha: config.delta_lambda_pow(P),
-            beta: config.delta(),
+            energy: channel.delta_lambda_pow(config.lambda(), P),
+            beta: channel.delta(),
             gamma: T::ONE,
             error: T::ZERO,
             backward: (T::ZERO, T::ZERO),
-            shell: Shell::new(),
+            shell: Shell::new(*channel),
         }
     }
 
-    /// Takes one sample and returns the a-priori prediction error `x_n - xhat_n`.
-    ///
-    /// Returns `None` when the sample was rejected (NaN, infinite or saturated: counted, the
-    /// state is unchanged) or when the monitor found the recursion diverging, which
-    /// re-initialises the filter (counted as a restart).
-    pub fn update(&mut self, config: &Config<T>, x: T) -> Option<T> {
+    /// The monitor: the two backward errors agree, `gamma`, `alpha` and `beta` are in range,
+    /// and every value is finite. A non-finite `g` makes `gamma` NaN or 0 in the same sample,
+    /// a non-finite `b` does the same through the next sample's `g`, before either can reach
+    /// `a` (which takes the `g` of the sample before), and NaN fails every comparison: so only
+    /// the coefficients `a` (their sum `a_sum`) and the energies need checking here.
+    fn healthy(&self, lambda: T, r_f: T, r_s: T, a_sum: T) -> bool {
+        // |r_f - r_s| <= tau (|r_f| + sqrt((1 - lambda) beta)), without the square root.
+        let excess = (r_f - r_s).abs() / tau::<T>() - r_f.abs();
+        let agree = excess <= T::ZERO || excess * excess <= (T::ONE - lambda) * self.beta;
+        let in_range = self.gamma > T::ZERO
+            && self.gamma <= T::from_f64(GAMMA_MAX)
+            && self.energy > T::ZERO
+            && self.beta > T::ZERO;
+        agree && in_range && (a_sum + self.energy + self.beta).is_finite()
+    }
+
+    /// The monitor's value after the last sample,
+    /// `d = |r_f - r_s| / (|r_f| + sqrt((1 - lambda) beta))` (0 before the first): how far
+    /// the two backward errors disagree. The filter is rescued when `d` passes `tau` (`1e-2`
+    /// in `f32`, `1e-6` in `f64`); a healthy run stays below it.
+    pub fn disagreement(&self, config: &Config<T>) -> T {
+        let (r_f, r_s) = self.backward;
+        let floor = libm::sqrt((1.0 - config.lambda().to_f64()) * self.beta.to_f64());
+        let scale = r_f.abs().to_f64() + floor;
+        let d = (r_f - r_s).abs().to_f64();
+        T::from_f64(if d > 0.0 { d / scale } else { 0.0 })
+    }
+
+    /// The forward energy `alpha_n = min J_n + delta lambda^(n+P)`.
+    pub fn energy(&self) -> T {
+        self.energy
+    }
+}
+
+transversal!(Sftf);
+
+impl<T: Scalar, const P: usize> Estimator<T, P> for Sftf<T, P> {
+    type Config = Config<T>;
+
+    fn update(&mut self, config: &Config<T>, x: T) -> Option<T> {
         let y = self.shell.intake(config, x)?;
         let lambda = config.lambda();
         // Added to both energy updates, as in the lattice: keeps `alpha` and `beta` positive
         // (and divisible) however long the input is exactly zero; relative to `delta`.
-        let floor = config.floor();
+        let floor = self.shell.channel().floor();
 
         let e = self
             .a
@@ -136,8 +175,8 @@ impl<T: Scalar, const P: usize> Sftf<T, P> {
             .zip(&self.phi)
             .fold(y, |e, (&a, &p)| e - a * p);
         let eps = self.gamma * e;
-        let c = e / (lambda * self.alpha);
-        self.alpha = lambda * self.alpha + eps * e + floor;
+        let c = e / (lambda * self.energy);
+        self.energy = lambda * self.energy + eps * e + floor;
 
         // One pass over k = 0..P-1, with the old a_k, g_k: gbar_k = [c; g - c a]_k,
         // a_k <- a_k + eps g_k, the delay line shifts to phi_{n+1}, g_k <- gbar_k + gbar_P b_k,
@@ -168,10 +207,10 @@ impl<T: Scalar, const P: usize> Sftf<T, P> {
         }
 
         if !self.healthy(lambda, r_f, r_s, a_sum) {
-            self.shell.restart(config);
+            self.shell.restart(lambda.to_f64());
             *self = Self {
                 shell: self.shell,
-                ..Self::new(config)
+                ..Self::new(config, self.shell.channel())
             };
             return None;
         }
@@ -179,7 +218,7 @@ impl<T: Scalar, const P: usize> Sftf<T, P> {
             // Halving the weight of every past sample halves the energies and doubles the
             // gain `g = R^-1 phi / lambda`, so `1/gamma - 1 = g^T phi` doubles.
             let half = T::from_f64(0.5);
-            self.alpha *= half;
+            self.energy *= half;
             self.beta *= half;
             for g in &mut self.g {
                 *g = *g + *g;
@@ -189,73 +228,8 @@ impl<T: Scalar, const P: usize> Sftf<T, P> {
         }
         self.error = e;
         self.backward = (r_f, r_s);
-        self.shell.refresh(config, self.alpha, || Some(self.a));
+        self.shell
+            .refresh(config.dt(), self.energy, || Some(self.a));
         Some(e)
-    }
-
-    /// The monitor: the two backward errors agree, `gamma`, `alpha` and `beta` are in range,
-    /// and every value is finite. A non-finite `g` makes `gamma` NaN or 0 in the same sample,
-    /// a non-finite `b` does the same through the next sample's `g`, before either can reach
-    /// `a` (which takes the `g` of the sample before), and NaN fails every comparison: so only
-    /// the coefficients `a` (their sum `a_sum`) and the energies need checking here.
-    fn healthy(&self, lambda: T, r_f: T, r_s: T, a_sum: T) -> bool {
-        // |r_f - r_s| <= tau (|r_f| + sqrt((1 - lambda) beta)), without the square root.
-        let excess = (r_f - r_s).abs() / tau::<T>() - r_f.abs();
-        let agree = excess <= T::ZERO || excess * excess <= (T::ONE - lambda) * self.beta;
-        let in_range = self.gamma > T::ZERO
-            && self.gamma <= T::from_f64(GAMMA_MAX)
-            && self.alpha > T::ZERO
-            && self.beta > T::ZERO;
-        agree && in_range && (a_sum + self.alpha + self.beta).is_finite()
-    }
-
-    /// The coefficients `a_1..a_P` after the last sample.
-    pub fn coefficients(&self) -> &[T; P] {
-        &self.a
-    }
-
-    /// The last a-priori prediction error.
-    pub fn error(&self) -> T {
-        self.error
-    }
-
-    /// The monitor's value after the last sample,
-    /// `d = |r_f - r_s| / (|r_f| + sqrt((1 - lambda) beta))` (0 before the first): how far
-    /// the two backward errors disagree. The filter is rescued when `d` passes `tau` (`1e-2`
-    /// in `f32`, `1e-6` in `f64`); a healthy run stays below it.
-    pub fn disagreement(&self, config: &Config<T>) -> T {
-        let (r_f, r_s) = self.backward;
-        let floor = libm::sqrt((1.0 - config.lambda().to_f64()) * self.beta.to_f64());
-        let scale = r_f.abs().to_f64() + floor;
-        let d = (r_f - r_s).abs().to_f64();
-        T::from_f64(if d > 0.0 { d / scale } else { 0.0 })
-    }
-
-    /// The forward energy `alpha_n = min J_n + delta lambda^(n+P)`.
-    pub fn energy(&self) -> T {
-        self.alpha
-    }
-
-    /// Innovation variance `alpha_n / W_n`; `None` before the first sample.
-    pub fn innovation_variance(&self) -> Option<T> {
-        self.shell.per_sample(self.alpha)
-    }
-
-    /// The weighted running mean removed from the input (0 without mean removal).
-    pub fn mean(&self) -> T {
-        self.shell.mean.mean()
-    }
-
-    /// What happened to the samples so far; [`Health::restarts`] counts the rescues.
-    pub fn health(&self) -> Health {
-        self.shell.health
-    }
-
-    /// The model after the last sample; after a rescue, the last good one (a snapshot the
-    /// filter takes itself, whether or not this method was called, as
-    /// [`Lattice::model`](super::Lattice::model) describes).
-    pub fn model(&self, config: &Config<T>) -> Option<ArModel<T, P>> {
-        let a = self.a;
-        self.shell.model(config, self.alpha, || Some(a))
     }
 }

@@ -378,14 +378,17 @@ impl Icm42688Config {
 /// # }
 /// # struct Delay;
 /// # impl embedded_hal::delay::DelayNs for Delay { fn delay_ns(&mut self, _: u32) {} }
-/// use imu_ar::recursive::{Config, Lattice};
+/// use imu_ar::recursive::{Channel, Config, Estimator, Lattice};
 /// use imu_ar::sensor::{AccelUnit, GyroUnit, Icm42688, Icm42688Config, ImuReader, RawSample};
 ///
 /// let mut imu = Icm42688::new(Bus);
 /// assert_eq!(imu.init(&mut Delay, Icm42688Config::default())?, 0x47);
 /// imu.enable_fifo()?;
-/// let config = Config::new(0.999f32, 1e-4, 0.01).unwrap();
-/// let mut axes = [Lattice::<f32, 4>::new(&config); 6];
+/// let config = Config::new(0.999f32, 0.01).unwrap();
+/// // delta about 0.1 x each axis's variance, in its own units: (rad/s)^2 and (m/s^2)^2.
+/// let (gyro, accel) = (Channel::new(3e-8).unwrap(), Channel::new(1e-4).unwrap());
+/// let mut axes: [Lattice<f32, 4>; 6] =
+///     core::array::from_fn(|i| Lattice::new(&config, if i < 3 { &gyro } else { &accel }));
 /// let mut batch = [RawSample::default(); 16];
 /// let n = imu.read_fifo(&mut batch)?;
 /// let scale = imu.scale();

@@ -112,7 +112,7 @@ impl Scale {
     }
 
     /// The saturation limit of the gyro axes in `unit`, for
-    /// [`Config::with_saturation`](crate::recursive::Config::with_saturation): half a count
+    /// [`Channel::with_saturation`](crate::recursive::Channel::with_saturation): half a count
     /// below the rail `i16::MAX`, so that a clipped reading (`i16::MAX` or `i16::MIN` counts) is
     /// at or beyond it and every reading of at most 32766 counts either way is inside it. (The
     /// estimators' screen is symmetric: -32767 counts, one count from the negative rail, is

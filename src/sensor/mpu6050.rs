@@ -318,13 +318,16 @@ impl Mpu6050Config {
 /// # }
 /// # struct Delay;
 /// # impl embedded_hal::delay::DelayNs for Delay { fn delay_ns(&mut self, _: u32) {} }
-/// use imu_ar::recursive::{Config, Lattice};
+/// use imu_ar::recursive::{Channel, Config, Estimator, Lattice};
 /// use imu_ar::sensor::{GyroUnit, ImuReader, Mpu6050, Mpu6050Config};
 ///
 /// let mut imu = Mpu6050::new(Bus, 0x68);
 /// assert_eq!(imu.init(&mut Delay, Mpu6050Config::default())?, 0x68);
-/// let config = Config::new(0.999f32, 1e-4, 0.01).unwrap();
-/// let mut axes = [Lattice::<f32, 4>::new(&config); 6];
+/// let config = Config::new(0.999f32, 0.01).unwrap();
+/// // delta about 0.1 x each axis's variance, in its own units: (deg/s)^2 and g^2.
+/// let (gyro, accel) = (Channel::new(1e-4).unwrap(), Channel::new(1e-6).unwrap());
+/// let mut axes: [Lattice<f32, 4>; 6] =
+///     core::array::from_fn(|i| Lattice::new(&config, if i < 3 { &gyro } else { &accel }));
 /// let sample = imu.read()?;
 /// let gyro = imu.scale().gyro(sample.gyro, GyroUnit::DegPerSec);
 /// let accel = imu.scale().accel(sample.accel, imu_ar::sensor::AccelUnit::G);

@@ -7,7 +7,7 @@ use super::{Error, FifoStats, ImuReader, RawSample, Scale};
 /// Serves the samples of a slice in order, with the sensitivities they were recorded at.
 ///
 /// ```
-/// use imu_ar::recursive::{Config, Lattice};
+/// use imu_ar::recursive::{Channel, Config, Estimator, Lattice};
 /// use imu_ar::sensor::{AccelUnit, Error, GyroUnit, ImuReader, RawSample, Replay, Scale};
 ///
 /// let scale = Scale { gyro_counts_per_dps: 131.0, accel_counts_per_g: 16384.0 };
@@ -16,8 +16,10 @@ use super::{Error, FifoStats, ImuReader, RawSample, Scale};
 ///     .collect();
 /// let mut replay = Replay::new(&record, scale);
 ///
-/// let config = Config::new(0.99f32, 1e-4, 0.01).unwrap();
-/// let mut axes = [Lattice::<f32, 2>::new(&config); 6];
+/// let config = Config::new(0.99f32, 0.01).unwrap();
+/// let (gyro, accel) = (Channel::new(1e-4).unwrap(), Channel::new(1e-6).unwrap());
+/// let mut axes: [Lattice<f32, 2>; 6] =
+///     core::array::from_fn(|i| Lattice::new(&config, if i < 3 { &gyro } else { &accel }));
 /// let mut batch = [RawSample::default(); 32];
 /// loop {
 ///     let n = replay.read_fifo(&mut batch)?;

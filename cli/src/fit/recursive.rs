@@ -1,8 +1,10 @@
 //! The recursive fits of `imu-ar fit`: RLS, the lattice and the SFTF in `f64` or `f32`, and
 //! the fixed-point lattice; each reports the model after the last sample.
 
-use imu_ar::fixed_point::{FixedConfig, FixedLattice};
-use imu_ar::recursive::{Config, ConfigError, FloatArith, Lattice, Rls, RlsInit, Sftf};
+use imu_ar::recursive::{
+    Channel, Config, ConfigError, Estimator, FixedChannel, FixedConfig, FixedLattice, FloatArith,
+    Lattice, Rls, Sftf,
+};
 
 use super::FitResult;
 use crate::error::Fail;
@@ -29,12 +31,14 @@ pub(super) enum Scale {
 }
 
 /// The configuration in `T`, with an error that says which setting `T` cannot carry.
-fn config_in<T: FloatArith>(r: &Recursive) -> Result<Config<T>, Fail> {
-    Config::new(
-        T::from_f64(r.lambda),
-        T::from_f64(r.delta),
-        T::from_f64(r.dt),
-    )
+fn config_in<T: FloatArith>(r: &Recursive) -> Result<(Config<T>, Channel<T>), Fail> {
+    let config = Config::new(T::from_f64(r.lambda), T::from_f64(r.dt));
+    // Checked in the order lambda, delta, interval.
+    match (config, Channel::new(T::from_f64(r.delta))) {
+        (Ok(config), Ok(channel)) => Ok((config, channel)),
+        (Err(ConfigError::Lambda), _) => Err(ConfigError::Lambda),
+        (_, Err(e)) | (Err(e), _) => Err(e),
+    }
     .map_err(|e| {
         if r.default_delta {
             Fail(format!(
@@ -71,7 +75,8 @@ pub(super) fn recursive_fit<T: FloatArith, const P: usize>(
     x: &[f64],
     r: &Recursive,
 ) -> Result<FitResult, Fail> {
-    let config = config_in::<T>(r)?.with_demean(r.demean);
+    let (config, channel) = config_in::<T>(r)?;
+    let config = config.with_demean(r.demean);
     let offset = if core::mem::size_of::<T>() < 8 {
         centre(x, r.demean)
     } else {
@@ -79,21 +84,21 @@ pub(super) fn recursive_fit<T: FloatArith, const P: usize>(
     };
     let (model, health, reflection) = match r.method {
         Method::Rls => {
-            let mut rls = Rls::<T, P>::new(&config, RlsInit::ShiftConsistent);
+            let mut rls = Rls::<T, P>::new(&config, &channel);
             for &v in x {
                 rls.update(&config, T::from_f64(v - offset));
             }
             (rls.model(&config), rls.health(), None)
         }
         Method::Sftf => {
-            let mut sftf = Sftf::<T, P>::new(&config);
+            let mut sftf = Sftf::<T, P>::new(&config, &channel);
             for &v in x {
                 sftf.update(&config, T::from_f64(v - offset));
             }
             (sftf.model(&config), sftf.health(), None)
         }
         _ => {
-            let mut lattice = Lattice::<T, P>::new(&config);
+            let mut lattice = Lattice::<T, P>::new(&config, &channel);
             for &v in x {
                 lattice.update(&config, T::from_f64(v - offset));
             }
@@ -131,11 +136,14 @@ pub(super) fn fixed_fit<const P: usize>(
     r: &Recursive,
     scale: Scale,
 ) -> Result<FitResult, Fail> {
-    let config = config_in::<f32>(r)?.with_demean(r.demean);
+    let (config, channel) = config_in::<f32>(r)?;
+    let config = config.with_demean(r.demean);
     let scale_value = match scale {
         Scale::Given(s) | Scale::Default(s) => s,
     };
-    let fixed = FixedConfig::new(&config, scale_value as f32).map_err(|e| {
+    let settings = FixedChannel::new(&channel, scale_value as f32)
+        .and_then(|channel| Ok((FixedConfig::new(&config)?, channel)));
+    let (fixed, fixed_channel) = settings.map_err(|e| {
         let product = r.delta * scale_value * scale_value;
         if e == ConfigError::FixedLambda {
             return Fail(format!("--lambda {}: {e}", r.lambda));
@@ -152,7 +160,7 @@ pub(super) fn fixed_fit<const P: usize>(
         }
     })?;
     let offset = centre(x, r.demean);
-    let mut lattice = FixedLattice::<P>::new(&fixed);
+    let mut lattice = FixedLattice::<P>::new(&fixed, &fixed_channel);
     for &v in x {
         lattice.update(&fixed, (v - offset) as f32);
     }
@@ -170,7 +178,7 @@ pub(super) fn fixed_fit<const P: usize>(
             .map(|k| k.iter().map(|&v| f64::from(v)).collect()),
         lambda: Some(fixed.lambda()),
         delta: Some(r.delta),
-        scale: Some(f64::from(fixed.scale())),
+        scale: Some(f64::from(fixed_channel.scale())),
         restarts: Some(health.restarts),
         saturated: Some(health.saturated),
         clipped: Some(health.clipped),

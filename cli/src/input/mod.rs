@@ -5,10 +5,10 @@ pub mod csv;
 
 use std::path::PathBuf;
 
-use imu_ar::recursive::Config;
+use imu_ar::recursive::Channel;
 
 use crate::error::{Fail, with_file};
-use crate::method::{DEFAULT_LAMBDA, MAX_ORDER};
+use crate::method::MAX_ORDER;
 
 /// One column of a record.
 #[derive(clap::Args)]
@@ -128,7 +128,7 @@ pub fn check_lambda(lambda: f64) -> Result<(), Fail> {
 
 /// A `--delta` that the f64 estimators can carry (the library's range check).
 pub fn check_delta(delta: f64) -> Result<(), Fail> {
-    Config::<f64>::new(DEFAULT_LAMBDA, delta, 1.0)
+    Channel::<f64>::new(delta)
         .map(|_| ())
         .map_err(|e| Fail(format!("--delta {delta}: {e}")))
 }

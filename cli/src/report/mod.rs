@@ -5,7 +5,7 @@ mod plot;
 use std::path::{Path, PathBuf};
 
 use imu_ar::batch::{BatchConfig, covariance};
-use imu_ar::recursive::Config;
+use imu_ar::recursive::{Channel, Config, Estimator};
 use serde::Serialize;
 
 use crate::error::Fail;
@@ -160,7 +160,7 @@ fn report<const P: usize>(r: &Report) -> Result<Summary, Fail> {
     let whole_fit = covariance::<f64, P>(x, &batch_config)?.model;
 
     // The recursive estimators over the whole record; their errors and coefficients sampled.
-    let config = Config::new(r.lambda, r.delta, dt)?;
+    let (config, channel) = (Config::new(r.lambda, dt)?, Channel::new(r.delta)?);
     // Only once the input has passed every check.
     std::fs::create_dir_all(r.out)
         .map_err(|e| Fail(format!("{}: cannot create: {e}", r.out.display())))?;
@@ -169,7 +169,7 @@ fn report<const P: usize>(r: &Report) -> Result<Summary, Fail> {
     let mut se = [vec![], vec![], vec![]];
     let mut block = [0.0; 3];
     let mut missing = 0usize;
-    let mut eval = predict(x, n_train, &train_fit, &config, |n, e, est| {
+    let mut eval = predict(x, n_train, &train_fit, &config, &channel, |n, e, est| {
         if n >= n_train && (e.rls.is_none() || e.lattice.is_none()) {
             missing += 1;
         }

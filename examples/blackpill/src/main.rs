@@ -15,7 +15,7 @@
 use cortex_m::peripheral::DWT;
 use cortex_m_rt::entry;
 use defmt_rtt as _;
-use imu_ar::recursive::{Config, Lattice};
+use imu_ar::recursive::{Channel, Config, Estimator, Lattice};
 use imu_ar::sensor::{AccelUnit, Error, GyroUnit, ImuReader, Mpu6050, Mpu6050Config, RawSample};
 use panic_probe as _;
 use stm32f4xx_hal::{i2c::I2c, pac, prelude::*};
@@ -69,19 +69,20 @@ fn main() -> ! {
         defmt::panic!("FIFO enable failed: {}", defmt::Debug2Format(&e));
     }
 
-    // Each channel's saturation limit comes from its own range: a clipped reading (at the
-    // rails of the i16 counts) is at or beyond it.
+    // One configuration for the six axes; each channel's regularisation (about 0.1 x its
+    // variance, in (deg/s)^2 or g^2) and saturation limit in its own units. The limit comes
+    // from the channel's range: a clipped reading (at the rails of the i16 counts) is at or
+    // beyond it.
     let scale = imu.scale();
-    let base =
-        Config::new(0.9995f32, 1e-4, 1.0 / config.sample_rate_hz()).expect("valid configuration");
-    let gyro = base
-        .with_saturation(scale.gyro_saturation(GyroUnit::DegPerSec))
-        .expect("valid gyro saturation limit");
-    let accel = base
-        .with_saturation(scale.accel_saturation(AccelUnit::G))
-        .expect("valid accel saturation limit");
-    let estimators = [gyro, gyro, gyro, accel, accel, accel];
-    let mut axes: [Lattice<f32, 4>; 6] = core::array::from_fn(|i| Lattice::new(&estimators[i]));
+    let shared = Config::new(0.9995f32, 1.0 / config.sample_rate_hz()).expect("valid configuration");
+    let gyro = Channel::new(1e-4)
+        .and_then(|c| c.with_saturation(scale.gyro_saturation(GyroUnit::DegPerSec)))
+        .expect("valid gyro channel");
+    let accel = Channel::new(1e-6)
+        .and_then(|c| c.with_saturation(scale.accel_saturation(AccelUnit::G)))
+        .expect("valid accel channel");
+    let mut axes: [Lattice<f32, 4>; 6] =
+        core::array::from_fn(|i| Lattice::new(&shared, if i < 3 { &gyro } else { &accel }));
     let mut batch = [RawSample::default(); 32];
     let mut samples = 0u32;
     // When a read last accounted for the FIFO: the start of an outage, by the board's clock.
@@ -118,19 +119,13 @@ fn main() -> ! {
         for s in &batch[..n] {
             let gyro = scale.gyro(s.gyro, GyroUnit::DegPerSec);
             let accel = scale.accel(s.accel, AccelUnit::G);
-            for ((lattice, estimator), x) in axes
-                .iter_mut()
-                .zip(&estimators)
-                .zip(gyro.into_iter().chain(accel))
-            {
-                lattice.update(estimator, x);
+            for (lattice, x) in axes.iter_mut().zip(gyro.into_iter().chain(accel)) {
+                lattice.update(&shared, x);
             }
             samples += 1;
             if samples.is_multiple_of(1000) {
-                for ((name, lattice), estimator) in
-                    NAMES.iter().zip(axes.iter_mut()).zip(&estimators)
-                {
-                    if let Some(m) = lattice.model(estimator) {
+                for (name, lattice) in NAMES.iter().zip(&axes) {
+                    if let Some(m) = lattice.model(&shared) {
                         defmt::info!(
                             "{=str}: a={=[?]} sigma^2={=f32} mean={=f32} {}",
                             name,
