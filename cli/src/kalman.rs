@@ -26,7 +26,7 @@ pub struct Args {
     #[arg(long, allow_negative_numbers = true)]
     rate: f64,
     /// Average blocks of M samples first; the model's rate becomes rate / M.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     decimate: usize,
     /// The filter's rate in Hz [default: the model's]. The model's rate must be an integer
     /// multiple of it, except for an AR(1) with a Gauss-Markov equivalent, which samples

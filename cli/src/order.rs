@@ -16,7 +16,7 @@ pub struct Args {
     #[command(flatten)]
     input: Input,
     /// Highest order, 1 to 32.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     max_order: usize,
     /// Estimator.
     #[arg(long, value_enum)]

@@ -22,7 +22,7 @@ pub struct Comparison {
     #[arg(long, allow_negative_numbers = true)]
     pub delta: Option<f64>,
     /// Average blocks of M samples first (a rate becomes rate / M).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     pub decimate: usize,
     /// Fraction of the record the batch model is fitted on, in (0, 1).
     #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]

@@ -27,16 +27,16 @@ pub struct Args {
     #[arg(long, allow_negative_numbers = true)]
     sigma: f64,
     /// Number of samples.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     n: usize,
     /// Seed of the ChaCha8 generator.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     seed: u64,
     /// Sample rate in Hz.
     #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     rate: f64,
     /// Samples drawn and discarded first.
-    #[arg(long, default_value_t = 1000)]
+    #[arg(long, default_value_t = 1000, allow_negative_numbers = true)]
     burn_in: usize,
     /// Coefficients at the last sample: they move linearly from `--a` to these over the
     /// record (a drifting process; burn-in uses `--a`).

@@ -27,11 +27,19 @@ fn main() -> ExitCode {
     let args: Vec<String> = env::args().skip(1).collect();
     match args.split_first() {
         Some((task, rest)) if task == "qemu" => match rest.split_first() {
+            Some((help, _)) if help == "-h" || help == "--help" => help_text(),
             Some((example, options)) if !example.starts_with('-') => qemu(example, options),
             _ => usage(),
         },
+        Some((help, _)) if help == "-h" || help == "--help" => help_text(),
         _ => usage(),
     }
+}
+
+/// Help asked for: the usage on stdout, status 0.
+fn help_text() -> ExitCode {
+    println!("{USAGE}");
+    ExitCode::SUCCESS
 }
 
 fn usage() -> ExitCode {
@@ -51,8 +59,7 @@ fn qemu(example: &str, options: &[String]) -> ExitCode {
         .args(options)
         .status();
     match status {
-        // A run ended by a signal has no code: report it as a failure.
-        Ok(s) => ExitCode::from(s.code().map_or(1, |c| u8::try_from(c).unwrap_or(1))),
+        Ok(s) => ExitCode::from(exit_code(s)),
         Err(e) => {
             eprintln!("cargo qemu: cannot run {}: {e}", cargo.to_string_lossy());
             ExitCode::from(1)
@@ -94,4 +101,18 @@ fn ensure_target() -> Result<(), String> {
     } else {
         Err(format!("`rustup target add {TARGET}` failed ({added})"))
     }
+}
+
+/// The status to exit with: the child's, or `128 + n` for a child ended by signal `n` (the
+/// shell's convention), with a line saying so.
+fn exit_code(status: std::process::ExitStatus) -> u8 {
+    if let Some(code) = status.code() {
+        return u8::try_from(code).unwrap_or(1);
+    }
+    #[cfg(unix)]
+    if let Some(signal) = std::os::unix::process::ExitStatusExt::signal(&status) {
+        eprintln!("cargo qemu: the build or run was ended by signal {signal}");
+        return u8::try_from(128 + signal).unwrap_or(1);
+    }
+    1
 }

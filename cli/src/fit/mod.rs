@@ -24,7 +24,7 @@ pub struct Args {
     #[arg(long, value_enum)]
     method: Method,
     /// Model order, 1 to 32.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     order: usize,
     /// Arithmetic of the recursive methods (the batch fits compute in f64).
     #[arg(long, value_enum, default_value = "f64")]
@@ -44,7 +44,7 @@ pub struct Args {
     #[arg(long)]
     no_demean: bool,
     /// Average blocks of M samples first (the rate, if given, becomes rate / M).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     decimate: usize,
     /// Sample rate in Hz; gives the model its time scale.
     #[arg(long, allow_negative_numbers = true)]

@@ -45,7 +45,7 @@ pub struct Record {
     #[command(flatten)]
     pub input: Input,
     /// Model order, 1 to 32.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub order: usize,
 }
 

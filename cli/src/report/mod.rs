@@ -72,6 +72,7 @@ pub struct Summary {
 
 /// Checks the settings, reads the record, and writes the plots.
 pub fn run(args: &Args) -> Result<Summary, Fail> {
+    check_out(&args.out)?;
     let run = &args.run;
     let rate = check_rate(args.rate)? / run.decimate.max(1) as f64;
     let reference = match &args.reference {
@@ -95,6 +96,29 @@ pub fn run(args: &Args) -> Result<Summary, Fail> {
         out: &args.out,
     };
     with_order!(run.record.order, report(&r)).map_err(|Fail(e)| run.record.input.fail(e))
+}
+
+/// Whether `out` can be a directory: it is one, or its nearest existing ancestor is one.
+/// Checked before the input is read, so that its error names the output, not the input;
+/// the directory itself is made only once the input has passed every check.
+fn check_out(out: &Path) -> Result<(), Fail> {
+    let blocked = out
+        .ancestors()
+        .filter(|p| !p.as_os_str().is_empty())
+        .find(|p| p.exists())
+        .filter(|p| !p.is_dir());
+    match blocked {
+        Some(p) if p == out => Err(Fail(format!(
+            "{}: cannot create: it exists and is not a directory",
+            out.display()
+        ))),
+        Some(p) => Err(Fail(format!(
+            "{}: cannot create: {} is not a directory",
+            out.display(),
+            p.display()
+        ))),
+        None => Ok(()),
+    }
 }
 
 /// `(tau_s, adev)` of `channel` from a published Allan table.

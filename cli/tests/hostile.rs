@@ -11,7 +11,16 @@ fn an_uncreatable_out_dir_is_not_blamed_on_the_input() {
     let input = simulated("red_out_dir.csv", "0.5", "400", "1");
     let input = input.to_str().unwrap();
     let out = imu_ar(&[
-        "report", input, "--column", "x", "--order", "2", "--rate", "100", "--out", "/dev/null/x",
+        "report",
+        input,
+        "--column",
+        "x",
+        "--order",
+        "2",
+        "--rate",
+        "100",
+        "--out",
+        "/dev/null/x",
     ]);
     assert_eq!(out.status.code(), Some(2));
     assert!(out.stdout.is_empty());
@@ -25,7 +34,9 @@ fn an_uncreatable_out_dir_is_not_blamed_on_the_input() {
 /// A negative `--n` names the argument it was meant for.
 #[test]
 fn a_negative_count_names_its_argument() {
-    let out = imu_ar(&["simulate", "--a", "0.5", "--sigma", "1", "--n", "-3", "--seed", "1"]);
+    let out = imu_ar(&[
+        "simulate", "--a", "0.5", "--sigma", "1", "--n", "-3", "--seed", "1",
+    ]);
     assert_eq!(out.status.code(), Some(2));
     assert!(out.stdout.is_empty());
     let err = stderr(&out);

@@ -23,7 +23,14 @@ fn scratch(name: &str) -> Dir {
 
 fn script(dir: &Path, name: &str, body: &str) {
     let path = dir.join(name);
-    fs::write(&path, format!("#!/bin/sh\necho \"$@\" >> '{}'\n{body}", dir.join(format!("{name}.log")).display())).unwrap();
+    fs::write(
+        &path,
+        format!(
+            "#!/bin/sh\necho \"$@\" >> '{}'\n{body}",
+            dir.join(format!("{name}.log")).display()
+        ),
+    )
+    .unwrap();
     fs::set_permissions(&path, fs::Permissions::from_mode(0o755)).unwrap();
 }
 
@@ -34,7 +41,9 @@ fn run(dir: &Path, args: &[&str], path_only_dir: bool, cargo_env: bool) -> Outpu
         cmd.env("PATH", dir);
     } else {
         let mut paths = vec![dir.to_path_buf()];
-        paths.extend(std::env::split_paths(&std::env::var_os("PATH").unwrap_or_default()));
+        paths.extend(std::env::split_paths(
+            &std::env::var_os("PATH").unwrap_or_default(),
+        ));
         cmd.env("PATH", std::env::join_paths(paths).unwrap());
     }
     if cargo_env {
@@ -49,7 +58,8 @@ fn log(dir: &Path, tool: &str) -> String {
     fs::read_to_string(dir.join(format!("{tool}.log"))).unwrap_or_default()
 }
 
-const LISTED: &str = "if [ \"$1 $2 $3\" = 'target list --installed' ]; then printf 'thumbv7em-none-eabihf\\n'; fi\n";
+const LISTED: &str =
+    "if [ \"$1 $2 $3\" = 'target list --installed' ]; then printf 'thumbv7em-none-eabihf\\n'; fi\n";
 
 /// A build (or QEMU under the runner) killed by a signal: the shell convention is status
 /// 128 + signal (143 for SIGTERM, 130 for Ctrl-C), so a script can tell it from a firmware
@@ -77,7 +87,8 @@ fn help_is_not_an_error() {
     for args in [&["qemu", "--help"][..], &["qemu", "-h"], &["--help"]] {
         let out = run(&d.0, args, false, true);
         assert_eq!(out.status.code(), Some(0), "{args:?}");
-        let all = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
+        let all = String::from_utf8_lossy(&out.stdout).into_owned()
+            + &String::from_utf8_lossy(&out.stderr);
         assert!(all.contains("usage: cargo qemu <example>"), "{args:?}");
     }
     assert_eq!(log(&d.0, "cargo"), "");
@@ -87,7 +98,11 @@ fn help_is_not_an_error() {
 #[test]
 fn an_installed_target_with_odd_whitespace_is_left_alone() {
     let d = scratch("ws");
-    script(&d.0, "rustup", "if [ \"$1 $2 $3\" = 'target list --installed' ]; then printf '  x86_64-unknown-linux-gnu\\r\\n\\tthumbv7em-none-eabihf  \\r\\n'; fi\n");
+    script(
+        &d.0,
+        "rustup",
+        "if [ \"$1 $2 $3\" = 'target list --installed' ]; then printf '  x86_64-unknown-linux-gnu\\r\\n\\tthumbv7em-none-eabihf  \\r\\n'; fi\n",
+    );
     script(&d.0, "cargo", "exit 0\n");
     let out = run(&d.0, &["qemu", "demo"], false, true);
     assert!(out.status.success());
@@ -101,7 +116,12 @@ fn no_rustup_and_no_cargo_env() {
     let d = scratch("norustup");
     script(&d.0, "cargo", "exit 3\n");
     let out = run(&d.0, &["qemu", "demo", "--", "arg with space"], true, false);
-    assert_eq!(out.status.code(), Some(3), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(
+        out.status.code(),
+        Some(3),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert_eq!(
         log(&d.0, "cargo"),
         "run --release --target thumbv7em-none-eabihf --example demo -- arg with space\n"
