@@ -8,7 +8,7 @@ use common::{imu_ar, simulated, stderr};
 /// the message starts with the directory, not `in.csv: `.
 #[test]
 fn an_uncreatable_out_dir_is_not_blamed_on_the_input() {
-    let input = simulated("red_out_dir.csv", "0.5", "400", "1");
+    let input = simulated("out_dir_input.csv", "0.5", "400", "1");
     let input = input.to_str().unwrap();
     let out = imu_ar(&[
         "report",
