@@ -2,7 +2,7 @@
 //! hand-off of recorded sensor logs, computed by the estimators of the `imu-ar` library.
 //!
 //! One module per command ([`fit`], [`order`], [`adev`], [`compare`], [`report`], [`kalman`],
-//! [`parity`], [`simulate`]), each with its arguments (`Args`), a `run` that checks them and
+//! [`parity`], [`simulate`], [`noise`]), each with its arguments (`Args`), a `run` that checks them and
 //! returns a typed result, and that result's text. What the commands share: [`input`] reads a
 //! record ([`input::csv`] is the CSV reader), [`method`] names the estimators, [`predict`] runs
 //! them for `compare` and `report`, [`output`] prints a result as JSON or text, [`error`] is
@@ -10,12 +10,14 @@
 #![deny(missing_docs)]
 
 pub mod adev;
+pub mod chart;
 pub mod compare;
 pub mod error;
 pub mod fit;
 pub mod input;
 pub mod kalman;
 pub mod method;
+pub mod noise;
 pub mod order;
 pub mod output;
 pub mod parity;

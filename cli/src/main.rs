@@ -8,6 +8,8 @@
 //!     [--json]
 //! imu-ar report FILE.. --column C --order P --rate HZ --out DIR [--lambda L] [--delta D]
 //!     [--decimate M] [--train F] [--unit U] [--reference TABLE]
+//! imu-ar noise FILE.. --column C --rate HZ [--gm-states K] [--ar-order P] [--oscillators]
+//!     [--ramp] [--filter-rate HZ] [--decimate M] [--unit U] [--json] [--plot FILE.png]
 //! imu-ar order FILE.. --column C --max-order P --method ls|yule-walker|burg [--no-demean] [--json]
 //! imu-ar adev FILE.. --column C --rate HZ [--json]
 //! imu-ar kalman FILE.. --column C --order P --rate HZ [--method ls|yule-walker|burg] [--decimate M]
@@ -27,7 +29,7 @@ use std::process::ExitCode;
 use clap::{CommandFactory, Parser, Subcommand};
 use imu_ar_cli::error::{Fail, clap_error, escaped};
 use imu_ar_cli::output::{json_line, render};
-use imu_ar_cli::{adev, compare, fit, kalman, order, parity, report, simulate};
+use imu_ar_cli::{adev, compare, fit, kalman, noise, order, parity, report, simulate};
 
 #[derive(Parser)]
 #[command(
@@ -56,6 +58,11 @@ enum Command {
     /// the filter's rate, the Gauss-Markov form of an AR(1), and the Allan check that the model
     /// explains the data's Allan deviation.
     Kalman(kalman::Args),
+    /// The composite noise model a navigation filter needs (white noise, quantisation,
+    /// Gauss-Markov terms, random walk, an AR part for the short-term colouring), fitted to the
+    /// Allan variance, checked at every averaging time, with its IEEE 952 readings and its
+    /// `Phi`, `Q` and `P0` at the filter's rate.
+    Noise(noise::Args),
     /// Order criteria (AIC, AICc, BIC, FPE) of orders 0..=P.
     Order(order::Args),
     /// Overlapping Allan deviation at m = 1, 2, 4, ...
@@ -89,6 +96,7 @@ fn run(command: Command) -> Result<String, Fail> {
         Command::Compare(args) => render(&compare::run(&args)?, args.json),
         Command::Report(args) => json_line(&report::run(&args)?),
         Command::Kalman(args) => render(&kalman::run(&args)?, args.json),
+        Command::Noise(args) => render(&noise::run(&args)?, args.json),
         Command::Order(args) => render(&order::run(&args)?, args.json),
         Command::Adev(args) => render(&adev::run(&args)?, args.json),
         Command::Parity => render(&parity::run()?, false),

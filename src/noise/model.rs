@@ -169,6 +169,10 @@ pub struct AllanRow {
     pub data_adev: f64,
     /// The model's Allan deviation, u.
     pub model_adev: f64,
+    /// The relative standard error of the measured deviation, `1 / sqrt(2 nu)`, with the
+    /// degrees of freedom `nu` of the estimator and of the noise type that dominates the model
+    /// there.
+    pub standard_error: f64,
     /// Two standard errors of the measured deviation, `2 / sqrt(2 nu)`, or 0.1 where that is
     /// larger, as a fraction.
     pub tolerance: f64,
@@ -340,11 +344,13 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
             let m = 1u64 << j.min(63);
             let nu = octaves.edf(j, self.dominant(m).0);
             let (data_adev, model_adev) = (libm::sqrt(*d), libm::sqrt(model[j]));
-            let tolerance = (2.0 / libm::sqrt(2.0 * nu)).max(0.1);
+            let standard_error = 1.0 / libm::sqrt(2.0 * nu);
+            let tolerance = (2.0 * standard_error).max(0.1);
             *row = AllanRow {
                 tau: octaves.tau(j),
                 data_adev,
                 model_adev,
+                standard_error,
                 tolerance,
                 agrees: libm::fabs(data_adev / model_adev - 1.0) <= tolerance,
             };

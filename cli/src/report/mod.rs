@@ -8,12 +8,13 @@ use imu_ar::batch::{BatchConfig, covariance};
 use imu_ar::recursive::{Channel, Config, Estimator};
 use serde::Serialize;
 
+use crate::chart::font;
 use crate::error::Fail;
 use crate::input::{check_rate, check_span, csv};
 use crate::method::with_order;
 use crate::output::finite;
 use crate::predict::{Comparison, predict};
-use plot::{adev_png, coefficients_png, error_png, font, psd_png};
+use plot::{adev_png, coefficients_png, error_png, psd_png};
 
 /// The arguments of `imu-ar report`.
 #[derive(clap::Args)]

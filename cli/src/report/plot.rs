@@ -8,48 +8,8 @@ use plotters::prelude::*;
 use rustfft::{FftPlanner, num_complex::Complex};
 
 use super::{Report, Track};
+use crate::chart::{SIZE, builder, draw_err, legend};
 use crate::error::Fail;
-
-const SIZE: (u32, u32) = (960, 600);
-
-/// Registers the embedded DejaVu Sans as the plots' font (no system fonts needed).
-pub(super) fn font() -> Result<(), Fail> {
-    plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular())
-        .map_err(|_| Fail("cannot load the embedded font".into()))
-}
-
-fn draw_err(e: impl std::fmt::Debug) -> Fail {
-    Fail(format!("drawing failed: {e:?}"))
-}
-
-/// A chart on `root` with the report's caption, margins and label areas.
-fn builder<'a, 'b, DB: DrawingBackend>(
-    root: &'a DrawingArea<DB, plotters::coord::Shift>,
-    caption: String,
-    y_labels: u32,
-) -> ChartBuilder<'a, 'b, DB> {
-    let mut builder = ChartBuilder::on(root);
-    builder
-        .caption(caption, ("sans-serif", 20))
-        .margin(12)
-        .x_label_area_size(45)
-        .y_label_area_size(y_labels);
-    builder
-}
-
-/// The legend of every series that has a label.
-fn legend<'a, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTranslate>(
-    chart: &mut ChartContext<'a, DB, CT>,
-    position: SeriesLabelPosition,
-) -> Result<(), Fail> {
-    chart
-        .configure_series_labels()
-        .position(position)
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
-        .map_err(draw_err)
-}
 
 fn caption(r: &Report, what: &str) -> String {
     format!(

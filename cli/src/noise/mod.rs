@@ -1,0 +1,538 @@
+//! `imu-ar noise`: the composite noise model of one axis, fitted to the record's overlapping
+//! Allan variance (`imu_ar::noise`): white noise, quantisation, first-order Gauss-Markov terms
+//! (and, with `--oscillators`, second-order ones), random walk, rate ramp and an AR part for
+//! the sensor's short-term colouring; checked at every averaging time and handed to a Kalman
+//! filter as `Phi`, `Q` and `P0`.
+
+mod plot;
+mod units;
+
+use std::path::PathBuf;
+
+use imu_ar::ArModel;
+use imu_ar::batch::criteria::Criterion;
+use imu_ar::batch::{BatchConfig, burg};
+use imu_ar::noise::{Check, FitConfig, Ieee952, KalmanForm, NoiseError, NoiseModel, Octaves};
+use serde::Serialize;
+
+use crate::error::Fail;
+use crate::input::{Input, check_decimate, check_order, check_rate, check_span};
+use crate::kalman::AllanRow;
+use crate::method::with_order;
+use crate::output::{Output, json};
+use units::Units;
+
+/// The most Kalman states the tool gives the Gauss-Markov terms (`--gm-states`).
+pub const MAX_GM_STATES: usize = 8;
+
+/// The highest AR order that the automatic choice (BIC) considers.
+pub const AUTO_AR_ORDER: usize = 8;
+
+/// Octaves held: `m = 1 .. 2^31` samples.
+const OCTAVES: usize = 32;
+
+/// The arguments of `imu-ar noise`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The column.
+    #[command(flatten)]
+    input: Input,
+    /// Sample rate in Hz of the raw record.
+    #[arg(long, allow_negative_numbers = true)]
+    rate: f64,
+    /// The Kalman states the Gauss-Markov terms may take, 0 to 8 (an oscillator takes two).
+    #[arg(long, default_value_t = 3, allow_negative_numbers = true)]
+    gm_states: usize,
+    /// Order of the AR part (the sensor's short-term colouring), 1 to 32, or 0 for none
+    /// [default: the order 0 to 8 that BIC selects].
+    #[arg(long, allow_negative_numbers = true)]
+    ar_order: Option<usize>,
+    /// Allow second-order Gauss-Markov terms (damped oscillators, two states each) for a
+    /// spectral line between 0.1 Hz and an eighth of the rate.
+    #[arg(long)]
+    oscillators: bool,
+    /// Fit a rate ramp too (in a static record, usually a temperature drift).
+    #[arg(long)]
+    ramp: bool,
+    /// The filter's rate in Hz for `phi`, `q` and `p0` [default: the model's rate].
+    #[arg(long, allow_negative_numbers = true)]
+    filter_rate: Option<f64>,
+    /// Average blocks of M samples first; the model's rate becomes rate / M.
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
+    decimate: usize,
+    /// The column's unit. deg/s, rad/s, g and m/s^2 are converted to the IEEE 952 units in
+    /// the text output (deg/sqrt(h), deg/h, ...); any other is a label.
+    #[arg(long, default_value = "units")]
+    unit: String,
+    /// Print one JSON object.
+    #[arg(long)]
+    pub json: bool,
+    /// Draw the decomposition plot (data with standard errors, model, components) into this
+    /// PNG file.
+    #[arg(long)]
+    plot: Option<PathBuf>,
+}
+
+/// Bias instability: the minimum Allan deviation of the data over 0.664, and where it is.
+#[derive(Serialize)]
+pub struct BiasInstability {
+    /// `B`, in the column's unit.
+    pub value: f64,
+    /// The `tau` of the minimum, s.
+    pub tau_s: f64,
+}
+
+/// A Gauss-Markov term. A second-order term (an oscillator) has a frequency too.
+#[derive(Serialize)]
+pub struct GmEntry {
+    /// Stationary standard deviation, in the column's unit.
+    pub sigma: f64,
+    /// Correlation time (an oscillator's decay time), s.
+    pub correlation_time_s: f64,
+    /// An oscillator's centre frequency, Hz.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub frequency_hz: Option<f64>,
+}
+
+/// The AR part: coefficients from the batch (Burg) fit, innovation variance scaled by the
+/// noise fit.
+#[derive(Serialize)]
+pub struct ArPart {
+    /// `p`.
+    pub order: usize,
+    /// `a_1..a_p`.
+    pub a: Vec<f64>,
+    /// Innovation variance in the model (the Burg fit's times `scale`).
+    pub noise_variance: f64,
+    /// The factor the noise fit put on the Burg fit's innovation variance.
+    pub scale: f64,
+}
+
+/// What the text output adds to the JSON object.
+#[derive(Default)]
+pub struct Details {
+    unit: String,
+    filter_rate_hz: f64,
+    states: Vec<String>,
+    white_term: f64,
+    white_noise_at_1s: Option<f64>,
+    measurement_variance: f64,
+}
+
+/// The composite model of one axis, its filter form and its Allan check.
+#[derive(Serialize)]
+pub struct NoiseResult {
+    /// The model's rate in Hz (after `--decimate`).
+    pub rate_hz: f64,
+    /// Samples fitted.
+    pub n: usize,
+    /// `N` of the whole model (white term and the AR part's white equivalent), u/sqrt(Hz).
+    pub white_noise: Option<f64>,
+    /// `Q`, u s.
+    pub quantization: Option<f64>,
+    /// `K`, u/s/sqrt(Hz).
+    pub random_walk: Option<f64>,
+    /// `R`, u/s.
+    pub rate_ramp: Option<f64>,
+    /// `B` and its `tau`.
+    pub bias_instability: BiasInstability,
+    /// The Gauss-Markov terms: first order by correlation time, then the oscillators.
+    pub gauss_markov: Vec<GmEntry>,
+    /// The AR part, or `None`.
+    pub ar: Option<ArPart>,
+    /// The filter's transition over one step: the Gauss-Markov states, the oscillators' state
+    /// pairs, the random-walk state, in that order.
+    pub phi: Vec<Vec<f64>>,
+    /// The process noise of one step.
+    pub q: Vec<Vec<f64>>,
+    /// The stationary covariance (for the random walk: its variance over the record).
+    pub p0: Vec<Vec<f64>>,
+    /// The Allan check at every octave.
+    pub allan: Vec<AllanRow>,
+    /// The largest `tau` (s) up to which every row agrees.
+    pub explained_up_to_s: Option<f64>,
+    /// For the text output.
+    #[serde(skip)]
+    pub details: Details,
+}
+
+/// Checks the settings, reads the record, fits and checks the model and draws its plot.
+pub fn run(args: &Args) -> Result<NoiseResult, Fail> {
+    let rate = check_rate(args.rate)?;
+    check_decimate(args.decimate)?;
+    if args.gm_states > MAX_GM_STATES {
+        return Err(Fail(format!(
+            "--gm-states {}: at most {MAX_GM_STATES}",
+            args.gm_states
+        )));
+    }
+    if let Some(p) = args.ar_order.filter(|p| *p > 0) {
+        check_order("--ar-order", p)?;
+    }
+    let filter_rate = match args.filter_rate {
+        Some(f) => Some(check_rate(f).map_err(|_| {
+            Fail(format!(
+                "--filter-rate {f}: must be a positive number of Hz"
+            ))
+        })?),
+        None => None,
+    };
+    if let Some(path) = &args.plot {
+        plot::check_path(path)?;
+    }
+    let x = args.input.load(args.decimate)?;
+    check_span("--rate", rate, x.len())?;
+    let rate = rate / args.decimate as f64;
+    let fit = Fitting {
+        x: &x,
+        rate,
+        filter_rate: filter_rate.unwrap_or(rate),
+        config: FitConfig::new(args.gm_states)
+            .with_oscillators(args.oscillators)
+            .with_ramp(args.ramp),
+        units: Units::of(&args.unit),
+        plot: args.plot.as_deref(),
+    };
+    let octaves =
+        Octaves::<OCTAVES>::overlapping(&x, 1.0 / rate).map_err(|e| args.input.fail(e))?;
+    if octaves.avar().len() < 2 {
+        return Err(args.input.fail(NoiseError::TooFewOctaves {
+            given: octaves.avar().len(),
+        }));
+    }
+    if x.iter().all(|v| *v == x[0]) {
+        return Err(args.input.fail(
+            "the record is constant (a stuck sensor?): every Allan variance is zero, there is \
+             no noise to model",
+        ));
+    }
+    let order = match args.ar_order {
+        Some(p) => p,
+        None => bic_order(&x, rate).map_err(|Fail(e)| args.input.fail(e))?,
+    };
+    match order {
+        0 => fit.model::<1>(&octaves, None),
+        p => with_order!(p, ar_part(&fit, &octaves)),
+    }
+    .map_err(|Fail(e)| args.input.fail(e))
+}
+
+/// The order `0..=8` (fewer for a short record) that BIC selects for a Burg fit.
+fn bic_order(x: &[f64], rate: f64) -> Result<usize, Fail> {
+    // Burg needs P + 2 samples with the mean removed.
+    let top = AUTO_AR_ORDER.min(x.len().saturating_sub(2));
+    if top == 0 {
+        return Ok(0);
+    }
+    let fit = with_order!(top, burg_fit(x, rate))?;
+    let variances = (0..=top).map(|m| fit.0.get(m).copied().unwrap_or(f64::NAN));
+    Ok(Criterion::Bic.select(fit.1, variances))
+}
+
+/// The innovation variances of orders `0..=P` of a Burg fit, and its effective length.
+fn burg_fit<const P: usize>(x: &[f64], rate: f64) -> Result<(Vec<f64>, usize), Fail> {
+    let fit = burg::<f64, P>(x, &BatchConfig::new(1.0 / rate)?)?;
+    let variances = (0..=P).filter_map(|m| fit.innovation_variance(m)).collect();
+    Ok((variances, fit.n_effective))
+}
+
+/// The Burg AR(`P`) fit of the record, and the composite with it as its AR part.
+fn ar_part<const P: usize>(fit: &Fitting, octaves: &Octaves<OCTAVES>) -> Result<NoiseResult, Fail> {
+    let ar = burg::<f64, P>(fit.x, &BatchConfig::new(1.0 / fit.rate)?)
+        .map_err(|e| Fail(format!("--ar-order {P}: {e}")))?
+        .model;
+    fit.model::<P>(octaves, Some(&ar))
+}
+
+/// One fit's inputs.
+struct Fitting<'a> {
+    x: &'a [f64],
+    rate: f64,
+    filter_rate: f64,
+    config: FitConfig,
+    units: Units,
+    plot: Option<&'a std::path::Path>,
+}
+
+impl Fitting<'_> {
+    /// Fits the composite with the AR part `ar`, checks it, and hands it over.
+    fn model<const P: usize>(
+        &self,
+        octaves: &Octaves<OCTAVES>,
+        ar: Option<&ArModel<f64, P>>,
+    ) -> Result<NoiseResult, Fail> {
+        let model = NoiseModel::<P, MAX_GM_STATES>::fit(octaves, ar, &self.config)?;
+        let check = model.check(octaves)?;
+        let span = self.x.len() as f64 / self.rate;
+        // The random walk's state starts with the variance it reaches over the record.
+        let rw_p0 = model.random_walk() * model.random_walk() * span;
+        let form = model.kalman(1.0 / self.filter_rate, rw_p0)?;
+        if let Some(path) = self.plot {
+            plot::decomposition_png(path, &model, octaves, &check, &self.caption(&model))?;
+        }
+        Ok(self.result(&model, ar, &model.ieee952(octaves), &form, &check))
+    }
+
+    fn caption<const P: usize>(&self, model: &NoiseModel<P, MAX_GM_STATES>) -> String {
+        let ar = model
+            .ar()
+            .map_or(String::new(), |_| format!(", AR({P}) part"));
+        format!(
+            "Allan deviation (n = {}, {} Hz{ar}), in {}",
+            self.x.len(),
+            self.rate,
+            self.units.name
+        )
+    }
+
+    fn result<const P: usize>(
+        &self,
+        model: &NoiseModel<P, MAX_GM_STATES>,
+        ar: Option<&ArModel<f64, P>>,
+        ieee: &Ieee952,
+        form: &KalmanForm<MAX_GM_STATES>,
+        check: &Check<OCTAVES>,
+    ) -> NoiseResult {
+        let positive = |v: f64| (v > 0.0).then_some(v);
+        let mut gauss_markov: Vec<GmEntry> = model
+            .gauss_markov()
+            .iter()
+            .map(|t| GmEntry {
+                sigma: t.sigma,
+                correlation_time_s: t.correlation_time,
+                frequency_hz: None,
+            })
+            .collect();
+        gauss_markov.extend(model.oscillators().iter().map(|o| GmEntry {
+            sigma: o.sigma,
+            correlation_time_s: o.decay_time,
+            frequency_hz: Some(o.frequency),
+        }));
+        let ar_part = model.ar().zip(ar).map(|(used, fitted)| ArPart {
+            order: P,
+            a: used.a().to_vec(),
+            noise_variance: used.noise_variance(),
+            scale: used.noise_variance() / fitted.noise_variance(),
+        });
+        let blocks = Blocks::of(form);
+        NoiseResult {
+            rate_hz: self.rate,
+            n: self.x.len(),
+            white_noise: positive(ieee.white_noise),
+            quantization: positive(ieee.quantization),
+            random_walk: positive(ieee.random_walk),
+            rate_ramp: positive(ieee.ramp),
+            bias_instability: BiasInstability {
+                value: ieee.bias_instability.0,
+                tau_s: ieee.bias_instability.1,
+            },
+            gauss_markov,
+            ar: ar_part,
+            phi: blocks.matrix(|b| b.phi),
+            q: blocks.matrix(|b| b.q),
+            p0: blocks.matrix(|b| b.p0),
+            allan: check
+                .rows()
+                .iter()
+                .map(|r| AllanRow {
+                    tau_s: r.tau,
+                    data_adev: r.data_adev,
+                    model_adev: r.model_adev,
+                    data_over_model: r.data_adev / r.model_adev,
+                    tolerance: r.tolerance,
+                    agrees: r.agrees,
+                })
+                .collect(),
+            explained_up_to_s: check.explained_up_to(),
+            details: Details {
+                unit: self.units.name.clone(),
+                filter_rate_hz: self.filter_rate,
+                states: blocks.names,
+                white_term: model.white_term(),
+                white_noise_at_1s: ieee.white_noise_at_1s,
+                measurement_variance: form.measurement_variance,
+            },
+        }
+    }
+}
+
+/// A diagonal block of the filter: one state, or an oscillator's pair.
+struct Block {
+    phi: [[f64; 2]; 2],
+    q: [[f64; 2]; 2],
+    p0: [[f64; 2]; 2],
+    size: usize,
+}
+
+/// The filter's states as diagonal blocks, and their names.
+struct Blocks {
+    blocks: Vec<Block>,
+    names: Vec<String>,
+}
+
+impl Blocks {
+    fn of(form: &KalmanForm<MAX_GM_STATES>) -> Self {
+        let one = |v: f64| [[v, 0.0], [0.0, 0.0]];
+        let mut blocks = Vec::new();
+        let mut names = Vec::new();
+        for (i, s) in form.gm[..form.gm_len].iter().enumerate() {
+            blocks.push(Block {
+                phi: one(s.phi),
+                q: one(s.q),
+                p0: one(s.p0),
+                size: 1,
+            });
+            names.push(format!("gauss_markov[{i}]"));
+        }
+        for (i, s) in form.osc[..form.osc_len].iter().enumerate() {
+            blocks.push(Block {
+                phi: s.phi,
+                q: s.q,
+                p0: s.p0,
+                size: 2,
+            });
+            let k = form.gm_len + i;
+            names.push(format!("gauss_markov[{k}] (x)"));
+            names.push(format!("gauss_markov[{k}] (dx/dt)"));
+        }
+        if let Some(s) = form.random_walk {
+            blocks.push(Block {
+                phi: one(s.phi),
+                q: one(s.q),
+                p0: one(s.p0),
+                size: 1,
+            });
+            names.push("random_walk".into());
+        }
+        Self { blocks, names }
+    }
+
+    /// The block-diagonal matrix of `part` of each block.
+    fn matrix(&self, part: impl Fn(&Block) -> [[f64; 2]; 2]) -> Vec<Vec<f64>> {
+        let n = self.names.len();
+        let mut m = vec![vec![0.0; n]; n];
+        let mut at = 0;
+        for b in &self.blocks {
+            let v = part(b);
+            for (i, row) in v.iter().enumerate().take(b.size) {
+                m[at + i][at..at + b.size].copy_from_slice(&row[..b.size]);
+            }
+            at += b.size;
+        }
+        m
+    }
+}
+
+impl Output for NoiseResult {
+    fn text(&self) -> String {
+        let d = &self.details;
+        let u = Units::of(&d.unit);
+        let mut s = format!(
+            "composite noise model of {} samples at {} Hz, unit {}\n",
+            self.n,
+            json(&self.rate_hz),
+            d.unit
+        );
+        let n = self.white_noise.unwrap_or(0.0);
+        s += &format!(
+            "white_noise {} {}{}\n",
+            json(&self.white_noise),
+            u.psd_root(),
+            u.arw(n)
+        );
+        s += &format!(
+            "  white term {}, AR part's white equivalent {}; Allan deviation at tau = 1 s: {}\n",
+            json(&d.white_term),
+            json(&(n * n - d.white_term * d.white_term).max(0.0).sqrt()),
+            json(&d.white_noise_at_1s)
+        );
+        s += &format!(
+            "quantization {}{}\n",
+            json(&self.quantization),
+            unit(self.quantization, &format!("{} s", u.name))
+        );
+        s += &format!("random_walk {}", json(&self.random_walk));
+        if let Some(k) = self.random_walk {
+            s += &format!(" {}/s{}", u.psd_root(), u.rrw(k));
+        }
+        s += "\n";
+        s += &format!(
+            "rate_ramp {}{}\n",
+            json(&self.rate_ramp),
+            unit(self.rate_ramp, &format!("{}/s", u.name))
+        );
+        let b = &self.bias_instability;
+        s += &format!(
+            "bias_instability {} {}{} at tau_s {}\n",
+            json(&b.value),
+            u.name,
+            u.bias(b.value),
+            json(&b.tau_s)
+        );
+        for (i, t) in self.gauss_markov.iter().enumerate() {
+            s += &format!(
+                "gauss_markov[{i}] sigma {} correlation_time_s {}",
+                json(&t.sigma),
+                json(&t.correlation_time_s)
+            );
+            if let Some(f) = t.frequency_hz {
+                s += &format!(" frequency_hz {} (second order: two states)", json(&f));
+            }
+            s += "\n";
+        }
+        match &self.ar {
+            Some(ar) => {
+                s += &format!(
+                    "ar order {} a {} noise_variance {} scale {}\n  \
+                     in the filter as its white equivalent (in white_noise); for the \
+                     short-term colouring, its companion form: imu-ar kalman --order {}\n",
+                    ar.order,
+                    json(&ar.a),
+                    json(&ar.noise_variance),
+                    json(&ar.scale),
+                    ar.order
+                )
+            }
+            None => s += "ar null\n",
+        }
+        s += &format!(
+            "filter at {} Hz; states: {}\n",
+            json(&d.filter_rate_hz),
+            if d.states.is_empty() {
+                "none".to_string()
+            } else {
+                d.states.join(", ")
+            }
+        );
+        s += &format!(
+            "phi {}\nq {}\np0 {}\nmeasurement_variance {} (N^2 / Dt + 2 Q^2 / Dt^2)\n",
+            json(&self.phi),
+            json(&self.q),
+            json(&self.p0),
+            json(&d.measurement_variance)
+        );
+        s += "# tau_s data_adev model_adev data/model tolerance agrees\n";
+        for r in &self.allan {
+            s += &format!(
+                "{} {:e} {:e} {:.3} {:.3} {}\n",
+                json(&r.tau_s),
+                r.data_adev,
+                r.model_adev,
+                r.data_over_model,
+                r.tolerance,
+                if r.agrees { "yes" } else { "NO" }
+            );
+        }
+        s += &format!("explained_up_to_s {}\n", json(&self.explained_up_to_s));
+        for line in plot::failures(&self.allan) {
+            s += &line;
+            s += "\n";
+        }
+        s
+    }
+}
+
+/// ` unit` after a value that is there.
+fn unit(v: Option<f64>, unit: &str) -> String {
+    v.map_or(String::new(), |_| format!(" {unit}"))
+}

@@ -1,0 +1,99 @@
+//! The IEEE Std 952-1997 units of the text output: a gyro in deg/s or rad/s, an accelerometer
+//! in g or m/s^2. The JSON keeps the column's own unit `u` (`N` in u/sqrt(Hz), `K` in
+//! u/s/sqrt(Hz), `B` in u).
+
+/// Standard gravity, m/s^2.
+const G: f64 = 9.806_65;
+
+/// What the column measures, by its unit.
+#[derive(Clone, Copy, PartialEq)]
+enum Kind {
+    /// A rate gyro in deg/s or rad/s (the angle unit).
+    Gyro(&'static str),
+    /// An accelerometer, with the factor to m/s^2.
+    Accelerometer(f64),
+    /// Any other unit: a label.
+    Other,
+}
+
+/// The column's unit and its conversions.
+pub struct Units {
+    /// The unit as given.
+    pub name: String,
+    kind: Kind,
+}
+
+impl Units {
+    /// The unit named `name` (`deg/s`, `rad/s`, `g`, `m/s^2`; anything else is a label).
+    pub fn of(name: &str) -> Self {
+        let kind = match name {
+            "deg/s" | "dps" => Kind::Gyro("deg"),
+            "rad/s" => Kind::Gyro("rad"),
+            "g" => Kind::Accelerometer(G),
+            "m/s^2" | "m/s2" => Kind::Accelerometer(1.0),
+            _ => Kind::Other,
+        };
+        Self {
+            name: name.to_string(),
+            kind,
+        }
+    }
+
+    /// The unit of `N`, u/sqrt(Hz).
+    pub fn psd_root(&self) -> String {
+        format!("{}/sqrt(Hz)", self.name)
+    }
+
+    /// `N` as angle random walk in deg/sqrt(h) (a gyro), or velocity random walk in
+    /// m/s/sqrt(h) (an accelerometer): ` = ...`, or nothing.
+    pub fn arw(&self, n: f64) -> String {
+        match self.kind {
+            Kind::Gyro(angle) => format!(" = {} {angle}/sqrt(h)", short(60.0 * n)),
+            Kind::Accelerometer(to_si) => format!(" = {} m/s/sqrt(h)", short(60.0 * n * to_si)),
+            Kind::Other => String::new(),
+        }
+    }
+
+    /// `K` of a gyro in deg/h/sqrt(h) (`216000 K`), or nothing.
+    pub fn rrw(&self, k: f64) -> String {
+        match self.kind {
+            Kind::Gyro(angle) => format!(" = {} {angle}/h/sqrt(h)", short(3600.0 * 60.0 * k)),
+            _ => String::new(),
+        }
+    }
+
+    /// `B` of a gyro in deg/h, of an accelerometer in micro-g: ` = ...`, or nothing.
+    pub fn bias(&self, b: f64) -> String {
+        match self.kind {
+            Kind::Gyro(angle) => format!(" = {} {angle}/h", short(3600.0 * b)),
+            Kind::Accelerometer(to_si) => format!(" = {} ug", short(1e6 * b * to_si / G)),
+            Kind::Other => String::new(),
+        }
+    }
+}
+
+/// `v` to 4 significant digits.
+fn short(v: f64) -> String {
+    format!("{v:.4e}")
+        .parse::<f64>()
+        .map_or_else(|_| v.to_string(), |r| r.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gyro_and_accelerometer_conversions() {
+        let deg = Units::of("deg/s");
+        // 1 deg/s/sqrt(Hz) = 1 deg/sqrt(s) = 60 deg/sqrt(h).
+        assert_eq!(deg.arw(0.5), " = 30 deg/sqrt(h)");
+        assert_eq!(deg.bias(1e-3), " = 3.6 deg/h");
+        assert_eq!(deg.rrw(1e-5), " = 2.16 deg/h/sqrt(h)");
+        let g = Units::of("g");
+        assert_eq!(g.bias(2e-5), " = 20 ug");
+        assert_eq!(g.arw(1e-4), " = 0.05884 m/s/sqrt(h)");
+        assert_eq!(Units::of("m/s^2").bias(G * 1e-6), " = 1 ug");
+        assert_eq!(Units::of("counts").arw(1.0), "");
+    }
+}

@@ -1,0 +1,285 @@
+//! `imu-ar noise`: the composite model of both real records at every averaging time, its
+//! hand-off to a filter, its keys, its plot and its refusals.
+
+use std::path::{Path, PathBuf};
+
+use imu_ar_host::composite::Composite;
+use imu_ar_host::fixtures::{AXES, real_records};
+use serde_json::Value;
+
+mod common;
+
+use common::{column_file, imu_ar, json, misused, stdout, temp_file};
+
+/// `imu-ar noise FILES --column C --rate HZ --json EXTRA..`, parsed.
+fn noise(files: &[PathBuf], column: &str, rate: &str, extra: &[&str]) -> Value {
+    let mut args: Vec<&str> = vec!["noise"];
+    args.extend(files.iter().map(|f| f.to_str().unwrap()));
+    args.extend(["--column", column, "--rate", rate, "--json"]);
+    args.extend_from_slice(extra);
+    json(&imu_ar(&args))
+}
+
+fn f(v: &Value) -> f64 {
+    v.as_f64().unwrap_or_else(|| panic!("{v} is not a number"))
+}
+
+/// The largest `tau` of the check: the whole record is explained when `explained_up_to_s`
+/// reaches it.
+fn longest_tau(v: &Value) -> f64 {
+    f(&v["allan"].as_array().unwrap().last().unwrap()["tau_s"])
+}
+
+/// The data's Allan deviation at 1 s, read log-log between the octaves around it: the reading
+/// of `N` of Kalibr and allan_variance_ros.
+fn adev_at_1s(v: &Value) -> f64 {
+    let rows = v["allan"].as_array().unwrap();
+    let i = rows.iter().position(|r| f(&r["tau_s"]) >= 1.0).unwrap();
+    let (t0, t1) = (f(&rows[i - 1]["tau_s"]), f(&rows[i]["tau_s"]));
+    let (d0, d1) = (f(&rows[i - 1]["data_adev"]), f(&rows[i]["data_adev"]));
+    let w = (1.0 / t0).ln() / (t1 / t0).ln();
+    (d0.ln() * (1.0 - w) + d1.ln() * w).exp()
+}
+
+/// The share of the model's Allan variance that its white noise makes at the octave at or
+/// above 1 s.
+fn white_share_at_1s(v: &Value) -> f64 {
+    let rows = v["allan"].as_array().unwrap();
+    let r = rows.iter().find(|r| f(&r["tau_s"]) >= 1.0).unwrap();
+    f(&v["white_noise"]).powi(2) / f(&r["tau_s"]) / f(&r["model_adev"]).powi(2)
+}
+
+#[test]
+#[cfg_attr(
+    not(imu_ar_data),
+    ignore = "needs the real records (../shared/data/imu or IMU_AR_DATA)"
+)]
+fn both_real_records_are_explained_at_every_averaging_time() {
+    let records = real_records().expect("the real records");
+    println!("record axis ar_order gm_states N adev(1s) explained_up_to_s of longest_tau");
+    for record in &records {
+        for axis in AXES {
+            let v = noise(&record.files, axis, "100", &[]);
+            let (upto, longest) = (&v["explained_up_to_s"], longest_tau(&v));
+            let order = v["ar"].get("order").map_or(0, |o| o.as_u64().unwrap());
+            let states = v["phi"].as_array().unwrap().len();
+            let (n, at_1s) = (f(&v["white_noise"]), adev_at_1s(&v));
+            println!(
+                "{} {axis} {order} {} {n:.4e} {at_1s:.4e} {upto} {longest}",
+                record.name,
+                v["gauss_markov"].as_array().unwrap().len()
+            );
+            assert!(
+                states <= 4,
+                "{} {axis}: {states} filter states",
+                record.name
+            );
+            // N against the classic reading at 1 s, where white noise dominates there.
+            if white_share_at_1s(&v) >= 0.5 {
+                assert!(
+                    (n / at_1s - 1.0).abs() <= 0.1,
+                    "{} {axis}: N {n} against ADEV(1 s) {at_1s}",
+                    record.name
+                );
+            }
+            let accel_line = record.name == "ADIS16405" && axis.starts_with('a');
+            if !accel_line {
+                assert_eq!(f(upto), longest, "{} {axis}: {v}", record.name);
+                continue;
+            }
+            // The ADIS16405 accelerometers have a line near 0.58 Hz (an Allan bump at
+            // 0.64 s): without oscillators the text names the failing range and the line...
+            let mut args = vec!["noise"];
+            args.extend(record.files.iter().map(|f| f.to_str().unwrap()));
+            args.extend(["--column", axis, "--rate", "100"]);
+            let text = stdout(&imu_ar(&args));
+            let line = text
+                .lines()
+                .find(|l| l.starts_with("check fails at tau 0.64"))
+                .unwrap_or_else(|| panic!("{axis}: no failure named:\n{text}"));
+            assert!(line.contains("near 0.580 Hz"), "{axis}: {line}");
+            // ...and one oscillator (two states) in a budget of five explains every octave.
+            let v = noise(
+                &record.files,
+                axis,
+                "100",
+                &["--oscillators", "--gm-states", "5"],
+            );
+            let oscillator = v["gauss_markov"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .find_map(|g| g.get("frequency_hz").map(f))
+                .expect("an oscillator");
+            println!(
+                "  with --oscillators --gm-states 5: line at {oscillator:.3} Hz, {v:.0}",
+                v = v["explained_up_to_s"]
+            );
+            assert!((0.5..0.7).contains(&oscillator), "{axis}: {oscillator} Hz");
+            assert_eq!(f(&v["explained_up_to_s"]), longest_tau(&v), "{axis}: {v}");
+        }
+    }
+}
+
+/// White noise, one Gauss-Markov term and a random walk at 100 Hz, as a CSV file.
+fn composite_record(name: &str) -> (Composite, PathBuf) {
+    let truth = Composite {
+        dt: 0.01,
+        white: 0.01,
+        quantization: 0.0,
+        gm: vec![(0.004, 5.0)],
+        random_walk: 2e-4,
+    };
+    let x = truth.simulate(1 << 19, 11);
+    let path = column_file(name, x.iter().map(|v| v.to_string()));
+    (truth, path)
+}
+
+#[test]
+fn hands_a_simulated_composite_to_a_filter_at_its_rate() {
+    let (truth, path) = composite_record("noise-composite.csv");
+    let files = [path];
+    let v = noise(
+        &files,
+        "x",
+        "100",
+        &["--ar-order", "0", "--filter-rate", "10"],
+    );
+    let keys: Vec<&str> = v.as_object().unwrap().keys().map(|k| k.as_str()).collect();
+    let mut documented = [
+        "rate_hz",
+        "n",
+        "white_noise",
+        "quantization",
+        "random_walk",
+        "rate_ramp",
+        "bias_instability",
+        "gauss_markov",
+        "ar",
+        "phi",
+        "q",
+        "p0",
+        "allan",
+        "explained_up_to_s",
+    ];
+    documented.sort_unstable();
+    assert_eq!(keys, documented);
+    assert_eq!(v["ar"], Value::Null);
+    assert_eq!(v["rate_ramp"], Value::Null);
+    assert_eq!(v["n"], 1 << 19);
+    assert!(
+        (f(&v["white_noise"]) / truth.white - 1.0).abs() < 0.03,
+        "{v}"
+    );
+    assert_eq!(f(&v["explained_up_to_s"]), longest_tau(&v));
+
+    // The filter's states: one per Gauss-Markov term, then the random walk; each block is the
+    // exact discretisation at the filter's step of 0.1 s.
+    let dt = 0.1;
+    let gm = v["gauss_markov"].as_array().unwrap();
+    let (phi, q, p0) = (&v["phi"], &v["q"], &v["p0"]);
+    let n = gm.len() + 1;
+    assert_eq!(phi.as_array().unwrap().len(), n);
+    for i in 0..n {
+        for k in (0..n).filter(|k| *k != i) {
+            assert_eq!(f(&phi[i][k]), 0.0);
+            assert_eq!(f(&q[i][k]), 0.0);
+            assert_eq!(f(&p0[i][k]), 0.0);
+        }
+    }
+    for (i, g) in gm.iter().enumerate() {
+        let (s, t) = (f(&g["sigma"]), f(&g["correlation_time_s"]));
+        assert!((f(&phi[i][i]) - (-dt / t).exp()).abs() < 1e-12);
+        assert!((f(&q[i][i]) / (s * s * (1.0 - (-2.0 * dt / t).exp())) - 1.0).abs() < 1e-9);
+        assert!((f(&p0[i][i]) / (s * s) - 1.0).abs() < 1e-12);
+    }
+    let k = f(&v["random_walk"]);
+    let last = n - 1;
+    assert_eq!(f(&phi[last][last]), 1.0);
+    assert!((f(&q[last][last]) / (k * k * dt) - 1.0).abs() < 1e-12);
+    // The random walk starts with the variance it reaches over the record.
+    let span = (1 << 19) as f64 * 0.01;
+    assert!((f(&p0[last][last]) / (k * k * span) - 1.0).abs() < 1e-12);
+}
+
+#[test]
+fn draws_the_decomposition_plot() {
+    let (_, path) = composite_record("noise-plot.csv");
+    let png = std::env::temp_dir().join(format!("imu-ar-noise-{}.png", std::process::id()));
+    let out = imu_ar(&[
+        "noise",
+        path.to_str().unwrap(),
+        "--column",
+        "x",
+        "--rate",
+        "100",
+        "--plot",
+        png.to_str().unwrap(),
+    ]);
+    assert!(out.status.success());
+    assert!(stdout(&out).contains("explained_up_to_s"));
+    let bytes = std::fs::read(&png).unwrap();
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
+    assert!(bytes.len() > 10_000);
+}
+
+/// `--plot PLOT` is refused before the input (a file that does not exist) is read.
+fn plot_refused(plot: &Path, expected: &str) {
+    misused(
+        &[
+            "noise",
+            "/nonexistent/input.csv",
+            "--column",
+            "x",
+            "--rate",
+            "100",
+            "--plot",
+            plot.to_str().unwrap(),
+        ],
+        expected,
+    );
+}
+
+#[test]
+fn refuses_bad_input_with_one_line_and_nothing_on_stdout() {
+    let constant = column_file("noise-constant.csv", (0..1000).map(|_| "1.5".to_string()));
+    let constant = constant.to_str().unwrap();
+    misused(
+        &["noise", constant, "--column", "x", "--rate", "100"],
+        "constant",
+    );
+    let short = column_file("noise-short.csv", ["1", "2", "4"].map(String::from));
+    let short = short.to_str().unwrap();
+    misused(
+        &["noise", short, "--column", "x", "--rate", "100"],
+        "1 Allan octave(s), at least 2",
+    );
+    let nan = temp_file("noise-nan.csv", "x\n1\n2\nNaN\n3\n5\n");
+    let nan = nan.to_str().unwrap();
+    misused(
+        &["noise", nan, "--column", "x", "--rate", "100"],
+        "'NaN' is not a finite number",
+    );
+    let good = column_file(
+        "noise-good.csv",
+        (0..400).map(|i| ((i * 37) % 11).to_string()),
+    );
+    let good = good.to_str().unwrap();
+    let base = ["noise", good, "--column", "x", "--rate", "100"];
+    let with = |extra: &[&str], expected: &str| {
+        let mut args = base.to_vec();
+        args.extend_from_slice(extra);
+        misused(&args, expected);
+    };
+    with(&["--gm-states", "9"], "--gm-states 9: at most 8");
+    with(&["--ar-order", "33"], "--ar-order 33");
+    with(&["--filter-rate", "0"], "--filter-rate 0");
+    with(&["--decimate", "0"], "--decimate 0");
+    with(&["--decimate", "200"], "1 Allan octave(s)");
+    misused(
+        &["noise", good, "--column", "x", "--rate", "-1"],
+        "--rate -1",
+    );
+    plot_refused(Path::new("/tmp/plot.txt"), "must name a .png file");
+    plot_refused(Path::new("/nonexistent/folder/plot.png"), "does not exist");
+}
