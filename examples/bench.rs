@@ -15,7 +15,9 @@
 //! p = 3, 5, 6, 7 for the f32 lattice and RLS (where one overtakes the other); `extract` per
 //! request of the exact coefficients of order p; `frame6` per six-axis frame of order-4
 //! lattices. Then the state of one channel, `<estimator> <scalar> p=<P> bytes=<N>`
-//! (`size_of` on the target).
+//! (`size_of` on the target). Last, one fit of the composite noise model from a 20-octave
+//! `AllanStream`, without and with an AR(8) part: `noise fit ... insns/fit=<N> stack=<B>`, and
+//! the bytes of the stream, the model and the octaves.
 #![cfg_attr(target_os = "none", no_std, no_main)]
 
 #[cfg(target_os = "none")]
@@ -29,6 +31,11 @@ mod firmware {
     use cortex_m::peripheral::{SYST, syst::SystClkSource};
     use imu_ar::recursive::{Channel, Config, Estimator, FixedChannel, FixedConfig, FixedLattice};
     use imu_ar::recursive::{Lattice, Rls, Sftf};
+    use imu_ar::{
+        ArModel,
+        allan::AllanStream,
+        noise::{FitConfig, NoiseModel, Octaves},
+    };
 
     use super::common;
 
@@ -191,6 +198,88 @@ mod firmware {
             });
             defmt::info!("frame6 f32 p=4 insns/sample={=u32}", n);
         }
+
+        /// One fit of the composite noise model from a 20-octave Allan stream (2^21 samples of
+        /// white noise, a Gauss-Markov drift and a random walk), without and with an AR(8)
+        /// part: instructions, and the stack it used (painted before, scanned after).
+        fn noise_fit(&mut self) {
+            let mut stream = AllanStream::<20>::new();
+            let (mut seed, mut drift, mut walk) = (777u32, 0.0f32, 0.0f32);
+            let mut uniform = || {
+                seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+                (seed >> 8) as f32 / 16_777_216.0 - 0.5
+            };
+            for _ in 0..1u32 << 21 {
+                drift = 0.999 * drift + 0.01 * uniform();
+                walk += 1e-4 * uniform();
+                stream.push(uniform() + drift + walk);
+            }
+            let dt = 0.01;
+            let (Ok(octaves), Ok(ar)) = (
+                Octaves::<20>::from_stream(&stream, dt),
+                ArModel::new([0.5, -0.2, 0.1, 0.0, 0.0, 0.0, 0.0, 0.05], 0.08, 0.0, dt),
+            ) else {
+                common::exit(false)
+            };
+            let config = FitConfig::new(3);
+            for (name, ar) in [("none", None), ("ar8", Some(&ar))] {
+                let mut fitted = None;
+                // The fit's frames start below this one; 1 KiB leaves room for the painter's.
+                let top = stack_pointer() - 1024;
+                paint_stack(top);
+                let n = ticks(&mut self.syst, || {
+                    fitted = Some(NoiseModel::<8, 3>::fit(black_box(&octaves), ar, &config));
+                }) * self.per_tick;
+                // The fit's stack: what it used below `top`, and the 1 KiB above it.
+                let stack = stack_used(top) + 1024;
+                let Some(Ok(model)) = fitted else {
+                    defmt::error!("noise fit ({=str}) failed", name);
+                    common::exit(false)
+                };
+                defmt::info!(
+                    "noise fit octaves=20 gm=3 ar={=str} insns/fit={=u32} stack={=usize} terms={=usize}",
+                    name,
+                    n,
+                    stack,
+                    model.gauss_markov().len()
+                );
+            }
+            defmt::info!(
+                "noise state allan_stream_l20 bytes={=usize} noise_model_p8_g3 bytes={=usize} octaves_l20 bytes={=usize}",
+                core::mem::size_of::<AllanStream<20>>(),
+                core::mem::size_of::<NoiseModel<8, 3>>(),
+                core::mem::size_of::<Octaves<20>>()
+            );
+        }
+    }
+
+    /// Bytes below the stack pointer that [`paint_stack`] fills and [`stack_used`] scans.
+    const PAINTED: usize = 256 * 1024;
+    const PAINT: u32 = 0x5AA5_C33C;
+
+    fn stack_pointer() -> usize {
+        cortex_m::register::msp::read() as usize
+    }
+
+    /// Fills the `PAINTED` bytes below `top` (free stack, below the live frames) with a
+    /// pattern.
+    #[inline(never)]
+    fn paint_stack(top: usize) {
+        for addr in (top - PAINTED..top).step_by(4) {
+            // SAFETY: free stack below the live frames, 4 MiB of RAM on the board, word aligned.
+            unsafe { core::ptr::write_volatile(addr as *mut u32, PAINT) };
+        }
+    }
+
+    /// The bytes below `top` used since [`paint_stack`]: down to the lowest overwritten word.
+    #[inline(never)]
+    fn stack_used(top: usize) -> usize {
+        let lowest = (top - PAINTED..top)
+            .step_by(4)
+            // SAFETY: the region written by `paint_stack`.
+            .find(|&addr| unsafe { core::ptr::read_volatile(addr as *const u32) } != PAINT)
+            .unwrap_or(top);
+        top - lowest
     }
 
     pub fn run() -> ! {
@@ -248,6 +337,7 @@ mod firmware {
         between!(rls_f32);
         orders!(extract_f32);
         bench.frame6_f32();
+        bench.noise_fit();
         common::exit(per_tick > 0)
     }
 }
