@@ -7,6 +7,9 @@
 //! cargo qemu nopanic
 //! ```
 //!
+//! The composite noise model's fit, check, IEEE 952 readings and filter form are called too
+//! (from the firmware's `AllanStream`, with the lattice's model as the AR part).
+//!
 //! It runs as well: the estimators get a short synthetic record and the firmware exits 0 when
 //! every output is finite. Nothing is logged, since the logger has panic paths of its own.
 #![cfg_attr(target_os = "none", no_std, no_main)]
@@ -18,6 +21,8 @@ mod firmware {
     use cortex_m_rt::{ExceptionFrame, entry, exception};
     use cortex_m_semihosting::debug;
     use imu_ar::allan::AllanStream;
+    use imu_ar::model::{ArModel, ModelError};
+    use imu_ar::noise::{FitConfig, NoiseError, NoiseModel, Octaves};
     use imu_ar::recursive::{Channel, Config, Estimator, FixedChannel, FixedConfig};
     use imu_ar::recursive::{FixedLattice, Lattice, OrderRule, OrderSelector, Rls, Sftf};
 
@@ -80,7 +85,32 @@ mod firmware {
         }
         let order = black_box(selector.order());
         finite &= order <= P;
+        finite &= noise::<P>(&allan, lattice.model(config).as_ref());
         finite && black_box(lattice.coefficients(P)).is_some()
+    }
+
+    /// The composite noise model from the stream, with the lattice's model as its AR part when
+    /// there is one: its check, IEEE 952 readings and filter form.
+    fn noise<const P: usize>(allan: &AllanStream<12>, ar: Option<&ArModel<f32, P>>) -> bool {
+        let ar = ar.and_then(|m| {
+            let a = m.a().map(f64::from);
+            let dt = f64::from(m.dt());
+            ArModel::new(a, f64::from(m.noise_variance()), 0.0, dt).ok()
+        });
+        let Ok(octaves) = Octaves::from_stream(allan, black_box(0.01)) else {
+            return false;
+        };
+        let config = FitConfig::new(black_box(2)).with_oscillators(black_box(true));
+        let fitted = NoiseModel::<P, 2>::fit(&octaves, ar.as_ref(), &config).and_then(|model| {
+            let check = model.check(&octaves)?;
+            let form = model.kalman(black_box(0.1), black_box(1e-4))?;
+            Ok((model.ieee952(&octaves), check.explained_up_to(), form))
+        });
+        match fitted {
+            Ok((ieee, _, form)) => ieee.white_noise.is_finite() && form.white_psd.is_finite(),
+            // An AR part the lattice's model cannot give (not stationary) is a typed error.
+            Err(e) => matches!(black_box(e), NoiseError::Ar(ModelError::Unstable { .. })),
+        }
     }
 
     #[entry]

@@ -283,3 +283,102 @@ fn refuses_bad_input_with_one_line_and_nothing_on_stdout() {
     plot_refused(Path::new("/tmp/plot.txt"), "must name a .png file");
     plot_refused(Path::new("/nonexistent/folder/plot.png"), "does not exist");
 }
+
+/// `column` of a temp file: a white-noise record of 4096 samples times `scale`.
+fn scaled_white(name: &str, scale: f64) -> PathBuf {
+    let mut seed = 77u64;
+    let values = (0..4096).map(|_| {
+        seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+        let u = (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+        format!("{:e}", u * scale)
+    });
+    column_file(name, values)
+}
+
+#[test]
+fn fits_any_magnitude_alike() {
+    let one = noise(
+        &[scaled_white("noise-one.csv", 1.0)],
+        "x",
+        "100",
+        &["--ar-order", "0"],
+    );
+    for scale in [1e-150, 1e-80, 1e100, 1e150] {
+        let file = scaled_white(&format!("noise-scaled-{scale:e}.csv"), scale);
+        let v = noise(&[file], "x", "100", &["--ar-order", "0"]);
+        let ratio = f(&v["white_noise"]) / scale / f(&one["white_noise"]);
+        assert!((ratio - 1.0).abs() < 1e-6, "scale {scale:e}: {v}");
+        assert_eq!(
+            v["explained_up_to_s"], one["explained_up_to_s"],
+            "scale {scale:e}"
+        );
+    }
+}
+
+#[test]
+fn refuses_rates_and_filter_steps_that_overflow() {
+    let file = scaled_white("noise-rates.csv", 1.0);
+    let file = file.to_str().unwrap();
+    for rate in ["1e-300", "1e300"] {
+        misused(&["noise", file, "--column", "x", "--rate", rate], "tau^2");
+    }
+    let quantised = column_file(
+        "noise-quantised.csv",
+        (0..4096).map(|i| ((i * 7919) % 5).to_string()),
+    );
+    misused(
+        &[
+            "noise",
+            quantised.to_str().unwrap(),
+            "--column",
+            "x",
+            "--rate",
+            "100",
+            "--filter-rate",
+            "1e300",
+        ],
+        "no filter form at this step",
+    );
+}
+
+#[test]
+fn names_a_plot_it_cannot_write_and_refuses_control_characters() {
+    let file = scaled_white("noise-unwritable.csv", 1.0);
+    let file = file.to_str().unwrap();
+    let base = ["noise", file, "--column", "x", "--rate", "100"];
+    let mut args = base.to_vec();
+    args.extend(["--plot", "/proc/imu-ar-noise.png"]);
+    misused(&args, "--plot /proc/imu-ar-noise.png: cannot draw");
+    let mut args = base.to_vec();
+    args.extend(["--unit", "deg\n/s"]);
+    misused(
+        &args,
+        "--unit \"deg\\n/s\": must not contain control characters",
+    );
+}
+
+#[test]
+fn a_record_no_ar_model_describes_gets_no_ar_part() {
+    // Alternating +-1: perfectly predictable, so Burg cannot fit it; the tool fits the
+    // composite without an AR part instead of failing.
+    let file = column_file(
+        "noise-alternating.csv",
+        (0..1000).map(|i| if i % 2 == 0 { "1" } else { "-1" }.to_string()),
+    );
+    let out = imu_ar(&[
+        "noise",
+        file.to_str().unwrap(),
+        "--column",
+        "x",
+        "--rate",
+        "100",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = stdout(&out);
+    assert!(text.contains("ar null"), "{text}");
+    common::no_nan_inf(&text);
+}

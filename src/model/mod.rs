@@ -319,14 +319,20 @@ impl<T: Scalar, const P: usize> Autocovariances<T, P> {
         let mut poly = [0.0; P];
         let mut e = r0;
         for m in 1..=P {
-            let km = k[m - 1];
-            let past = (1..m).map(|j| poly[j - 1] * r_at(r0, &head, m - j));
-            head[m - 1] = past.sum::<f64>() + km * e;
+            let km = at(&k, m - 1);
+            let past: f64 = (1..m)
+                .map(|j| at(&poly, j - 1) * r_at(r0, &head, m - j))
+                .sum();
+            set(&mut head, m - 1, past + km * e);
             let prev = poly;
             for j in 1..m {
-                poly[j - 1] = prev[j - 1] - km * prev[m - j - 1];
+                set(
+                    &mut poly,
+                    j - 1,
+                    at(&prev, j - 1) - km * at(&prev, m - j - 1),
+                );
             }
-            poly[m - 1] = km;
+            set(&mut poly, m - 1, km);
             e *= 1.0 - km * km;
         }
         let mut last = head;
@@ -343,13 +349,16 @@ impl<T: Scalar, const P: usize> Autocovariances<T, P> {
 
     fn next_f64(&mut self) -> f64 {
         let k = self.k;
-        self.k += 1;
+        self.k = self.k.saturating_add(1);
         if k <= P {
             return r_at(self.r0, &self.head, k);
         }
         let r = self.a.iter().zip(&self.last).map(|(a, r)| a * r).sum();
-        self.last.copy_within(0..P - 1, 1);
-        self.last[0] = r;
+        // The newest first.
+        if P > 0 {
+            self.last.rotate_right(1);
+        }
+        set(&mut self.last, 0, r);
         r
     }
 }
@@ -363,7 +372,20 @@ impl<T: Scalar, const P: usize> Iterator for Autocovariances<T, P> {
 }
 
 fn r_at<const P: usize>(r0: f64, head: &[f64; P], lag: usize) -> f64 {
-    if lag == 0 { r0 } else { head[lag - 1] }
+    lag.checked_sub(1).map_or(r0, |i| at(head, i))
+}
+
+/// `v[i]`, or 0 past the end: the recursions index within bounds, and this keeps them free of
+/// panic paths where the compiler cannot prove it.
+fn at(v: &[f64], i: usize) -> f64 {
+    v.get(i).copied().unwrap_or(0.0)
+}
+
+/// `v[i] = x` within bounds, as [`at`] reads.
+fn set(v: &mut [f64], i: usize, x: f64) {
+    if let Some(slot) = v.get_mut(i) {
+        *slot = x;
+    }
 }
 
 /// Step-down: the partial autocorrelations `k_1..k_P` (`k_m = a_m^(m)`) and the lower-order
@@ -373,17 +395,21 @@ fn step_down<const P: usize>(a: &[f64; P]) -> Result<([f64; P], f64), ModelError
     let mut k = [0.0; P];
     let mut prod = 1.0;
     for m in (1..=P).rev() {
-        let km = cur[m - 1];
+        let km = at(&cur, m - 1);
         let inside_unit_circle = km.abs() < 1.0;
         if !inside_unit_circle {
             return Err(ModelError::Unstable { order: m });
         }
-        k[m - 1] = km;
+        set(&mut k, m - 1, km);
         let d = 1.0 - km * km;
         prod *= d;
         let prev = cur;
         for j in 1..m {
-            cur[j - 1] = (prev[j - 1] + km * prev[m - j - 1]) / d;
+            set(
+                &mut cur,
+                j - 1,
+                (at(&prev, j - 1) + km * at(&prev, m - j - 1)) / d,
+            );
         }
     }
     Ok((k, prod))
@@ -392,8 +418,9 @@ fn step_down<const P: usize>(a: &[f64; P]) -> Result<([f64; P], f64), ModelError
 fn companion<const P: usize>(a: &[f64; P]) -> Matrix<f64, P> {
     let mut phi = [[0.0; P]; P];
     phi[0] = *a;
-    for (i, row) in phi.iter_mut().enumerate().skip(1) {
-        row[i - 1] = 1.0;
+    // The subdiagonal: row i + 1 has its 1 in column i.
+    for (row, i) in phi.iter_mut().skip(1).zip(0..P) {
+        set(row, i, 1.0);
     }
     phi
 }

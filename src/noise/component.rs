@@ -87,9 +87,9 @@ pub fn oscillator(dt: f64, frequency: f64, t: f64, j: usize) -> Result<f64, Mode
     let ar = ArModel::new([2.0 * r * libm::cos(theta), -r * r], 1.0, 0.0, dt)?;
     let r0 = ar.autocovariances()?.next().unwrap_or(1.0);
     let mut out = [0.0; 64];
-    let out = &mut out[..=j.min(63)];
+    let out = &mut out[..j.min(63) + 1];
     ar_octaves(&ar, out)?;
-    Ok(out[out.len() - 1] / r0)
+    Ok(out.last().copied().unwrap_or(0.0) / r0)
 }
 
 /// The Allan variances of a stationary AR model at `m = 1, 2, 4, .., 2^(L-1)` into `out`.
@@ -113,7 +113,7 @@ pub fn ar_octaves<const P: usize>(
     for (slot, v) in g0.iter_mut().zip(&mut r) {
         *slot = v;
     }
-    let r0 = g0[0];
+    let r0 = g0.first().copied().unwrap_or(0.0);
     let mut phi = model.transition(); // Phi^m
     let mut s = identity::<P>(); // S_m
     let mut t = [[0.0; P]; P]; // T_m
@@ -132,8 +132,11 @@ pub fn ar_octaves<const P: usize>(
         add_product(&mut phi2, &phi, &phi);
         (t, s, phi) = (t2, s2, phi2);
         let m2 = 2.0 * m;
-        let a: f64 = s[0].iter().zip(&g0).map(|(p, q)| p * q).sum();
-        let b: f64 = t[0].iter().zip(&g0).map(|(p, q)| p * q).sum();
+        let first_row = |m: &[[f64; P]; P]| -> f64 {
+            m.first()
+                .map_or(0.0, |row| row.iter().zip(&g0).map(|(p, q)| p * q).sum())
+        };
+        let (a, b) = (first_row(&s), first_row(&t));
         let var2 = m2 * (2.0 * a - r0) - 2.0 * b;
         *slot = (2.0 * previous - var2 / 2.0) / (m * m);
         previous = var2;
@@ -144,8 +147,10 @@ pub fn ar_octaves<const P: usize>(
 
 fn identity<const P: usize>() -> [[f64; P]; P] {
     let mut i = [[0.0; P]; P];
-    for (k, row) in i.iter_mut().enumerate() {
-        row[k] = 1.0;
+    for (k, row) in super::indexed(i.iter_mut()) {
+        if let Some(v) = row.get_mut(k) {
+            *v = 1.0;
+        }
     }
     i
 }
@@ -160,8 +165,8 @@ fn add_scaled<const P: usize>(acc: &mut [[f64; P]; P], x: &[[f64; P]; P], f: f64
 /// `acc += x y`.
 fn add_product<const P: usize>(acc: &mut [[f64; P]; P], x: &[[f64; P]; P], y: &[[f64; P]; P]) {
     for (ra, rx) in acc.iter_mut().zip(x) {
-        for (k, xk) in rx.iter().enumerate() {
-            ra.iter_mut().zip(&y[k]).for_each(|(a, yk)| *a += xk * yk);
+        for (xk, yk) in rx.iter().zip(y) {
+            ra.iter_mut().zip(yk).for_each(|(a, y)| *a += xk * y);
         }
     }
 }

@@ -3,7 +3,7 @@
 use crate::model::ArModel;
 
 use super::model::{GmTerm, NoiseModel, Oscillator};
-use super::{NoiseError, NoiseType, Octaves, component, nnls};
+use super::{NoiseError, NoiseType, Octaves, component, indexed, nnls};
 
 /// How to fit a [`NoiseModel`].
 ///
@@ -122,12 +122,13 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
     /// 1. Columns: quantisation, white noise, random walk, optionally ramp and the AR part, and
     ///    a Gauss-Markov term at every correlation time of the grid ([`FitConfig`]), each the
     ///    exact Allan curve of unit parameter ([`component`]).
-    /// 2. Rows: the octaves, weighted by `nu / AVAR` (the inverse standard error of each
-    ///    estimate, [`super::Estimator::edf`]), first with the data's `AVAR` and white-noise
+    /// 2. Rows: the octaves, weighted by `sqrt(nu) / AVAR` (the inverse standard error
+    ///    `AVAR sqrt(2 / nu)` of each estimate, up to a constant, [`super::Estimator::edf`]), first with the data's `AVAR` and white-noise
     ///    degrees of freedom, then, for two more passes, with the model's `AVAR` and the
     ///    degrees of freedom of the noise type that dominates it there, so that a noisy
     ///    long-`tau` estimate does not pull the fit. Columns are scaled to unit norm.
-    /// 3. Lawson-Hanson NNLS ([`nnls::nnls`]).
+    /// 3. Lawson-Hanson NNLS ([`nnls::nnls`]), in units where the largest Allan variance is 1
+    ///    (scaled by a power of two), so that any magnitude of data fits alike.
     /// 4. While more Gauss-Markov terms are positive than the budget allows, the one change
     ///    that raises the weighted residual least is made: two neighbours merged into one at
     ///    their `sigma^2`-weighted geometric mean correlation time, or one term dropped, and
@@ -156,6 +157,9 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
     ///
     /// [`NoiseError::Budget`] for a budget above `G`; [`NoiseError::TooFewOctaves`] for fewer
     /// than 2 octaves; [`NoiseError::Constant`] when every Allan variance is zero;
+    /// [`NoiseError::Interval`] when `1 / tau^2` at the first octave or `tau^2` at the last
+    /// overflows; [`NoiseError::Capacity`] for an `L` too small for the fixed columns;
+    /// [`NoiseError::Overflow`] when a fitted parameter overflows `f64`;
     /// [`NoiseError::Ar`] for a non-stationary AR part.
     pub fn fit<const L: usize>(
         octaves: &Octaves<L>,
@@ -175,6 +179,36 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
         if data.iter().all(|v| *v == 0.0) {
             return Err(NoiseError::Constant);
         }
+        let (first, last) = (octaves.tau(0), octaves.tau(data.len() - 1));
+        if !((1.0 / (first * first)).is_finite() && (last * last).is_finite()) {
+            return Err(NoiseError::Interval);
+        }
+        // Fit in units where the largest Allan variance is 1 (a power of two away, so that
+        // the scaling is exact), and scale back.
+        let exponent = libm::ilogb(data.iter().copied().fold(0.0, f64::max));
+        let scaled = octaves.scaled(exponent.saturating_neg());
+        let ar = match ar {
+            Some(ar) => Some(
+                ArModel::new(
+                    *ar.a(),
+                    libm::scalbn(ar.noise_variance(), exponent.saturating_neg()),
+                    ar.mean(),
+                    ar.dt(),
+                )
+                .map_err(NoiseError::Ar)?,
+            ),
+            None => None,
+        };
+        Self::fit_unit(&scaled, ar.as_ref(), config)?.scaled(exponent)
+    }
+
+    /// [`NoiseModel::fit`] in the scaled units.
+    fn fit_unit<const L: usize>(
+        octaves: &Octaves<L>,
+        ar: Option<&ArModel<f64, P>>,
+        config: &FitConfig,
+    ) -> Result<Self, NoiseError> {
+        let data = octaves.avar();
         let mut problem = Problem {
             octaves,
             ar,
@@ -182,48 +216,50 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
             weight: [0.0; L],
         };
         if let Some(ar) = ar {
-            component::ar_octaves(ar, &mut problem.ar_curve[..data.len()])
+            component::ar_octaves(ar, &mut problem.ar_curve[..data.len().min(L)])
                 .map_err(NoiseError::Ar)?;
         }
         let mut store = [[Column::default(); L]; 2];
         let columns = store.as_flattened_mut();
-        let mut n = 0;
-        let mut push = |c: Column| {
-            columns[n] = c;
-            n += 1;
-        };
-        if config.quantization {
-            push(Column::Quantization);
-        }
-        push(Column::White);
-        push(Column::RandomWalk);
-        if config.ramp {
-            push(Column::Ramp);
-        }
-        if ar.is_some() {
-            push(Column::Ar);
-        }
-        let fixed = n;
-        let longest = octaves.tau(data.len() - 1);
-        let mut t = octaves.dt();
         let capacity = columns.len().min(MAX);
-        while t <= longest * (1.0 + 1e-9) && n < capacity {
-            columns[n] = Column::GaussMarkov(t);
-            n += 1;
+        let mut n = 0;
+        let mut push = |c: Column| match columns.get_mut(n).filter(|_| n < capacity) {
+            Some(slot) => {
+                *slot = c;
+                n = n.saturating_add(1);
+                true
+            }
+            None => false,
+        };
+        let fixed_columns = [
+            config.quantization.then_some(Column::Quantization),
+            Some(Column::White),
+            Some(Column::RandomWalk),
+            config.ramp.then_some(Column::Ramp),
+            ar.map(|_| Column::Ar),
+        ];
+        for c in fixed_columns.into_iter().flatten() {
+            if !push(c) {
+                return Err(NoiseError::Capacity);
+            }
+        }
+        let mut t = octaves.dt();
+        let longest = octaves.tau(data.len().saturating_sub(1));
+        while t <= longest * (1.0 + 1e-9) && push(Column::GaussMarkov(t)) {
             t *= libm::exp2(config.spacing);
         }
         for j in (3..data.len()).filter(|_| config.oscillators) {
-            if n == capacity || 0.371 / octaves.tau(j) < OSCILLATOR_MIN_HZ {
+            let f = 0.371 / octaves.tau(j);
+            if f < OSCILLATOR_MIN_HZ || !push(Column::Oscillator(f)) {
                 break;
             }
-            columns[n] = Column::Oscillator(0.371 / octaves.tau(j));
-            n += 1;
         }
+        let fixed = fixed_columns.iter().flatten().count();
 
-        let fit = problem.refine(&columns[..n], None)?;
-        n = compact(&mut columns[..n], &fit.1);
+        let fit = problem.refine(head(columns, n), None)?;
+        n = compact(head_mut(columns, n), &fit.1);
         n = problem.reduce(columns, fixed, n, config.gm_states)?;
-        let fit = problem.refine(&columns[..n], Some(&fit.0))?;
+        let fit = problem.refine(head(columns, n), Some(&fit.0))?;
         let full = fit.0;
         let mut model = Self::default_at(octaves.dt());
         (
@@ -239,11 +275,49 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
             full.ramp,
             full.ar,
         );
-        model.gm_len = full.gm_len.min(G);
-        model.gm[..model.gm_len].copy_from_slice(&full.gm[..model.gm_len]);
-        model.osc_len = full.osc_len.min(G);
-        model.osc[..model.osc_len].copy_from_slice(&full.osc[..model.osc_len]);
+        model.gm_len = full.gauss_markov().len().min(G);
+        model
+            .gm
+            .iter_mut()
+            .zip(full.gauss_markov())
+            .for_each(|(d, s)| *d = *s);
+        model.osc_len = full.oscillators().len().min(G);
+        model
+            .osc
+            .iter_mut()
+            .zip(full.oscillators())
+            .for_each(|(d, s)| *d = *s);
         Ok(model)
+    }
+
+    /// The model with every variance times `2^exponent`.
+    fn scaled(mut self, exponent: i32) -> Result<Self, NoiseError> {
+        let root = |v: f64| libm::sqrt(libm::scalbn(v * v, exponent));
+        self.quantization = root(self.quantization);
+        self.white = root(self.white);
+        self.random_walk = root(self.random_walk);
+        self.ramp = root(self.ramp);
+        for t in self.gm.iter_mut() {
+            t.sigma = root(t.sigma);
+        }
+        for o in self.osc.iter_mut() {
+            o.sigma = root(o.sigma);
+        }
+        if let Some(ar) = self.ar {
+            let variance = libm::scalbn(ar.noise_variance(), exponent);
+            self.ar = Some(
+                ArModel::new(*ar.a(), variance, ar.mean(), ar.dt())
+                    .map_err(|_| NoiseError::Overflow)?,
+            );
+        }
+        let terms = self.gm.iter().map(|t| t.sigma);
+        let sigmas = terms.chain(self.osc.iter().map(|o| o.sigma));
+        let parameters = [self.quantization, self.white, self.random_walk, self.ramp];
+        if parameters.into_iter().chain(sigmas).all(f64::is_finite) {
+            Ok(self)
+        } else {
+            Err(NoiseError::Overflow)
+        }
     }
 
     fn default_at(dt: f64) -> Self {
@@ -271,7 +345,7 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
             Column::White => component::white(dt, m),
             Column::RandomWalk => component::random_walk(dt, m),
             Column::Ramp => component::ramp(dt, m),
-            Column::Ar => self.ar_curve[j],
+            Column::Ar => self.ar_curve.get(j).copied().unwrap_or(0.0),
             Column::GaussMarkov(t) => component::gauss_markov(dt, t, m),
             // The candidates' poles are inside the unit circle by construction.
             Column::Oscillator(f) => {
@@ -291,16 +365,17 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
         let mut curve = [0.0; L];
         if let Some(model) = model {
             // A fitted model's AR part is the (stationary) one given: this cannot fail.
-            let _ = model.avar_octaves(&mut curve[..data.len()]);
+            let _ = model.avar_octaves(&mut curve[..data.len().min(L)]);
         }
-        for (j, d) in data.iter().enumerate() {
+        let rows = data.iter().zip(&curve).zip(self.weight.iter_mut());
+        for (j, ((d, c), weight)) in indexed(rows) {
             let m = 1u64 << j.min(63);
             let (kind, reference) = match model {
-                Some(model) if curve[j] > 0.0 => (model.dominant(m).0, curve[j]),
+                Some(model) if *c > 0.0 => (model.dominant(m).0, *c),
                 _ => (NoiseType::WhiteFrequency, d.max(floor)),
             };
             let nu = self.octaves.edf(j, kind);
-            self.weight[j] = libm::sqrt(nu) / reference;
+            *weight = libm::sqrt(nu) / reference;
         }
     }
 
@@ -341,25 +416,28 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
                     }
                 }
                 Column::GaussMarkov(t) if v > 0.0 => {
-                    model.gm[model.gm_len] = GmTerm {
-                        sigma: root,
-                        correlation_time: t,
-                    };
-                    model.gm_len += 1;
+                    if let Some(slot) = model.gm.get_mut(model.gm_len) {
+                        *slot = GmTerm {
+                            sigma: root,
+                            correlation_time: t,
+                        };
+                        model.gm_len = model.gm_len.saturating_add(1);
+                    }
                 }
                 Column::Oscillator(f) if v > 0.0 => {
-                    model.osc[model.osc_len] = Oscillator {
-                        sigma: root,
-                        frequency: f,
-                        decay_time: OSCILLATOR_CYCLES / f,
-                    };
-                    model.osc_len += 1;
+                    if let Some(slot) = model.osc.get_mut(model.osc_len) {
+                        *slot = Oscillator {
+                            sigma: root,
+                            frequency: f,
+                            decay_time: OSCILLATOR_CYCLES / f,
+                        };
+                        model.osc_len = model.osc_len.saturating_add(1);
+                    }
                 }
                 Column::GaussMarkov(_) | Column::Oscillator(_) => {}
             }
         }
-        model.gm[..model.gm_len]
-            .sort_unstable_by(|p, q| p.correlation_time.total_cmp(&q.correlation_time));
+        sort_by_correlation_time(&mut model.gm[..model.gm_len.min(MAX)]);
         Ok((model, x))
     }
 
@@ -368,11 +446,12 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
     fn nnls(&self, columns: &[Column]) -> Result<([f64; MAX], f64), NoiseError> {
         let rows = self.octaves.avar().len();
         let mut a = [[[0.0; L]; L]; 2];
-        let a = &mut a.as_flattened_mut()[..columns.len()];
+        let a = &mut a.as_flattened_mut()[..columns.len().min(2 * L)];
         let mut scale = [0.0; MAX];
         for ((col, column), s) in a.iter_mut().zip(columns).zip(scale.iter_mut()) {
-            for (j, v) in col.iter_mut().enumerate().take(rows) {
-                *v = self.weight[j] * self.unit(*column, j);
+            let cells = indexed(col.iter_mut().zip(&self.weight)).take(rows);
+            for (j, (v, w)) in cells {
+                *v = w * self.unit(*column, j);
             }
             *s = libm::sqrt(col.iter().map(|v| v * v).sum::<f64>());
             if *s > 0.0 {
@@ -380,16 +459,18 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
             }
         }
         let mut b = [0.0; L];
-        for (j, (bj, d)) in b.iter_mut().zip(self.octaves.avar()).enumerate() {
-            *bj = self.weight[j] * d;
+        let weighted = b.iter_mut().zip(self.octaves.avar()).zip(&self.weight);
+        for ((bj, d), w) in weighted {
+            *bj = w * d;
         }
         let mut work = [[[0.0; L]; L]; 2];
+        let work = work.as_flattened_mut();
         let mut x = [0.0; MAX];
         let residual = nnls::nnls(
             a,
             &b,
-            &mut x[..columns.len()],
-            &mut work.as_flattened_mut()[..columns.len()],
+            &mut x[..columns.len().min(MAX)],
+            &mut work[..columns.len().min(2 * L)],
         )?;
         for (v, s) in x.iter_mut().zip(&scale).take(columns.len()) {
             *v = if *s > 0.0 { *v / s } else { 0.0 };
@@ -406,27 +487,36 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
         mut n: usize,
         budget: usize,
     ) -> Result<usize, NoiseError> {
-        while states(&columns[fixed..n]) > budget {
-            let (x, _) = self.nnls(&columns[..n])?;
+        while states(head(columns, n).get(fixed..).unwrap_or(&[])) > budget {
+            let (x, _) = self.nnls(head(columns, n))?;
             let mut best: Option<(f64, usize, Option<f64>)> = None;
             let mut trial = [[Column::default(); L]; 2];
             let trial = trial.as_flattened_mut();
             for i in fixed..n {
                 // Drop term i, or merge it with the next one.
-                let merged = (i + 1 < n).then(|| merge(columns[i], x[i], columns[i + 1], x[i + 1]));
-                for candidate in [None, merged.flatten()] {
-                    let k = edit(&columns[..n], i, candidate, trial);
-                    let (_, r) = self.nnls(&trial[..k])?;
+                let pair = i..i.saturating_add(2);
+                let merged = match (columns.get(pair.clone()), x.get(pair)) {
+                    (Some(&[p, q]), Some(&[vp, vq])) if i.saturating_add(1) < n => {
+                        merge(p, vp, q, vq)
+                    }
+                    _ => None,
+                };
+                for candidate in [None, merged] {
+                    let k = edit(head(columns, n), i, candidate, trial);
+                    let (_, r) = self.nnls(head(trial, k))?;
                     if best.is_none_or(|b| r < b.0) {
                         best = Some((r, i, candidate));
                     }
                 }
             }
             let Some((_, i, candidate)) = best else { break };
-            let k = edit(&columns[..n], i, candidate, trial);
-            columns[..k].copy_from_slice(&trial[..k]);
-            let (x, _) = self.nnls(&columns[..k])?;
-            n = compact(&mut columns[..k], &x);
+            let k = edit(head(columns, n), i, candidate, trial);
+            columns
+                .iter_mut()
+                .zip(head(trial, k))
+                .for_each(|(c, t)| *c = *t);
+            let (x, _) = self.nnls(head(columns, k))?;
+            n = compact(head_mut(columns, k), &x);
         }
         Ok(n)
     }
@@ -443,11 +533,14 @@ const MAX: usize = nnls::MAX_COLUMNS;
 fn compact(columns: &mut [Column], x: &[f64]) -> usize {
     let mut kept = 0;
     for c in 0..columns.len() {
-        let term = matches!(columns[c], Column::GaussMarkov(_) | Column::Oscillator(_));
-        let zero_term = term && x[c] <= 0.0;
+        let column = columns[c];
+        let term = matches!(column, Column::GaussMarkov(_) | Column::Oscillator(_));
+        let zero_term = term && x.get(c).is_none_or(|v| *v <= 0.0);
         if !zero_term {
-            columns[kept] = columns[c];
-            kept += 1;
+            if let Some(slot) = columns.get_mut(kept) {
+                *slot = column;
+            }
+            kept = kept.saturating_add(1);
         }
     }
     kept
@@ -455,14 +548,13 @@ fn compact(columns: &mut [Column], x: &[f64]) -> usize {
 
 /// Kalman states of the terms `columns`: one per Gauss-Markov term, two per oscillator.
 fn states(columns: &[Column]) -> usize {
-    columns
-        .iter()
-        .map(|c| match c {
+    columns.iter().fold(0usize, |n, c| {
+        n.saturating_add(match c {
             Column::GaussMarkov(_) => 1,
             Column::Oscillator(_) => 2,
             _ => 0,
         })
-        .sum()
+    })
 }
 
 /// The term replacing Gauss-Markov columns `p` and `q` of variances `vp` and `vq`: their
@@ -480,14 +572,41 @@ fn merge(p: Column, vp: f64, q: Column, vq: f64) -> Option<f64> {
 /// into `out`, returning the count.
 fn edit(columns: &[Column], i: usize, merged: Option<f64>, out: &mut [Column]) -> usize {
     let mut k = 0;
-    for (j, c) in columns.iter().enumerate() {
+    for (j, c) in indexed(columns.iter()) {
         let c = match (j, merged) {
             (j, _) if j == i => continue,
-            (j, Some(t)) if j == i + 1 => Column::GaussMarkov(t),
+            (j, Some(t)) if j == i.saturating_add(1) => Column::GaussMarkov(t),
             _ => *c,
         };
-        out[k] = c;
-        k += 1;
+        if let Some(slot) = out.get_mut(k) {
+            *slot = c;
+            k = k.saturating_add(1);
+        }
     }
     k
+}
+
+/// The first `n` columns (all of them when there are fewer).
+fn head(columns: &[Column], n: usize) -> &[Column] {
+    &columns[..n.min(columns.len())]
+}
+
+/// The first `n` columns, to change.
+fn head_mut(columns: &mut [Column], n: usize) -> &mut [Column] {
+    let n = n.min(columns.len());
+    &mut columns[..n]
+}
+
+/// Sorts Gauss-Markov terms by correlation time: a bubble sort of a few terms, with no panic
+/// path (the library sorts check their comparison and can panic).
+fn sort_by_correlation_time(terms: &mut [GmTerm]) {
+    for end in (1..terms.len()).rev() {
+        for k in 0..end {
+            if let Some([p, q]) = terms.get_mut(k..k.saturating_add(2))
+                && p.correlation_time > q.correlation_time
+            {
+                core::mem::swap(p, q);
+            }
+        }
+    }
 }

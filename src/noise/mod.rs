@@ -42,7 +42,8 @@ pub use octaves::{Estimator, NoiseType, Octaves};
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum NoiseError {
-    /// The sample interval (or the filter's step) is not positive and finite.
+    /// The sample interval (or the filter's step) is not positive and finite, or so small or
+    /// large that `1 / tau^2` or `tau^2` overflows.
     Interval,
     /// A sample or an Allan variance at this index is NaN, infinite or negative.
     NonFinite {
@@ -70,6 +71,11 @@ pub enum NoiseError {
     },
     /// The grid spacing is not in [0.5, 8] octaves.
     Spacing,
+    /// The octave capacity `L` is too small for the fixed columns of the fit (quantisation,
+    /// white noise, random walk, ramp, AR part: at most `2 L` columns in all).
+    Capacity,
+    /// A fitted parameter overflows `f64` (Allan variances near the top of its range).
+    Overflow,
     /// The AR part is not a stationary model.
     Ar(ModelError),
     /// The least-squares solve failed.
@@ -79,7 +85,10 @@ pub enum NoiseError {
 impl fmt::Display for NoiseError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match *self {
-            Self::Interval => f.write_str("sample interval must be positive and finite"),
+            Self::Interval => f.write_str(
+                "sample interval must be positive and finite, and tau^2 and 1/tau^2 finite at \
+                 every octave",
+            ),
             Self::NonFinite { index } => write!(f, "value {index} is NaN, infinite or negative"),
             Self::TooFewOctaves { given } => write!(
                 f,
@@ -97,6 +106,13 @@ impl fmt::Display for NoiseError {
                 "{requested} Gauss-Markov states asked for, at most {capacity} held"
             ),
             Self::Spacing => f.write_str("grid spacing must be in [0.5, 8] octaves"),
+            Self::Capacity => f.write_str(
+                "the octave capacity is too small for the model's columns (at most 2 per octave)",
+            ),
+            Self::Overflow => f.write_str(
+                "a fitted parameter overflows f64: the Allan variances are too large; rescale \
+                 the data",
+            ),
             Self::Ar(e) => write!(f, "AR part: {e}"),
             Self::Nnls(e) => write!(f, "least squares: {e:?}"),
         }
@@ -104,6 +120,20 @@ impl fmt::Display for NoiseError {
 }
 
 impl core::error::Error for NoiseError {}
+
+/// `iter.enumerate()` without its counter's overflow check (the index is bounded by the
+/// range), so that the fit has no panic path with overflow checks on.
+pub(crate) fn indexed<I: Iterator>(iter: I) -> impl Iterator<Item = (usize, I::Item)> {
+    (0..usize::MAX).zip(iter)
+}
+
+/// `1 << j` as a column mask bit, 0 from `j = 64` on.
+pub(crate) fn bit(j: usize) -> u64 {
+    u32::try_from(j)
+        .ok()
+        .and_then(|j| 1u64.checked_shl(j))
+        .unwrap_or(0)
+}
 
 impl From<NnlsError> for NoiseError {
     fn from(e: NnlsError) -> Self {

@@ -4,7 +4,7 @@
 use crate::model::ArModel;
 
 use super::component;
-use super::{NoiseError, NoiseType, Octaves};
+use super::{NoiseError, NoiseType, Octaves, indexed};
 
 /// One first-order Gauss-Markov term: `dx/dt = -x / T + u`, stationary standard deviation
 /// `sigma`.
@@ -116,8 +116,8 @@ impl OscillatorState {
         let s2 = o.sigma * o.sigma;
         let p = [s2, wn2 * s2];
         let mut q = [[0.0; 2]; 2];
-        for (i, row) in q.iter_mut().enumerate() {
-            for (k, v) in row.iter_mut().enumerate() {
+        for (i, row) in indexed(q.iter_mut()) {
+            for (k, v) in indexed(row.iter_mut()) {
                 let fpf: f64 = (0..2).map(|l| phi[i][l] * p[l] * phi[k][l]).sum();
                 *v = if i == k { p[i] } else { 0.0 } - fpf;
             }
@@ -176,7 +176,12 @@ pub struct AllanRow {
     /// Two standard errors of the measured deviation, `2 / sqrt(2 nu)`, or 0.1 where that is
     /// larger, as a fraction.
     pub tolerance: f64,
-    /// `|data / model - 1| <= tolerance`.
+    /// `data / model` within the two-standard-error interval of the measured deviation: the
+    /// chi^2 interval at `z = +-2` for `nu` degrees of freedom (Wilson-Hilferty), widened to
+    /// at least `[0.9, 1.1]`. For many degrees of freedom this is `1 +- tolerance`; for few,
+    /// it is skewed as the chi^2 distribution is (with 4 degrees of freedom, 0.34 to 1.68;
+    /// with 1, 0.03 to 2.2), so that a model far above the data fails however wide the
+    /// tolerance.
     pub agrees: bool,
 }
 
@@ -191,7 +196,7 @@ pub struct Check<const L: usize> {
 impl<const L: usize> Check<L> {
     /// The rows, one per octave.
     pub fn rows(&self) -> &[AllanRow] {
-        &self.rows[..self.len]
+        &self.rows[..self.len.min(L)]
     }
 
     /// The largest `tau` up to which every row agrees, or `None` when the first does not.
@@ -243,12 +248,12 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
 
     /// The Gauss-Markov terms, by increasing correlation time.
     pub fn gauss_markov(&self) -> &[GmTerm] {
-        &self.gm[..self.gm_len]
+        &self.gm[..self.gm_len.min(G)]
     }
 
     /// The second-order Gauss-Markov terms (two Kalman states each), by increasing frequency.
     pub fn oscillators(&self) -> &[Oscillator] {
-        &self.osc[..self.osc_len]
+        &self.osc[..self.osc_len.min(G)]
     }
 
     /// The AR part, with the noise variance the fit scaled it to.
@@ -273,7 +278,7 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
             Some(ar) => component::ar_octaves(ar, out).map_err(NoiseError::Ar)?,
             None => out.fill(0.0),
         }
-        for (j, v) in out.iter_mut().enumerate() {
+        for (j, v) in indexed(out.iter_mut()) {
             let (_, total) = self.dominant(1u64 << j.min(63));
             *v += total;
             for o in self.oscillators() {
@@ -292,23 +297,28 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
         let dt = self.dt;
         let tau = m as f64 * dt;
         let sq = |v: f64| v * v;
+        // A component that is absent adds nothing, even where its unit curve overflows.
+        let term = |p: f64, unit: f64| if p == 0.0 { 0.0 } else { p * unit };
         let mut parts = [
             (
                 NoiseType::WhitePhase,
-                sq(self.quantization) * component::quantization(dt, m),
+                term(sq(self.quantization), component::quantization(dt, m)),
             ),
             (
                 NoiseType::WhiteFrequency,
-                (sq(self.white) + self.ar_white_psd()) * component::white(dt, m),
+                term(
+                    sq(self.white) + self.ar_white_psd(),
+                    component::white(dt, m),
+                ),
             ),
             (
                 NoiseType::RandomWalkFrequency,
-                sq(self.random_walk) * component::random_walk(dt, m)
-                    + sq(self.ramp) * component::ramp(dt, m),
+                term(sq(self.random_walk), component::random_walk(dt, m))
+                    + term(sq(self.ramp), component::ramp(dt, m)),
             ),
             (NoiseType::FlickerFrequency, 0.0),
         ];
-        let mut total = parts[0].1 + parts[2].1 + sq(self.white) * component::white(dt, m);
+        let mut total = parts[0].1 + parts[2].1 + term(sq(self.white), component::white(dt, m));
         for t in self.gauss_markov() {
             let v = sq(t.sigma) * component::gauss_markov(dt, t.correlation_time, m);
             total += v;
@@ -340,10 +350,10 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
         self.avar_octaves(&mut model)?;
         let mut rows = [AllanRow::default(); L];
         let data = octaves.avar();
-        for (j, (row, d)) in rows.iter_mut().zip(data).enumerate() {
+        for (j, ((row, d), v)) in indexed(rows.iter_mut().zip(data).zip(&model)) {
             let m = 1u64 << j.min(63);
             let nu = octaves.edf(j, self.dominant(m).0);
-            let (data_adev, model_adev) = (libm::sqrt(*d), libm::sqrt(model[j]));
+            let (data_adev, model_adev) = (libm::sqrt(*d), libm::sqrt(*v));
             let standard_error = 1.0 / libm::sqrt(2.0 * nu);
             let tolerance = (2.0 * standard_error).max(0.1);
             *row = AllanRow {
@@ -352,7 +362,7 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
                 model_adev,
                 standard_error,
                 tolerance,
-                agrees: libm::fabs(data_adev / model_adev - 1.0) <= tolerance,
+                agrees: agrees(data_adev / model_adev, nu),
             };
         }
         Ok(Check {
@@ -364,7 +374,7 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
     /// The IEEE 952 readings of the model, with `B` and the 1 s reading of `N` taken from the
     /// data `octaves`.
     pub fn ieee952<const L: usize>(&self, octaves: &Octaves<L>) -> Ieee952 {
-        let adev = |j: usize| libm::sqrt(octaves.avar()[j]);
+        let adev = |j: usize| libm::sqrt(octaves.avar().get(j).copied().unwrap_or(0.0));
         let lowest = (0..octaves.avar().len())
             .min_by(|&p, &q| adev(p).total_cmp(&adev(q)))
             .map_or((0.0, 0.0), |j| (adev(j) / 0.664, octaves.tau(j)));
@@ -375,7 +385,8 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
                 let (t0, t1) = (octaves.tau(j - 1), octaves.tau(j));
                 let f = libm::log(1.0 / t0) / libm::log(t1 / t0);
                 libm::exp(libm::log(adev(j - 1)) * (1.0 - f) + libm::log(adev(j)) * f)
-            });
+            })
+            .filter(|v| v.is_finite());
         Ieee952 {
             white_noise: self.white_noise(),
             white_noise_at_1s: at_1s,
@@ -395,8 +406,8 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
     ///
     /// # Errors
     ///
-    /// [`NoiseError::Interval`] for a step that is not positive and finite, or a negative or
-    /// non-finite `random_walk_p0`.
+    /// [`NoiseError::Interval`] for a step that is not positive and finite, a negative or
+    /// non-finite `random_walk_p0`, or a step that makes a variance overflow.
     pub fn kalman(&self, dt_filter: f64, random_walk_p0: f64) -> Result<KalmanForm<G>, NoiseError> {
         let step_ok = dt_filter.is_finite() && dt_filter > 0.0;
         let p0_ok = random_walk_p0.is_finite() && random_walk_p0 >= 0.0;
@@ -419,7 +430,7 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
         let k2 = self.random_walk * self.random_walk;
         let n2 = self.white_noise() * self.white_noise();
         let q2 = self.quantization * self.quantization;
-        Ok(KalmanForm {
+        let form = KalmanForm {
             dt: dt_filter,
             gm,
             gm_len: self.gm_len,
@@ -432,6 +443,41 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
             }),
             measurement_variance: n2 / dt_filter + 2.0 * q2 / (dt_filter * dt_filter),
             white_psd: n2,
-        })
+        };
+        // A step so short or so long that a variance overflows has no filter form.
+        let states = form.gm.iter().chain(form.random_walk.as_ref());
+        let finite = states.flat_map(|s| [s.phi, s.q, s.p0]).all(f64::is_finite)
+            && form.osc.iter().all(|s| {
+                let cells = s.phi.iter().chain(&s.q).chain(&s.p0).flatten();
+                cells.copied().all(f64::is_finite)
+            })
+            && form.measurement_variance.is_finite();
+        if finite {
+            Ok(form)
+        } else {
+            Err(NoiseError::Interval)
+        }
     }
+}
+
+/// Whether `ratio = data / model` is within the check's interval for a deviation measured with
+/// `nu` degrees of freedom (see [`AllanRow::agrees`]).
+fn agrees(ratio: f64, nu: f64) -> bool {
+    if nu.is_nan() || nu <= 0.0 {
+        return ratio.is_finite();
+    }
+    // Wilson-Hilferty: chi^2_nu / nu at z standard normal deviations is about
+    // (1 - c + z sqrt(c))^3 with c = 2 / (9 nu).
+    let c = 2.0 / (9.0 * nu);
+    let quantile = |z: f64| {
+        let b = 1.0 - c + z * libm::sqrt(c);
+        if b > 0.0 { b * b * b } else { 0.0 }
+    };
+    // Below about 2 degrees of freedom that lower bound reaches 0; the lower tail of chi^2
+    // there, P(chi^2 < x) ~ (x/2)^(nu/2) / Gamma(nu/2 + 1), keeps one (the z = -2 tail has
+    // probability 0.0228).
+    let tail = 2.0 * libm::pow(0.0228 * libm::tgamma(nu / 2.0 + 1.0), 2.0 / nu) / nu;
+    let lower = libm::sqrt(quantile(-2.0).max(tail)).min(0.9);
+    let upper = libm::sqrt(quantile(2.0)).max(1.1);
+    (lower..=upper).contains(&ratio)
 }

@@ -14,6 +14,8 @@
 //! Columns are stored as `[[f64; M]]` (column-major, `M` rows). Allocation-free: the caller
 //! lends a work area of the same size; at most 64 columns.
 
+use super::{bit, indexed};
+
 /// The largest number of columns [`nnls`] accepts (the passive set is a `u64` bit mask).
 pub const MAX_COLUMNS: usize = 64;
 
@@ -64,25 +66,37 @@ pub fn nnls<const M: usize>(
     if !finite(b) || !a.iter().all(|c| finite(c)) {
         return Err(NnlsError::NonFinite);
     }
-    x.fill(0.0);
+    // Work on fixed-size copies: every index below is a column number under MAX_COLUMNS.
+    let mut xs = [0.0; MAX_COLUMNS];
+    let mut z = [0.0; MAX_COLUMNS];
     let mut passive = 0u64;
     // Columns set aside until the passive set changes (their solve was not positive).
     let mut set_aside = 0u64;
-    let mut z = [0.0; MAX_COLUMNS];
-    for _ in 0..3 * n.max(1) {
-        let residual = residual(a, b, x);
-        let w = |j: usize| dot(&a[j], &residual);
+    let xn = &mut xs[..n.min(MAX_COLUMNS)];
+    // A gradient within rounding of zero is zero: `a_j . r` carries an error of a few
+    // `eps |a_j| |b|`, and a column let in on that noise can cycle instead of converging.
+    let b_norm = norm(b);
+    for _ in 0..n.max(1).saturating_mul(3) {
+        let residual = residual(a, b, xn);
+        let w = |j: usize| {
+            a.get(j).map_or(0.0, |c| {
+                let g = dot(c, &residual);
+                if g > 1e-12 * norm(c) * b_norm { g } else { 0.0 }
+            })
+        };
         let candidate = (0..n)
-            .filter(|&j| (passive | set_aside) & (1 << j) == 0)
+            .filter(|&j| (passive | set_aside) & bit(j) == 0)
             .map(|j| (j, w(j)))
             .filter(|&(_, wj)| wj > 0.0)
             .max_by(|p, q| p.1.total_cmp(&q.1));
         let Some((t, _)) = candidate else {
+            x.iter_mut().zip(xn.iter()).for_each(|(o, v)| *o = *v);
             return Ok(norm(&residual));
         };
-        let trial = passive | (1 << t);
-        if !solve(a, b, trial, &mut z[..n], work) || z[t] <= 0.0 {
-            set_aside |= 1 << t;
+        let trial = passive | bit(t);
+        let zn = &mut z[..n.min(MAX_COLUMNS)];
+        if !solve(a, b, trial, zn, work) || zn.get(t).is_none_or(|v| *v <= 0.0) {
+            set_aside |= bit(t);
             continue;
         }
         passive = trial;
@@ -91,30 +105,36 @@ pub fn nnls<const M: usize>(
         loop {
             // Step from x towards z as far as feasibility allows; x > 0 >= z on the limiting
             // column, so the ratio is in [0, 1).
+            let at = |v: &[f64], j: usize| v.get(j).copied().unwrap_or(0.0);
             let ratio = |j: usize| {
-                let d = x[j] - z[j];
-                if d > 0.0 { x[j] / d } else { 0.0 }
+                let d = at(xn, j) - at(zn, j);
+                if d > 0.0 { at(xn, j) / d } else { 0.0 }
             };
             let Some(limiting) = ones(passive)
-                .filter(|&j| z[j] <= 0.0)
+                .filter(|&j| at(zn, j) <= 0.0)
                 .min_by(|&p, &q| ratio(p).total_cmp(&ratio(q)))
             else {
-                x.copy_from_slice(&z[..n]);
+                xn.iter_mut().zip(zn.iter()).for_each(|(x, z)| *x = *z);
                 break;
             };
             let alpha = ratio(limiting);
-            for j in ones(passive) {
-                x[j] += alpha * (z[j] - x[j]);
+            for (j, (xj, zj)) in indexed(xn.iter_mut().zip(zn.iter())) {
+                if passive & bit(j) != 0 {
+                    *xj += alpha * (zj - *xj);
+                }
             }
-            x[limiting] = 0.0;
-            let gone = ones(passive)
-                .filter(|&j| x[j] <= 0.0)
-                .fold(0, |mask, j| mask | 1 << j);
-            for j in ones(gone) {
-                x[j] = 0.0;
+            if let Some(v) = xn.get_mut(limiting) {
+                *v = 0.0;
+            }
+            let mut gone = 0u64;
+            for (j, xj) in indexed(xn.iter_mut()) {
+                if passive & bit(j) != 0 && *xj <= 0.0 {
+                    *xj = 0.0;
+                    gone |= bit(j);
+                }
             }
             passive &= !gone;
-            if passive == 0 || !solve(a, b, passive, &mut z[..n], work) {
+            if passive == 0 || !solve(a, b, passive, zn, work) {
                 break;
             }
         }
@@ -124,7 +144,7 @@ pub fn nnls<const M: usize>(
 
 /// The indices of the set bits of `mask`, in increasing order.
 fn ones(mask: u64) -> impl Iterator<Item = usize> {
-    (0..MAX_COLUMNS).filter(move |&j| mask & (1 << j) != 0)
+    (0..MAX_COLUMNS).filter(move |&j| mask & bit(j) != 0)
 }
 
 fn dot<const M: usize>(u: &[f64; M], v: &[f64; M]) -> f64 {
@@ -157,46 +177,67 @@ fn solve<const M: usize>(
     work: &mut [[f64; M]],
 ) -> bool {
     let k = mask.count_ones() as usize;
-    if k > M {
+    if k > M || k > work.len() {
         return false;
     }
     for (slot, j) in work.iter_mut().zip(ones(mask)) {
-        *slot = a[j];
+        let Some(column) = a.get(j) else {
+            return false;
+        };
+        *slot = *column;
     }
-    let q = &mut work[..k];
+    let q = &mut work[..k.min(M)];
     let mut rhs = *b;
-    for c in 0..k {
+    for c in 0..q.len() {
         // Householder reflection zeroing q[c][c+1..].
-        let scale = norm(&q[c]);
-        let tail: f64 = q[c][c..].iter().map(|v| v * v).sum();
-        let alpha = -libm::copysign(libm::sqrt(tail), q[c][c]);
+        let Some(&column) = q.get(c) else { break };
+        let scale = norm(&column);
+        let tail: f64 = column.iter().skip(c).map(|v| v * v).sum();
+        let pivot = column.get(c).copied().unwrap_or(0.0);
+        let alpha = -libm::copysign(libm::sqrt(tail), pivot);
         // Also false for a NaN pivot.
         let independent = alpha.abs() > 1e-12 * scale;
         if !independent {
             return false;
         }
         let mut v = [0.0; M];
-        v[c..].copy_from_slice(&q[c][c..]);
-        v[c] -= alpha;
-        let vv: f64 = v[c..].iter().map(|e| e * e).sum();
-        for col in q[c..].iter_mut().chain(core::iter::once(&mut rhs)) {
-            let s: f64 = v[c..].iter().zip(&col[c..]).map(|(p, q)| p * q).sum();
+        v.iter_mut()
+            .zip(&column)
+            .skip(c)
+            .for_each(|(vi, qi)| *vi = *qi);
+        if let Some(vc) = v.get_mut(c) {
+            *vc -= alpha;
+        }
+        let vv: f64 = v.iter().skip(c).map(|e| e * e).sum();
+        for col in q.iter_mut().skip(c).chain(core::iter::once(&mut rhs)) {
+            let s: f64 = v.iter().zip(col.iter()).skip(c).map(|(p, q)| p * q).sum();
             let f = 2.0 * s / vv;
-            col[c..]
-                .iter_mut()
-                .zip(&v[c..])
+            col.iter_mut()
+                .zip(&v)
+                .skip(c)
                 .for_each(|(e, vi)| *e -= f * vi);
         }
     }
     // Back substitution: R is q[c][r] for r <= c.
     let mut sol = [0.0; MAX_COLUMNS];
-    for c in (0..k).rev() {
-        let s: f64 = (c + 1..k).map(|j| q[j][c] * sol[j]).sum();
-        sol[c] = (rhs[c] - s) / q[c][c];
+    for c in (0..q.len().min(MAX_COLUMNS)).rev() {
+        let s: f64 = q
+            .iter()
+            .zip(&sol)
+            .skip(c.saturating_add(1))
+            .map(|(col, x)| col.get(c).copied().unwrap_or(0.0) * x)
+            .sum();
+        let diagonal = q.get(c).and_then(|col| col.get(c)).copied();
+        let (Some(r), Some(d)) = (rhs.get(c), diagonal) else {
+            return false;
+        };
+        sol[c] = (r - s) / d;
     }
     z.fill(0.0);
-    for (i, j) in ones(mask).enumerate() {
-        z[j] = sol[i];
+    for (j, value) in ones(mask).zip(sol) {
+        if let Some(slot) = z.get_mut(j) {
+            *slot = value;
+        }
     }
     z.iter().all(|v| v.is_finite())
 }

@@ -4,7 +4,7 @@
 use crate::Scalar;
 use crate::allan::{AllanStream, overlapping_avar};
 
-use super::NoiseError;
+use super::{NoiseError, indexed};
 
 /// Which estimator measured the Allan variances: it sets their equivalent degrees of freedom.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -77,7 +77,9 @@ fn overlapping_edf(big: f64, m: f64, noise: NoiseType) -> f64 {
             (3.0 * (big - 1.0) / (2.0 * m) - 2.0 * (big - 2.0) / big) * 4.0 * m * m
                 / (4.0 * m * m + 5.0)
         }
-        NoiseType::FlickerFrequency if m < 2.0 => 2.0 * (big - 2.0) / (2.3 * big - 4.9),
+        NoiseType::FlickerFrequency if m < 2.0 => {
+            2.0 * (big - 2.0) * (big - 2.0) / (2.3 * big - 4.9)
+        }
         NoiseType::FlickerFrequency => 5.0 * big * big / (4.0 * m * (big + 3.0 * m)),
         NoiseType::RandomWalkFrequency => {
             let b1 = big - 1.0;
@@ -113,10 +115,10 @@ impl<const L: usize> Octaves<L> {
         let mut avar = [0.0; L];
         let mut differences = [0.0; L];
         let mut len = 0;
-        while let Some(v) = stream.avar(len) {
-            avar[len] = v;
-            differences[len] = stream.differences(len);
-            len += 1;
+        for (j, (a, d)) in indexed(avar.iter_mut().zip(differences.iter_mut())) {
+            let Some(v) = stream.avar(j) else { break };
+            (*a, *d) = (v, stream.differences(j));
+            len = j.saturating_add(1);
         }
         Ok(Self {
             dt,
@@ -142,8 +144,8 @@ impl<const L: usize> Octaves<L> {
             return Err(NoiseError::NonFinite { index });
         }
         let mut avar = [0.0; L];
-        let mut len = 0;
-        for (j, slot) in avar.iter_mut().enumerate() {
+        let mut len = 0usize;
+        for (j, slot) in indexed(avar.iter_mut()) {
             let m = 1usize << j.min(63);
             if j >= 63 || x.len() / 2 < m {
                 break;
@@ -151,7 +153,7 @@ impl<const L: usize> Octaves<L> {
             // m >= 1, 2m <= n and every sample finite: the estimate exists.
             let Ok(v) = overlapping_avar(x, m) else { break };
             *slot = v.to_f64();
-            len += 1;
+            len = len.saturating_add(1);
         }
         Ok(Self {
             dt,
@@ -166,7 +168,7 @@ impl<const L: usize> Octaves<L> {
     ///
     /// # Errors
     ///
-    /// [`NoiseError::Interval`] for a bad `dt`, [`NoiseError::TooFewOctaves`] for more than `L`
+    /// [`NoiseError::Interval`] for a bad `dt`, [`NoiseError::TooManyOctaves`] for more than `L`
     /// values, [`NoiseError::NonFinite`] for a NaN, infinite or negative value.
     pub fn new(dt: f64, avar: &[f64], estimator: Estimator) -> Result<Self, NoiseError> {
         check_dt(dt)?;
@@ -177,7 +179,7 @@ impl<const L: usize> Octaves<L> {
             return Err(NoiseError::NonFinite { index });
         }
         let mut out = [0.0; L];
-        out[..avar.len()].copy_from_slice(avar);
+        out.iter_mut().zip(avar).for_each(|(o, v)| *o = *v);
         Ok(Self {
             dt,
             avar: out,
@@ -187,6 +189,15 @@ impl<const L: usize> Octaves<L> {
         })
     }
 
+    /// The octaves with every Allan variance times `2^exponent`.
+    pub(super) fn scaled(&self, exponent: i32) -> Self {
+        let mut out = *self;
+        out.avar
+            .iter_mut()
+            .for_each(|v| *v = libm::scalbn(*v, exponent));
+        out
+    }
+
     /// The sample interval, in seconds.
     pub fn dt(&self) -> f64 {
         self.dt
@@ -194,7 +205,7 @@ impl<const L: usize> Octaves<L> {
 
     /// The Allan variances, `[j]` at `tau = 2^j dt`, in units^2.
     pub fn avar(&self) -> &[f64] {
-        &self.avar[..self.len]
+        &self.avar[..self.len.min(L)]
     }
 
     /// The estimator that measured them.

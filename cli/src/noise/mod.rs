@@ -180,6 +180,12 @@ pub fn run(args: &Args) -> Result<NoiseResult, Fail> {
     if let Some(path) = &args.plot {
         plot::check_path(path)?;
     }
+    if args.unit.chars().any(char::is_control) {
+        return Err(Fail(format!(
+            "--unit {:?}: must not contain control characters",
+            args.unit
+        )));
+    }
     let x = args.input.load(args.decimate)?;
     check_span("--rate", rate, x.len())?;
     let rate = rate / args.decimate as f64;
@@ -206,16 +212,25 @@ pub fn run(args: &Args) -> Result<NoiseResult, Fail> {
              no noise to model",
         ));
     }
+    // A record that no AR model describes (a Burg fit fails on perfectly predictable data)
+    // gets no AR part.
     let order = match args.ar_order {
         Some(p) => p,
-        None => bic_order(&x, rate).map_err(|Fail(e)| args.input.fail(e))?,
+        None => bic_order(&x, rate).unwrap_or(0),
     };
-    match order {
+    let fitted = match order {
         0 => fit.model::<1>(&octaves, None),
         p => with_order!(p, ar_part(&fit, &octaves)),
+    };
+    let (result, draw) = fitted.map_err(|Fail(e)| args.input.fail(e))?;
+    if let (Some(path), Some(draw)) = (&args.plot, draw) {
+        draw().map_err(|e| Fail(format!("--plot {}: cannot draw: {e}", path.display())))?;
     }
-    .map_err(|Fail(e)| args.input.fail(e))
+    Ok(result)
 }
+
+/// What draws the plot, once the model is known to be good.
+type Draw<'a> = Box<dyn FnOnce() -> Result<(), String> + 'a>;
 
 /// The order `0..=8` (fewer for a short record) that BIC selects for a Burg fit.
 fn bic_order(x: &[f64], rate: f64) -> Result<usize, Fail> {
@@ -237,7 +252,10 @@ fn burg_fit<const P: usize>(x: &[f64], rate: f64) -> Result<(Vec<f64>, usize), F
 }
 
 /// The Burg AR(`P`) fit of the record, and the composite with it as its AR part.
-fn ar_part<const P: usize>(fit: &Fitting, octaves: &Octaves<OCTAVES>) -> Result<NoiseResult, Fail> {
+fn ar_part<'a, const P: usize>(
+    fit: &'a Fitting,
+    octaves: &'a Octaves<OCTAVES>,
+) -> Result<(NoiseResult, Option<Draw<'a>>), Fail> {
     let ar = burg::<f64, P>(fit.x, &BatchConfig::new(1.0 / fit.rate)?)
         .map_err(|e| Fail(format!("--ar-order {P}: {e}")))?
         .model;
@@ -255,22 +273,30 @@ struct Fitting<'a> {
 }
 
 impl Fitting<'_> {
-    /// Fits the composite with the AR part `ar`, checks it, and hands it over.
-    fn model<const P: usize>(
-        &self,
-        octaves: &Octaves<OCTAVES>,
+    /// Fits the composite with the AR part `ar`, checks it, and hands it over; with the plot
+    /// to draw, if one was asked for.
+    fn model<'a, const P: usize>(
+        &'a self,
+        octaves: &'a Octaves<OCTAVES>,
         ar: Option<&ArModel<f64, P>>,
-    ) -> Result<NoiseResult, Fail> {
+    ) -> Result<(NoiseResult, Option<Draw<'a>>), Fail> {
         let model = NoiseModel::<P, MAX_GM_STATES>::fit(octaves, ar, &self.config)?;
         let check = model.check(octaves)?;
         let span = self.x.len() as f64 / self.rate;
         // The random walk's state starts with the variance it reaches over the record.
         let rw_p0 = model.random_walk() * model.random_walk() * span;
-        let form = model.kalman(1.0 / self.filter_rate, rw_p0)?;
-        if let Some(path) = self.plot {
-            plot::decomposition_png(path, &model, octaves, &check, &self.caption(&model))?;
-        }
-        Ok(self.result(&model, ar, &model.ieee952(octaves), &form, &check))
+        let form = model.kalman(1.0 / self.filter_rate, rw_p0).map_err(|e| {
+            Fail(format!(
+                "--filter-rate {}: no filter form at this step: {e}",
+                self.filter_rate
+            ))
+        })?;
+        let result = self.result(&model, ar, &model.ieee952(octaves), &form, &check);
+        let draw = self.plot.map(|path| -> Draw<'a> {
+            let caption = self.caption(&model);
+            Box::new(move || plot::decomposition_png(path, &model, octaves, &check, &caption))
+        });
+        Ok((result, draw))
     }
 
     fn caption<const P: usize>(&self, model: &NoiseModel<P, MAX_GM_STATES>) -> String {
@@ -434,12 +460,11 @@ impl Output for NoiseResult {
             d.unit
         );
         let n = self.white_noise.unwrap_or(0.0);
-        s += &format!(
-            "white_noise {} {}{}\n",
-            json(&self.white_noise),
-            u.psd_root(),
-            u.arw(n)
-        );
+        s += &format!("white_noise {}", json(&self.white_noise));
+        if self.white_noise.is_some() {
+            s += &format!(" {}{}", u.psd_root(), u.arw(n));
+        }
+        s += "\n";
         s += &format!(
             "  white term {}, AR part's white equivalent {}; Allan deviation at tau = 1 s: {}\n",
             json(&d.white_term),
@@ -512,14 +537,29 @@ impl Output for NoiseResult {
             json(&d.measurement_variance)
         );
         s += "# tau_s data_adev model_adev data/model tolerance agrees\n";
+        // As in the JSON, a number that is not finite is null.
+        let e = |v: f64| {
+            if v.is_finite() {
+                format!("{v:e}")
+            } else {
+                "null".into()
+            }
+        };
+        let f = |v: f64| {
+            if v.is_finite() {
+                format!("{v:.3}")
+            } else {
+                "null".into()
+            }
+        };
         for r in &self.allan {
             s += &format!(
-                "{} {:e} {:e} {:.3} {:.3} {}\n",
+                "{} {} {} {} {} {}\n",
                 json(&r.tau_s),
-                r.data_adev,
-                r.model_adev,
-                r.data_over_model,
-                r.tolerance,
+                e(r.data_adev),
+                e(r.model_adev),
+                f(r.data_over_model),
+                f(r.tolerance),
                 if r.agrees { "yes" } else { "NO" }
             );
         }

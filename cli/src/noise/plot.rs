@@ -5,7 +5,7 @@ use std::path::Path;
 use imu_ar::noise::{Check, NoiseModel, Octaves, component};
 use plotters::prelude::*;
 
-use crate::chart::{SIZE, builder, draw_err, font, legend};
+use crate::chart::{SIZE, builder, font, legend};
 use crate::error::Fail;
 use crate::kalman::AllanRow;
 
@@ -84,11 +84,12 @@ pub(super) fn decomposition_png<const P: usize, const G: usize, const L: usize>(
     octaves: &Octaves<L>,
     check: &Check<L>,
     caption: &str,
-) -> Result<(), Fail> {
-    font()?;
+) -> Result<(), String> {
+    font().map_err(|Fail(e)| e)?;
+    let draw_err = |e: DrawingAreaErrorKind<_>| e.to_string();
     let rows = check.rows();
     let tau: Vec<f64> = rows.iter().map(|r| r.tau).collect();
-    let components = components(model, octaves)?;
+    let components = components(model, octaves).map_err(|Fail(e)| e)?;
     let lowest_data = rows
         .iter()
         .map(|r| r.data_adev)
@@ -161,7 +162,7 @@ pub(super) fn decomposition_png<const P: usize, const G: usize, const L: usize>(
             .label("check fails")
             .legend(|(x, y)| Cross::new((x + 10, y), 5, BLACK.stroke_width(2)));
     }
-    legend(&mut chart, SeriesLabelPosition::LowerLeft)?;
+    legend(&mut chart, SeriesLabelPosition::LowerLeft).map_err(|Fail(e)| e)?;
     root.present().map_err(draw_err)
 }
 

@@ -1,0 +1,177 @@
+//! The noise-model fit at its edges: the degrees of freedom of the check, a model far above
+//! the data, magnitudes across the range of f64, exact curves, capacities, intervals and filter
+//! steps that overflow.
+
+use imu_ar::ArModel;
+use imu_ar::noise::{Estimator, FitConfig, NoiseError, NoiseModel, NoiseType, Octaves, component};
+
+/// `avar[j] = f(2^j)` for `j < l`.
+fn curve(l: usize, f: impl Fn(u64) -> f64) -> Vec<f64> {
+    (0..l).map(|j| f(1u64 << j)).collect()
+}
+
+/// White noise `N^2 = n2` and random walk `K^2 = k2` at `dt`.
+fn white_and_walk(dt: f64, n2: f64, k2: f64) -> impl Fn(u64) -> f64 {
+    move |m| n2 * component::white(dt, m) + k2 * component::random_walk(dt, m)
+}
+
+#[test]
+fn overlapping_edf_follows_riley_table_5_at_m_1() {
+    // NIST SP 1065, table 5, flicker frequency noise at m = 1: 2 (N - 2)^2 / (2.3 N - 4.9)
+    // for N phase points (n + 1 for n frequency samples).
+    let n = 1_000_000u64;
+    let big = (n + 1) as f64;
+    let want = 2.0 * (big - 2.0) * (big - 2.0) / (2.3 * big - 4.9);
+    let got = Estimator::Overlapping { n }.edf(1, NoiseType::FlickerFrequency);
+    assert!((got / want - 1.0).abs() < 1e-12, "{got} against {want}");
+    // The same order as the other noise types there, not 1.
+    let white = Estimator::Overlapping { n }.edf(1, NoiseType::WhiteFrequency);
+    assert!(got > 0.5 * white, "{got} against white {white}");
+}
+
+#[test]
+fn the_check_refuses_a_doubled_first_octave() {
+    // A Gauss-Markov term with T = dt dominates the first octave; a model fitted to the true
+    // curve must not pass against data whose deviation there is twice as large.
+    let dt = 0.01;
+    let truth = |m| component::gauss_markov(dt, dt, m) + 1e-6 * component::white(dt, m);
+    let avar = curve(20, truth);
+    let estimator = Estimator::Overlapping { n: 1 << 21 };
+    let octaves = Octaves::<20>::new(dt, &avar, estimator).unwrap();
+    let model = NoiseModel::<1, 3>::fit(&octaves, None, &FitConfig::new(3)).unwrap();
+    assert!(model.check(&octaves).unwrap().holds());
+    let mut doubled = avar.clone();
+    doubled[0] *= 4.0;
+    let doubled = Octaves::<20>::new(dt, &doubled, estimator).unwrap();
+    let row = model.check(&doubled).unwrap().rows()[0];
+    assert!(!row.agrees, "{row:?}");
+    assert!(row.tolerance < 0.2, "{row:?}");
+}
+
+#[test]
+fn a_model_far_above_the_data_fails_however_wide_the_tolerance() {
+    // Few samples: the last octaves have tolerances above 1.
+    let dt = 0.01;
+    let avar = curve(6, white_and_walk(dt, 1e-4, 0.0));
+    let octaves = Octaves::<6>::new(dt, &avar, Estimator::NonOverlapping { n: 80 }).unwrap();
+    let model = NoiseModel::<1, 1>::fit(&octaves, None, &FitConfig::new(0)).unwrap();
+    let check = model.check(&octaves).unwrap();
+    assert!(check.rows().iter().any(|r| r.tolerance >= 1.0));
+    assert!(check.holds());
+    // The same model against data 1000 times smaller in variance.
+    let small: Vec<f64> = avar.iter().map(|v| v * 1e-6).collect();
+    let small = Octaves::<6>::new(dt, &small, Estimator::NonOverlapping { n: 80 }).unwrap();
+    let check = model.check(&small).unwrap();
+    assert!(check.rows().iter().all(|r| !r.agrees), "{:?}", check.rows());
+}
+
+#[test]
+fn the_fit_scales_with_the_data_across_the_range_of_f64() {
+    let dt = 0.01;
+    let base = curve(20, |m| {
+        1e-4 * component::white(dt, m)
+            + 1e-8 * component::random_walk(dt, m)
+            + 1e-2 * component::gauss_markov(dt, 2.0, m)
+    });
+    let fit = |scale: f64| {
+        let avar: Vec<f64> = base.iter().map(|v| v * scale).collect();
+        let octaves = Octaves::<20>::new(dt, &avar, Estimator::Overlapping { n: 1 << 21 }).unwrap();
+        let model = NoiseModel::<1, 3>::fit(&octaves, None, &FitConfig::new(3)).unwrap();
+        assert!(model.check(&octaves).unwrap().holds(), "scale {scale:e}");
+        (
+            model.white_noise(),
+            model.random_walk(),
+            model.gauss_markov().len(),
+        )
+    };
+    let reference = fit(1.0);
+    for scale in [1e-300, 1e-200, 1e-80, 1e-30, 1e30, 1e80, 1e200, 1e290] {
+        let (n, k, terms) = fit(scale);
+        let root = scale.sqrt();
+        assert!(
+            (n / root / reference.0 - 1.0).abs() < 1e-9,
+            "scale {scale:e}: N {n:e}"
+        );
+        assert!(
+            (k / root / reference.1 - 1.0).abs() < 1e-9,
+            "scale {scale:e}: K {k:e}"
+        );
+        assert_eq!(terms, reference.2, "scale {scale:e}");
+    }
+}
+
+#[test]
+fn a_parameter_beyond_f64_is_a_typed_error() {
+    let big = [f64::MAX, f64::MAX];
+    let octaves = Octaves::<2>::new(0.01, &big, Estimator::Overlapping { n: 4 }).unwrap();
+    let got = NoiseModel::<1, 1>::fit(&octaves, None, &FitConfig::new(1));
+    assert!(matches!(got, Err(NoiseError::Overflow)), "{got:?}");
+}
+
+#[test]
+fn exact_white_and_walk_curves_always_fit() {
+    // 400 random mixtures over eight decades each: the NNLS must converge on noise-free data.
+    let mut seed = 0x2545_f491_4f6c_dd1du64;
+    let mut uniform = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for trial in 0..400 {
+        let n2 = 10f64.powf(-8.0 + 8.0 * uniform());
+        let k2 = 10f64.powf(-10.0 + 8.0 * uniform());
+        let avar = curve(20, white_and_walk(0.01, n2, k2));
+        let octaves =
+            Octaves::<20>::new(0.01, &avar, Estimator::Overlapping { n: 1 << 21 }).unwrap();
+        let model = NoiseModel::<1, 3>::fit(&octaves, None, &FitConfig::new(3))
+            .unwrap_or_else(|e| panic!("trial {trial}: N^2 {n2:e} K^2 {k2:e}: {e}"));
+        assert!(model.check(&octaves).unwrap().holds(), "trial {trial}");
+    }
+}
+
+#[test]
+fn a_capacity_too_small_for_the_columns_is_a_typed_error() {
+    // L = 2 holds four columns: quantisation, white, random walk, ramp and an AR part are five.
+    let ar = ArModel::new([0.5], 1.0, 0.0, 0.01).unwrap();
+    let octaves = Octaves::<2>::new(0.01, &[1e-2, 5e-3], Estimator::Overlapping { n: 4 }).unwrap();
+    let config = FitConfig::new(0).with_ramp(true);
+    let got = NoiseModel::<1, 1>::fit(&octaves, Some(&ar), &config);
+    assert_eq!(got.err(), Some(NoiseError::Capacity));
+    // Without the ramp the four fit.
+    assert!(NoiseModel::<1, 1>::fit(&octaves, Some(&ar), &FitConfig::new(0)).is_ok());
+}
+
+#[test]
+fn intervals_whose_tau_squared_overflows_are_refused() {
+    let avar = curve(20, white_and_walk(1.0, 1e-4, 1e-8));
+    for dt in [1e-200, 1e200] {
+        let octaves = Octaves::<20>::new(dt, &avar, Estimator::Overlapping { n: 1 << 21 }).unwrap();
+        let got = NoiseModel::<1, 1>::fit(&octaves, None, &FitConfig::new(1));
+        assert_eq!(got.err(), Some(NoiseError::Interval), "dt {dt:e}");
+    }
+}
+
+#[test]
+fn a_filter_step_that_overflows_a_variance_is_refused() {
+    let dt = 0.01;
+    let avar = curve(20, |m| {
+        1e-6 * component::quantization(dt, m) + 1e-4 * component::white(dt, m)
+    });
+    let octaves = Octaves::<20>::new(dt, &avar, Estimator::Overlapping { n: 1 << 21 }).unwrap();
+    let model = NoiseModel::<1, 1>::fit(&octaves, None, &FitConfig::new(1)).unwrap();
+    assert!(model.quantization() > 0.0);
+    assert_eq!(model.kalman(1e-300, 0.0).err(), Some(NoiseError::Interval));
+    let form = model.kalman(0.01, 0.0).unwrap();
+    assert!(form.measurement_variance.is_finite());
+}
+
+#[test]
+fn the_one_second_reading_is_a_number_or_none() {
+    // Zero Allan variance at the octaves around 1 s: no reading rather than NaN.
+    let octaves =
+        Octaves::<4>::new(1.0, &[2.0, 0.0, 0.0], Estimator::Overlapping { n: 16 }).unwrap();
+    let model = NoiseModel::<1, 1>::fit(&octaves, None, &FitConfig::new(1)).unwrap();
+    let reading = model.ieee952(&octaves).white_noise_at_1s;
+    assert!(reading.is_none_or(f64::is_finite), "{reading:?}");
+}
