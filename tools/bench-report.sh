@@ -52,6 +52,20 @@ with open(f"{tmp}/perf-state.md", "w") as out:
 PY
     replace perf-target "$tmp/perf-target.md"
     replace perf-state "$tmp/perf-state.md"
+    python3 - "$tmp/bench.txt" > "$tmp/perf-noise.md" <<'PY'
+import re, sys
+text = open(sys.argv[1]).read()
+print("| noise-model fit, 20 octaves, budget 3 | instructions | stack (bytes) | Gauss-Markov terms |")
+print("|---|---|---|---|")
+for ar, insns, stack, terms in re.findall(r"noise fit octaves=20 gm=3 ar=(\w+) insns/fit=(\d+) stack=(\d+) terms=(\d+)", text):
+    label = "with an AR(8) part" if ar == "ar8" else "without an AR part"
+    print(f"| {label} | {int(insns):,} | {int(stack):,} | {terms} |")
+m = re.search(r"allan_stream_l20 bytes=(\d+) noise_model_p8_g3 bytes=(\d+) octaves_l20 bytes=(\d+)", text)
+print()
+print(f"State: `AllanStream<20>` {m.group(1)} bytes (kept per axis, fed every sample), "
+      f"`Octaves<20>` {m.group(3)} bytes, `NoiseModel<8, 3>` {m.group(2)} bytes.")
+PY
+    replace perf-noise "$tmp/perf-noise.md"
 fi
 
 if [ "$only" = all ] || [ "$only" = host ]; then

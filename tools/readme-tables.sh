@@ -3,13 +3,16 @@
 #   - f32 and fixed-point accuracy of the lattice (host-tests/tests/recursive_f32.rs, fixed.rs),
 #   - the demo's output and footprint (`cargo qemu demo`, tools/footprint.sh),
 #   - `imu-ar compare` on a drifting AR(2),
+#   - `imu-ar noise` on every axis of both real records, the ADIS16405 gx composite next to the
+#     two AR(1) hand-offs, its decomposition plot (docs/plots/adis-gx-noise.png) and the one of
+#     the ax axis (docs/plots/adis-ax-noise.png),
 #   - the SFTF against the lattice and RLS: instructions per sample on the target (`cargo qemu
 #     bench`) and restarts per 10^6 samples (host-tests/tests/sftf.rs).
 #
 # The performance tables are written by tools/bench-report.sh.
 #
 #   tools/readme-tables.sh            all of them (about 3 minutes)
-#   tools/readme-tables.sh accuracy   one group: accuracy | demo | compare | sftf
+#   tools/readme-tables.sh accuracy   one group: accuracy | demo | compare | sftf | noise
 #   tools/readme-tables.sh check-demo FILE   exit 1 when the README's demo-output block differs
 #                                            from the demo output in FILE (CI)
 set -euo pipefail
@@ -123,4 +126,78 @@ for est in ("sftf", "lattice", "rls"):
 PY
     replace sftf-cost "$tmp/sftf-cost.md"
     test_tables sftf "| process (10^6 samples) |=sftf-restarts" "| record (six axes=sftf-real"
+fi
+
+if [ "$only" = all ] || [ "$only" = noise ]; then
+    data=${IMU_AR_DATA:-../shared/data/imu}
+    cargo build -q -p imu-ar-cli
+    tool=target/debug/imu-ar
+    adis="$data/adis16405_imu1_part1.csv $data/adis16405_imu1_part2.csv"
+    mpu="$data/mpu6050_static_10min.csv"
+    for axis in gx gy gz ax ay az; do
+        # shellcheck disable=SC2086
+        "$tool" noise $adis --column "$axis" --rate 100 --json > "$tmp/adis-$axis.json"
+        "$tool" noise "$mpu" --column "$axis" --rate 100 --json > "$tmp/mpu-$axis.json"
+    done
+    for axis in ax ay az; do
+        # shellcheck disable=SC2086
+        "$tool" noise $adis --column "$axis" --rate 100 --oscillators --gm-states 5 --json \
+            > "$tmp/adis-$axis-osc.json"
+    done
+    # shellcheck disable=SC2086
+    "$tool" noise $adis --column gx --rate 100 --unit deg/s --plot docs/plots/adis-gx-noise.png > /dev/null
+    # shellcheck disable=SC2086
+    "$tool" noise $adis --column ax --rate 100 --unit g --plot docs/plots/adis-ax-noise.png > /dev/null
+    # shellcheck disable=SC2086
+    "$tool" kalman $adis --column gx --order 1 --rate 100 --filter-rate 100 --json > "$tmp/k1.json"
+    # shellcheck disable=SC2086
+    "$tool" kalman $adis --column gx --order 1 --rate 100 --decimate 1000 --filter-rate 100 \
+        --json > "$tmp/k1000.json"
+    python3 - "$tmp" <<'PY'
+import json, math, sys
+tmp = sys.argv[1]
+load = lambda name: json.load(open(f"{tmp}/{name}.json"))
+def at_1s(v):
+    rows = v["allan"]
+    i = next(k for k, r in enumerate(rows) if r["tau_s"] >= 1.0)
+    (t0, d0), (t1, d1) = [(rows[k]["tau_s"], rows[k]["data_adev"]) for k in (i - 1, i)]
+    w = math.log(1 / t0) / math.log(t1 / t0)
+    return math.exp(math.log(d0) * (1 - w) + math.log(d1) * w)
+def upto(v):
+    last = v["allan"][-1]["tau_s"]
+    e = v["explained_up_to_s"]
+    return f"{e:g} s (every tau)" if e == last else f"{e:g} s of {last:g} s"
+def sig(x):
+    return "null" if x is None else f"{x:.4g}"
+with open(f"{tmp}/noise-handoff.md", "w") as out:
+    out.write("| model of ADIS16405 gx | filter states | N (deg/s/sqrt(Hz)) | B (deg/h) | K (deg/s/s/sqrt(Hz)) | Allan check holds up to |\n")
+    out.write("|---|---|---|---|---|---|\n")
+    for name, label in (("k1", "AR(1) of the 100 Hz samples"), ("k1000", "AR(1) of 10 s averages")):
+        v = load(name)
+        out.write(f"| {label} | 1 | – | – | – | {upto(v)} |\n")
+    v = load("adis-gx")
+    states = len(v["phi"])
+    ar = v["ar"]["order"] if v["ar"] else 0
+    out.write(f"| composite: white + AR({ar}) part + {len(v['gauss_markov'])} Gauss-Markov + random walk "
+              f"| {states} | {sig(v['white_noise'])} | {sig(v['bias_instability']['value'] * 3600)} "
+              f"| {sig(v['random_walk'])} | {upto(v)} |\n")
+with open(f"{tmp}/noise-axes.md", "w") as out:
+    out.write("| record | axis | AR order | Gauss-Markov terms | filter states | N | ADEV at 1 s | N / ADEV(1 s) | Allan check holds up to |\n")
+    out.write("|---|---|---|---|---|---|---|---|---|\n")
+    for rec, label in (("adis", "ADIS16405"), ("mpu", "MPU-6050")):
+        for axis in ("gx", "gy", "gz", "ax", "ay", "az"):
+            runs = [(axis, load(f"{rec}-{axis}"))]
+            if rec == "adis" and axis.startswith("a"):
+                runs.append((axis + " `--oscillators --gm-states 5`", load(f"{rec}-{axis}-osc")))
+            for name, v in runs:
+                ar = v["ar"]["order"] if v["ar"] else 0
+                terms = len(v["gauss_markov"])
+                osc = sum(1 for g in v["gauss_markov"] if "frequency_hz" in g)
+                terms_text = f"{terms} ({osc} oscillator at {v['gauss_markov'][-1]['frequency_hz']:.2f} Hz)" if osc else str(terms)
+                n, a1 = v["white_noise"], at_1s(v)
+                out.write(f"| {label} | {name} | {ar} | {terms_text} | {len(v['phi'])} | {n:.4g} "
+                          f"| {a1:.4g} | {n / a1:.3f} | {upto(v)} |\n")
+PY
+    replace noise-handoff "$tmp/noise-handoff.md"
+    replace noise-axes "$tmp/noise-axes.md"
 fi
