@@ -175,3 +175,39 @@ fn the_one_second_reading_is_a_number_or_none() {
     let reading = model.ieee952(&octaves).white_noise_at_1s;
     assert!(reading.is_none_or(f64::is_finite), "{reading:?}");
 }
+
+#[test]
+fn constant_short_and_non_finite_records_are_typed_errors() {
+    let fit = |x: &[f64]| -> Result<NoiseModel<1, 2>, NoiseError> {
+        let octaves = Octaves::<20>::overlapping(x, 0.01)?;
+        NoiseModel::<1, 2>::fit(&octaves, None, &FitConfig::new(2))
+    };
+    assert_eq!(fit(&[1.5; 1000]).err(), Some(NoiseError::Constant));
+    // Three samples: one octave (m = 1).
+    assert_eq!(
+        fit(&[1.0, 2.0, 4.0]).err(),
+        Some(NoiseError::TooFewOctaves { given: 1 })
+    );
+    let mut x: Vec<f64> = (0..1000).map(|i| f64::from((i * 37) % 11)).collect();
+    x[500] = f64::NAN;
+    assert_eq!(fit(&x).err(), Some(NoiseError::NonFinite { index: 500 }));
+    x[500] = f64::INFINITY;
+    assert_eq!(fit(&x).err(), Some(NoiseError::NonFinite { index: 500 }));
+    // A stream that rejected its non-finite samples has nothing to report for them: its
+    // octaves are those of the finite ones.
+    let mut stream = imu_ar::allan::AllanStream::<20>::new();
+    for v in &x {
+        stream.push(*v);
+    }
+    assert_eq!(stream.rejected(), 1);
+    let octaves = Octaves::from_stream(&stream, 0.01).unwrap();
+    assert!(NoiseModel::<1, 2>::fit(&octaves, None, &FitConfig::new(2)).is_ok());
+    // A constant stream is a typed error too.
+    let mut flat = imu_ar::allan::AllanStream::<20>::new();
+    (0..1000).for_each(|_| {
+        flat.push(2.0f32);
+    });
+    let octaves = Octaves::from_stream(&flat, 0.01).unwrap();
+    let got = NoiseModel::<1, 2>::fit(&octaves, None, &FitConfig::new(2));
+    assert_eq!(got.err(), Some(NoiseError::Constant));
+}
