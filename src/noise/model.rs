@@ -152,7 +152,9 @@ pub struct KalmanForm<const G: usize> {
     /// caller gave), or `None` when the model has no random walk.
     pub random_walk: Option<GmState>,
     /// Variance of the sensor averaged over one step `Dt` (a filter that uses it as a
-    /// measurement): `N^2 / Dt + 2 Q^2 / Dt^2`, u^2.
+    /// measurement): `N^2 / Dt + 2 Q^2 / Dt^2`, u^2. (A
+    /// quantised angle `e_k` of variance `Q^2` differenced over `Dt` has variance `2 Q^2 / Dt^2`;
+    /// `3 Q^2 / Dt^2` is its Allan variance at `tau = Dt`.)
     pub measurement_variance: f64,
     /// Two-sided PSD of the white part, `N^2`, u^2/Hz (u^2 s): the process noise density of the
     /// integrated angle or velocity in a strapdown filter.
