@@ -382,3 +382,26 @@ fn a_record_no_ar_model_describes_gets_no_ar_part() {
     assert!(text.contains("ar null"), "{text}");
     common::no_nan_inf(&text);
 }
+
+#[test]
+fn a_trend_gets_no_ar_part_and_out_of_range_magnitudes_are_named() {
+    // A ramp: Burg fits it, but not with a stationary model; the automatic order falls back.
+    let ramp = column_file(
+        "noise-ramp.csv",
+        (0..1000).map(|i| format!("{}", f64::from(i) * 0.01)),
+    );
+    let v = noise(&[ramp], "x", "100", &[]);
+    assert_eq!(v["ar"], Value::Null);
+    let huge = scaled_white("noise-huge.csv", 1e153);
+    let huge = huge.to_str().unwrap();
+    misused(
+        &["noise", huge, "--column", "x", "--rate", "100"],
+        "overflows f64",
+    );
+    let tiny = scaled_white("noise-tiny.csv", 1e-300);
+    let tiny = tiny.to_str().unwrap();
+    misused(
+        &["noise", tiny, "--column", "x", "--rate", "100"],
+        "underflows f64",
+    );
+}

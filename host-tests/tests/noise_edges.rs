@@ -4,6 +4,7 @@
 
 use imu_ar::ArModel;
 use imu_ar::noise::{Estimator, FitConfig, NoiseError, NoiseModel, NoiseType, Octaves, component};
+use rand_core::SeedableRng;
 
 /// `avar[j] = f(2^j)` for `j < l`.
 fn curve(l: usize, f: impl Fn(u64) -> f64) -> Vec<f64> {
@@ -210,4 +211,83 @@ fn constant_short_and_non_finite_records_are_typed_errors() {
     let octaves = Octaves::from_stream(&flat, 0.01).unwrap();
     let got = NoiseModel::<1, 2>::fit(&octaves, None, &FitConfig::new(2));
     assert_eq!(got.err(), Some(NoiseError::Constant));
+}
+
+#[test]
+fn non_overlapping_degrees_of_freedom_match_a_monte_carlo_count() {
+    // 4000 records of 201 white samples: 200 consecutive differences at m = 1. The estimate's
+    // degrees of freedom, 2 mean^2 / variance, against 2 K^2 / (3 K - 1) = 133.6, not 200.
+    let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+    let mut normal = imu_ar::sim::StandardNormal::new();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+    let estimates: Vec<f64> = (0..4000)
+        .map(|_| {
+            let mut stream = imu_ar::allan::AllanStream::<2>::new();
+            for _ in 0..201 {
+                seed = seed.wrapping_add(1);
+                stream.push(normal.sample(&mut rng));
+            }
+            stream.avar(0).unwrap()
+        })
+        .collect();
+    let mean = estimates.iter().sum::<f64>() / 4000.0;
+    let var = estimates.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / 3999.0;
+    let measured = 2.0 * mean * mean / var;
+    let claimed = Estimator::NonOverlapping { n: 201 }.edf(1, NoiseType::WhiteFrequency);
+    assert!(
+        (claimed - 2.0 * 200.0 * 200.0 / 599.0).abs() < 1e-9,
+        "{claimed}"
+    );
+    // The Monte Carlo count has a relative standard error of about 5 % here.
+    assert!(
+        (measured / claimed - 1.0).abs() < 0.15,
+        "{measured} against {claimed}"
+    );
+}
+
+#[test]
+fn octaves_beyond_what_the_samples_give_are_refused_and_never_agree() {
+    let avar = curve(6, white_and_walk(0.01, 1e-4, 0.0));
+    // Four samples give two octaves (m = 1 and 2).
+    let got = Octaves::<6>::new(0.01, &avar, Estimator::Overlapping { n: 4 });
+    assert_eq!(got.err(), Some(NoiseError::TooManyOctaves { capacity: 2 }));
+    // Riley's formulas on tiny records stay within the differences there are.
+    for (n, m) in [(2u64, 1u64), (3, 1), (4, 1), (4, 2)] {
+        let nu = Estimator::Overlapping { n }.edf(m, NoiseType::RandomWalkFrequency);
+        assert!(
+            nu.is_finite() && nu <= (n - 2 * m + 1) as f64,
+            "n {n} m {m}: {nu}"
+        );
+    }
+}
+
+#[test]
+fn allan_variances_that_overflow_are_a_typed_error() {
+    let x: Vec<f64> = (0..1000)
+        .map(|i| 1e153 * f64::from((i * 37) % 11))
+        .collect();
+    let got = Octaves::<20>::overlapping(&x, 0.01);
+    assert_eq!(got.err(), Some(NoiseError::Overflow));
+}
+
+#[test]
+fn an_extreme_range_across_octaves_gives_no_silent_zero_model() {
+    for dt in [1.0, 0.01, 1e-4] {
+        let octaves = Octaves::<4>::new(
+            dt,
+            &[1.0, 1e-300, 1e-300, 1e-300],
+            Estimator::Overlapping { n: 16 },
+        )
+        .unwrap();
+        if let Ok(model) = NoiseModel::<1, 1>::fit(&octaves, None, &FitConfig::new(1)) {
+            let parameters = [
+                model.quantization(),
+                model.white_noise(),
+                model.random_walk(),
+                model.ramp(),
+            ];
+            let any = parameters.iter().any(|p| *p > 0.0) || !model.gauss_markov().is_empty();
+            assert!(any, "dt {dt}: an all-zero model of non-zero data");
+        }
+    }
 }

@@ -159,7 +159,8 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
     /// than 2 octaves; [`NoiseError::Constant`] when every Allan variance is zero;
     /// [`NoiseError::Interval`] when `1 / tau^2` at the first octave or `tau^2` at the last
     /// overflows; [`NoiseError::Capacity`] for an `L` too small for the fixed columns;
-    /// [`NoiseError::Overflow`] when a fitted parameter overflows `f64`;
+    /// [`NoiseError::Overflow`] when a fitted parameter overflows `f64`; [`NoiseError::Range`]
+    /// when the Allan variances span too many decades to weigh (about 1e300);
     /// [`NoiseError::Ar`] for a non-stationary AR part.
     pub fn fit<const L: usize>(
         octaves: &Octaves<L>,
@@ -199,7 +200,15 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
             ),
             None => None,
         };
-        Self::fit_unit(&scaled, ar.as_ref(), config)?.scaled(exponent)
+        let model = Self::fit_unit(&scaled, ar.as_ref(), config)?;
+        // A model of no noise at all for data with some: the weights spanned more than f64
+        // can hold.
+        let mut curve = [0.0; L];
+        model.avar_octaves(&mut curve[..data.len().min(L)])?;
+        if curve.iter().all(|v| *v == 0.0) {
+            return Err(NoiseError::Range);
+        }
+        model.scaled(exponent)
     }
 
     /// [`NoiseModel::fit`] in the scaled units.
@@ -453,7 +462,14 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
             for (j, (v, w)) in cells {
                 *v = w * self.unit(*column, j);
             }
-            *s = libm::sqrt(col.iter().map(|v| v * v).sum::<f64>());
+            // The norm scaled by the largest entry, so that squares neither overflow nor
+            // underflow.
+            let big = col.iter().fold(0.0f64, |m, v| m.max(libm::fabs(*v)));
+            *s = if big > 0.0 && big.is_finite() {
+                big * libm::sqrt(col.iter().map(|v| (v / big) * (v / big)).sum::<f64>())
+            } else {
+                big
+            };
             if *s > 0.0 {
                 col.iter_mut().for_each(|v| *v /= *s);
             }

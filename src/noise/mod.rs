@@ -76,6 +76,8 @@ pub enum NoiseError {
     Capacity,
     /// A fitted parameter overflows `f64` (Allan variances near the top of its range).
     Overflow,
+    /// The Allan variances span too many decades (about 1e300) for their weights: no model.
+    Range,
     /// The AR part is not a stationary model.
     Ar(ModelError),
     /// The least-squares solve failed.
@@ -113,6 +115,9 @@ impl fmt::Display for NoiseError {
                 "a fitted parameter overflows f64: the Allan variances are too large; rescale \
                  the data",
             ),
+            Self::Range => {
+                f.write_str("the Allan variances span more decades than f64 can weigh (about 300)")
+            }
             Self::Ar(e) => write!(f, "AR part: {e}"),
             Self::Nnls(e) => write!(f, "least squares: {e:?}"),
         }

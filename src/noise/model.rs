@@ -181,7 +181,7 @@ pub struct AllanRow {
     /// `data / model` within the two-standard-error interval of the measured deviation: the
     /// chi^2 interval at `z = +-2` for `nu` degrees of freedom (Wilson-Hilferty), widened to
     /// at least `[0.9, 1.1]`. For many degrees of freedom this is `1 +- tolerance`; for few,
-    /// it is skewed as the chi^2 distribution is (with 4 degrees of freedom, 0.34 to 1.68;
+    /// it is skewed as the chi^2 distribution is (with 4 degrees of freedom, 0.33 to 1.68;
     /// with 1, 0.03 to 2.2), so that a model far above the data fails however wide the
     /// tolerance.
     pub agrees: bool,
@@ -465,8 +465,9 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
 /// Whether `ratio = data / model` is within the check's interval for a deviation measured with
 /// `nu` degrees of freedom (see [`AllanRow::agrees`]).
 fn agrees(ratio: f64, nu: f64) -> bool {
+    // No degrees of freedom: no estimate to agree with.
     if nu.is_nan() || nu <= 0.0 {
-        return ratio.is_finite();
+        return false;
     }
     // Wilson-Hilferty: chi^2_nu / nu at z standard normal deviations is about
     // (1 - c + z sqrt(c))^3 with c = 2 / (9 nu).

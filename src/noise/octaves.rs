@@ -50,11 +50,13 @@ impl Estimator {
     /// when `noise` dominates: the estimate is distributed as `AVAR chi^2_nu / nu`, so its
     /// relative standard error is `sqrt(2 / nu)` (and the deviation's `1 / sqrt(2 nu)`).
     ///
-    /// - Non-overlapping: the number of differences, `floor(n/m) - 1`, whatever the noise
-    ///   (exact for white frequency noise, whose differences are independent).
+    /// - Non-overlapping, `K = floor(n/m) - 1` differences of consecutive cluster means:
+    ///   `2 K^2 / (3 K - 1)`, whatever the noise. Neighbouring differences share a cluster
+    ///   (correlation -1/2 for white frequency noise), so `sum d^2` has the variance
+    ///   `sigma^4 (12 K - 4)`, and this is exact for white frequency noise (about `2 K / 3`).
     /// - Overlapping: the simple formulas of W. J. Riley, *Handbook of Frequency Stability
     ///   Analysis*, NIST SP 1065 (2008), table 5 (after Howe, Allan and Barnes 1981), with
-    ///   `N = n + 1` phase points.
+    ///   `N = n + 1` phase points, at most the `n - 2m + 1` differences there are.
     ///
     /// At least 1; 0 when fewer than two clusters fit (no estimate).
     pub fn edf(&self, m: u64, noise: NoiseType) -> f64 {
@@ -63,10 +65,23 @@ impl Estimator {
             return 0.0;
         }
         match *self {
-            Self::NonOverlapping { .. } => (n / m - 1) as f64,
-            Self::Overlapping { .. } => overlapping_edf(n as f64 + 1.0, m as f64, noise).max(1.0),
+            Self::NonOverlapping { .. } => non_overlapping_edf((n / m - 1) as f64),
+            Self::Overlapping { .. } => {
+                let differences = n.saturating_sub(m.saturating_mul(2)).saturating_add(1) as f64;
+                let riley = overlapping_edf(n as f64 + 1.0, m as f64, noise);
+                riley.min(differences).max(1.0)
+            }
         }
     }
+}
+
+/// The degrees of freedom of `k` (effective) consecutive differences of cluster means:
+/// `2 k^2 / (3 k - 1)` (see [`Estimator::edf`]).
+pub(super) fn non_overlapping_edf(k: f64) -> f64 {
+    if k <= 0.0 {
+        return 0.0;
+    }
+    2.0 * k * k / (3.0 * k - 1.0)
 }
 
 /// Riley's table 5 for `big` phase points and `m` samples per cluster.
@@ -152,6 +167,10 @@ impl<const L: usize> Octaves<L> {
             }
             // m >= 1, 2m <= n and every sample finite: the estimate exists.
             let Ok(v) = overlapping_avar(x, m) else { break };
+            // Sums of m samples of about 1e152 or more overflow.
+            if !v.to_f64().is_finite() {
+                return Err(NoiseError::Overflow);
+            }
             *slot = v.to_f64();
             len = len.saturating_add(1);
         }
@@ -169,11 +188,18 @@ impl<const L: usize> Octaves<L> {
     /// # Errors
     ///
     /// [`NoiseError::Interval`] for a bad `dt`, [`NoiseError::TooManyOctaves`] for more than `L`
-    /// values, [`NoiseError::NonFinite`] for a NaN, infinite or negative value.
+    /// values or more octaves than the estimator's `n` samples give (octave `j` needs
+    /// `2^(j+1)`), [`NoiseError::NonFinite`] for a NaN, infinite or negative value.
     pub fn new(dt: f64, avar: &[f64], estimator: Estimator) -> Result<Self, NoiseError> {
         check_dt(dt)?;
         if avar.len() > L {
             return Err(NoiseError::TooManyOctaves { capacity: L });
+        }
+        // Octave j needs two clusters of 2^j samples.
+        let n = estimator.samples();
+        let possible = (u64::BITS - n.leading_zeros()).saturating_sub(1) as usize;
+        if avar.len() > possible {
+            return Err(NoiseError::TooManyOctaves { capacity: possible });
         }
         if let Some(index) = avar.iter().position(|v| !(v.is_finite() && *v >= 0.0)) {
             return Err(NoiseError::NonFinite { index });
@@ -213,11 +239,12 @@ impl<const L: usize> Octaves<L> {
         self.estimator
     }
 
-    /// The degrees of freedom of octave `j` when `noise` dominates it: a stream's effective
-    /// number of differences (at least 1), or [`Estimator::edf`].
+    /// The degrees of freedom of octave `j` when `noise` dominates it: from a stream's
+    /// effective number of differences `K`, `2 K^2 / (3 K - 1)` as for
+    /// [`Estimator::NonOverlapping`] (at least 1), or [`Estimator::edf`].
     pub fn edf(&self, j: usize, noise: NoiseType) -> f64 {
         match &self.differences {
-            Some(d) => d.get(j).map_or(0.0, |v| v.max(1.0)),
+            Some(d) => d.get(j).map_or(0.0, |v| non_overlapping_edf(*v).max(1.0)),
             None => self.estimator.edf(1u64 << j.min(63), noise),
         }
     }

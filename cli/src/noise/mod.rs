@@ -199,8 +199,12 @@ pub fn run(args: &Args) -> Result<NoiseResult, Fail> {
         units: Units::of(&args.unit),
         plot: args.plot.as_deref(),
     };
-    let octaves =
-        Octaves::<OCTAVES>::overlapping(&x, 1.0 / rate).map_err(|e| args.input.fail(e))?;
+    let octaves = Octaves::<OCTAVES>::overlapping(&x, 1.0 / rate).map_err(|e| match e {
+        NoiseError::Overflow => args.input.fail(
+            "the Allan variance overflows f64 (values of about 1e152 or more); rescale the record",
+        ),
+        e => args.input.fail(e),
+    })?;
     if octaves.avar().len() < 2 {
         return Err(args.input.fail(NoiseError::TooFewOctaves {
             given: octaves.avar().len(),
@@ -222,7 +226,23 @@ pub fn run(args: &Args) -> Result<NoiseResult, Fail> {
         0 => fit.model::<1>(&octaves, None),
         p => with_order!(p, ar_part(&fit, &octaves)),
     };
-    let (result, draw) = fitted.map_err(|Fail(e)| args.input.fail(e))?;
+    // The same when the order was chosen here and its model does not describe the record
+    // (a trend or a pure tone: not stationary).
+    let fitted = match fitted {
+        Err(_) if args.ar_order.is_none() && order > 0 => fit.model::<1>(&octaves, None),
+        fitted => fitted,
+    };
+    let (result, draw) = fitted.map_err(|Fail(e)| {
+        // Every Allan variance underflowed, though the samples differ.
+        if e == NoiseError::Constant.to_string() {
+            args.input.fail(
+                "the Allan variance underflows f64 (differences of about 1e-160 or less); \
+                 rescale the record",
+            )
+        } else {
+            args.input.fail(e)
+        }
+    })?;
     if let (Some(path), Some(draw)) = (&args.plot, draw) {
         draw().map_err(|e| Fail(format!("--plot {}: cannot draw: {e}", path.display())))?;
     }
