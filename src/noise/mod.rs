@@ -18,7 +18,7 @@
 //! Everything here runs in `f64`, on the host and on the device alike, allocation-free: the fit
 //! is not per-sample work. On the emulated Cortex-M4F one fit from a 20-octave
 //! [`AllanStream`](crate::allan::AllanStream) with a budget of three Gauss-Markov states takes
-//! about 68 million instructions (80 million with an AR(8) part) and 34 KiB of stack
+//! about 70 million instructions (82 million with an AR(8) part) and 34 KiB of stack
 //! (`cargo qemu bench`, README "Performance").
 
 use core::fmt;
