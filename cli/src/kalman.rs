@@ -122,6 +122,38 @@ pub fn run(args: &Args) -> Result<Handoff, Fail> {
         .map_err(|Fail(e)| record.input.fail(e))
 }
 
+/// The Allan check as text, one row a line; as in the JSON, a number that is not finite is
+/// `null`.
+pub fn allan_text(rows: &[AllanRow]) -> String {
+    let e = |v: f64| {
+        if v.is_finite() {
+            format!("{v:e}")
+        } else {
+            "null".into()
+        }
+    };
+    let f = |v: f64| {
+        if v.is_finite() {
+            format!("{v:.3}")
+        } else {
+            "null".into()
+        }
+    };
+    let mut s = String::from("# tau_s data_adev model_adev data/model tolerance agrees\n");
+    for r in rows {
+        s += &format!(
+            "{} {} {} {} {} {}\n",
+            json(&r.tau_s),
+            e(r.data_adev),
+            e(r.model_adev),
+            f(r.data_over_model),
+            f(r.tolerance),
+            if r.agrees { "yes" } else { "NO" }
+        );
+    }
+    s
+}
+
 /// Relative difference of a measured Allan deviation from a model's accepted at `m`
 /// samples per cluster out of `n`: two standard errors of the measured value,
 /// `1 / sqrt(2 (n/m - 1))` (IEEE Std 952-1997, Annex C), and never less than 10 %, the
@@ -254,19 +286,7 @@ impl Output for Handoff {
             json(&self.q),
             json(&self.p0)
         );
-        s += "# tau_s data_adev model_adev data/model tolerance\n";
-        // As in the JSON, a number that is not finite is undefined (NaN).
-        let shown = |v: f64| if v.is_finite() { v } else { f64::NAN };
-        for row in &self.allan {
-            s += &format!(
-                "{} {:e} {:e} {:.3} {:.3}\n",
-                json(&row.tau_s),
-                shown(row.data_adev),
-                shown(row.model_adev),
-                shown(row.data_over_model),
-                shown(row.tolerance)
-            );
-        }
+        s += &allan_text(&self.allan);
         s += &format!("explained_up_to_s {}\n", json(&self.explained_up_to_s));
         s
     }

@@ -17,7 +17,7 @@ use serde::Serialize;
 
 use crate::error::Fail;
 use crate::input::{Input, check_decimate, check_order, check_rate, check_span};
-use crate::kalman::AllanRow;
+use crate::kalman::{AllanRow, allan_text};
 use crate::method::with_order;
 use crate::output::{Output, json};
 use units::Units;
@@ -556,33 +556,7 @@ impl Output for NoiseResult {
             json(&self.p0),
             json(&d.measurement_variance)
         );
-        s += "# tau_s data_adev model_adev data/model tolerance agrees\n";
-        // As in the JSON, a number that is not finite is null.
-        let e = |v: f64| {
-            if v.is_finite() {
-                format!("{v:e}")
-            } else {
-                "null".into()
-            }
-        };
-        let f = |v: f64| {
-            if v.is_finite() {
-                format!("{v:.3}")
-            } else {
-                "null".into()
-            }
-        };
-        for r in &self.allan {
-            s += &format!(
-                "{} {} {} {} {} {}\n",
-                json(&r.tau_s),
-                e(r.data_adev),
-                e(r.model_adev),
-                f(r.data_over_model),
-                f(r.tolerance),
-                if r.agrees { "yes" } else { "NO" }
-            );
-        }
+        s += &allan_text(&self.allan);
         s += &format!("explained_up_to_s {}\n", json(&self.explained_up_to_s));
         for line in plot::failures(&self.allan) {
             s += &line;
