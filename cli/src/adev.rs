@@ -13,9 +13,9 @@ pub struct Args {
     /// The column.
     #[command(flatten)]
     input: Input,
-    /// Sample rate in Hz.
+    /// Sample rate in Hz [default: from the timestamps].
     #[arg(long, allow_negative_numbers = true)]
-    rate: f64,
+    rate: Option<f64>,
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -51,18 +51,22 @@ impl Output for AdevResult {
 
 /// Checks the rate, reads the record and computes its Allan deviation.
 pub fn run(args: &Args) -> Result<AdevResult, Fail> {
-    let rate = check_rate(args.rate)?;
-    let x = args.input.read()?;
+    if let Some(r) = args.rate {
+        check_rate(r)?;
+    }
+    let series = args.input.series(args.rate.is_none())?;
+    let x = &series.x;
     if x.len() < 2 {
         let e = format!("{} sample(s), at least 2 needed", x.len());
         return Err(args.input.fail(e));
     }
+    let rate = series.rate(args.rate)?;
     check_span("--rate", rate, x.len())?;
     let (mut tau, mut avar) = (Vec::new(), Vec::new());
     let mut m = 1usize;
     while x.len() / 2 >= m {
         tau.push(m as f64 / rate);
-        avar.push(overlapping_avar(&x, m)?);
+        avar.push(overlapping_avar(x, m)?);
         m *= 2;
     }
     Ok(AdevResult {

@@ -10,6 +10,7 @@
 #![deny(missing_docs)]
 
 pub mod adev;
+pub mod characterise;
 pub mod chart;
 pub mod compare;
 pub mod error;

@@ -29,7 +29,9 @@ use std::process::ExitCode;
 use clap::{CommandFactory, Parser, Subcommand};
 use imu_ar_cli::error::{Fail, clap_error, escaped};
 use imu_ar_cli::output::{json_line, render};
-use imu_ar_cli::{adev, compare, fit, kalman, noise, order, parity, report, simulate};
+use imu_ar_cli::{
+    adev, characterise, compare, fit, kalman, noise, order, parity, report, simulate,
+};
 
 #[derive(Parser)]
 #[command(
@@ -63,6 +65,10 @@ enum Command {
     /// Allan variance, checked at every averaging time, with its IEEE 952 readings and its
     /// `Phi`, `Q` and `P0` at the filter's rate.
     Noise(noise::Args),
+    /// All six axes of a recording (CSV, ROS 1 bag, MCAP) in one streaming pass: per axis the
+    /// Allan deviation, the composite noise model and its IEEE 952 readings; decomposition
+    /// plots, parameter files for navigation filters, and a summary table.
+    Characterise(characterise::Args),
     /// Order criteria (AIC, AICc, BIC, FPE) of orders 0..=P.
     Order(order::Args),
     /// Overlapping Allan deviation at m = 1, 2, 4, ...
@@ -97,6 +103,7 @@ fn run(command: Command) -> Result<String, Fail> {
         Command::Report(args) => json_line(&report::run(&args)?),
         Command::Kalman(args) => render(&kalman::run(&args)?, args.json),
         Command::Noise(args) => render(&noise::run(&args)?, args.json),
+        Command::Characterise(args) => render(&characterise::run(&args)?, args.json),
         Command::Order(args) => render(&order::run(&args)?, args.json),
         Command::Adev(args) => render(&adev::run(&args)?, args.json),
         Command::Parity => render(&parity::run()?, false),

@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{ar2, assert_one_line_failure, command, imu_ar, misused, stderr, stdout};
+use common::{ar2, assert_one_line_failure, command, imu_ar, misused, stderr, stdout, temp_file};
 
 // Formerly: a missing required argument prints only clap's first line, "the following required
 // arguments were not provided:", dropping the names of the arguments. Expected: one line that
@@ -28,7 +28,10 @@ fn missing_argument_error_names_the_argument() {
 fn missing_arguments_are_named_for_every_subcommand() {
     let file = ar2("miss-all.csv");
     let f = file.to_str().unwrap();
-    let cases: [(Vec<&str>, &str); 8] = [
+    // Without a time column, the rate must be given.
+    let untimed = temp_file("miss-untimed.csv", "x\n1\n2\n3\n5\n");
+    let u = untimed.to_str().unwrap();
+    let cases: [(Vec<&str>, &str); 10] = [
         (
             vec!["fit", f, "--column", "x", "--method", "ls"],
             "--order <ORDER>",
@@ -46,7 +49,9 @@ fn missing_arguments_are_named_for_every_subcommand() {
             vec!["order", f, "--column", "x", "--method", "ls"],
             "--max-order <MAX_ORDER>",
         ),
-        (vec!["adev", f, "--column", "x"], "--rate <RATE>"),
+        (vec!["adev", u, "--column", "x"], "--rate is required"),
+        (vec!["noise", u, "--column", "x"], "--rate is required"),
+        (vec!["characterise", f], "--out <OUT>"),
         (
             vec!["simulate", "--a", "0.5", "--n", "3", "--seed", "1"],
             "--sigma <SIGMA>",

@@ -44,7 +44,11 @@ fn error(file: &Path, line: Option<u64>, problem: impl Into<String>) -> DataErro
 pub const STDIN: &str = "-";
 
 /// Reads column `column` of each file in turn (a record split over several files is joined in
-/// order). Files are CSV with a header row; lines starting with `#` are ignored. The files are
+/// order). Files are CSV with a header row; lines starting with `#` are ignored, but for a
+/// header written as a comment (`#timestamp [ns],w_RS_S_x [rad s^-1],...`, as in EuRoC, ASL
+/// and TUM-VI files): when the first line that is not a comment holds only numbers, the last
+/// comment line before it, without its `#`, is the header. A column is named as in the header,
+/// by its name without a unit bracket (`w_RS_S_x`), or by its 0-based index. The files are
 /// streamed row by row; on a terminal, progress goes to stderr every 100,000 rows.
 ///
 /// The file [`STDIN`] (`-`) is standard input, read to its end first (so that an error can
@@ -53,29 +57,183 @@ pub const STDIN: &str = "-";
 /// Every cell must be a finite number: a missing column, an empty or non-numeric cell, NaN or
 /// infinity is an error naming the file and line, and so is a file without data rows.
 pub fn read_column(files: &[PathBuf], column: &str) -> Result<Vec<f64>, DataError> {
-    read_cells(files, column, finite(column))
+    let parse = finite(column);
+    let mut out = Vec::new();
+    read_rows(
+        files,
+        &mut |header| Ok(vec![position(header, column)?]),
+        &mut |cells| {
+            out.push(parse(cells[0])?);
+            Ok(())
+        },
+    )?;
+    Ok(out)
 }
 
 /// Reads column `column` of each file as text, as [`read_column`] reads numbers.
 pub fn read_text_column(files: &[PathBuf], column: &str) -> Result<Vec<String>, DataError> {
-    read_cells(files, column, |cell| Ok(cell.to_string()))
+    let mut out = Vec::new();
+    read_rows(
+        files,
+        &mut |header| Ok(vec![position(header, column)?]),
+        &mut |cells| {
+            out.push(cells[0].to_string());
+            Ok(())
+        },
+    )?;
+    Ok(out)
 }
 
 /// Reads column `column` of CSV text held in memory, as [`read_column`] reads a file;
 /// errors name `label` as the file.
 pub fn parse_column(label: &Path, bytes: &[u8], column: &str) -> Result<Vec<f64>, DataError> {
+    let parse = finite(column);
     let mut out = Vec::new();
     let locate = |byte| line_at(bytes, byte);
+    let header = comment_header(bytes).map_err(|e| error(label, None, e))?;
     read_source(
         label,
-        bytes,
-        column,
-        &finite(column),
-        &mut out,
-        false,
+        (bytes, header),
+        &mut |header| Ok(vec![position(header, column)?]),
+        &mut |cells| {
+            out.push(parse(cells[0])?);
+            Ok(())
+        },
         &locate,
     )?;
     Ok(out)
+}
+
+/// The cells of the columns that `select` picks from each file's header (by index), row by row,
+/// to `each`, in order over all files; an error from either names the file (and, from `each`,
+/// the line). Returns the number of rows. What [`read_column`] says of files and headers holds.
+pub fn read_rows(
+    files: &[PathBuf],
+    select: &mut dyn FnMut(&[String]) -> Result<Vec<usize>, String>,
+    each: &mut dyn FnMut(&[&str]) -> Result<(), String>,
+) -> Result<u64, DataError> {
+    let progress = std::io::stderr().is_terminal();
+    let mut rows = 0u64;
+    let mut counted = |cells: &[&str]| {
+        rows += 1;
+        if progress && rows.is_multiple_of(100_000) {
+            eprint!("\rread {rows} rows");
+            let _ = std::io::stderr().flush();
+        }
+        each(cells)
+    };
+    for path in files {
+        if path.as_os_str() == STDIN {
+            let bytes = stdin().map_err(|e| error(path, None, format!("cannot read: {e}")))?;
+            let header = comment_header(bytes).map_err(|e| error(path, None, e))?;
+            let locate = |byte| line_at(bytes, byte);
+            read_source(path, (bytes, header), select, &mut counted, &locate)?;
+            continue;
+        }
+        let open = || File::open(path).map_err(|e| error(path, None, format!("cannot open: {e}")));
+        let header = comment_header(BufReader::new(open()?)).map_err(|e| error(path, None, e))?;
+        let source = BufReader::with_capacity(1 << 16, open()?);
+        let locate = |byte| line_at(File::open(path).ok()?, byte);
+        read_source(path, (source, header), select, &mut counted, &locate)?;
+    }
+    if progress && rows >= 100_000 {
+        eprintln!("\rread {rows} rows");
+    }
+    Ok(rows)
+}
+
+/// The header of the first of `files` (a comment header too, as [`read_column`] finds it).
+pub fn header(files: &[PathBuf]) -> Result<Vec<String>, DataError> {
+    let mut names = Vec::new();
+    let stop = "\0";
+    let got = read_rows(
+        &files[..files.len().min(1)],
+        &mut |header| {
+            names = header.to_vec();
+            Err(stop.into())
+        },
+        &mut |_| Ok(()),
+    );
+    match got {
+        Err(e) if e.problem == stop => Ok(names),
+        Err(e) => Err(e),
+        Ok(_) => Ok(names),
+    }
+}
+
+/// The index of `column` in `header`: the name as written, the name without its unit bracket
+/// (`w_RS_S_x` for `w_RS_S_x [rad s^-1]`), or a 0-based index.
+pub fn position(header: &[String], column: &str) -> Result<usize, String> {
+    let exact: Vec<usize> = (0..header.len()).filter(|&i| header[i] == column).collect();
+    let bare: Vec<usize> = (0..header.len())
+        .filter(|&i| split_unit(&header[i]).0 == column)
+        .collect();
+    let found = if exact.is_empty() { bare } else { exact };
+    match (found.as_slice(), column.parse::<usize>()) {
+        ([i], _) => Ok(*i),
+        ([], Ok(i)) if i < header.len() => Ok(i),
+        ([], _) => {
+            let names: Vec<String> = header.iter().map(|h| shown(h)).collect();
+            Err(format!(
+                "no column '{}' (columns: {})",
+                escaped(column),
+                names.join(", ")
+            ))
+        }
+        (copies, _) => Err(format!(
+            "the header names column '{}' {} times",
+            escaped(column),
+            copies.len()
+        )),
+    }
+}
+
+/// A header name split into its name and the unit in a trailing bracket:
+/// `w_RS_S_x [rad s^-1]` is `("w_RS_S_x", Some("rad s^-1"))`.
+pub fn split_unit(name: &str) -> (&str, Option<&str>) {
+    let name = name.trim();
+    for (open, close) in [('[', ']'), ('(', ')')] {
+        if let Some(inner) = name.strip_suffix(close)
+            && let Some(at) = inner.rfind(open)
+        {
+            let bare = inner[..at].trim_end();
+            if !bare.is_empty() {
+                return (bare, Some(inner[at + 1..].trim()));
+            }
+        }
+    }
+    (name, None)
+}
+
+/// The header of a file whose header is a comment: when the first record that is not a
+/// comment holds only numbers and a comment line comes before it, that comment line without
+/// its `#`. `None` when the file has an ordinary header row (or no comment before its data).
+fn comment_header(source: impl Read) -> Result<Option<Vec<String>>, String> {
+    let mut reader = ::csv::ReaderBuilder::new()
+        .comment(None)
+        .has_headers(false)
+        .flexible(true)
+        .from_reader(source);
+    let mut last_comment = None;
+    let mut record = ::csv::StringRecord::new();
+    loop {
+        match reader.read_record(&mut record) {
+            Ok(true) => {}
+            Ok(false) => return Ok(None),
+            Err(e) => return Err(format!("cannot read the header: {e}")),
+        }
+        let first = record.get(0).unwrap_or("");
+        if let Some(rest) = first.strip_prefix('#') {
+            let mut names = vec![rest.trim().to_string()];
+            names.extend(record.iter().skip(1).map(|c| c.trim().to_string()));
+            last_comment = Some(names);
+            continue;
+        }
+        let numeric = record
+            .iter()
+            .all(|c| !c.trim().is_empty() && c.trim().parse::<f64>().is_ok());
+        return Ok(if numeric { last_comment } else { None });
+    }
 }
 
 /// The 1-based line of the record that starts at `byte` of `source` (or at the first line
@@ -139,7 +297,7 @@ fn line_at(source: impl Read, byte: u64) -> Option<u64> {
 }
 
 /// A cell as shown in an error: cut to its first 40 characters when it is longer.
-fn shown(cell: &str) -> String {
+pub fn shown(cell: &str) -> String {
     const KEEP: usize = 40;
     match cell.char_indices().nth(KEEP) {
         Some((end, _)) => format!("{}... ({} bytes)", escaped(&cell[..end]), cell.len()),
@@ -148,7 +306,7 @@ fn shown(cell: &str) -> String {
 }
 
 /// A cell as a finite number, or what is wrong with it.
-fn finite(column: &str) -> impl Fn(&str) -> Result<f64, String> + '_ {
+pub fn finite(column: &str) -> impl Fn(&str) -> Result<f64, String> + '_ {
     move |cell| match cell.parse::<f64>() {
         Ok(v) if v.is_finite() => Ok(v),
         Ok(_) => Err(format!(
@@ -160,32 +318,6 @@ fn finite(column: &str) -> impl Fn(&str) -> Result<f64, String> + '_ {
             shown(cell)
         )),
     }
-}
-
-/// The cells of `column`, each converted by `parse` (whose error names the problem).
-fn read_cells<T>(
-    files: &[PathBuf],
-    column: &str,
-    parse: impl Fn(&str) -> Result<T, String>,
-) -> Result<Vec<T>, DataError> {
-    let progress = std::io::stderr().is_terminal();
-    let mut out = Vec::new();
-    for path in files {
-        if path.as_os_str() == STDIN {
-            let bytes = stdin().map_err(|e| error(path, None, format!("cannot read: {e}")))?;
-            let locate = |byte| line_at(bytes, byte);
-            read_source(path, bytes, column, &parse, &mut out, progress, &locate)?;
-            continue;
-        }
-        let file = File::open(path).map_err(|e| error(path, None, format!("cannot open: {e}")))?;
-        let source = BufReader::with_capacity(1 << 16, file);
-        let locate = |byte| line_at(File::open(path).ok()?, byte);
-        read_source(path, source, column, &parse, &mut out, progress, &locate)?;
-    }
-    if progress && out.len() >= 100_000 {
-        eprintln!("\rread {} rows", out.len());
-    }
-    Ok(out)
 }
 
 /// All of standard input, read once.
@@ -203,51 +335,37 @@ fn stdin() -> Result<&'static [u8], &'static str> {
         .map_err(String::as_str)
 }
 
-/// Appends the cells of `column` of one CSV source (named `path` in errors) to `out`;
-/// `locate` gives the line of a byte offset, for errors.
-fn read_source<T>(
+/// Passes the cells that `select` picks of each row of one CSV source (named `path` in errors,
+/// with its header if that is a comment line) to `each`; `locate` gives the line of a byte
+/// offset, for errors.
+fn read_source(
     path: &Path,
-    source: impl Read,
-    column: &str,
-    parse: &impl Fn(&str) -> Result<T, String>,
-    out: &mut Vec<T>,
-    progress: bool,
+    (source, comment_header): (impl Read, Option<Vec<String>>),
+    select: &mut dyn FnMut(&[String]) -> Result<Vec<usize>, String>,
+    each: &mut dyn FnMut(&[&str]) -> Result<(), String>,
     locate: &dyn Fn(u64) -> Option<u64>,
 ) -> Result<(), DataError> {
     let mut reader = ::csv::ReaderBuilder::new()
         .comment(Some(b'#'))
         .trim(::csv::Trim::All)
         .flexible(true)
+        .has_headers(comment_header.is_none())
         .from_reader(source);
-    let headers = reader
-        .headers()
-        .map_err(|e| error(path, None, format!("cannot read the header: {e}")))?
-        .clone();
-    if headers.is_empty() {
+    let header: Vec<String> = match comment_header {
+        Some(names) => names,
+        None => reader
+            .headers()
+            .map_err(|e| error(path, None, format!("cannot read the header: {e}")))?
+            .iter()
+            .map(str::to_string)
+            .collect(),
+    };
+    if header.is_empty() {
         return Err(error(path, None, "empty file (no header row)"));
     }
-    let Some(index) = headers.iter().position(|h| h == column) else {
-        let names: Vec<String> = headers.iter().map(shown).collect();
-        return Err(error(
-            path,
-            None,
-            format!(
-                "no column '{}' (columns: {})",
-                escaped(column),
-                names.join(", ")
-            ),
-        ));
-    };
-    let copies = headers.iter().filter(|h| *h == column).count();
-    if copies > 1 {
-        return Err(error(
-            path,
-            None,
-            format!("the header names column '{column}' {copies} times"),
-        ));
-    }
-    let start = out.len();
+    let indices = select(&header).map_err(|problem| error(path, None, problem))?;
     let mut record = ::csv::StringRecord::new();
+    let mut rows = 0u64;
     loop {
         match reader.read_record(&mut record) {
             Ok(false) => break,
@@ -258,20 +376,24 @@ fn read_source<T>(
             }
         }
         let line = || record.position().and_then(|p| locate(p.byte()));
-        let cell = record.get(index).ok_or_else(|| {
-            error(
-                path,
-                line(),
-                format!("column '{column}' missing in this row"),
-            )
-        })?;
-        out.push(parse(cell).map_err(|problem| error(path, line(), problem))?);
-        if progress && out.len().is_multiple_of(100_000) {
-            eprint!("\rread {} rows", out.len());
-            let _ = std::io::stderr().flush();
+        let mut cells: Vec<&str> = Vec::with_capacity(indices.len());
+        for &i in &indices {
+            match record.get(i) {
+                Some(cell) => cells.push(cell),
+                None => {
+                    let name = header.get(i).map_or(String::new(), |h| escaped(h));
+                    return Err(error(
+                        path,
+                        line(),
+                        format!("column '{name}' missing in this row"),
+                    ));
+                }
+            }
         }
+        each(&cells).map_err(|problem| error(path, line(), problem))?;
+        rows += 1;
     }
-    if out.len() == start {
+    if rows == 0 {
         return Err(error(path, None, "no data rows"));
     }
     Ok(())

@@ -1,7 +1,15 @@
-//! Reading a record: one column of CSV files ([`csv`]), averaged in blocks (`--decimate`), and
-//! the checks of the settings the commands share. An error names the flag, or the files.
+//! Reading a record: one column of CSV files ([`csv`]), of a ROS 1 bag ([`bag`]) or of an MCAP
+//! file ([`mcap`]), all through [`source`]; its timestamps ([`timing`]) and units ([`units`]);
+//! averaged in blocks (`--decimate`); and the checks of the settings the commands share. An
+//! error names the flag, or the files.
 
+pub mod bag;
 pub mod csv;
+pub mod frame;
+pub mod mcap;
+pub mod source;
+pub mod timing;
+pub mod units;
 
 use std::path::PathBuf;
 
@@ -9,22 +17,57 @@ use imu_ar::recursive::Channel;
 
 use crate::error::{Fail, with_file};
 use crate::method::MAX_ORDER;
+use frame::Skipped;
+use source::Request;
+use timing::TimingSummary;
+use units::Unit;
 
 /// One column of a record.
 #[derive(clap::Args)]
 pub struct Input {
-    /// CSV files with a header row, read as one record (`-` is standard input).
+    /// CSV files with a header row (a `#`-prefixed one too, as in EuRoC), read as one record
+    /// (`-` is standard input); or ROS 1 bags or MCAP files, with --topic.
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
-    /// Column name.
+    /// Column: its name, its name without the unit bracket, or its 0-based index; for a bag or
+    /// an MCAP file gx, gy, gz, ax, ay or az.
     #[arg(long)]
     pub column: String,
+    /// The sensor_msgs/Imu topic of a ROS 1 bag or an MCAP file.
+    #[arg(long)]
+    pub topic: Option<String>,
+    /// The CSV column of the timestamps, when --rate is not given [default: the column named
+    /// timestamp, time, t or t_<unit>; its unit from its bracket or suffix (s, ms, us, ns), else
+    /// from its magnitude].
+    #[arg(long)]
+    pub time_column: Option<String>,
+    /// Drop samples whose timestamp is not after the one before (counted) instead of refusing
+    /// the record.
+    #[arg(long)]
+    pub drop_backward: bool,
+    /// The unit of the results. A column whose unit is known (a header bracket such as
+    /// `[rad s^-1]`, a bag's SI units) is converted to it: rad/s, deg/s, deg/h; m/s^2, g, mg.
+    /// For a column of unknown unit it is a label.
+    #[arg(long)]
+    pub unit: Option<String>,
+}
+
+/// A record's samples, and what its reader found.
+pub struct Series {
+    /// The samples, in [`Series::unit`].
+    pub x: Vec<f64>,
+    /// The timestamps' statistics, when they were read.
+    pub timing: Option<TimingSummary>,
+    /// The unit of the samples (`units` when nothing says).
+    pub unit: String,
+    /// Messages skipped, counted.
+    pub skipped: Skipped,
 }
 
 impl Input {
     /// The column's samples.
     pub fn read(&self) -> Result<Vec<f64>, Fail> {
-        Ok(csv::read_column(&self.files, &self.column)?)
+        Ok(self.series(false)?.x)
     }
 
     /// The column's samples averaged in blocks of `decimate`.
@@ -32,9 +75,98 @@ impl Input {
         decimated(&self.files, &self.read()?, decimate)
     }
 
+    /// The column's samples in the unit of `--unit`, with the timestamps' statistics when
+    /// `want_time` (or when the record is a bag or an MCAP file, or `--time-column` is given).
+    pub fn series(&self, want_time: bool) -> Result<Series, Fail> {
+        let columns = [self.column.clone()];
+        let request = Request {
+            columns: &columns,
+            topic: self.topic.as_deref(),
+            time_column: self.time_column.as_deref(),
+            want_time,
+            drop_backward: self.drop_backward,
+        };
+        let mut x = Vec::new();
+        let read = source::stream(&self.files, &request, &mut |v| x.push(v[0]))?;
+        let (factor, unit) = convert(read.units.first().copied().flatten(), self.unit.as_deref())?;
+        if factor != 1.0 {
+            x.iter_mut().for_each(|v| *v *= factor);
+        }
+        let timing = match read.timing {
+            Some((t, u)) => Some(t.summary(u).map_err(|e| self.fail(e))?),
+            None => None,
+        };
+        Ok(Series {
+            x,
+            timing,
+            unit,
+            skipped: read.skipped,
+        })
+    }
+
     /// `e` after the names of the files.
     pub fn fail(&self, e: impl std::fmt::Display) -> Fail {
         with_file(&self.files, e)
+    }
+}
+
+impl Series {
+    /// The sample rate: `--rate` when given (an error when the timestamps give one more than
+    /// 1 % away), else the timestamps'.
+    pub fn rate(&self, given: Option<f64>) -> Result<f64, Fail> {
+        resolve_rate(given, self.timing.as_ref())
+    }
+}
+
+/// The sample rate: `given` (`--rate`) when there is one (an error when the timestamps give
+/// one more than 1 % away), else the timestamps'.
+pub fn resolve_rate(given: Option<f64>, timing: Option<&TimingSummary>) -> Result<f64, Fail> {
+    match (given, timing) {
+        (Some(r), Some(t)) => {
+            let r = check_rate(r)?;
+            if (r / t.rate_hz - 1.0).abs() > 0.01 {
+                return Err(Fail(format!(
+                    "--rate {r}: the timestamps give {} Hz",
+                    t.rate_hz
+                )));
+            }
+            Ok(r)
+        }
+        (Some(r), None) => check_rate(r),
+        (None, Some(t)) => Ok(t.rate_hz),
+        (None, None) => Err(Fail(
+            "--rate is required: the record has no time column (name one with \
+                 --time-column)"
+                .into(),
+        )),
+    }
+}
+
+/// The factor from a column in `from` (where known) to `--unit` `to`, and the unit of the result.
+pub fn convert(from: Option<Unit>, to: Option<&str>) -> Result<(f64, String), Fail> {
+    if let Some(t) = to
+        && t.chars().any(char::is_control)
+    {
+        return Err(Fail(format!(
+            "--unit {t:?}: must not contain control characters"
+        )));
+    }
+    match (from, to) {
+        (Some(f), Some(t)) => match Unit::parse(t) {
+            Some(u) => Ok((
+                f.factor_to(u)
+                    .map_err(|e| Fail(format!("--unit {t}: {e}")))?,
+                u.name.into(),
+            )),
+            None => Err(Fail(format!(
+                "--unit {t}: the column is in {}, which converts to rad/s, deg/s, deg/h (a rate) \
+                 or m/s^2, g, mg (an acceleration)",
+                f.name
+            ))),
+        },
+        (Some(f), None) => Ok((1.0, f.name.into())),
+        (None, Some(t)) => Ok((1.0, t.into())),
+        (None, None) => Ok((1.0, "units".into())),
     }
 }
 
@@ -59,7 +191,7 @@ impl Record {
 }
 
 /// `x` averaged in blocks of `m` samples; an error when no sample is left.
-fn decimated(files: &[PathBuf], x: &[f64], m: usize) -> Result<Vec<f64>, Fail> {
+pub fn decimated(files: &[PathBuf], x: &[f64], m: usize) -> Result<Vec<f64>, Fail> {
     let y = block_average(x, m);
     if y.is_empty() {
         return Err(with_file(

@@ -4,8 +4,8 @@
 //! the sensor's short-term colouring; checked at every averaging time and handed to a Kalman
 //! filter as `Phi`, `Q` and `P0`.
 
-mod plot;
-mod units;
+pub(crate) mod plot;
+pub(crate) mod units;
 
 use std::path::PathBuf;
 
@@ -15,8 +15,10 @@ use imu_ar::batch::{BatchConfig, burg};
 use imu_ar::noise::{Check, FitConfig, Ieee952, KalmanForm, NoiseError, NoiseModel, Octaves};
 use serde::Serialize;
 
+use crate::chart;
 use crate::error::Fail;
-use crate::input::{Input, check_decimate, check_order, check_rate, check_span};
+use crate::input::timing::TimingSummary;
+use crate::input::{Input, check_decimate, check_order, check_rate, check_span, decimated};
 use crate::kalman::{AllanRow, allan_text};
 use crate::method::with_order;
 use crate::output::{Output, json};
@@ -29,7 +31,7 @@ pub const MAX_GM_STATES: usize = 8;
 pub const AUTO_AR_ORDER: usize = 8;
 
 /// Octaves held: `m = 1 .. 2^31` samples.
-const OCTAVES: usize = 32;
+pub(crate) const OCTAVES: usize = 32;
 
 /// The arguments of `imu-ar noise`.
 #[derive(clap::Args)]
@@ -37,9 +39,9 @@ pub struct Args {
     /// The column.
     #[command(flatten)]
     input: Input,
-    /// Sample rate in Hz of the raw record.
+    /// Sample rate in Hz of the raw record [default: from the timestamps].
     #[arg(long, allow_negative_numbers = true)]
-    rate: f64,
+    rate: Option<f64>,
     /// The Kalman states the Gauss-Markov terms may take, 0 to 8 (an oscillator takes two).
     #[arg(long, default_value_t = 3, allow_negative_numbers = true)]
     gm_states: usize,
@@ -60,10 +62,6 @@ pub struct Args {
     /// Average blocks of M samples first; the model's rate becomes rate / M.
     #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     decimate: usize,
-    /// The column's unit. deg/s, rad/s, g and m/s^2 are converted to the IEEE 952 units in
-    /// the text output (deg/sqrt(h), deg/h, ...); any other is a label.
-    #[arg(long, default_value = "units")]
-    unit: String,
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -151,6 +149,9 @@ pub struct NoiseResult {
     pub allan: Vec<AllanRow>,
     /// The largest `tau` (s) up to which every row agrees.
     pub explained_up_to_s: Option<f64>,
+    /// What the timestamps show, when the rate came from them.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub timing: Option<TimingSummary>,
     /// For the text output.
     #[serde(skip)]
     pub details: Details,
@@ -158,7 +159,9 @@ pub struct NoiseResult {
 
 /// Checks the settings, reads the record, fits and checks the model and draws its plot.
 pub fn run(args: &Args) -> Result<NoiseResult, Fail> {
-    let rate = check_rate(args.rate)?;
+    if let Some(r) = args.rate {
+        check_rate(r)?;
+    }
     check_decimate(args.decimate)?;
     if args.gm_states > MAX_GM_STATES {
         return Err(Fail(format!(
@@ -180,24 +183,19 @@ pub fn run(args: &Args) -> Result<NoiseResult, Fail> {
     if let Some(path) = &args.plot {
         plot::check_path(path)?;
     }
-    if args.unit.chars().any(char::is_control) {
-        return Err(Fail(format!(
-            "--unit {:?}: must not contain control characters",
-            args.unit
-        )));
-    }
-    let x = args.input.load(args.decimate)?;
+    let series = args.input.series(args.rate.is_none())?;
+    let rate = series.rate(args.rate)?;
+    let x = decimated(&args.input.files, &series.x, args.decimate)?;
     check_span("--rate", rate, x.len())?;
     let rate = rate / args.decimate as f64;
     let fit = Fitting {
-        x: &x,
+        n: x.len(),
         rate,
         filter_rate: filter_rate.unwrap_or(rate),
         config: FitConfig::new(args.gm_states)
             .with_oscillators(args.oscillators)
             .with_ramp(args.ramp),
-        units: Units::of(&args.unit),
-        plot: args.plot.as_deref(),
+        units: Units::of(&series.unit),
     };
     let octaves = Octaves::<OCTAVES>::overlapping(&x, 1.0 / rate).map_err(|e| match e {
         NoiseError::Overflow => args.input.fail(
@@ -224,7 +222,7 @@ pub fn run(args: &Args) -> Result<NoiseResult, Fail> {
     };
     let fitted = match order {
         0 => fit.model::<1>(&octaves, None),
-        p => with_order!(p, ar_part(&fit, &octaves)),
+        p => with_order!(p, ar_part(&fit, &x, &octaves)),
     };
     // The same when the order was chosen here and its model does not describe the record
     // (a trend or a pure tone: not stationary).
@@ -232,7 +230,9 @@ pub fn run(args: &Args) -> Result<NoiseResult, Fail> {
         Err(_) if args.ar_order.is_none() && order > 0 => fit.model::<1>(&octaves, None),
         fitted => fitted,
     };
-    let (result, draw) = fitted.map_err(|Fail(e)| {
+    let Fitted {
+        mut result, paint, ..
+    } = fitted.map_err(|Fail(e)| {
         // Every Allan variance underflowed, though the samples differ.
         if e == NoiseError::Constant.to_string() {
             args.input.fail(
@@ -243,14 +243,24 @@ pub fn run(args: &Args) -> Result<NoiseResult, Fail> {
             args.input.fail(e)
         }
     })?;
-    if let (Some(path), Some(draw)) = (&args.plot, draw) {
-        draw().map_err(|e| Fail(format!("--plot {}: cannot draw: {e}", path.display())))?;
+    if let Some(path) = &args.plot {
+        plot::png(path, chart::SIZE, &[(&paint, String::new())])
+            .map_err(|e| Fail(format!("--plot {}: cannot draw: {e}", path.display())))?;
     }
+    result.timing = series.timing;
     Ok(result)
 }
 
-/// What draws the plot, once the model is known to be good.
-type Draw<'a> = Box<dyn FnOnce() -> Result<(), String> + 'a>;
+/// What draws a fit's decomposition on an area, with a caption.
+pub(crate) type Paint<'a> = Box<dyn Fn(&plot::Area, &str) -> Result<(), String> + 'a>;
+
+/// A fitted and checked model: its result, and what draws it.
+pub(crate) struct Fitted<'a> {
+    /// The result.
+    pub result: NoiseResult,
+    /// Draws the decomposition (the caption empty for the default one).
+    pub paint: Paint<'a>,
+}
 
 /// The order `0..=8` (fewer for a short record) that BIC selects for a Burg fit.
 fn bic_order(x: &[f64], rate: f64) -> Result<usize, Fail> {
@@ -274,35 +284,40 @@ fn burg_fit<const P: usize>(x: &[f64], rate: f64) -> Result<(Vec<f64>, usize), F
 /// The Burg AR(`P`) fit of the record, and the composite with it as its AR part.
 fn ar_part<'a, const P: usize>(
     fit: &'a Fitting,
+    x: &[f64],
     octaves: &'a Octaves<OCTAVES>,
-) -> Result<(NoiseResult, Option<Draw<'a>>), Fail> {
-    let ar = burg::<f64, P>(fit.x, &BatchConfig::new(1.0 / fit.rate)?)
+) -> Result<Fitted<'a>, Fail> {
+    let ar = burg::<f64, P>(x, &BatchConfig::new(1.0 / fit.rate)?)
         .map_err(|e| Fail(format!("--ar-order {P}: {e}")))?
         .model;
     fit.model::<P>(octaves, Some(&ar))
 }
 
 /// One fit's inputs.
-struct Fitting<'a> {
-    x: &'a [f64],
-    rate: f64,
-    filter_rate: f64,
-    config: FitConfig,
-    units: Units,
-    plot: Option<&'a std::path::Path>,
+pub(crate) struct Fitting {
+    /// Samples in the record.
+    pub n: usize,
+    /// The model's rate, Hz.
+    pub rate: f64,
+    /// The filter's rate, Hz.
+    pub filter_rate: f64,
+    /// The fit's settings.
+    pub config: FitConfig,
+    /// The record's unit.
+    pub units: Units,
 }
 
-impl Fitting<'_> {
+impl Fitting {
     /// Fits the composite with the AR part `ar`, checks it, and hands it over; with the plot
     /// to draw, if one was asked for.
-    fn model<'a, const P: usize>(
+    pub(crate) fn model<'a, const P: usize>(
         &'a self,
         octaves: &'a Octaves<OCTAVES>,
         ar: Option<&ArModel<f64, P>>,
-    ) -> Result<(NoiseResult, Option<Draw<'a>>), Fail> {
+    ) -> Result<Fitted<'a>, Fail> {
         let model = NoiseModel::<P, MAX_GM_STATES>::fit(octaves, ar, &self.config)?;
         let check = model.check(octaves)?;
-        let span = self.x.len() as f64 / self.rate;
+        let span = self.n as f64 / self.rate;
         // The random walk's state starts with the variance it reaches over the record.
         let rw_p0 = model.random_walk() * model.random_walk() * span;
         let form = model.kalman(1.0 / self.filter_rate, rw_p0).map_err(|e| {
@@ -312,11 +327,16 @@ impl Fitting<'_> {
             ))
         })?;
         let result = self.result(&model, ar, &model.ieee952(octaves), &form, &check);
-        let draw = self.plot.map(|path| -> Draw<'a> {
-            let caption = self.caption(&model);
-            Box::new(move || plot::decomposition_png(path, &model, octaves, &check, &caption))
+        let default = self.caption(&model);
+        let paint: Paint<'a> = Box::new(move |area, caption| {
+            let caption = if caption.is_empty() {
+                &default
+            } else {
+                caption
+            };
+            plot::decomposition(area, &model, octaves, &check, caption)
         });
-        Ok((result, draw))
+        Ok(Fitted { result, paint })
     }
 
     fn caption<const P: usize>(&self, model: &NoiseModel<P, MAX_GM_STATES>) -> String {
@@ -325,9 +345,7 @@ impl Fitting<'_> {
             .map_or(String::new(), |_| format!(", AR({P}) part"));
         format!(
             "Allan deviation (n = {}, {} Hz{ar}), in {}",
-            self.x.len(),
-            self.rate,
-            self.units.name
+            self.n, self.rate, self.units.name
         )
     }
 
@@ -363,7 +381,7 @@ impl Fitting<'_> {
         let blocks = Blocks::of(form);
         NoiseResult {
             rate_hz: self.rate,
-            n: self.x.len(),
+            n: self.n,
             white_noise: positive(ieee.white_noise),
             quantization: positive(ieee.quantization),
             random_walk: positive(ieee.random_walk),
@@ -390,6 +408,7 @@ impl Fitting<'_> {
                 })
                 .collect(),
             explained_up_to_s: check.explained_up_to(),
+            timing: None,
             details: Details {
                 unit: self.units.name.clone(),
                 filter_rate_hz: self.filter_rate,
@@ -469,6 +488,13 @@ impl Blocks {
     }
 }
 
+impl NoiseResult {
+    /// `N` read as the Allan deviation at `tau = 1 s`, where the record has that octave pair.
+    pub fn white_noise_at_1s(&self) -> Option<f64> {
+        self.details.white_noise_at_1s
+    }
+}
+
 impl Output for NoiseResult {
     fn text(&self) -> String {
         let d = &self.details;
@@ -479,6 +505,10 @@ impl Output for NoiseResult {
             json(&self.rate_hz),
             d.unit
         );
+        if let Some(t) = &self.timing {
+            s += &t.text();
+            s += "\n";
+        }
         let n = self.white_noise.unwrap_or(0.0);
         s += &format!("white_noise {}", json(&self.white_noise));
         if self.white_noise.is_some() {

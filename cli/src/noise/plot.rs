@@ -3,9 +3,10 @@
 use std::path::Path;
 
 use imu_ar::noise::{Check, NoiseModel, Octaves, component};
+use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use crate::chart::{SIZE, builder, font, legend};
+use crate::chart::{builder, font, legend};
 use crate::error::Fail;
 use crate::kalman::AllanRow;
 
@@ -76,16 +77,34 @@ pub(super) fn failures(rows: &[AllanRow]) -> Vec<String> {
     lines
 }
 
-/// The data's Allan deviation with one standard error either side, the model's, and each
-/// component's, on log-log axes; octaves where the check fails are crossed.
-pub(super) fn decomposition_png<const P: usize, const G: usize, const L: usize>(
+/// A drawing area of the PNG plots.
+pub(crate) type Area<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
+
+/// A PNG file of `size` pixels with the panels `paint` side by side, each with its caption
+/// (empty for the default one).
+pub(crate) fn png(
     path: &Path,
+    size: (u32, u32),
+    paint: &[(&super::Paint, String)],
+) -> Result<(), String> {
+    font().map_err(|Fail(e)| e)?;
+    let root = BitMapBackend::new(path, size).into_drawing_area();
+    let panels = root.split_evenly((1, paint.len().max(1)));
+    for (area, (p, caption)) in panels.iter().zip(paint) {
+        p(area, caption)?;
+    }
+    root.present().map_err(|e| e.to_string())
+}
+
+/// The data's Allan deviation with one standard error either side, the model's, and each
+/// component's, on log-log axes, on `root`; octaves where the check fails are crossed.
+pub(crate) fn decomposition<const P: usize, const G: usize, const L: usize>(
+    root: &Area,
     model: &NoiseModel<P, G>,
     octaves: &Octaves<L>,
     check: &Check<L>,
     caption: &str,
 ) -> Result<(), String> {
-    font().map_err(|Fail(e)| e)?;
     let draw_err = |e: DrawingAreaErrorKind<_>| e.to_string();
     let rows = check.rows();
     let tau: Vec<f64> = rows.iter().map(|r| r.tau).collect();
@@ -102,10 +121,9 @@ pub(super) fn decomposition_png<const P: usize, const G: usize, const L: usize>(
         .chain(components.iter().flat_map(|c| c.1.iter().copied()))
         .filter(|v| v.is_finite())
         .fold(0.0f64, f64::max);
-    let root = BitMapBackend::new(path, SIZE).into_drawing_area();
     root.fill(&WHITE).map_err(draw_err)?;
     let (t_lo, t_hi) = (tau[0], tau[tau.len() - 1]);
-    let mut chart = builder(&root, caption.to_string(), 80)
+    let mut chart = builder(root, caption.to_string(), 80)
         .build_cartesian_2d(
             (t_lo * 0.8..t_hi * 1.25).log_scale(),
             (floor..top * 1.5).log_scale(),
@@ -162,8 +180,7 @@ pub(super) fn decomposition_png<const P: usize, const G: usize, const L: usize>(
             .label("check fails")
             .legend(|(x, y)| Cross::new((x + 10, y), 5, BLACK.stroke_width(2)));
     }
-    legend(&mut chart, SeriesLabelPosition::LowerLeft).map_err(|Fail(e)| e)?;
-    root.present().map_err(draw_err)
+    legend(&mut chart, SeriesLabelPosition::LowerLeft).map_err(|Fail(e)| e)
 }
 
 /// Each non-zero component's Allan deviation at the octaves, with its label.

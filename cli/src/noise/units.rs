@@ -2,14 +2,13 @@
 //! in g or m/s^2. The JSON keeps the column's own unit `u` (`N` in u/sqrt(Hz), `K` in
 //! u/s/sqrt(Hz), `B` in u).
 
-/// Standard gravity, m/s^2.
-const G: f64 = 9.806_65;
+use crate::input::units::{G, Quantity, Unit};
 
 /// What the column measures, by its unit.
 #[derive(Clone, Copy, PartialEq)]
 enum Kind {
-    /// A rate gyro in deg/s or rad/s (the angle unit).
-    Gyro(&'static str),
+    /// A rate gyro: the angle unit (deg or rad) and the factor to that angle per second.
+    Gyro(&'static str, f64),
     /// An accelerometer, with the factor to m/s^2.
     Accelerometer(f64),
     /// Any other unit: a label.
@@ -24,14 +23,16 @@ pub struct Units {
 }
 
 impl Units {
-    /// The unit named `name` (`deg/s`, `rad/s`, `g`, `m/s^2`; anything else is a label).
+    /// The unit named `name` (an angular rate or an acceleration of
+    /// [`Unit`](crate::input::units::Unit); anything else is a label).
     pub fn of(name: &str) -> Self {
-        let kind = match name {
-            "deg/s" | "dps" => Kind::Gyro("deg"),
-            "rad/s" => Kind::Gyro("rad"),
-            "g" => Kind::Accelerometer(G),
-            "m/s^2" | "m/s2" => Kind::Accelerometer(1.0),
-            _ => Kind::Other,
+        let kind = match Unit::parse(name) {
+            Some(u) if u.name == "rad/s" => Kind::Gyro("rad", 1.0),
+            Some(u) if u.quantity == Quantity::AngularRate => {
+                Kind::Gyro("deg", u.to_si * 180.0 / std::f64::consts::PI)
+            }
+            Some(u) => Kind::Accelerometer(u.to_si),
+            None => Kind::Other,
         };
         Self {
             name: name.to_string(),
@@ -48,7 +49,7 @@ impl Units {
     /// m/s/sqrt(h) (an accelerometer): ` = ...`, or nothing.
     pub fn arw(&self, n: f64) -> String {
         match self.kind {
-            Kind::Gyro(angle) => format!(" = {} {angle}/sqrt(h)", short(60.0 * n)),
+            Kind::Gyro(angle, f) => format!(" = {} {angle}/sqrt(h)", short(60.0 * n * f)),
             Kind::Accelerometer(to_si) => format!(" = {} m/s/sqrt(h)", short(60.0 * n * to_si)),
             Kind::Other => String::new(),
         }
@@ -57,7 +58,9 @@ impl Units {
     /// `K` of a gyro in deg/h/sqrt(h) (`216000 K`), or nothing.
     pub fn rrw(&self, k: f64) -> String {
         match self.kind {
-            Kind::Gyro(angle) => format!(" = {} {angle}/h/sqrt(h)", short(3600.0 * 60.0 * k)),
+            Kind::Gyro(angle, f) => {
+                format!(" = {} {angle}/h/sqrt(h)", short(3600.0 * 60.0 * k * f))
+            }
             _ => String::new(),
         }
     }
@@ -65,7 +68,7 @@ impl Units {
     /// `B` of a gyro in deg/h, of an accelerometer in micro-g: ` = ...`, or nothing.
     pub fn bias(&self, b: f64) -> String {
         match self.kind {
-            Kind::Gyro(angle) => format!(" = {} {angle}/h", short(3600.0 * b)),
+            Kind::Gyro(angle, f) => format!(" = {} {angle}/h", short(3600.0 * b * f)),
             Kind::Accelerometer(to_si) => format!(" = {} ug", short(1e6 * b * to_si / G)),
             Kind::Other => String::new(),
         }
@@ -95,5 +98,7 @@ mod tests {
         assert_eq!(g.arw(1e-4), " = 0.05884 m/s/sqrt(h)");
         assert_eq!(Units::of("m/s^2").bias(G * 1e-6), " = 1 ug");
         assert_eq!(Units::of("counts").arw(1.0), "");
+        // 3600 deg/h = 1 deg/s.
+        assert_eq!(Units::of("deg/h").bias(3600.0 * 1e-3), " = 3.6 deg/h");
     }
 }

@@ -25,9 +25,6 @@ pub struct Args {
     /// Sample rate in Hz of the raw record.
     #[arg(long, allow_negative_numbers = true)]
     rate: f64,
-    /// The column's unit, for the axis labels.
-    #[arg(long, default_value = "units")]
-    unit: String,
     /// A published Allan table to draw too: CSV with `channel`, `tau_s` and `adev`
     /// columns (`-` is standard input); the rows of channel `--column` are used.
     #[arg(long)]
@@ -92,7 +89,7 @@ pub fn run(args: &Args) -> Result<Summary, Fail> {
         lambda: run.lambda,
         delta,
         train: run.train,
-        unit: &args.unit,
+        unit: run.record.input.unit.as_deref().unwrap_or("units"),
         reference,
         out: &args.out,
     };

@@ -1,0 +1,434 @@
+//! `imu-ar characterise`: all six axes of a recording in one streaming pass. Per axis: the
+//! overlapping Allan deviation, the composite noise model of `imu-ar noise` (its AR part from the
+//! streamed autocovariances, Yule-Walker, order by BIC), the Allan check and the IEEE 952
+//! readings; then two decomposition plots (gyros, accelerometers), the parameter files of
+//! `--format`, and a summary table.
+//!
+//! Nothing but the streaming statistics is held ([`stream`]: about 2.6 MB per axis), so a
+//! recording of any length fits in memory. `imu-ar noise` holds its column (its AR part is a
+//! Burg fit over the samples), as do `fit`, `compare`, `report`, `order`, `kalman` and `adev`.
+
+pub mod stream;
+
+use std::io::IsTerminal;
+use std::path::PathBuf;
+
+use imu_ar::ArModel;
+use imu_ar::batch::criteria::Criterion;
+use imu_ar::batch::levinson_durbin;
+use imu_ar::noise::{FitConfig, Octaves};
+use serde::Serialize;
+
+use crate::error::{Fail, escaped, with_file};
+use crate::input::source::{self, AXES, Kind, Request};
+use crate::input::timing::TimingSummary;
+use crate::input::units::{Quantity, Unit};
+use crate::input::{check_rate, check_span, resolve_rate};
+use crate::method::with_order;
+use crate::noise::units::Units;
+use crate::noise::{Fitted, Fitting, MAX_GM_STATES, NoiseResult, OCTAVES, plot};
+use crate::output::{Output, json};
+use stream::{AxisStream, LAGS};
+
+/// The arguments of `imu-ar characterise`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The recording: CSV files read as one record (`-` is standard input), or ROS 1 bags or
+    /// MCAP files with --topic.
+    #[arg(required = true)]
+    files: Vec<PathBuf>,
+    /// The sensor_msgs/Imu topic of a bag or an MCAP file.
+    #[arg(long)]
+    topic: Option<String>,
+    /// The six CSV columns: gyro x, y, z, then accelerometer x, y, z (names, names without
+    /// their unit bracket, or 0-based indices) [default: w_RS_S_x .. a_RS_S_z (EuRoC), or
+    /// gx .. az].
+    #[arg(long, value_delimiter = ',')]
+    columns: Option<Vec<String>>,
+    /// The CSV column of the timestamps [default: timestamp, time, t or t_<unit>].
+    #[arg(long)]
+    time_column: Option<String>,
+    /// Drop samples whose timestamp is not after the one before (counted).
+    #[arg(long)]
+    drop_backward: bool,
+    /// Sample rate in Hz [default: from the timestamps].
+    #[arg(long, allow_negative_numbers = true)]
+    rate: Option<f64>,
+    /// The gyro columns' unit when their header does not say: rad/s, deg/s or deg/h.
+    #[arg(long)]
+    gyro_unit: Option<String>,
+    /// The accelerometer columns' unit when their header does not say: m/s^2, g or mg.
+    #[arg(long)]
+    accel_unit: Option<String>,
+    /// The Kalman states the Gauss-Markov terms may take per axis, 0 to 8.
+    #[arg(long, default_value_t = 3, allow_negative_numbers = true)]
+    gm_states: usize,
+    /// Allow second-order Gauss-Markov terms (oscillators).
+    #[arg(long)]
+    oscillators: bool,
+    /// Fit a rate ramp too.
+    #[arg(long)]
+    ramp: bool,
+    /// The filter's rate in Hz for the state-space form [default: the record's].
+    #[arg(long, allow_negative_numbers = true)]
+    filter_rate: Option<f64>,
+    /// Directory for the plots and parameter files (created if needed).
+    #[arg(long)]
+    out: PathBuf,
+    /// Print one JSON object instead of the table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The six axes' models and what was written.
+#[derive(Serialize)]
+pub struct Characterisation {
+    /// The rate, Hz.
+    pub rate_hz: f64,
+    /// Samples per axis.
+    pub n: u64,
+    /// What the timestamps show, when the rate came from them.
+    pub timing: Option<TimingSummary>,
+    /// Messages skipped, counted.
+    pub skipped: SkippedCounts,
+    /// Per axis (gx, gy, gz, ax, ay, az): the model, in SI units (rad/s, m/s^2).
+    pub axes: Vec<AxisResult>,
+    /// The files written.
+    pub files: Vec<String>,
+}
+
+/// Skipped messages, by cause.
+#[derive(Serialize)]
+pub struct SkippedCounts {
+    /// Undecodable messages.
+    pub undecodable: u64,
+    /// Messages with a NaN or infinite axis.
+    pub non_finite: u64,
+    /// Samples whose timestamp went backwards (with --drop-backward).
+    pub backward: u64,
+}
+
+/// One axis.
+#[derive(Serialize)]
+pub struct AxisResult {
+    /// gx .. az.
+    pub axis: &'static str,
+    /// The column it was read from.
+    pub column: String,
+    /// rad/s or m/s^2.
+    pub unit: &'static str,
+    /// The model, as `imu-ar noise --json` gives it.
+    pub model: NoiseResult,
+}
+
+/// Reads the recording once, fits every axis and writes the files.
+pub fn run(args: &Args) -> Result<Characterisation, Fail> {
+    if let Some(r) = args.rate {
+        check_rate(r)?;
+    }
+    if args.gm_states > MAX_GM_STATES {
+        return Err(Fail(format!(
+            "--gm-states {}: at most {MAX_GM_STATES}",
+            args.gm_states
+        )));
+    }
+    if let Some(f) = args.filter_rate {
+        check_rate(f).map_err(|_| {
+            Fail(format!(
+                "--filter-rate {f}: must be a positive number of Hz"
+            ))
+        })?;
+    }
+    let given = [
+        args.gyro_unit.as_deref().map(parse_unit).transpose()?,
+        args.accel_unit.as_deref().map(parse_unit).transpose()?,
+    ];
+    let columns = columns(args)?;
+    std::fs::create_dir_all(&args.out)
+        .map_err(|e| Fail(format!("--out {}: cannot create: {e}", args.out.display())))?;
+
+    let mut axes: Vec<AxisStream<OCTAVES>> = (0..6).map(|_| AxisStream::new()).collect();
+    let progress = Progress::new();
+    let request = Request {
+        columns: &columns,
+        topic: args.topic.as_deref(),
+        time_column: args.time_column.as_deref(),
+        want_time: args.rate.is_none(),
+        drop_backward: args.drop_backward,
+    };
+    let read = source::stream(&args.files, &request, &mut |v| {
+        for (axis, x) in axes.iter_mut().zip(v) {
+            axis.push(*x);
+        }
+        progress.tick(axes[0].samples());
+    })?;
+    progress.finish();
+    let n = axes[0].samples();
+    let timing = match read.timing {
+        Some((t, u)) => Some(t.summary(u).map_err(|e| with_file(&args.files, e))?),
+        None => None,
+    };
+    let rate = resolve_rate(args.rate, timing.as_ref())?;
+    check_span("--rate", rate, n as usize)?;
+    let units: Vec<Unit> = (0..6)
+        .map(|i| {
+            axis_unit(
+                i,
+                read.units.get(i).copied().flatten(),
+                given[i / 3],
+                &columns[i],
+            )
+        })
+        .collect::<Result<_, _>>()?;
+    let fits: Vec<Fitting> = units
+        .iter()
+        .map(|u| Fitting {
+            n: n as usize,
+            rate,
+            filter_rate: args.filter_rate.unwrap_or(rate),
+            config: FitConfig::new(args.gm_states)
+                .with_oscillators(args.oscillators)
+                .with_ramp(args.ramp),
+            units: Units::of(u.si().name),
+        })
+        .collect();
+    let octaves = axes
+        .iter()
+        .zip(&units)
+        .map(|(a, u)| a.octaves(1.0 / rate, u.to_si * u.to_si))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| with_file(&args.files, e))?;
+    let mut results = Vec::new();
+    let mut paints = Vec::new();
+    for i in 0..6 {
+        let fail = |e: String| with_file(&args.files, format!("{} ({}): {e}", AXES[i], columns[i]));
+        if axes[i].is_constant() {
+            return Err(fail("constant (a stuck sensor?): no noise to model".into()));
+        }
+        let Fitted { result, paint } =
+            fit_axis(&fits[i], &axes[i], &octaves[i], units[i].to_si).map_err(|Fail(e)| fail(e))?;
+        results.push(AxisResult {
+            axis: AXES[i],
+            column: columns[i].clone(),
+            unit: units[i].si().name,
+            model: result,
+        });
+        paints.push(paint);
+    }
+    let mut files = Vec::new();
+    for (name, range, what) in [
+        ("gyro.png", 0..3, "gyro"),
+        ("accel.png", 3..6, "accelerometer"),
+    ] {
+        let path = args.out.join(name);
+        let panels: Vec<(&crate::noise::Paint, String)> = range
+            .map(|i| {
+                (
+                    &paints[i],
+                    format!(
+                        "{what} {} ({}), {}",
+                        AXES[i],
+                        escaped(&columns[i]),
+                        units[i].si().name
+                    ),
+                )
+            })
+            .collect();
+        plot::png(&path, (1800, 600), &panels)
+            .map_err(|e| Fail(format!("{}: cannot draw: {e}", path.display())))?;
+        files.push(path.display().to_string());
+    }
+    Ok(Characterisation {
+        rate_hz: rate,
+        n,
+        skipped: SkippedCounts {
+            undecodable: read.skipped.undecodable,
+            non_finite: read.skipped.non_finite,
+            backward: timing.as_ref().map_or(0, |t| t.dropped_backward),
+        },
+        timing,
+        axes: results,
+        files,
+    })
+}
+
+/// One axis's composite, with the AR part (order by BIC, 0 to [`LAGS`]) from its streamed
+/// autocovariances; without one when none fits.
+fn fit_axis<'a>(
+    fit: &'a Fitting,
+    axis: &AxisStream<OCTAVES>,
+    octaves: &'a Octaves<OCTAVES>,
+    to_si: f64,
+) -> Result<Fitted<'a>, Fail> {
+    let c = axis.autocovariances().map(|v| v * to_si * to_si);
+    let order = match levinson_durbin::<f64, LAGS>(&c) {
+        Ok(l) => {
+            let variances = std::iter::once(c[0]).chain(l.error_power.iter().copied());
+            Criterion::Bic.select(axis.samples() as usize, variances)
+        }
+        Err(_) => 0,
+    };
+    let mean = axis.mean() * to_si;
+    let with_ar = match order {
+        0 => None,
+        p => Some(with_order!(p, ar_part(fit, &c, mean, octaves))),
+    };
+    match with_ar {
+        Some(Ok(fitted)) => Ok(fitted),
+        _ => fit.model::<1>(octaves, None),
+    }
+}
+
+/// The composite with the Yule-Walker AR(`P`) part of autocovariances `c`.
+fn ar_part<'a, const P: usize>(
+    fit: &'a Fitting,
+    c: &[f64],
+    mean: f64,
+    octaves: &'a Octaves<OCTAVES>,
+) -> Result<Fitted<'a>, Fail> {
+    let l = levinson_durbin::<f64, P>(c).map_err(|e| Fail(e.to_string()))?;
+    let ar = ArModel::new(l.a, l.error_power[P - 1], mean, 1.0 / fit.rate)?;
+    fit.model::<P>(octaves, Some(&ar))
+}
+
+/// The six columns to read.
+fn columns(args: &Args) -> Result<Vec<String>, Fail> {
+    if let Some(c) = &args.columns {
+        if c.len() != 6 {
+            return Err(Fail(format!(
+                "--columns: {} names given; six are needed (gyro x, y, z, accelerometer x, y, z)",
+                c.len()
+            )));
+        }
+        return Ok(c.clone());
+    }
+    let named = |names: [&str; 6]| names.map(String::from).to_vec();
+    if Kind::of(&args.files[0]) != Kind::Csv {
+        return Ok(named(AXES));
+    }
+    let header = crate::input::csv::header(&args.files).map_err(|e| Fail(e.to_string()))?;
+    let euroc = [
+        "w_RS_S_x", "w_RS_S_y", "w_RS_S_z", "a_RS_S_x", "a_RS_S_y", "a_RS_S_z",
+    ];
+    for names in [euroc, AXES] {
+        if names
+            .iter()
+            .all(|n| crate::input::csv::position(&header, n).is_ok())
+        {
+            return Ok(named(names));
+        }
+    }
+    Err(with_file(
+        &args.files,
+        "no EuRoC (w_RS_S_x .. a_RS_S_z) or gx .. az columns: name the six with --columns",
+    ))
+}
+
+/// A `--gyro-unit` or `--accel-unit`.
+fn parse_unit(name: &str) -> Result<Unit, Fail> {
+    Unit::parse(name).ok_or_else(|| {
+        Fail(format!(
+            "unit '{}': rad/s, deg/s, deg/h (gyros) or m/s^2, g, mg (accelerometers)",
+            escaped(name)
+        ))
+    })
+}
+
+/// The unit of axis `i`: its header's (or the message's), else the flag's, checked to measure
+/// what the axis measures.
+fn axis_unit(
+    i: usize,
+    read: Option<Unit>,
+    given: Option<Unit>,
+    column: &str,
+) -> Result<Unit, Fail> {
+    let (want, flag) = match i {
+        0..3 => (Quantity::AngularRate, "--gyro-unit"),
+        _ => (Quantity::Acceleration, "--accel-unit"),
+    };
+    let unit = read.or(given).ok_or_else(|| {
+        Fail(format!(
+            "column '{}': its unit is unknown (no unit bracket in the header); give {flag}",
+            escaped(column)
+        ))
+    })?;
+    if unit.quantity != want {
+        return Err(Fail(format!(
+            "column '{}' is in {}, which is not what {} measures",
+            escaped(column),
+            unit.name,
+            AXES[i]
+        )));
+    }
+    Ok(unit)
+}
+
+/// A spinner with the messages read, on a terminal only.
+struct Progress(Option<indicatif::ProgressBar>);
+
+impl Progress {
+    fn new() -> Self {
+        if !std::io::stderr().is_terminal() {
+            return Self(None);
+        }
+        let bar = indicatif::ProgressBar::new_spinner();
+        if let Ok(style) = indicatif::ProgressStyle::with_template(
+            "{spinner} {human_pos} samples per axis read, {per_sec}, {elapsed}",
+        ) {
+            bar.set_style(style);
+        }
+        Self(Some(bar))
+    }
+
+    fn tick(&self, n: u64) {
+        if let Some(bar) = &self.0
+            && n.is_multiple_of(1 << 16)
+        {
+            bar.set_position(n);
+        }
+    }
+
+    fn finish(&self) {
+        if let Some(bar) = &self.0 {
+            bar.finish_and_clear();
+        }
+    }
+}
+
+impl Output for Characterisation {
+    fn text(&self) -> String {
+        let mut s = format!(
+            "{} samples per axis at {} Hz; skipped: {} undecodable, {} not finite, {} backward\n",
+            self.n,
+            json(&self.rate_hz),
+            self.skipped.undecodable,
+            self.skipped.non_finite,
+            self.skipped.backward
+        );
+        if let Some(t) = &self.timing {
+            s += &t.text();
+            s += "\n";
+        }
+        s += "axis unit   N (u/sqrt(Hz)) ADEV(1 s)   K (u/s/sqrt(Hz)) B (u)       tau_B (s)  GM AR explained_up_to_s\n";
+        for a in &self.axes {
+            let m = &a.model;
+            let e = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.4e}"));
+            s += &format!(
+                "{:<4} {:<6} {:<14} {:<11} {:<16} {:<11} {:<10} {:<2} {:<2} {}\n",
+                a.axis,
+                a.unit,
+                e(m.white_noise),
+                e(m.white_noise_at_1s()),
+                e(m.random_walk),
+                e(Some(m.bias_instability.value)),
+                format!("{}", m.bias_instability.tau_s),
+                m.gauss_markov.len(),
+                m.ar.as_ref().map_or(0, |a| a.order),
+                m.explained_up_to_s
+                    .map_or("none".to_string(), |t| t.to_string())
+            );
+        }
+        s += &format!("wrote {}\n", self.files.join(", "));
+        s
+    }
+}

@@ -1,0 +1,297 @@
+//! One reader over every kind of recording: CSV files, ROS 1 bags and MCAP files, streamed
+//! row by row (message by message) with their timestamps checked on the way.
+
+use std::cell::Cell;
+use std::io::Read as _;
+use std::path::{Path, PathBuf};
+
+use super::csv::{self, DataError, position, split_unit};
+use super::frame::{Frame, Skipped};
+use super::timing::{Step, TimeUnit, Timing};
+use super::units::Unit;
+use super::{bag, mcap};
+use crate::error::{Fail, escaped, with_file};
+
+/// The kinds of recording.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// CSV with a header row.
+    Csv,
+    /// A ROS 1 bag (format 2.0).
+    Bag,
+    /// An MCAP file (ROS 2).
+    Mcap,
+}
+
+impl Kind {
+    /// The kind of `path`, by its first bytes (standard input and short files are CSV).
+    pub fn of(path: &Path) -> Kind {
+        if path.as_os_str() == csv::STDIN {
+            return Kind::Csv;
+        }
+        let mut head = [0u8; 13];
+        let n = std::fs::File::open(path)
+            .and_then(|mut f| f.read(&mut head))
+            .unwrap_or(0);
+        match &head[..n] {
+            h if h.starts_with(b"#ROSBAG V2.0") => Kind::Bag,
+            h if h.starts_with(b"\x89MCAP0\r\n") => Kind::Mcap,
+            _ => Kind::Csv,
+        }
+    }
+}
+
+/// The six axes of a `sensor_msgs/Imu` message, as `--column` names them.
+pub const AXES: [&str; 6] = ["gx", "gy", "gz", "ax", "ay", "az"];
+
+/// The index in [`AXES`] of a column name: `gx` or `angular_velocity.x` .. `az` or
+/// `linear_acceleration.z`.
+pub fn axis(name: &str) -> Option<usize> {
+    const LONG: [&str; 6] = [
+        "angular_velocity.x",
+        "angular_velocity.y",
+        "angular_velocity.z",
+        "linear_acceleration.x",
+        "linear_acceleration.y",
+        "linear_acceleration.z",
+    ];
+    AXES.iter()
+        .position(|a| *a == name)
+        .or_else(|| LONG.iter().position(|a| *a == name))
+}
+
+/// What to read.
+pub struct Request<'a> {
+    /// The columns (CSV names or indices; for a bag or an MCAP file, names of [`axis`]).
+    pub columns: &'a [String],
+    /// The `sensor_msgs/Imu` topic of a bag or an MCAP file.
+    pub topic: Option<&'a str>,
+    /// The CSV time column, when the user named one.
+    pub time_column: Option<&'a str>,
+    /// Whether the timestamps are wanted (they are read and checked only then, or when
+    /// `time_column` names one; a bag's and an MCAP file's always are).
+    pub want_time: bool,
+    /// Drop (and count) samples whose stamp is not after the last one, instead of refusing them.
+    pub drop_backward: bool,
+}
+
+/// What a read gave besides the samples.
+pub struct Read {
+    /// The unit of each column, where its header bracket (or the message's SI units) says it.
+    pub units: Vec<Option<Unit>>,
+    /// The timestamps, when read: their statistics and unit.
+    pub timing: Option<(Timing, TimeUnit)>,
+    /// Messages skipped (undecodable or not finite), counted.
+    pub skipped: Skipped,
+}
+
+/// Reads `request` from `files` (one kind, joined in order), passing the values of each row
+/// (message) whose stamp moves forward to `each`, in the order of `request.columns`.
+pub fn stream(
+    files: &[PathBuf],
+    request: &Request,
+    each: &mut dyn FnMut(&[f64]),
+) -> Result<Read, Fail> {
+    let kind = Kind::of(&files[0]);
+    if let Some(other) = files.iter().find(|f| Kind::of(f) != kind) {
+        return Err(with_file(
+            files,
+            format!(
+                "{} is a {:?} file and {} is not: one record is one kind of file",
+                files[0].display(),
+                kind,
+                other.display()
+            ),
+        ));
+    }
+    match (kind, request.topic) {
+        (Kind::Csv, None) => csv_stream(files, request, each),
+        (Kind::Csv, Some(t)) => Err(with_file(
+            files,
+            format!(
+                "--topic {}: the file is CSV; --topic is for ROS 1 bags and MCAP files",
+                escaped(t)
+            ),
+        )),
+        (kind, topic) => messages(files, kind, topic, request, each),
+    }
+}
+
+/// A bag's or an MCAP file's messages.
+fn messages(
+    files: &[PathBuf],
+    kind: Kind,
+    topic: Option<&str>,
+    request: &Request,
+    each: &mut dyn FnMut(&[f64]),
+) -> Result<Read, Fail> {
+    let read = match kind {
+        Kind::Mcap => mcap::read,
+        _ => bag::read,
+    };
+    let Some(topic) = topic else {
+        // The reader's error for no topic lists the file's IMU topics.
+        let listed = read(&files[0], "", &mut |_| {}).err();
+        let topics = listed.map_or(String::new(), |e| {
+            e.problem
+                .split_once('(')
+                .map_or(String::new(), |(_, t)| format!(" ({}", t))
+        });
+        return Err(with_file(
+            files,
+            format!("a {kind:?} file needs --topic{topics}"),
+        ));
+    };
+    let picks = request
+        .columns
+        .iter()
+        .map(|c| {
+            axis(c).ok_or_else(|| {
+                with_file(
+                    files,
+                    format!(
+                        "--column {}: a sensor_msgs/Imu message has gx, gy, gz (angular_velocity, \
+                         rad/s) and ax, ay, az (linear_acceleration, m/s^2)",
+                        escaped(c)
+                    ),
+                )
+            })
+        })
+        .collect::<Result<Vec<usize>, Fail>>()?;
+    let mut timing = Timing::new();
+    let mut skipped = Skipped::default();
+    let mut backward: Option<(u64, i64, i64)> = None;
+    let mut count = 0u64;
+    let mut values = vec![0.0; picks.len()];
+    for file in files {
+        let s = read(file, topic, &mut |frame: Frame| {
+            count += 1;
+            if let Step::Backward { last } = timing.push(frame.stamp_ns) {
+                timing.drop_one();
+                backward.get_or_insert((count, frame.stamp_ns, last));
+                return;
+            }
+            for (v, &i) in values.iter_mut().zip(&picks) {
+                *v = frame.axes[i];
+            }
+            each(&values);
+        })
+        .map_err(|e| Fail(e.to_string()))?;
+        skipped.undecodable += s.undecodable;
+        skipped.non_finite += s.non_finite;
+    }
+    if let Some((at, stamp, last)) = backward
+        && !request.drop_backward
+    {
+        return Err(with_file(files, backward_text(&timing, at, stamp, last)));
+    }
+    let si = |i: usize| Unit::parse(if i < 3 { "rad/s" } else { "m/s^2" });
+    Ok(Read {
+        units: picks.iter().map(|&i| si(i)).collect(),
+        timing: Some((timing, TimeUnit::Nanoseconds)),
+        skipped,
+    })
+}
+
+/// The refusal of stamps that go backwards.
+fn backward_text(timing: &Timing, at: u64, stamp: i64, last: i64) -> String {
+    format!(
+        "{} timestamps are not after the one before (the first: message {at}, {stamp} ns after \
+         {last} ns); --drop-backward drops such samples and counts them",
+        timing.dropped()
+    )
+}
+
+/// The names a time column goes by.
+fn is_time(name: &str) -> bool {
+    let bare = split_unit(name).0.to_ascii_lowercase();
+    let bare = bare.trim_start_matches('#');
+    matches!(
+        bare,
+        "t" | "time" | "timestamp" | "stamp" | "sec" | "seconds"
+    ) || ["t_", "time_", "timestamp_", "stamp_"].iter().any(|p| {
+        bare.strip_prefix(p)
+            .is_some_and(|u| TimeUnit::of(u, Some(u)).is_some())
+    })
+}
+
+/// CSV files.
+fn csv_stream(
+    files: &[PathBuf],
+    request: &Request,
+    each: &mut dyn FnMut(&[f64]),
+) -> Result<Read, Fail> {
+    let mut units: Option<Vec<Option<Unit>>> = None;
+    // The time column's index and unit (when the column does not say: by its first value).
+    let time: Cell<Option<(usize, Option<TimeUnit>)>> = Cell::new(None);
+    let mut timing = Timing::new();
+    let mut values = vec![0.0; request.columns.len()];
+    let mut select = |header: &[String]| -> Result<Vec<usize>, String> {
+        let mut picks = request
+            .columns
+            .iter()
+            .map(|c| position(header, c))
+            .collect::<Result<Vec<usize>, String>>()?;
+        let here: Vec<Option<Unit>> = picks
+            .iter()
+            .map(|&i| split_unit(&header[i]).1.and_then(Unit::parse))
+            .collect();
+        units.get_or_insert(here);
+        let t = match request.time_column {
+            Some(name) => Some(position(header, name)?),
+            None if request.want_time => (0..header.len()).find(|&i| is_time(&header[i])),
+            None => None,
+        };
+        time.set(t.map(|i| {
+            let (name, bracket) = split_unit(&header[i]);
+            (i, TimeUnit::of(name, bracket))
+        }));
+        if let Some((i, _)) = time.get() {
+            picks.push(i);
+        }
+        Ok(picks)
+    };
+    let mut row = |cells: &[&str]| -> Result<(), String> {
+        let (cells, stamp) = match time.get() {
+            Some((i, unit)) => {
+                let (last, cells) = cells.split_last().ok_or("no cells")?;
+                let unit = match unit {
+                    Some(u) => u,
+                    None => {
+                        let first = last.parse::<f64>().unwrap_or(0.0);
+                        let u = TimeUnit::by_magnitude(first);
+                        time.set(Some((i, Some(u))));
+                        u
+                    }
+                };
+                (cells, Some(unit.nanoseconds(last)?))
+            }
+            None => (cells, None),
+        };
+        for ((v, cell), name) in values.iter_mut().zip(cells).zip(request.columns) {
+            *v = csv::finite(name)(cell)?;
+        }
+        if let Some(t) = stamp
+            && let Step::Backward { last } = timing.push(t)
+        {
+            timing.drop_one();
+            if !request.drop_backward {
+                return Err(format!(
+                    "timestamp {t} ns is not after the one before ({last} ns); \
+                     --drop-backward drops such samples and counts them"
+                ));
+            }
+            return Ok(());
+        }
+        each(&values);
+        Ok(())
+    };
+    csv::read_rows(files, &mut select, &mut row).map_err(|e: DataError| Fail(e.to_string()))?;
+    Ok(Read {
+        units: units.unwrap_or_default(),
+        timing: time
+            .get()
+            .map(|(_, u)| (timing, u.unwrap_or(TimeUnit::Seconds))),
+        skipped: Skipped::default(),
+    })
+}

@@ -1,0 +1,273 @@
+//! A record's timestamps: their unit, and the rate, jitter, gaps and backward steps they show,
+//! gathered in one streaming pass with bounded memory.
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+/// The unit of a time column.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TimeUnit {
+    /// Seconds.
+    Seconds,
+    /// Milliseconds.
+    Milliseconds,
+    /// Microseconds.
+    Microseconds,
+    /// Nanoseconds.
+    Nanoseconds,
+}
+
+impl TimeUnit {
+    /// The unit of a time column named `name` with unit bracket `bracket`: the bracket (`[ns]`,
+    /// `[s]`, ...) or the name's suffix (`t_ns`, `time_s`, ...); `None` when neither says.
+    pub fn of(name: &str, bracket: Option<&str>) -> Option<Self> {
+        let unit = match bracket {
+            Some(b) => b.trim(),
+            None => name.rsplit_once('_').map_or("", |(_, suffix)| suffix),
+        };
+        match unit.to_ascii_lowercase().as_str() {
+            "s" | "sec" | "secs" | "seconds" => Some(Self::Seconds),
+            "ms" => Some(Self::Milliseconds),
+            "us" | "\u{b5}s" | "\u{3bc}s" => Some(Self::Microseconds),
+            "ns" | "nsec" | "nsecs" => Some(Self::Nanoseconds),
+            _ => None,
+        }
+    }
+
+    /// The unit of stamps whose first value is `first` when the column does not say: epoch
+    /// times in ms, us or ns by their magnitude (1.7e12, 1.7e15, 1.7e18 in 2024), else seconds.
+    pub fn by_magnitude(first: f64) -> Self {
+        match first.abs() {
+            v if v >= 1e17 => Self::Nanoseconds,
+            v if v >= 1e14 => Self::Microseconds,
+            v if v >= 1e11 => Self::Milliseconds,
+            _ => Self::Seconds,
+        }
+    }
+
+    /// Its name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Seconds => "s",
+            Self::Milliseconds => "ms",
+            Self::Microseconds => "us",
+            Self::Nanoseconds => "ns",
+        }
+    }
+
+    /// A cell in this unit as nanoseconds. Integer cells are read exactly (an epoch time in ns
+    /// has more digits than f64 holds).
+    pub fn nanoseconds(self, cell: &str) -> Result<i64, String> {
+        let scale: i64 = match self {
+            Self::Seconds => 1_000_000_000,
+            Self::Milliseconds => 1_000_000,
+            Self::Microseconds => 1_000,
+            Self::Nanoseconds => 1,
+        };
+        if let Ok(v) = cell.parse::<i64>() {
+            return v
+                .checked_mul(scale)
+                .ok_or_else(|| format!("timestamp '{cell}' {} is out of range", self.name()));
+        }
+        match cell.parse::<f64>() {
+            Ok(v) if v.is_finite() && (v * scale as f64).abs() < 9.2e18 => {
+                Ok((v * scale as f64).round() as i64)
+            }
+            Ok(_) => Err(format!(
+                "timestamp '{cell}' {} is out of range",
+                self.name()
+            )),
+            Err(_) => Err(format!("timestamp '{cell}' is not a number")),
+        }
+    }
+}
+
+/// Whether a timestamp moved forward.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Step {
+    /// After the last one (or the first): the sample counts.
+    Forward,
+    /// At or before the last one: `last` is the last accepted stamp, ns.
+    Backward {
+        /// The last accepted stamp, ns.
+        last: i64,
+    },
+}
+
+/// The most distinct intervals held before they are rounded to a coarser quantum.
+const DISTINCT: usize = 1 << 16;
+
+/// Timestamps taken one by one: their intervals in a histogram (exact for a clock with a few
+/// distinct intervals; rounded to a coarser quantum past [`DISTINCT`] of them).
+#[derive(Clone, Debug, Default)]
+pub struct Timing {
+    first: Option<i64>,
+    last: i64,
+    accepted: u64,
+    dropped: u64,
+    /// Interval / quantum -> count.
+    intervals: BTreeMap<i64, u64>,
+    quantum: i64,
+}
+
+impl Timing {
+    /// No stamps yet.
+    pub fn new() -> Self {
+        Self {
+            quantum: 1,
+            ..Self::default()
+        }
+    }
+
+    /// Takes the stamp `t` (ns) of the next sample: [`Step::Forward`] when it is later than the
+    /// last accepted one, which it then becomes.
+    pub fn push(&mut self, t: i64) -> Step {
+        let Some(_) = self.first else {
+            self.first = Some(t);
+            self.last = t;
+            self.accepted = 1;
+            return Step::Forward;
+        };
+        if t <= self.last {
+            return Step::Backward { last: self.last };
+        }
+        let interval = t.saturating_sub(self.last);
+        *self.intervals.entry(interval / self.quantum).or_insert(0) += 1;
+        if self.intervals.len() > DISTINCT {
+            self.coarsen();
+        }
+        self.last = t;
+        self.accepted += 1;
+        Step::Forward
+    }
+
+    /// Counts a sample dropped for its backward stamp.
+    pub fn drop_one(&mut self) {
+        self.dropped += 1;
+    }
+
+    /// The samples dropped so far.
+    pub fn dropped(&self) -> u64 {
+        self.dropped
+    }
+
+    fn coarsen(&mut self) {
+        let mut coarse = BTreeMap::new();
+        for (k, n) in std::mem::take(&mut self.intervals) {
+            *coarse.entry(k / 10).or_insert(0) += n;
+        }
+        self.intervals = coarse;
+        self.quantum = self.quantum.saturating_mul(10);
+    }
+
+    /// The summary of the stamps taken; an error when they give no rate (fewer than two) or
+    /// several (less than 90 % of the intervals within 50 % of the median).
+    pub fn summary(&self, unit: TimeUnit) -> Result<TimingSummary, String> {
+        let intervals: u64 = self.intervals.values().sum();
+        if intervals == 0 {
+            return Err("fewer than two timestamps: no rate".into());
+        }
+        // The median interval, ns (the middle of its quantum).
+        let mut seen = 0;
+        let mut median = 0.0;
+        for (k, n) in &self.intervals {
+            seen += n;
+            if 2 * seen >= intervals {
+                median =
+                    (*k as f64 + if self.quantum > 1 { 0.5 } else { 0.0 }) * self.quantum as f64;
+                break;
+            }
+        }
+        let (mut short, mut gaps, mut missing) = (0u64, 0u64, 0u64);
+        let (mut sq, mut regular, mut worst) = (0.0, 0u64, 0.0f64);
+        for (k, n) in &self.intervals {
+            let v = *k as f64 * self.quantum as f64;
+            let r = v / median;
+            if r < 0.5 {
+                short += n;
+            } else if r > 1.5 {
+                gaps += n;
+                missing += n * ((r.round() as u64).saturating_sub(1));
+            } else {
+                regular += n;
+                sq += *n as f64 * (r - 1.0) * (r - 1.0);
+                worst = worst.max((r - 1.0).abs());
+            }
+        }
+        let span_s = self.last.saturating_sub(self.first.unwrap_or(self.last)) as f64 * 1e-9;
+        let summary = TimingSummary {
+            unit: unit.name(),
+            rate_hz: 1e9 / median,
+            median_interval_s: median * 1e-9,
+            jitter_rms: (sq / regular.max(1) as f64).sqrt(),
+            jitter_max: worst,
+            gaps,
+            missing_samples: missing,
+            short_intervals: short,
+            dropped_backward: self.dropped,
+            span_s,
+        };
+        if (regular as f64) < 0.9 * intervals as f64 {
+            return Err(format!(
+                "the timestamps show mixed rates: only {regular} of {intervals} intervals lie \
+                 within 50 % of the median interval {:.6e} s ({short} shorter, {gaps} longer); \
+                 one record must have one rate",
+                median * 1e-9
+            ));
+        }
+        Ok(summary)
+    }
+}
+
+/// What a record's timestamps show.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TimingSummary {
+    /// The unit of the time column (`ns` for a bag's header stamps).
+    pub unit: &'static str,
+    /// The rate, the reciprocal of the median interval, Hz.
+    pub rate_hz: f64,
+    /// The median interval, s.
+    pub median_interval_s: f64,
+    /// The RMS deviation of the regular intervals (within 50 % of the median) from the median,
+    /// relative to it.
+    pub jitter_rms: f64,
+    /// Their largest deviation, relative.
+    pub jitter_max: f64,
+    /// Intervals longer than 1.5 times the median.
+    pub gaps: u64,
+    /// The samples those gaps miss (each gap's interval over the median, rounded, less one).
+    pub missing_samples: u64,
+    /// Intervals shorter than half the median.
+    pub short_intervals: u64,
+    /// Samples dropped for a timestamp at or before the last one (`--drop-backward`).
+    pub dropped_backward: u64,
+    /// From the first stamp to the last, s.
+    pub span_s: f64,
+}
+
+impl TimingSummary {
+    /// One line for the text outputs.
+    pub fn text(&self) -> String {
+        format!(
+            "timestamps ({}): rate {} Hz (median interval {:e} s), jitter {:.3} % RMS, {:.3} % \
+             at most; {} gaps ({} samples missing), {} short intervals, {} backward dropped",
+            self.unit,
+            short(self.rate_hz),
+            self.median_interval_s,
+            100.0 * self.jitter_rms,
+            100.0 * self.jitter_max,
+            self.gaps,
+            self.missing_samples,
+            self.short_intervals,
+            self.dropped_backward
+        )
+    }
+}
+
+/// `v` to 7 significant digits, without trailing zeros.
+fn short(v: f64) -> String {
+    let s = format!("{v:.6}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    s.to_string()
+}
