@@ -1,7 +1,10 @@
 //! Reading a record: one column of CSV files ([`csv`]), averaged in blocks (`--decimate`), and
 //! the checks of the settings the commands share. An error names the flag, or the files.
 
+pub mod bag;
 pub mod csv;
+pub mod frame;
+pub mod mcap;
 
 use std::path::PathBuf;
 
