@@ -87,7 +87,12 @@ pub fn read(path: &Path, topic: &str, each: &mut dyn FnMut(Frame)) -> Result<Ski
         }
     }
     if ids.is_empty() {
-        return Err(fail(absent_topic(IMU_TYPE, topic, &imu_topics, &all_topics)));
+        return Err(fail(absent_topic(
+            IMU_TYPE,
+            topic,
+            &imu_topics,
+            &all_topics,
+        )));
     }
 
     let mut tally = Tally::new(each);
@@ -139,6 +144,9 @@ fn check_header(path: &Path) -> Result<(), DataError> {
         .read_to_end(&mut head)
         .map_err(|e| fail(format!("cannot read: {e}")))?;
     if !head.starts_with(MAGIC) {
+        if MAGIC.starts_with(&head) {
+            return Err(corrupt(&format!("{len} bytes, shorter than the magic")));
+        }
         return Err(fail(not_a_bag(&head)));
     }
     let at = MAGIC.len();

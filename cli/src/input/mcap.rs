@@ -69,6 +69,11 @@ pub fn read(path: &Path, topic: &str, each: &mut dyn FnMut(Frame)) -> Result<Ski
         .read_to_end(&mut head)
         .map_err(|e| fail(format!("cannot read: {e}")))?;
     if head != ::mcap::MAGIC {
+        if ::mcap::MAGIC.starts_with(&head) {
+            return Err(fail(format!(
+                "truncated or corrupt MCAP file: {len} bytes, shorter than the magic"
+            )));
+        }
         return Err(fail(not_mcap(&head)));
     }
     let limit = usize::try_from(len.max(MIN_RECORD_LIMIT)).unwrap_or(usize::MAX);
