@@ -4,152 +4,16 @@
 //! truncated, bit-flipped or random bytes. The read speed: `cargo test --release -p imu-ar-cli
 //! --test bags -- --ignored --nocapture`.
 
+mod ros;
+
 use std::collections::BTreeMap;
-use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
-use std::process::Command;
-use std::sync::Once;
-use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
-use imu_ar_cli::input::csv::DataError;
 use imu_ar_cli::input::frame::{Frame, Skipped};
 use imu_ar_cli::input::{bag, mcap as mcap_reader};
 use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
-
-type Reader = fn(&Path, &str, &mut dyn FnMut(Frame)) -> Result<Skipped, DataError>;
-
-/// Fails, with what to install, when Python cannot import `rosbags`.
-fn require_rosbags() {
-    static CHECK: Once = Once::new();
-    CHECK.call_once(|| {
-        let ok = Command::new("python3")
-            .args(["-c", "import rosbags"])
-            .status()
-            .is_ok_and(|s| s.success());
-        assert!(
-            ok,
-            "the fixtures of these tests are written by the Python package rosbags: \
-             `pip install rosbags` (python3 -c 'import rosbags' failed)"
-        );
-    });
-}
-
-/// An empty directory for one test's files.
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("imu-ar-bags-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-/// `n` frames from `seed`: stamps 2.5 ms apart with a jitter, axes of all magnitudes, with
-/// negative zeros, subnormals and extremes among them.
-fn frames(n: usize, seed: u64) -> Vec<Frame> {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let specials = [
-        -0.0,
-        5e-324,
-        -2.2e-308,
-        f64::MAX,
-        f64::MIN_POSITIVE,
-        1e300,
-        -1e-300,
-    ];
-    (0..n)
-        .map(|i| {
-            let jitter = (rng.next_u32() % 100_000) as i64;
-            let stamp_ns = 1_700_000_000_123_456_789 + i as i64 * 2_500_000 + jitter;
-            let axes = std::array::from_fn(|_| {
-                let r = rng.next_u64();
-                if r % 97 == 0 {
-                    specials[(r >> 32) as usize % specials.len()]
-                } else {
-                    let unit = (r >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0;
-                    unit * 10f64.powi((r % 9) as i32 - 4)
-                }
-            });
-            Frame { stamp_ns, axes }
-        })
-        .collect()
-}
-
-/// A CSV of `frames` for the script (`{:?}` round-trips every f64).
-fn write_csv(path: &Path, frames: &[Frame]) {
-    let mut s = String::from("t_ns,gx,gy,gz,ax,ay,az\n");
-    for f in frames {
-        write!(s, "{}", f.stamp_ns).unwrap();
-        for v in f.axes {
-            write!(s, ",{v:?}").unwrap();
-        }
-        s.push('\n');
-    }
-    std::fs::write(path, s).unwrap();
-}
-
-/// `write_imu.py OUT FORMAT TOPIC COMPRESSION CSV EXTRA...` into `dir`, the file `name`.
-fn fixture(dir: &Path, name: &str, args: [&str; 3], csv: &Path, extra: &[&str]) -> PathBuf {
-    require_rosbags();
-    let out = dir.join(name);
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/write_imu.py");
-    let status = Command::new("python3")
-        .arg(script)
-        .arg(&out)
-        .args(args)
-        .arg(csv)
-        .args(extra)
-        .status()
-        .expect("run python3");
-    assert!(status.success(), "write_imu.py {name} {args:?} {extra:?}");
-    out
-}
-
-/// `frames` written as `format` with `compression` on `/imu`.
-fn imu_file(dir: &Path, format: &str, compression: &str, frames: &[Frame]) -> PathBuf {
-    let csv = dir.join("frames.csv");
-    write_csv(&csv, frames);
-    static FILES: AtomicUsize = AtomicUsize::new(0);
-    let k = FILES.fetch_add(1, Ordering::Relaxed);
-    let name = format!("{k}-{compression}.{}", extension(format));
-    fixture(dir, &name, [format, "/imu", compression], &csv, &[])
-}
-
-fn extension(format: &str) -> &str {
-    if format == "ros1" { "bag" } else { "mcap" }
-}
-
-fn reader(format: &str) -> Reader {
-    if format == "ros1" {
-        bag::read
-    } else {
-        mcap_reader::read
-    }
-}
-
-/// The frames `read` delivers from `path` on `topic`, and its result.
-fn collect(read: Reader, path: &Path, topic: &str) -> (Vec<Frame>, Result<Skipped, DataError>) {
-    let mut got = Vec::new();
-    let result = read(path, topic, &mut |f| got.push(f));
-    (got, result)
-}
-
-/// The error's problem, asserting that it names the file and is one line.
-fn problem(path: &Path, result: Result<Skipped, DataError>) -> String {
-    let e = result.expect_err("an error");
-    assert_eq!(e.file, path);
-    assert!(!e.problem.contains('\n'), "{e}");
-    e.problem
-}
-
-fn assert_bits(got: &[Frame], want: &[Frame], what: &str) {
-    assert_eq!(got.len(), want.len(), "{what}: number of frames");
-    for (i, (g, w)) in got.iter().zip(want).enumerate() {
-        assert_eq!(g.stamp_ns, w.stamp_ns, "{what}: stamp of frame {i}");
-        let bits = |f: &Frame| f.axes.map(f64::to_bits);
-        assert_eq!(bits(g), bits(w), "{what}: axes of frame {i}");
-    }
-}
+use ros::*;
 
 #[test]
 fn every_frame_back_bit_for_bit() {
@@ -382,14 +246,6 @@ fn truncated_files_are_errors_even_after_frames() {
     assert_bits(&got, &want[..got.len()], "before the damaged chunk");
 }
 
-fn find_all(hay: &[u8], needle: &[u8]) -> Vec<usize> {
-    hay.windows(needle.len())
-        .enumerate()
-        .filter(|(_, w)| *w == needle)
-        .map(|(i, _)| i)
-        .collect()
-}
-
 #[test]
 fn other_files_are_named() {
     let dir = temp_dir("other");
@@ -565,17 +421,6 @@ fn damaged_bytes_never_panic() {
     );
 }
 
-/// The largest anonymous (heap) memory of this process so far, in kB, from
-/// /proc/self/status (RssAnon: the mapped bag's pages are file pages, not counted).
-fn rss_anon_kb() -> u64 {
-    let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
-    status
-        .lines()
-        .find_map(|l| l.strip_prefix("RssAnon:"))
-        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok())
-        .unwrap_or(0)
-}
-
 #[test]
 #[ignore = "writes 1 M messages with Python (minutes); run with --release --ignored --nocapture"]
 fn read_speed() {
@@ -593,12 +438,12 @@ fn read_speed() {
         let before = rss_anon_kb();
         let mut peak = before;
         let mut count = 0usize;
-        let mut sum = 0.0;
+        let mut check = 0u64;
         let start = Instant::now();
         let result = reader(format)(&path, "/imu", &mut |f| {
             count += 1;
-            sum += f.axes[0];
-            if count % 100_000 == 0 {
+            check ^= f.axes[0].to_bits();
+            if count.is_multiple_of(100_000) {
                 peak = peak.max(rss_anon_kb());
             }
         });
@@ -607,7 +452,7 @@ fn read_speed() {
         assert_eq!(count, n);
         println!(
             "{format} {compression}: {n} messages, {:.0} MB, in {secs:.3} s: {:.2} M messages/s, \
-             {:.2} s per million; heap grew by {} kB (checksum {sum:e})",
+             {:.2} s per million; heap grew by {} kB (check {check:x})",
             size as f64 / 1e6,
             n as f64 / secs / 1e6,
             secs / (n as f64 / 1e6),
