@@ -1,0 +1,244 @@
+//! Streaming `sensor_msgs/msg/Imu` messages out of a ROS 2 MCAP file
+//! (<https://mcap.dev/spec>, ROS 2 profile <https://mcap.dev/spec/registry>), uncompressed,
+//! zstd or lz4 chunks, through the sans-I/O reader of the [`mcap`] crate.
+//!
+//! The file is read front to back in pieces of 256 KiB and one chunk is decompressed at a
+//! time (its CRC, when it has one, checked before any of its messages is delivered): memory is
+//! bounded by the largest chunk, whatever the length of the file. Messages are delivered in
+//! file order (chunk after chunk, each chunk's messages as stored), not re-sorted by log time.
+//! A channel is checked when its record is read, which is before any of its messages.
+//!
+//! A message is decoded by hand from its CDR serialization (OMG CDR, XCDR version 1: OMG DDS-XTypes
+//! 1.3 section 7.4.3, <https://www.omg.org/spec/DDS-XTypes/1.3>, as the ROS 2 middleware writes
+//! it, <https://design.ros2.org/articles/generated_interfaces_cpp.html> and
+//! <https://github.com/eProsima/Fast-CDR>): a 4-byte encapsulation header (CDR_LE `00 01` or
+//! CDR_BE `00 00`, then two option bytes), then `sensor_msgs/msg/Imu`
+//! (<https://docs.ros2.org/latest/api/sensor_msgs/msg/Imu.html>): builtin_interfaces/Time
+//! (int32 sec, uint32 nanosec), string frame_id (uint32 length counting its NUL, then the bytes),
+//! then 37 float64 (orientation, its covariance, angular_velocity, its covariance,
+//! linear_acceleration, its covariance), the first aligned to 8 bytes counted from the end of
+//! the encapsulation header.
+
+use std::collections::HashMap;
+use std::fs::File;
+use std::io::{ErrorKind, Read};
+use std::path::Path;
+
+use ::mcap::records::{Record, op};
+use ::mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
+
+use crate::input::csv::DataError;
+use crate::input::frame::{
+    Frame, Skipped, Tally, absent_topic, bytes_at, data_error, imu_axes, stamp_ns, u32_at,
+};
+
+/// The schema name of the IMU channels.
+pub const IMU_SCHEMA: &str = "sensor_msgs/msg/Imu";
+
+/// The one message encoding read.
+const CDR: &str = "cdr";
+
+/// The schema encodings of ROS 2 message definitions.
+const SCHEMA_ENCODINGS: [&str; 2] = ["ros2msg", "ros2idl"];
+
+/// How much of the file is asked for at a time, at least.
+const READ_SIZE: usize = 256 * 1024;
+
+/// The longest record (or decompressed chunk) read when the file is shorter: longer ones are
+/// corrupt lengths, not allocated.
+const MIN_RECORD_LIMIT: u64 = 64 * 1024 * 1024;
+
+/// Calls `each` with every finite `sensor_msgs/msg/Imu` message on `topic` of the MCAP file
+/// `path`, in file order, and returns what was skipped.
+///
+/// Messages that cannot be decoded, and those with a NaN or an infinite axis, are counted and
+/// not delivered. An error (after the frames already delivered, when the damage is found
+/// midway) when the file is not an MCAP file, is truncated or corrupt, has no channel on
+/// `topic`, has one with another schema, another schema encoding than ros2msg or ros2idl, or
+/// another message encoding than cdr, or has no finite message on it.
+pub fn read(path: &Path, topic: &str, each: &mut dyn FnMut(Frame)) -> Result<Skipped, DataError> {
+    let fail = |problem: String| data_error(path, problem);
+    let mut file = File::open(path).map_err(|e| fail(format!("cannot open: {e}")))?;
+    let len = file
+        .metadata()
+        .map_err(|e| fail(format!("cannot read: {e}")))?
+        .len();
+    let mut head = Vec::new();
+    (&mut file)
+        .take(::mcap::MAGIC.len() as u64)
+        .read_to_end(&mut head)
+        .map_err(|e| fail(format!("cannot read: {e}")))?;
+    if head != ::mcap::MAGIC {
+        if ::mcap::MAGIC.starts_with(&head) {
+            return Err(fail(format!(
+                "truncated or corrupt MCAP file: {len} bytes, shorter than the magic"
+            )));
+        }
+        return Err(fail(not_mcap(&head)));
+    }
+    let limit = usize::try_from(len.max(MIN_RECORD_LIMIT)).unwrap_or(usize::MAX);
+    let mut reader = LinearReader::new_with_options(
+        LinearReaderOptions::default()
+            .with_skip_start_magic(true)
+            .with_prevalidate_chunk_crcs(true)
+            .with_record_length_limit(limit),
+    );
+
+    let mut channels = Channels::default();
+    let mut tally = Tally::new(each);
+    let mut messages = 0u64;
+    let corrupt = |what: &dyn std::fmt::Display, messages: u64| {
+        fail(format!(
+            "truncated or corrupt MCAP file: {what} (after {messages} messages)"
+        ))
+    };
+    while let Some(event) = reader.next_event() {
+        match event.map_err(|e| corrupt(&e, messages))? {
+            LinearReadEvent::ReadRequest(need) => {
+                let buf = reader.insert(need.max(READ_SIZE));
+                let n = loop {
+                    match file.read(buf) {
+                        Ok(n) => break n,
+                        Err(e) if e.kind() == ErrorKind::Interrupted => continue,
+                        Err(e) => return Err(fail(format!("cannot read: {e}"))),
+                    }
+                };
+                reader.notify_read(n);
+            }
+            LinearReadEvent::Record { opcode, data } => match opcode {
+                op::SCHEMA | op::CHANNEL => {
+                    let record =
+                        ::mcap::parse_record(opcode, data).map_err(|e| corrupt(&e, messages))?;
+                    channels.add(record, topic).map_err(fail)?;
+                }
+                op::MESSAGE => {
+                    messages += 1;
+                    // channel_id (u16), sequence (u32), log_time, publish_time (u64), data.
+                    let channel = bytes_at::<2>(data, 0)
+                        .map(u16::from_le_bytes)
+                        .ok_or_else(|| corrupt(&"a message record of 0 or 1 bytes", messages))?;
+                    if channels.wanted.contains(&channel) {
+                        tally.offer(data.get(22..).and_then(decode));
+                    }
+                }
+                _ => {}
+            },
+        }
+    }
+    if channels.wanted.is_empty() {
+        return Err(fail(absent_topic(
+            IMU_SCHEMA,
+            topic,
+            &channels.imu_topics,
+            &channels.all_topics,
+        )));
+    }
+    tally.finish(path, topic)
+}
+
+/// The schemas and channels read so far.
+#[derive(Default)]
+struct Channels {
+    /// Schema ID to name and encoding.
+    schemas: HashMap<u16, (String, String)>,
+    /// The IDs of the channels on the topic.
+    wanted: Vec<u16>,
+    /// The topics of the IMU channels, in the order first seen.
+    imu_topics: Vec<String>,
+    /// All topics, in the order first seen.
+    all_topics: Vec<String>,
+}
+
+impl Channels {
+    /// Takes in a schema or channel record; an error when it is a channel on `topic` that
+    /// cannot be read.
+    fn add(&mut self, record: Record<'_>, topic: &str) -> Result<(), String> {
+        match record {
+            Record::Schema { header, .. } => {
+                self.schemas
+                    .insert(header.id, (header.name, header.encoding));
+            }
+            Record::Channel(c) => {
+                let schema = self.schemas.get(&c.schema_id);
+                let name = schema.map_or("", |s| s.0.as_str());
+                if c.topic == topic {
+                    check_channel(topic, c.schema_id, schema, &c.message_encoding)?;
+                    if !self.wanted.contains(&c.id) {
+                        self.wanted.push(c.id);
+                    }
+                }
+                if name == IMU_SCHEMA && !self.imu_topics.contains(&c.topic) {
+                    self.imu_topics.push(c.topic.clone());
+                }
+                if !self.all_topics.contains(&c.topic) {
+                    self.all_topics.push(c.topic);
+                }
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+}
+
+/// A channel on `topic` (its schema, and its message encoding) that this reader can decode.
+fn check_channel(
+    topic: &str,
+    schema_id: u16,
+    schema: Option<&(String, String)>,
+    message_encoding: &str,
+) -> Result<(), String> {
+    let Some((name, encoding)) = schema else {
+        return Err(if schema_id == 0 {
+            format!("topic '{topic}' has no schema, not {IMU_SCHEMA}")
+        } else {
+            format!("topic '{topic}' names schema {schema_id}, which the file does not define")
+        });
+    };
+    if name != IMU_SCHEMA {
+        return Err(format!("topic '{topic}' has type {name}, not {IMU_SCHEMA}"));
+    }
+    if !SCHEMA_ENCODINGS.contains(&encoding.as_str()) {
+        return Err(format!(
+            "unknown schema encoding '{encoding}' on topic '{topic}' (supported: {})",
+            SCHEMA_ENCODINGS.join(", ")
+        ));
+    }
+    if message_encoding != CDR {
+        return Err(format!(
+            "unknown encoding '{message_encoding}' on topic '{topic}' (supported: {CDR})"
+        ));
+    }
+    Ok(())
+}
+
+/// Why a file that does not start with the MCAP magic is not read.
+fn not_mcap(head: &[u8]) -> String {
+    if head.starts_with(b"#ROSBAG") {
+        "not an MCAP file: a ROS 1 bag (read it as a bag)".to_string()
+    } else if head.starts_with(b"SQLite format 3") {
+        "not an MCAP file: an SQLite database (a rosbag2 .db3 file?)".to_string()
+    } else {
+        "not an MCAP file (it does not start with the MCAP magic)".to_string()
+    }
+}
+
+/// The frame of one CDR-serialized `sensor_msgs/msg/Imu`: `None` when the encapsulation is not
+/// CDR_LE or CDR_BE, or the message is too short.
+fn decode(b: &[u8]) -> Option<Frame> {
+    let big = match b.get(..2)? {
+        [0, 1] => false,
+        [0, 0] => true,
+        _ => return None,
+    };
+    // Offsets past the encapsulation header, where CDR alignment counts from.
+    let body = b.get(4..)?;
+    let sec = u32_at(body, 0, big)? as i32;
+    let nanosec = u32_at(body, 4, big)?;
+    let frame_id = usize::try_from(u32_at(body, 8, big)?).ok()?;
+    let end = 12usize.checked_add(frame_id)?;
+    let at = end.checked_add(7)? & !7;
+    Some(Frame {
+        stamp_ns: stamp_ns(i64::from(sec), nanosec),
+        axes: imu_axes(body, at, big)?,
+    })
+}

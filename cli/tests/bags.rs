@@ -1,0 +1,463 @@
+//! The ROS readers (`input::bag`, `input::mcap`) against files written by the Python package
+//! `rosbags` (`cli/tests/fixtures/write_imu.py`; `pip install rosbags`): every frame back bit
+//! for bit, for every compression; each error's text; what is skipped; and no panic on
+//! truncated, bit-flipped or random bytes. The read speed: `cargo test --release -p imu-ar-cli
+//! --test bags -- --ignored --nocapture`.
+
+mod ros;
+
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+use imu_ar_cli::input::frame::{Frame, Skipped};
+use imu_ar_cli::input::{bag, mcap as mcap_reader};
+use rand_chacha::ChaCha8Rng;
+use rand_core::{RngCore, SeedableRng};
+use ros::*;
+
+#[test]
+fn every_frame_back_bit_for_bit() {
+    let dir = temp_dir("round-trip");
+    let want = frames(4000, 1);
+    for (format, compressions) in [
+        ("ros1", ["none", "bz2", "lz4"]),
+        ("mcap", ["none", "zstd", "lz4"]),
+    ] {
+        for compression in compressions {
+            let path = imu_file(&dir, format, compression, &want);
+            let (got, result) = collect(reader(format), &path, "/imu");
+            assert_eq!(result, Ok(Skipped::default()), "{format} {compression}");
+            assert_bits(&got, &want, &format!("{format} {compression}"));
+        }
+    }
+}
+
+#[test]
+fn big_endian_cdr_and_every_frame_id_alignment() {
+    // Hand-made CDR: frame_id lengths 0 to 9 move the float64s to each alignment case.
+    let dir = temp_dir("cdr");
+    let want = frames(20, 2);
+    let path = dir.join("hand.mcap");
+    let mut w = mcap::Writer::new(std::io::BufWriter::new(
+        std::fs::File::create(&path).unwrap(),
+    ))
+    .unwrap();
+    let schema = w.add_schema("sensor_msgs/msg/Imu", "ros2msg", b"").unwrap();
+    let channel = w
+        .add_channel(schema, "/imu", "cdr", &BTreeMap::new())
+        .unwrap();
+    for (i, f) in want.iter().enumerate() {
+        let big = i % 2 == 1;
+        let u32b = |v: u32| {
+            if big {
+                v.to_be_bytes()
+            } else {
+                v.to_le_bytes()
+            }
+        };
+        let mut b = vec![0, u8::from(!big), 0, 0];
+        b.extend(u32b(f.stamp_ns.div_euclid(1_000_000_000) as u32));
+        b.extend(u32b(f.stamp_ns.rem_euclid(1_000_000_000) as u32));
+        let id_len = i % 10;
+        b.extend(u32b(id_len as u32 + 1));
+        b.extend(std::iter::repeat_n(b'f', id_len));
+        b.push(0);
+        while (b.len() - 4) % 8 != 0 {
+            b.push(0xee);
+        }
+        let mut values = [0.5; 37];
+        values[13..16].copy_from_slice(&f.axes[..3]);
+        values[25..28].copy_from_slice(&f.axes[3..]);
+        for v in values {
+            b.extend(if big {
+                v.to_be_bytes()
+            } else {
+                v.to_le_bytes()
+            });
+        }
+        let header = mcap::records::MessageHeader {
+            channel_id: channel,
+            sequence: i as u32,
+            log_time: 0,
+            publish_time: 0,
+        };
+        w.write_to_known_channel(&header, &b).unwrap();
+    }
+    w.finish().unwrap();
+    drop(w);
+    let (got, result) = collect(mcap_reader::read, &path, "/imu");
+    assert_eq!(result, Ok(Skipped::default()));
+    assert_bits(&got, &want, "hand-made CDR");
+}
+
+#[test]
+fn an_absent_topic_lists_the_imu_topics() {
+    let dir = temp_dir("absent");
+    let csv = dir.join("f.csv");
+    write_csv(&csv, &frames(10, 3));
+    let chatter = ["--string-topic", "/chatter"];
+    for (format, imu) in [("ros1", "sensor_msgs/Imu"), ("mcap", "sensor_msgs/msg/Imu")] {
+        let ext = extension(format);
+        let read = reader(format);
+        let path = fixture(
+            &dir,
+            &format!("a.{ext}"),
+            [format, "/imu0", "none"],
+            &csv,
+            &chatter,
+        );
+        assert_eq!(
+            problem(&path, read(&path, "/imu", &mut |_| {})),
+            format!("no {imu} messages on topic '/imu' (IMU topics: /imu0)")
+        );
+        let strings = ["--string-topic", "/a", "--string-topic", "/b"];
+        let path = fixture(
+            &dir,
+            &format!("b.{ext}"),
+            [format, "-", "none"],
+            &csv,
+            &strings,
+        );
+        assert_eq!(
+            problem(&path, read(&path, "/imu", &mut |_| {})),
+            format!("no {imu} messages on topic '/imu' (no IMU topics; topics: /a, /b)")
+        );
+    }
+}
+
+#[test]
+fn a_topic_of_another_type_is_named() {
+    let dir = temp_dir("type");
+    let csv = dir.join("f.csv");
+    write_csv(&csv, &frames(10, 4));
+    let string = ["--string-topic", "/imu"];
+    for (format, want) in [
+        (
+            "ros1",
+            "topic '/imu' has type std_msgs/String, not sensor_msgs/Imu",
+        ),
+        (
+            "mcap",
+            "topic '/imu' has type std_msgs/msg/String, not sensor_msgs/msg/Imu",
+        ),
+    ] {
+        let name = format!("t.{}", extension(format));
+        let path = fixture(&dir, &name, [format, "/imu0", "lz4"], &csv, &string);
+        let (got, result) = collect(reader(format), &path, "/imu");
+        assert_eq!(problem(&path, result), want);
+        assert!(got.is_empty());
+        // The IMU topic of the same file reads.
+        assert_eq!(collect(reader(format), &path, "/imu0").0.len(), 10);
+    }
+}
+
+#[test]
+fn other_mcap_encodings_are_refused() {
+    let dir = temp_dir("encoding");
+    let csv = dir.join("f.csv");
+    write_csv(&csv, &frames(10, 5));
+    let path = fixture(
+        &dir,
+        "json.mcap",
+        ["mcap", "/imu", "none"],
+        &csv,
+        &["--encoding", "json"],
+    );
+    assert_eq!(
+        problem(&path, mcap_reader::read(&path, "/imu", &mut |_| {})),
+        "unknown encoding 'json' on topic '/imu' (supported: cdr)"
+    );
+    // A schema in another encoding, from the mcap crate's writer.
+    let path = dir.join("jsonschema.mcap");
+    let mut w = mcap::Writer::new(std::fs::File::create(&path).unwrap()).unwrap();
+    let schema = w
+        .add_schema("sensor_msgs/msg/Imu", "jsonschema", b"{}")
+        .unwrap();
+    w.add_channel(schema, "/imu", "cdr", &BTreeMap::new())
+        .unwrap();
+    w.finish().unwrap();
+    drop(w);
+    assert_eq!(
+        problem(&path, mcap_reader::read(&path, "/imu", &mut |_| {})),
+        "unknown schema encoding 'jsonschema' on topic '/imu' (supported: ros2msg, ros2idl)"
+    );
+}
+
+#[test]
+fn truncated_files_are_errors_even_after_frames() {
+    let dir = temp_dir("truncated");
+    let want = frames(4000, 6);
+    for (format, compression, start) in [
+        ("ros1", "none", "truncated or corrupt bag: "),
+        ("ros1", "lz4", "truncated or corrupt bag: "),
+        ("mcap", "none", "truncated or corrupt MCAP file: "),
+        ("mcap", "zstd", "truncated or corrupt MCAP file: "),
+    ] {
+        let path = imu_file(&dir, format, compression, &want);
+        let bytes = std::fs::read(&path).unwrap();
+        let cut = dir.join("cut");
+        let n = bytes.len();
+        for at in [
+            0,
+            5,
+            12,
+            13,
+            20,
+            100,
+            4000,
+            4200,
+            n / 3,
+            n / 2,
+            n - 100,
+            n - 1,
+        ] {
+            std::fs::write(&cut, &bytes[..at]).unwrap();
+            let (got, result) = collect(reader(format), &cut, "/imu");
+            let p = problem(&cut, result);
+            assert!(
+                p.starts_with(start),
+                "{format} {compression} cut at {at}: {p}"
+            );
+            if format == "mcap" && compression == "none" && at >= n / 2 {
+                // Streamed: the frames before the cut came, then the error.
+                assert!(!got.is_empty(), "{format} {compression} cut at {at}");
+                assert_bits(&got, &want[..got.len()], "before the cut");
+            }
+        }
+    }
+    // A bag whose second chunk is damaged: the first chunk's frames, then the error.
+    let path = imu_file(&dir, "ros1", "none", &want);
+    let mut bytes = std::fs::read(&path).unwrap();
+    let chunks: Vec<usize> = find_all(&bytes, b"compression=none");
+    assert!(chunks.len() >= 2, "{} chunks", chunks.len());
+    bytes[chunks[1] + 12..chunks[1] + 16].copy_from_slice(b"nope");
+    std::fs::write(&path, &bytes).unwrap();
+    let (got, result) = collect(bag::read, &path, "/imu");
+    let p = problem(&path, result);
+    assert!(
+        p.starts_with("truncated or corrupt bag: invalid header (in the chunk section, after "),
+        "{p}"
+    );
+    assert!(
+        !got.is_empty() && got.len() < want.len(),
+        "{} frames",
+        got.len()
+    );
+    assert_bits(&got, &want[..got.len()], "before the damaged chunk");
+}
+
+#[test]
+fn other_files_are_named() {
+    let dir = temp_dir("other");
+    let mut noise = vec![0u8; 8192];
+    ChaCha8Rng::seed_from_u64(7).fill_bytes(&mut noise);
+    let path = dir.join("noise");
+    std::fs::write(&path, &noise).unwrap();
+    assert_eq!(
+        problem(&path, bag::read(&path, "/imu", &mut |_| {})),
+        "not a ROS 1 bag (it does not start with '#ROSBAG V2.0')"
+    );
+    assert_eq!(
+        problem(&path, mcap_reader::read(&path, "/imu", &mut |_| {})),
+        "not an MCAP file (it does not start with the MCAP magic)"
+    );
+    let want = frames(10, 8);
+    let bag_path = imu_file(&dir, "ros1", "none", &want);
+    let mcap_path = imu_file(&dir, "mcap", "none", &want);
+    assert_eq!(
+        problem(&bag_path, mcap_reader::read(&bag_path, "/imu", &mut |_| {})),
+        "not an MCAP file: a ROS 1 bag (read it as a bag)"
+    );
+    assert_eq!(
+        problem(&mcap_path, bag::read(&mcap_path, "/imu", &mut |_| {})),
+        "not a ROS 1 bag: an MCAP file (read it as MCAP)"
+    );
+    let missing = dir.join("missing.bag");
+    assert!(
+        problem(&missing, bag::read(&missing, "/imu", &mut |_| {})).starts_with("cannot open: ")
+    );
+}
+
+#[test]
+fn non_finite_and_undecodable_messages_are_counted() {
+    let dir = temp_dir("skipped");
+    let mut want = frames(50, 9);
+    want[3].axes[0] = f64::NAN;
+    want[7].axes[5] = f64::INFINITY;
+    want[8].axes[2] = f64::NEG_INFINITY;
+    for format in ["ros1", "mcap"] {
+        let path = imu_file(&dir, format, "none", &want);
+        let (got, result) = collect(reader(format), &path, "/imu");
+        let skipped = Skipped {
+            undecodable: 0,
+            non_finite: 3,
+        };
+        assert_eq!(result, Ok(skipped), "{format}");
+        let finite: Vec<Frame> = want
+            .iter()
+            .copied()
+            .filter(|f| f.axes.iter().all(|v| v.is_finite()))
+            .collect();
+        assert_bits(&got, &finite, format);
+
+        // frame_id "imu_link" given another length: that message no longer decodes.
+        let mut bytes = std::fs::read(&path).unwrap();
+        let ids = find_all(&bytes, b"imu_link");
+        let len_at = ids[10] - 4;
+        bytes[len_at..len_at + 4].copy_from_slice(&1000u32.to_le_bytes());
+        std::fs::write(&path, &bytes).unwrap();
+        let (got, result) = collect(reader(format), &path, "/imu");
+        assert_eq!(
+            result,
+            Ok(Skipped {
+                undecodable: 1,
+                non_finite: 3
+            }),
+            "{format}"
+        );
+        assert_eq!(got.len(), finite.len() - 1);
+    }
+}
+
+#[test]
+fn no_decodable_message_is_an_error() {
+    let dir = temp_dir("none");
+    for format in ["ros1", "mcap"] {
+        let empty = imu_file(&dir, format, "none", &[]);
+        assert_eq!(
+            problem(&empty, reader(format)(&empty, "/imu", &mut |_| {})),
+            "no decodable messages on '/imu' (0 undecodable)"
+        );
+        let path = imu_file(&dir, format, "none", &frames(1, 10));
+        let mut bytes = std::fs::read(&path).unwrap();
+        let at = find_all(&bytes, b"imu_link")[0] - 4;
+        bytes[at..at + 4].copy_from_slice(&u32::MAX.to_le_bytes());
+        std::fs::write(&path, &bytes).unwrap();
+        assert_eq!(
+            problem(&path, reader(format)(&path, "/imu", &mut |_| {})),
+            "no decodable messages on '/imu' (1 undecodable)"
+        );
+        let mut nan = frames(2, 11);
+        nan[0].axes[1] = f64::NAN;
+        nan[1].axes[4] = f64::NAN;
+        let path = imu_file(&dir, format, "none", &nan);
+        assert_eq!(
+            problem(&path, reader(format)(&path, "/imu", &mut |_| {})),
+            "no finite messages on '/imu' (0 undecodable, 2 with a NaN or infinite axis)"
+        );
+    }
+}
+
+#[test]
+fn damaged_bytes_never_panic() {
+    let dir = temp_dir("fuzz");
+    let want = frames(40, 12);
+    let mut seeds = Vec::new();
+    for (format, compression) in [
+        ("ros1", "none"),
+        ("ros1", "bz2"),
+        ("ros1", "lz4"),
+        ("mcap", "none"),
+        ("mcap", "zstd"),
+        ("mcap", "lz4"),
+    ] {
+        seeds.push(std::fs::read(imu_file(&dir, format, compression, &want)).unwrap());
+    }
+    let mut rng = ChaCha8Rng::seed_from_u64(13);
+    let path = dir.join("mutant");
+    let mut outcomes = [0usize; 2];
+    for i in 0..2000 {
+        let seed = &seeds[i % seeds.len()];
+        let mut bytes = seed.clone();
+        match rng.next_u32() % 5 {
+            0 => bytes.truncate(rng.next_u32() as usize % bytes.len()),
+            1 => {
+                for _ in 0..1 + rng.next_u32() % 8 {
+                    let at = rng.next_u32() as usize % bytes.len();
+                    bytes[at] ^= 1 << (rng.next_u32() % 8);
+                }
+            }
+            2 => {
+                let at = rng.next_u32() as usize % bytes.len();
+                let end = (at + 1 + rng.next_u32() as usize % 16).min(bytes.len());
+                rng.fill_bytes(&mut bytes[at..end]);
+            }
+            3 => {
+                // A length field set to an extreme.
+                let at = rng.next_u32() as usize % (bytes.len() - 8);
+                let v = [u32::MAX, 0x8000_0000, 0, 1][rng.next_u32() as usize % 4];
+                bytes[at..at + 4].copy_from_slice(&v.to_le_bytes());
+            }
+            _ => {
+                let mut noise = vec![0u8; rng.next_u32() as usize % 5000];
+                rng.fill_bytes(&mut noise);
+                let keep = rng.next_u32() as usize % 64;
+                noise.splice(0..0, seed[..keep].iter().copied());
+                bytes = noise;
+            }
+        }
+        std::fs::write(&path, &bytes).unwrap();
+        for (k, read) in [bag::read as Reader, mcap_reader::read]
+            .into_iter()
+            .enumerate()
+        {
+            let outcome = std::panic::catch_unwind(|| read(&path, "/imu", &mut |_| {}));
+            match outcome {
+                Ok(result) => outcomes[k] += usize::from(result.is_ok()),
+                Err(_) => {
+                    let keep = dir.join(format!("panic-{i}-{k}"));
+                    std::fs::copy(&path, &keep).unwrap();
+                    panic!(
+                        "reader {k} panicked on mutant {i}, kept as {}",
+                        keep.display()
+                    );
+                }
+            }
+        }
+    }
+    println!(
+        "mutants read without an error: bag {}, mcap {}",
+        outcomes[0], outcomes[1]
+    );
+}
+
+#[test]
+#[ignore = "writes 1 M messages with Python (minutes); run with --release --ignored --nocapture"]
+fn read_speed() {
+    let dir = temp_dir("speed");
+    let n = 1_000_000;
+    let want = frames(n, 14);
+    for (format, compression) in [
+        ("ros1", "none"),
+        ("ros1", "lz4"),
+        ("mcap", "none"),
+        ("mcap", "zstd"),
+    ] {
+        let path = imu_file(&dir, format, compression, &want);
+        let size = std::fs::metadata(&path).unwrap().len();
+        let before = rss_anon_kb();
+        let mut peak = before;
+        let mut count = 0usize;
+        let mut check = 0u64;
+        let start = Instant::now();
+        let result = reader(format)(&path, "/imu", &mut |f| {
+            count += 1;
+            check ^= f.axes[0].to_bits();
+            if count.is_multiple_of(100_000) {
+                peak = peak.max(rss_anon_kb());
+            }
+        });
+        let secs = start.elapsed().as_secs_f64();
+        assert_eq!(result, Ok(Skipped::default()));
+        assert_eq!(count, n);
+        println!(
+            "{format} {compression}: {n} messages, {:.0} MB, in {secs:.3} s: {:.2} M messages/s, \
+             {:.2} s per million; heap grew by {} kB (check {check:x})",
+            size as f64 / 1e6,
+            n as f64 / secs / 1e6,
+            secs / (n as f64 / 1e6),
+            peak.saturating_sub(before)
+        );
+        std::fs::remove_file(&path).unwrap();
+    }
+}
