@@ -13,6 +13,7 @@ pub mod adev;
 pub mod chart;
 pub mod compare;
 pub mod error;
+pub mod export;
 pub mod fit;
 pub mod input;
 pub mod kalman;
