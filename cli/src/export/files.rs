@@ -131,6 +131,21 @@ pub fn header(model: &ImuModel, target: &str, convention: &[&str]) -> Vec<String
     lines
 }
 
+/// The comment lines of a file for `target`: its header with `convention`, then the lines of
+/// each sensor written.
+pub fn document(
+    model: &ImuModel,
+    target: &str,
+    convention: &[&str],
+    sensors: &[&Written],
+) -> Vec<String> {
+    let mut lines = header(model, target, convention);
+    for w in sensors {
+        lines.extend(w.lines.iter().cloned());
+    }
+    lines
+}
+
 /// The sensor's written `N` and `K` (or `K_H` with `horizon`) and their comments.
 pub fn written(model: &ImuModel, sensor: &Sensor, horizon: Option<f64>) -> Written {
     let axes: Vec<(usize, &AxisModel)> = sensor.axes.clone().map(|i| (i, &model.axes[i])).collect();
@@ -286,16 +301,15 @@ fn both(model: &ImuModel, horizon: Option<f64>) -> Result<[Written; 2], Fail> {
 /// `*_random_walk` is the continuous `K` (SI/s/sqrt(Hz)). Read with PyYAML (YAML 1.1).
 pub fn kalibr(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
     let [g, a] = both(model, horizon)?;
-    let mut lines = header(
+    let lines = document(
         model,
         "Kalibr imu.yaml",
         &[
             "Kalibr takes continuous-time densities and discretises them itself with update_rate",
             "(ethz-asl/kalibr ConfigReader.py: N_d = N / sqrt(1/update_rate); wiki IMU-Noise-Model).",
         ],
+        &[&g, &a],
     );
-    lines.extend(g.lines);
-    lines.extend(a.lines);
     let topic = yaml_string("topic", model.topic.as_deref().unwrap_or("/imu0"))?;
     Ok(comments(&lines)
         + &format!(
@@ -336,7 +350,7 @@ fn matrix(size: usize, identity: bool) -> String {
 /// `config/euroc_mav/kalibr_imu_chain.yaml`.
 pub fn openvins(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
     let [g, a] = both(model, horizon)?;
-    let mut lines = header(
+    let lines = document(
         model,
         "OpenVINS kalibr_imu_chain.yaml",
         &[
@@ -344,9 +358,8 @@ pub fn openvins(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> 
             "step (rpng/open_vins Propagator.cpp: sigma_w^2/dt, sigma_wb^2 dt).",
             "Intrinsics: identity (Tw, R_IMUtoGYRO, Ta, R_IMUtoACC) and Tg zero: none estimated.",
         ],
+        &[&g, &a],
     );
-    lines.extend(g.lines);
-    lines.extend(a.lines);
     let topic = yaml_string("topic", model.topic.as_deref().unwrap_or("/imu0"))?;
     Ok(format!("%YAML:1.0\n\n{}\nimu0:\n", comments(&lines))
         + &format!("  T_i_b:\n{}", matrix(4, true))
@@ -384,7 +397,7 @@ pub fn vins(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
     let rate = model.rate_hz;
     let white = |n: f64| finite("VINS white noise", n * (2.0 * rate).sqrt());
     let walk = |k: f64| finite("VINS random walk", k * rate.sqrt());
-    let mut lines = header(
+    let lines = document(
         model,
         "VINS-Mono IMU parameters",
         &[
@@ -395,9 +408,8 @@ pub fn vins(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
             ),
             "Give the estimator IMU data at this rate; at another rate these values change.",
         ],
+        &[&g, &a],
     );
-    lines.extend(g.lines);
-    lines.extend(a.lines);
     Ok(format!("%YAML:1.0\n\n{}\n", comments(&lines))
         + &format!(
             "acc_n: {}  # m/s^2, per sample\ngyr_n: {}  # rad/s, per sample\n\
@@ -420,16 +432,15 @@ pub fn vins(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
 /// `IMU.Frequency`.
 pub fn orbslam3(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
     let [g, a] = both(model, horizon)?;
-    let mut lines = header(
+    let lines = document(
         model,
         "ORB-SLAM3 IMU parameters",
         &[
             "ORB-SLAM3 takes continuous-time densities and discretises them with IMU.Frequency",
             "(UZ-SLAMLab/ORB_SLAM3 Tracking.cc: Ng*sqrt(f), Ngw/sqrt(f); ImuTypes.cc preintegration).",
         ],
+        &[&g, &a],
     );
-    lines.extend(g.lines);
-    lines.extend(a.lines);
     Ok(format!("%YAML:1.0\n\n{}\n", comments(&lines))
         + &format!(
             "IMU.NoiseGyro: {}  # rad/s/sqrt(Hz), continuous\nIMU.NoiseAcc: {}  # \

@@ -5,7 +5,7 @@
 //! ([`super::ImuModel::filter_rate_hz`]).
 
 use super::ImuModel;
-use super::files::{ACCEL, GYRO, comments, finite, header, num, short, written};
+use super::files::{ACCEL, GYRO, Written, comments, document, finite, num, short, written};
 use crate::error::Fail;
 
 /// PX4's default `EKF2_PREDICT_US`, us.
@@ -20,15 +20,62 @@ fn per_step(what: &str, x: f64, dt: f64) -> Result<f64, Fail> {
     finite(what, x / dt.sqrt())
 }
 
-/// A note for a value outside the target's documented range.
-fn range_note(name: &str, v: f64, (low, high): (f64, f64)) -> Option<String> {
-    (v < low || v > high).then(|| {
-        format!(
-            "note: {name} = {} is outside its documented range [{low}, {high}]; the ground \
-             station may refuse or clamp it.",
-            short(v)
-        )
-    })
+/// An autopilot's four parameters (gyro noise, accelerometer noise, gyro bias noise,
+/// accelerometer bias noise), each with its documented range.
+type Names = [(&'static str, (f64, f64)); 4];
+
+/// A parameter, its value and its documented range.
+type Value = (&'static str, f64, (f64, f64));
+
+/// PX4's, from `src/modules/ekf2/module.yaml`.
+const PX4_NAMES: Names = [
+    ("EKF2_GYR_NOISE", (1e-4, 0.1)),
+    ("EKF2_ACC_NOISE", (0.01, 1.0)),
+    ("EKF2_GYR_B_NOISE", (0.0, 0.01)),
+    ("EKF2_ACC_B_NOISE", (0.0, 0.01)),
+];
+
+/// ArduPilot's, from the `@Range` of `libraries/AP_NavEKF3/AP_NavEKF3.cpp`.
+const ARDUPILOT_NAMES: Names = [
+    ("EK3_GYRO_P_NSE", (1e-4, 0.1)),
+    ("EK3_ACC_P_NSE", (0.01, 1.0)),
+    ("EK3_GBIAS_P_NSE", (1e-5, 1e-3)),
+    ("EK3_ABIAS_P_NSE", (1e-5, 5e-3)),
+];
+
+/// The values `N / sqrt(dt)`, `K / sqrt(dt)` of `names` for a filter stepping `dt`, and the
+/// two sensors written.
+fn autopilot(
+    model: &ImuModel,
+    horizon: Option<f64>,
+    dt: f64,
+    names: &Names,
+) -> Result<(Vec<Value>, [Written; 2]), Fail> {
+    let sensors = [
+        written(model, &GYRO, horizon),
+        written(model, &ACCEL, horizon),
+    ];
+    let [g, a] = &sensors;
+    let mut values = Vec::new();
+    for (&(name, range), x) in names.iter().zip([g.n, a.n, g.k, a.k]) {
+        values.push((name, per_step(name, x, dt)?, range));
+    }
+    Ok((values, sensors))
+}
+
+/// A note for each value outside the target's documented range.
+fn range_notes(values: &[Value]) -> Vec<String> {
+    values
+        .iter()
+        .filter(|(_, v, (low, high))| v < low || v > high)
+        .map(|(name, v, (low, high))| {
+            format!(
+                "note: {name} = {} is outside its documented range [{low}, {high}]; the ground \
+                 station may refuse or clamp it.",
+                short(*v)
+            )
+        })
+        .collect()
 }
 
 /// PX4 EKF2 parameters as a QGroundControl parameter file (tab-separated `Vehicle-Id
@@ -66,37 +113,12 @@ pub fn px4(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
         )));
     }
     let dt = predict_us * 1e-6;
-    let (g, a) = (
-        written(model, &GYRO, horizon),
-        written(model, &ACCEL, horizon),
-    );
-    let values = [
-        (
-            "EKF2_GYR_NOISE",
-            per_step("EKF2_GYR_NOISE", g.n, dt)?,
-            (1e-4, 0.1),
-        ),
-        (
-            "EKF2_ACC_NOISE",
-            per_step("EKF2_ACC_NOISE", a.n, dt)?,
-            (0.01, 1.0),
-        ),
-        (
-            "EKF2_GYR_B_NOISE",
-            per_step("EKF2_GYR_B_NOISE", g.k, dt)?,
-            (0.0, 0.01),
-        ),
-        (
-            "EKF2_ACC_B_NOISE",
-            per_step("EKF2_ACC_B_NOISE", a.k, dt)?,
-            (0.0, 0.01),
-        ),
-    ];
+    let (values, sensors) = autopilot(model, horizon, dt, &PX4_NAMES)?;
     let mut lines = vec![
         "Onboard parameters for Vehicle 1".to_string(),
         String::new(),
     ];
-    lines.extend(header(
+    lines.extend(document(
         model,
         "PX4 EKF2",
         &[
@@ -108,10 +130,9 @@ pub fn px4(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
             ),
             "(EKF2 steps an integer number of IMU samples: set EKF2_PREDICT_US to a multiple.)",
         ],
+        &[&sensors[0], &sensors[1]],
     ));
-    lines.extend(g.lines);
-    lines.extend(a.lines);
-    lines.extend(values.iter().filter_map(|(n, v, r)| range_note(n, *v, *r)));
+    lines.extend(range_notes(&values));
     lines.push(String::new());
     lines.push("Vehicle-Id\tComponent-Id\tName\tValue\tType".into());
     let mut text = comments(&lines);
@@ -129,45 +150,20 @@ pub fn px4(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
 /// Convention (ArduPilot/ardupilot, `libraries/AP_NavEKF3/AP_NavEKF3_core.cpp`,
 /// `NavEKF3_core::CovariancePrediction`, at 363e7e9eec9bdd54953b1bcc3e6bb71895c3c139): `dt`
 /// is the EKF's step (the IMU samples it averages, about `EKF_TARGET_DT` = 12 ms in
-/// `AP_NavEKF3_core.h`); `daxVar = sq(dt * _gyrNoise)` (`EK3_GYRO_P_NSE`) and `dvxVar = sq(dt
-/// * _accNoise)` (`EK3_ACC_P_NSE`) per step; the delta-angle bias state (the rate bias times
-/// `dt`) gets `sq(sq(dt) * _gyroBiasProcessNoise)` (`EK3_GBIAS_P_NSE`), the delta-velocity
-/// bias `sq(sq(dt) * _accelBiasProcessNoise)` (`EK3_ABIAS_P_NSE`): the rate bias variance grows
-/// by `(dt * EK3_GBIAS_P_NSE)^2` per step. Matching `N^2 dt` and `K^2 dt`: value = `N /
-/// sqrt(dt)`, `K / sqrt(dt)`; one number for the three axes.
+/// `AP_NavEKF3_core.h`); per step, `daxVar = sq(dt*_gyrNoise)` (`EK3_GYRO_P_NSE`) and
+/// `dvxVar = sq(dt*_accNoise)` (`EK3_ACC_P_NSE`); the delta-angle bias state (the rate bias
+/// times `dt`) gets `sq(sq(dt) * _gyroBiasProcessNoise)` (`EK3_GBIAS_P_NSE`), the
+/// delta-velocity bias `sq(sq(dt) * _accelBiasProcessNoise)` (`EK3_ABIAS_P_NSE`): the rate
+/// bias variance grows by `(dt EK3_GBIAS_P_NSE)^2` per step. Matching `N^2 dt` and `K^2 dt`:
+/// value = `N / sqrt(dt)`, `K / sqrt(dt)`; one number for the three axes.
 ///
 /// # Errors
 ///
 /// A [`Fail`] for a value that is not finite.
 pub fn ardupilot(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
     let dt = model.filter_rate_hz.map_or(ARDUPILOT_DT, |f| 1.0 / f);
-    let (g, a) = (
-        written(model, &GYRO, horizon),
-        written(model, &ACCEL, horizon),
-    );
-    let values = [
-        (
-            "EK3_GYRO_P_NSE",
-            per_step("EK3_GYRO_P_NSE", g.n, dt)?,
-            (1e-4, 0.1),
-        ),
-        (
-            "EK3_ACC_P_NSE",
-            per_step("EK3_ACC_P_NSE", a.n, dt)?,
-            (0.01, 1.0),
-        ),
-        (
-            "EK3_GBIAS_P_NSE",
-            per_step("EK3_GBIAS_P_NSE", g.k, dt)?,
-            (1e-5, 1e-3),
-        ),
-        (
-            "EK3_ABIAS_P_NSE",
-            per_step("EK3_ABIAS_P_NSE", a.k, dt)?,
-            (1e-5, 5e-3),
-        ),
-    ];
-    let mut lines = header(
+    let (values, sensors) = autopilot(model, horizon, dt, &ARDUPILOT_NAMES)?;
+    let mut lines = document(
         model,
         "ArduPilot EKF3",
         &[
@@ -185,10 +181,9 @@ pub fn ardupilot(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail>
                 }
             ),
         ],
+        &[&sensors[0], &sensors[1]],
     );
-    lines.extend(g.lines);
-    lines.extend(a.lines);
-    lines.extend(values.iter().filter_map(|(n, v, r)| range_note(n, *v, *r)));
+    lines.extend(range_notes(&values));
     let mut text = comments(&lines);
     for (name, v, _) in values {
         text += &format!("{name},{}\n", num(v));
