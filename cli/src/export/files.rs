@@ -292,6 +292,18 @@ fn both(model: &ImuModel, horizon: Option<f64>) -> Result<[Written; 2], Fail> {
     Ok(out)
 }
 
+/// Both sensors written, and the comment lines of a file for `target` with its `convention`.
+fn opened(
+    model: &ImuModel,
+    horizon: Option<f64>,
+    target: &str,
+    convention: &[&str],
+) -> Result<([Written; 2], Vec<String>), Fail> {
+    let [g, a] = both(model, horizon)?;
+    let lines = document(model, target, convention, &[&g, &a]);
+    Ok(([g, a], lines))
+}
+
 /// Kalibr's `imu.yaml`: continuous-time densities, one per sensor.
 ///
 /// Convention (<https://github.com/ethz-asl/kalibr/wiki/IMU-Noise-Model> and
@@ -300,31 +312,35 @@ fn both(model: &ImuModel, horizon: Option<f64>) -> Result<[Written; 2], Fail> {
 /// (SI/sqrt(Hz)), which Kalibr discretises itself as `N / sqrt(1 / update_rate)`;
 /// `*_random_walk` is the continuous `K` (SI/s/sqrt(Hz)). Read with PyYAML (YAML 1.1).
 pub fn kalibr(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
-    let [g, a] = both(model, horizon)?;
-    let lines = document(
+    let ([g, a], lines) = opened(
         model,
+        horizon,
         "Kalibr imu.yaml",
         &[
             "Kalibr takes continuous-time densities and discretises them itself with update_rate",
             "(ethz-asl/kalibr ConfigReader.py: N_d = N / sqrt(1/update_rate); wiki IMU-Noise-Model).",
         ],
-        &[&g, &a],
-    );
-    let topic = yaml_string("topic", model.topic.as_deref().unwrap_or("/imu0"))?;
+    )?;
     Ok(comments(&lines)
-        + &format!(
-            "accelerometer_noise_density: {}  # m/s^2/sqrt(Hz), continuous\n\
-             accelerometer_random_walk: {}  # m/s^3/sqrt(Hz), continuous\n\
-             gyroscope_noise_density: {}  # rad/s/sqrt(Hz), continuous\n\
-             gyroscope_random_walk: {}  # rad/s^2/sqrt(Hz), continuous\n\
-             rostopic: {topic}\n\
-             update_rate: {}  # Hz\n",
-            num(a.n),
-            num(a.k),
-            num(g.n),
-            num(g.k),
-            num(model.rate_hz)
-        ))
+        + &kalibr_keys("", model, [&g, &a])?
+        + &format!("update_rate: {}  # Hz\n", num(model.rate_hz)))
+}
+
+/// Kalibr's four densities and its topic, each line behind `indent`.
+fn kalibr_keys(indent: &str, model: &ImuModel, [g, a]: [&Written; 2]) -> Result<String, Fail> {
+    let topic = yaml_string("topic", model.topic.as_deref().unwrap_or("/imu0"))?;
+    let keys = [
+        ("accelerometer_noise_density", a.n, "m/s^2/sqrt(Hz)"),
+        ("accelerometer_random_walk", a.k, "m/s^3/sqrt(Hz)"),
+        ("gyroscope_noise_density", g.n, "rad/s/sqrt(Hz)"),
+        ("gyroscope_random_walk", g.k, "rad/s^2/sqrt(Hz)"),
+    ];
+    let mut text: String = keys
+        .iter()
+        .map(|(key, v, unit)| format!("{indent}{key}: {}  # {unit}, continuous\n", num(*v)))
+        .collect();
+    text += &format!("{indent}rostopic: {topic}\n");
+    Ok(text)
 }
 
 /// The rows of a 3x3 or 4x4 identity (or zero) matrix as an OpenCV YAML sequence.
@@ -349,30 +365,21 @@ fn matrix(size: usize, identity: bool) -> String {
 /// `N` and `K`. The file is read with OpenCV's `FileStorage` (`%YAML:1.0`), as in its
 /// `config/euroc_mav/kalibr_imu_chain.yaml`.
 pub fn openvins(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
-    let [g, a] = both(model, horizon)?;
-    let lines = document(
+    let ([g, a], lines) = opened(
         model,
+        horizon,
         "OpenVINS kalibr_imu_chain.yaml",
         &[
             "OpenVINS takes Kalibr's continuous-time densities and discretises them at each IMU",
             "step (rpng/open_vins Propagator.cpp: sigma_w^2/dt, sigma_wb^2 dt).",
             "Intrinsics: identity (Tw, R_IMUtoGYRO, Ta, R_IMUtoACC) and Tg zero: none estimated.",
         ],
-        &[&g, &a],
-    );
-    let topic = yaml_string("topic", model.topic.as_deref().unwrap_or("/imu0"))?;
+    )?;
     Ok(format!("%YAML:1.0\n\n{}\nimu0:\n", comments(&lines))
         + &format!("  T_i_b:\n{}", matrix(4, true))
+        + &kalibr_keys("  ", model, [&g, &a])?
         + &format!(
-            "  accelerometer_noise_density: {}  # m/s^2/sqrt(Hz), continuous\n  \
-             accelerometer_random_walk: {}  # m/s^3/sqrt(Hz), continuous\n  \
-             gyroscope_noise_density: {}  # rad/s/sqrt(Hz), continuous\n  \
-             gyroscope_random_walk: {}  # rad/s^2/sqrt(Hz), continuous\n  \
-             rostopic: {topic}\n  time_offset: 0.0\n  update_rate: {}\n  model: \"kalibr\"\n",
-            num(a.n),
-            num(a.k),
-            num(g.n),
-            num(g.k),
+            "  time_offset: 0.0\n  update_rate: {}\n  model: \"kalibr\"\n",
             num(model.rate_hz)
         )
         + &format!("  Tw:\n{}", matrix(3, true))
@@ -431,16 +438,15 @@ pub fn vins(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
 /// continuous `N`, `IMU.GyroWalk`/`IMU.AccWalk` the continuous `K`, discretised with
 /// `IMU.Frequency`.
 pub fn orbslam3(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
-    let [g, a] = both(model, horizon)?;
-    let lines = document(
+    let ([g, a], lines) = opened(
         model,
+        horizon,
         "ORB-SLAM3 IMU parameters",
         &[
             "ORB-SLAM3 takes continuous-time densities and discretises them with IMU.Frequency",
             "(UZ-SLAMLab/ORB_SLAM3 Tracking.cc: Ng*sqrt(f), Ngw/sqrt(f); ImuTypes.cc preintegration).",
         ],
-        &[&g, &a],
-    );
+    )?;
     Ok(format!("%YAML:1.0\n\n{}\n", comments(&lines))
         + &format!(
             "IMU.NoiseGyro: {}  # rad/s/sqrt(Hz), continuous\nIMU.NoiseAcc: {}  # \
