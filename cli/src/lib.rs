@@ -14,6 +14,7 @@ pub mod characterise;
 pub mod chart;
 pub mod compare;
 pub mod error;
+pub mod export;
 pub mod fit;
 pub mod input;
 pub mod kalman;

@@ -17,6 +17,7 @@ use serde::Serialize;
 
 use crate::chart;
 use crate::error::Fail;
+use crate::export::StateSpace;
 use crate::input::timing::TimingSummary;
 use crate::input::{Input, check_decimate, check_order, check_rate, check_span, decimated};
 use crate::kalman::{AllanRow, allan_text};
@@ -378,7 +379,7 @@ impl Fitting {
             noise_variance: used.noise_variance(),
             scale: used.noise_variance() / fitted.noise_variance(),
         });
-        let blocks = Blocks::of(form);
+        let space = StateSpace::of(form, 1.0);
         NoiseResult {
             rate_hz: self.rate,
             n: self.n,
@@ -392,9 +393,9 @@ impl Fitting {
             },
             gauss_markov,
             ar: ar_part,
-            phi: blocks.matrix(|b| b.phi),
-            q: blocks.matrix(|b| b.q),
-            p0: blocks.matrix(|b| b.p0),
+            phi: space.phi,
+            q: space.q,
+            p0: space.p0,
             allan: check
                 .rows()
                 .iter()
@@ -412,79 +413,12 @@ impl Fitting {
             details: Details {
                 unit: self.units.name.clone(),
                 filter_rate_hz: self.filter_rate,
-                states: blocks.names,
+                states: space.states,
                 white_term: model.white_term(),
                 white_noise_at_1s: ieee.white_noise_at_1s,
                 measurement_variance: form.measurement_variance,
             },
         }
-    }
-}
-
-/// A diagonal block of the filter: one state, or an oscillator's pair.
-struct Block {
-    phi: [[f64; 2]; 2],
-    q: [[f64; 2]; 2],
-    p0: [[f64; 2]; 2],
-    size: usize,
-}
-
-/// The filter's states as diagonal blocks, and their names.
-struct Blocks {
-    blocks: Vec<Block>,
-    names: Vec<String>,
-}
-
-impl Blocks {
-    fn of(form: &KalmanForm<MAX_GM_STATES>) -> Self {
-        let one = |v: f64| [[v, 0.0], [0.0, 0.0]];
-        let mut blocks = Vec::new();
-        let mut names = Vec::new();
-        for (i, s) in form.gm[..form.gm_len].iter().enumerate() {
-            blocks.push(Block {
-                phi: one(s.phi),
-                q: one(s.q),
-                p0: one(s.p0),
-                size: 1,
-            });
-            names.push(format!("gauss_markov[{i}]"));
-        }
-        for (i, s) in form.osc[..form.osc_len].iter().enumerate() {
-            blocks.push(Block {
-                phi: s.phi,
-                q: s.q,
-                p0: s.p0,
-                size: 2,
-            });
-            let k = form.gm_len + i;
-            names.push(format!("gauss_markov[{k}] (x)"));
-            names.push(format!("gauss_markov[{k}] (dx/dt)"));
-        }
-        if let Some(s) = form.random_walk {
-            blocks.push(Block {
-                phi: one(s.phi),
-                q: one(s.q),
-                p0: one(s.p0),
-                size: 1,
-            });
-            names.push("random_walk".into());
-        }
-        Self { blocks, names }
-    }
-
-    /// The block-diagonal matrix of `part` of each block.
-    fn matrix(&self, part: impl Fn(&Block) -> [[f64; 2]; 2]) -> Vec<Vec<f64>> {
-        let n = self.names.len();
-        let mut m = vec![vec![0.0; n]; n];
-        let mut at = 0;
-        for b in &self.blocks {
-            let v = part(b);
-            for (i, row) in v.iter().enumerate().take(b.size) {
-                m[at + i][at..at + b.size].copy_from_slice(&row[..b.size]);
-            }
-            at += b.size;
-        }
-        m
     }
 }
 

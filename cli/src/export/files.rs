@@ -1,0 +1,461 @@
+//! The YAML files: Kalibr's `imu.yaml`, the OpenVINS IMU chain, VINS-Mono and ORB-SLAM3 (OpenCV
+//! YAML), and what every single-number file shares: the worst axis, its comments and the
+//! horizon statement.
+
+use std::ops::Range;
+
+use super::bound::{self, FROM_TAU};
+use super::{AXIS_NAMES, AxisModel, ImuModel};
+use crate::error::Fail;
+
+/// The tool, in every file's first line.
+pub const TOOL: &str = concat!("imu-ar ", env!("CARGO_PKG_VERSION"), " (imu-ar-cli export)");
+
+/// One sensor of the IMU: three axes of one unit.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Sensor {
+    /// `gyroscope` or `accelerometer`.
+    pub name: &'static str,
+    /// Its SI unit.
+    pub unit: &'static str,
+    /// Its axes in [`ImuModel::axes`].
+    pub axes: Range<usize>,
+}
+
+/// The gyroscope, rad/s.
+pub const GYRO: Sensor = Sensor {
+    name: "gyroscope",
+    unit: "rad/s",
+    axes: 0..3,
+};
+
+/// The accelerometer, m/s^2.
+pub const ACCEL: Sensor = Sensor {
+    name: "accelerometer",
+    unit: "m/s^2",
+    axes: 3..6,
+};
+
+impl Sensor {
+    /// The sensor of the axis named `name` (one of [`AXIS_NAMES`]).
+    pub fn of_axis(name: &str) -> &'static Sensor {
+        if name.starts_with("gyro") {
+            &GYRO
+        } else {
+            &ACCEL
+        }
+    }
+}
+
+/// What a single-number file says of one sensor: the continuous `N` and `K` (or `K_H`) it
+/// stands for, and its comment lines.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Written {
+    /// `N` written: the largest axis's, SI/sqrt(Hz).
+    pub n: f64,
+    /// `K` written: the largest axis's, or `K_H` with a horizon, SI/s/sqrt(Hz).
+    pub k: f64,
+    /// The comments: per-axis values, which axis is written, the horizon statement.
+    pub lines: Vec<String>,
+}
+
+/// `v` to 4 significant digits, for comments.
+pub fn short(v: f64) -> String {
+    format!("{v:.4e}")
+}
+
+/// `v` exactly (the shortest text that reads back as `v`), in a form that YAML 1.1 (PyYAML,
+/// which needs a point and a signed exponent), OpenCV's YAML and the parameter-file readers
+/// all read as a float: `1.7e-04`, `2.0e+02`.
+pub fn num(v: f64) -> String {
+    let text = format!("{v:e}");
+    let (mantissa, exponent) = text.split_once('e').unwrap_or((&text, "0"));
+    let mantissa = if mantissa.contains('.') {
+        mantissa.to_string()
+    } else {
+        format!("{mantissa}.0")
+    };
+    let e: i32 = exponent.parse().unwrap_or(0);
+    let sign = if e < 0 { '-' } else { '+' };
+    format!("{mantissa}e{sign}{:02}", e.unsigned_abs())
+}
+
+/// `v` if finite, else a [`Fail`] naming `what`.
+pub fn finite(what: &str, v: f64) -> Result<f64, Fail> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(Fail(format!("{what} is not finite ({v})")))
+    }
+}
+
+/// `text` as a double-quoted YAML scalar (`\` and `"` escaped); control characters are refused.
+pub fn yaml_string(what: &str, text: &str) -> Result<String, Fail> {
+    if text.chars().any(char::is_control) {
+        return Err(Fail(format!(
+            "{what} {:?}: must not contain control characters",
+            crate::error::escaped(text)
+        )));
+    }
+    Ok(format!(
+        "\"{}\"",
+        text.replace('\\', "\\\\").replace('"', "\\\"")
+    ))
+}
+
+/// The comment block: `lines` behind `# `.
+pub fn comments(lines: &[String]) -> String {
+    lines
+        .iter()
+        .map(|l| {
+            if l.is_empty() {
+                "#\n".to_string()
+            } else {
+                format!("# {l}\n")
+            }
+        })
+        .collect()
+}
+
+/// The opening comment lines of a file for `target`, with its `convention`.
+pub fn header(model: &ImuModel, target: &str, convention: &[&str]) -> Vec<String> {
+    let mut lines = vec![
+        format!("{target}: IMU noise parameters written by {TOOL}"),
+        format!(
+            "from the composite noise model (imu-ar noise) of six axes sampled at {} Hz.",
+            model.rate_hz
+        ),
+        "Units: SI (gyroscope rad/s, accelerometer m/s^2).".to_string(),
+    ];
+    lines.extend(convention.iter().map(|l| l.to_string()));
+    lines
+}
+
+/// The comment lines of a file for `target`: its header with `convention`, then the lines of
+/// each sensor written.
+pub fn document(
+    model: &ImuModel,
+    target: &str,
+    convention: &[&str],
+    sensors: &[&Written],
+) -> Vec<String> {
+    let mut lines = header(model, target, convention);
+    for w in sensors {
+        lines.extend(w.lines.iter().cloned());
+    }
+    lines
+}
+
+/// The sensor's written `N` and `K` (or `K_H` with `horizon`) and their comments.
+pub fn written(model: &ImuModel, sensor: &Sensor, horizon: Option<f64>) -> Written {
+    let axes: Vec<(usize, &AxisModel)> = sensor.axes.clone().map(|i| (i, &model.axes[i])).collect();
+    let worst = |f: fn(&AxisModel) -> f64| {
+        axes.iter()
+            .max_by(|p, q| f(p.1).total_cmp(&f(q.1)))
+            .map_or((0.0, 0), |(i, a)| (f(a), *i))
+    };
+    let (n, n_axis) = worst(|a| a.white_noise);
+    let (k, k_axis) = worst(|a| a.random_walk);
+    let u = sensor.unit;
+    let mut lines = vec![
+        String::new(),
+        format!(
+            "{} per axis: continuous N ({u}/sqrt(Hz)), K ({u}/s/sqrt(Hz)), bias instability B \
+             ({u}) at its tau (none of these files has a term for B):",
+            sensor.name
+        ),
+    ];
+    for &(i, a) in &axes {
+        let mut line = format!(
+            "  {}: N = {}, K = {}, B = {} at tau = {} s",
+            AXIS_NAMES[i],
+            short(a.white_noise),
+            short(a.random_walk),
+            short(a.bias_instability.0),
+            short(a.bias_instability.1)
+        );
+        if let Some(h) = horizon {
+            let (kh, _) = bound::horizon_random_walk(a.white_noise, a.random_walk, &[(i, a)], h);
+            line += &format!(" (alone: K_H = {})", short(kh));
+        }
+        lines.push(line);
+    }
+    lines.push(format!(
+        "One number for the three axes: the worst (largest) is written: N of {}, K of {}.",
+        AXIS_NAMES[n_axis], AXIS_NAMES[k_axis]
+    ));
+    let written_k = match horizon {
+        None => k,
+        Some(h) => {
+            let (kh, at) = bound::horizon_random_walk(n, k, &axes, h);
+            lines.extend(horizon_lines(k, kh, at, h));
+            kh
+        }
+    };
+    lines.extend(reach_lines(n, written_k, &axes, horizon.is_some()));
+    Written {
+        n,
+        k: written_k,
+        lines,
+    }
+}
+
+/// The statement of the random walk `K_H` raised from `k` for the horizon `h`.
+fn horizon_lines(k: f64, kh: f64, at: Option<(usize, f64)>, h: f64) -> Vec<String> {
+    let factor = if k > 0.0 {
+        format!("K_H/K = {}", short(kh / k))
+    } else {
+        "the model has no random walk: K_H stands alone".to_string()
+    };
+    let mut lines = vec![format!(
+        "Horizon H = {h} s: the random walk written is K_H = {} ({factor}; K = {}), the \
+         smallest K_H >= K with sqrt(N^2/tau + K_H^2 tau/3) at or above the model's Allan \
+         deviation of every axis at every octave tau in [{FROM_TAU} s, H]",
+        short(kh),
+        short(k)
+    )];
+    lines.push(match at {
+        Some((i, tau)) => format!(
+            "(set by {} at tau = {} s): it stands in for the bias instability (Gauss-Markov \
+             terms) that this file cannot hold, a checked choice instead of a rule of thumb.",
+            AXIS_NAMES[i],
+            short(tau)
+        ),
+        None => {
+            "(K_H = K: white noise and random walk already overbound the model there).".to_string()
+        }
+    });
+    lines
+}
+
+/// The statement of how far the curve of `(n, k)` overbounds the model of `axes`.
+fn reach_lines(n: f64, k: f64, axes: &[(usize, &AxisModel)], raised: bool) -> Vec<String> {
+    let curve = if raised {
+        "With K_H, sqrt(N^2/tau + K_H^2 tau/3)"
+    } else {
+        "The file's white noise and random walk, sqrt(N^2/tau + K^2 tau/3),"
+    };
+    let r = bound::reach(n, k, axes);
+    let Some(last) = r.last else {
+        return vec![format!(
+            "The model has no octave at or above {FROM_TAU} s: no statement of its reach."
+        )];
+    };
+    let mut lines = vec![match r.up_to {
+        Some(t) if t >= last => format!(
+            "{curve} stays at or above the model's Allan deviation of every axis at every octave \
+             from {FROM_TAU} s to the last, tau = {} s.",
+            short(last)
+        ),
+        Some(t) => format!(
+            "{curve} stays at or above the model's Allan deviation of every axis at every octave \
+             from {FROM_TAU} s up to tau = {} s.",
+            short(t)
+        ),
+        None => format!(
+            "{curve} is below the model's Allan deviation already at the first octave from \
+             {FROM_TAU} s."
+        ),
+    }];
+    if let Some((short_by, tau, i)) = r.shortfall {
+        lines.push(format!(
+            "{} it falls short by up to {:.1} % (of the Allan deviation, {} at tau = {} \
+             s){}.",
+            if r.up_to.is_some() {
+                "Beyond,"
+            } else {
+                "There"
+            },
+            100.0 * short_by,
+            AXIS_NAMES[i],
+            short(tau),
+            if raised {
+                ""
+            } else {
+                "; a filter that must coast longer: export with a horizon"
+            }
+        ));
+    }
+    lines
+}
+
+/// The written values of both sensors, checked finite.
+fn both(model: &ImuModel, horizon: Option<f64>) -> Result<[Written; 2], Fail> {
+    let out = [
+        written(model, &GYRO, horizon),
+        written(model, &ACCEL, horizon),
+    ];
+    for (w, s) in out.iter().zip([&GYRO, &ACCEL]) {
+        finite(&format!("{} N", s.name), w.n)?;
+        finite(&format!("{} K", s.name), w.k)?;
+    }
+    Ok(out)
+}
+
+/// Both sensors written, and the comment lines of a file for `target` with its `convention`.
+fn opened(
+    model: &ImuModel,
+    horizon: Option<f64>,
+    target: &str,
+    convention: &[&str],
+) -> Result<([Written; 2], Vec<String>), Fail> {
+    let [g, a] = both(model, horizon)?;
+    let lines = document(model, target, convention, &[&g, &a]);
+    Ok(([g, a], lines))
+}
+
+/// Kalibr's `imu.yaml`: continuous-time densities, one per sensor.
+///
+/// Convention (<https://github.com/ethz-asl/kalibr/wiki/IMU-Noise-Model> and
+/// `aslam_offline_calibration/kalibr/python/kalibr_common/ConfigReader.py`, lines 473 and 491
+/// at 1f60227442d25e36365ef5f72cd80b9666d73467): `*_noise_density` is the continuous `N`
+/// (SI/sqrt(Hz)), which Kalibr discretises itself as `N / sqrt(1 / update_rate)`;
+/// `*_random_walk` is the continuous `K` (SI/s/sqrt(Hz)). Read with PyYAML (YAML 1.1).
+pub fn kalibr(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
+    let ([g, a], lines) = opened(
+        model,
+        horizon,
+        "Kalibr imu.yaml",
+        &[
+            "Kalibr takes continuous-time densities and discretises them itself with update_rate",
+            "(ethz-asl/kalibr ConfigReader.py: N_d = N / sqrt(1/update_rate); wiki IMU-Noise-Model).",
+        ],
+    )?;
+    Ok(comments(&lines)
+        + &kalibr_keys("", model, [&g, &a])?
+        + &format!("update_rate: {}  # Hz\n", num(model.rate_hz)))
+}
+
+/// Kalibr's four densities and its topic, each line behind `indent`.
+fn kalibr_keys(indent: &str, model: &ImuModel, [g, a]: [&Written; 2]) -> Result<String, Fail> {
+    let topic = yaml_string("topic", model.topic.as_deref().unwrap_or("/imu0"))?;
+    let keys = [
+        ("accelerometer_noise_density", a.n, "m/s^2/sqrt(Hz)"),
+        ("accelerometer_random_walk", a.k, "m/s^3/sqrt(Hz)"),
+        ("gyroscope_noise_density", g.n, "rad/s/sqrt(Hz)"),
+        ("gyroscope_random_walk", g.k, "rad/s^2/sqrt(Hz)"),
+    ];
+    let mut text: String = keys
+        .iter()
+        .map(|(key, v, unit)| format!("{indent}{key}: {}  # {unit}, continuous\n", num(*v)))
+        .collect();
+    text += &format!("{indent}rostopic: {topic}\n");
+    Ok(text)
+}
+
+/// The rows of a 3x3 or 4x4 identity (or zero) matrix as an OpenCV YAML sequence.
+fn matrix(size: usize, identity: bool) -> String {
+    (0..size)
+        .map(|i| {
+            let row: Vec<&str> = (0..size)
+                .map(|j| if identity && i == j { "1.0" } else { "0.0" })
+                .collect();
+            format!("    - [ {} ]\n", row.join(", "))
+        })
+        .collect()
+}
+
+/// OpenVINS's `kalibr_imu_chain.yaml`: Kalibr's continuous densities under `imu0`, with the
+/// IMU intrinsics it expects (identity, `Tg` zero: no intrinsic error).
+///
+/// Convention (rpng/open_vins at 69488123ed9362dd44b6f28e7f4680abbff1442b):
+/// `ov_msckf/src/core/VioManagerOptions.h` lines 159-162 read the four densities as `sigma_w`,
+/// `sigma_wb`, `sigma_a`, `sigma_ab`; `ov_msckf/src/state/Propagator.cpp` lines 225-228 and
+/// 463-466 discretise them (`sigma_w^2 / dt` per sample, `sigma_wb^2 dt` per step): continuous
+/// `N` and `K`. The file is read with OpenCV's `FileStorage` (`%YAML:1.0`), as in its
+/// `config/euroc_mav/kalibr_imu_chain.yaml`.
+pub fn openvins(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
+    let ([g, a], lines) = opened(
+        model,
+        horizon,
+        "OpenVINS kalibr_imu_chain.yaml",
+        &[
+            "OpenVINS takes Kalibr's continuous-time densities and discretises them at each IMU",
+            "step (rpng/open_vins Propagator.cpp: sigma_w^2/dt, sigma_wb^2 dt).",
+            "Intrinsics: identity (Tw, R_IMUtoGYRO, Ta, R_IMUtoACC) and Tg zero: none estimated.",
+        ],
+    )?;
+    Ok(format!("%YAML:1.0\n\n{}\nimu0:\n", comments(&lines))
+        + &format!("  T_i_b:\n{}", matrix(4, true))
+        + &kalibr_keys("  ", model, [&g, &a])?
+        + &format!(
+            "  time_offset: 0.0\n  update_rate: {}\n  model: \"kalibr\"\n",
+            num(model.rate_hz)
+        )
+        + &format!("  Tw:\n{}", matrix(3, true))
+        + &format!("  R_IMUtoGYRO:\n{}", matrix(3, true))
+        + &format!("  Ta:\n{}", matrix(3, true))
+        + &format!("  R_IMUtoACC:\n{}", matrix(3, true))
+        + &format!("  Tg:\n{}", matrix(3, false)))
+}
+
+/// VINS-Mono's IMU keys (OpenCV YAML): standard deviations per IMU sample.
+///
+/// Convention (HKUST-Aerial-Robotics/VINS-Mono at 90dabb5ec79946ae42fd2e1e91d4e69aabe1e25d):
+/// `vins_estimator/src/parameters.cpp` lines 70-73 read `acc_n`, `acc_w`, `gyr_n`, `gyr_w`;
+/// `vins_estimator/src/factor/integration_base.h` puts `ACC_N^2`, `GYR_N^2` on each of the two
+/// samples of a mid-point step and `ACC_W^2`, `GYR_W^2` on the bias (lines 22-27), with
+/// `V(3,3) = V(3,9) = 0.5 dt` and `V(9,12) = V(12,15) = dt` (lines 113-120), `P = F P F^T + V
+/// noise V^T` (line 125), `dt` the IMU's sample interval. Per step the angle error grows by
+/// `0.5 gyr_n^2 dt^2` and the bias by `gyr_w^2 dt^2`; matching the continuous `N^2 dt` and
+/// `K^2 dt`: `gyr_n = N sqrt(2 / dt)`, `gyr_w = K / sqrt(dt)` (the same for the accelerometer).
+pub fn vins(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
+    let [g, a] = both(model, horizon)?;
+    let rate = model.rate_hz;
+    let white = |n: f64| finite("VINS white noise", n * (2.0 * rate).sqrt());
+    let walk = |k: f64| finite("VINS random walk", k * rate.sqrt());
+    let lines = document(
+        model,
+        "VINS-Mono IMU parameters",
+        &[
+            "VINS-Mono uses them per IMU sample (HKUST-Aerial-Robotics/VINS-Mono integration_base.h:",
+            "mid-point step, Var(angle step) = 0.5 gyr_n^2 dt^2, Var(bias step) = gyr_w^2 dt^2):",
+            &format!(
+                "discrete at the IMU's rate {rate} Hz: *_n = N sqrt(2 rate), *_w = K sqrt(rate)."
+            ),
+            "Give the estimator IMU data at this rate; at another rate these values change.",
+        ],
+        &[&g, &a],
+    );
+    Ok(format!("%YAML:1.0\n\n{}\n", comments(&lines))
+        + &format!(
+            "acc_n: {}  # m/s^2, per sample\ngyr_n: {}  # rad/s, per sample\n\
+             acc_w: {}  # m/s^2 per sample step of the bias\ngyr_w: {}  # rad/s per sample \
+             step of the bias\n",
+            num(white(a.n)?),
+            num(white(g.n)?),
+            num(walk(a.k)?),
+            num(walk(g.k)?)
+        ))
+}
+
+/// ORB-SLAM3's IMU keys (OpenCV YAML): continuous densities and the IMU rate.
+///
+/// Convention (UZ-SLAMLab/ORB_SLAM3, `src/Tracking.cc`, `Tracking::newParameterLoader`):
+/// `sf = sqrt(mImuFreq); IMU::Calib(Tbc, Ng*sf, Na*sf, Ngw/sf, Naw/sf)`, and
+/// `src/ImuTypes.cc`, `Preintegrated::IntegrateNewMeasurement`: `C = A C A^T + B Nga B^T` (`B`
+/// with `dt`), `C(9.., 9..) += NgaWalk` per sample. So `IMU.NoiseGyro`/`IMU.NoiseAcc` are the
+/// continuous `N`, `IMU.GyroWalk`/`IMU.AccWalk` the continuous `K`, discretised with
+/// `IMU.Frequency`.
+pub fn orbslam3(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
+    let ([g, a], lines) = opened(
+        model,
+        horizon,
+        "ORB-SLAM3 IMU parameters",
+        &[
+            "ORB-SLAM3 takes continuous-time densities and discretises them with IMU.Frequency",
+            "(UZ-SLAMLab/ORB_SLAM3 Tracking.cc: Ng*sqrt(f), Ngw/sqrt(f); ImuTypes.cc preintegration).",
+        ],
+    )?;
+    Ok(format!("%YAML:1.0\n\n{}\n", comments(&lines))
+        + &format!(
+            "IMU.NoiseGyro: {}  # rad/s/sqrt(Hz), continuous\nIMU.NoiseAcc: {}  # \
+             m/s^2/sqrt(Hz), continuous\nIMU.GyroWalk: {}  # rad/s^2/sqrt(Hz), continuous\n\
+             IMU.AccWalk: {}  # m/s^3/sqrt(Hz), continuous\nIMU.Frequency: {}  # Hz\n",
+            num(g.n),
+            num(a.n),
+            num(g.k),
+            num(a.k),
+            num(model.rate_hz)
+        ))
+}

@@ -1,0 +1,192 @@
+//! The autopilot parameter files: PX4 EKF2 (a QGroundControl parameter file) and ArduPilot
+//! EKF3 (a Mission Planner / MAVProxy parameter file). Both filters use their noise
+//! parameters as continuous-looking rates that they multiply by their own prediction step, so
+//! the values depend on the filter's rate, which the caller may set
+//! ([`super::ImuModel::filter_rate_hz`]).
+
+use super::ImuModel;
+use super::files::{ACCEL, GYRO, Written, comments, document, finite, num, short, written};
+use crate::error::Fail;
+
+/// PX4's default `EKF2_PREDICT_US`, us.
+pub const PX4_PREDICT_US: f64 = 10_000.0;
+
+/// ArduPilot EKF3's `EKF_TARGET_DT`, s.
+pub const ARDUPILOT_DT: f64 = 0.012;
+
+/// The discrete value `x / sqrt(dt)` of a continuous density `x` for a filter that adds
+/// `(dt * value)^2` per step (so that the variance grows by `x^2 dt`).
+fn per_step(what: &str, x: f64, dt: f64) -> Result<f64, Fail> {
+    finite(what, x / dt.sqrt())
+}
+
+/// An autopilot's four parameters (gyro noise, accelerometer noise, gyro bias noise,
+/// accelerometer bias noise), each with its documented range.
+type Names = [(&'static str, (f64, f64)); 4];
+
+/// A parameter, its value and its documented range.
+type Value = (&'static str, f64, (f64, f64));
+
+/// PX4's, from `src/modules/ekf2/module.yaml`.
+const PX4_NAMES: Names = [
+    ("EKF2_GYR_NOISE", (1e-4, 0.1)),
+    ("EKF2_ACC_NOISE", (0.01, 1.0)),
+    ("EKF2_GYR_B_NOISE", (0.0, 0.01)),
+    ("EKF2_ACC_B_NOISE", (0.0, 0.01)),
+];
+
+/// ArduPilot's, from the `@Range` of `libraries/AP_NavEKF3/AP_NavEKF3.cpp`.
+const ARDUPILOT_NAMES: Names = [
+    ("EK3_GYRO_P_NSE", (1e-4, 0.1)),
+    ("EK3_ACC_P_NSE", (0.01, 1.0)),
+    ("EK3_GBIAS_P_NSE", (1e-5, 1e-3)),
+    ("EK3_ABIAS_P_NSE", (1e-5, 5e-3)),
+];
+
+/// The values `N / sqrt(dt)`, `K / sqrt(dt)` of `names` for a filter stepping `dt`, and the
+/// two sensors written.
+fn autopilot(
+    model: &ImuModel,
+    horizon: Option<f64>,
+    dt: f64,
+    names: &Names,
+) -> Result<(Vec<Value>, [Written; 2]), Fail> {
+    let sensors = [
+        written(model, &GYRO, horizon),
+        written(model, &ACCEL, horizon),
+    ];
+    let [g, a] = &sensors;
+    let mut values = Vec::new();
+    for (&(name, range), x) in names.iter().zip([g.n, a.n, g.k, a.k]) {
+        values.push((name, per_step(name, x, dt)?, range));
+    }
+    Ok((values, sensors))
+}
+
+/// A note for each value outside the target's documented range.
+fn range_notes(values: &[Value]) -> Vec<String> {
+    values
+        .iter()
+        .filter(|(_, v, (low, high))| v < low || v > high)
+        .map(|(name, v, (low, high))| {
+            format!(
+                "note: {name} = {} is outside its documented range [{low}, {high}]; the ground \
+                 station may refuse or clamp it.",
+                short(*v)
+            )
+        })
+        .collect()
+}
+
+/// PX4 EKF2 parameters as a QGroundControl parameter file (tab-separated `Vehicle-Id
+/// Component-Id Name Value Type`, type 9 `MAV_PARAM_TYPE_REAL32`, 6 `INT32`; `#` comments:
+/// <https://docs.qgroundcontrol.com/master/en/qgc-dev-guide/file_formats/parameters.html>).
+/// This is the file PX4 users load (QGroundControl, Parameters > Tools > Load from file); a
+/// list of `param set` lines would need the MAVLink shell or an SD-card start script.
+///
+/// Convention (PX4/PX4-Autopilot): `src/modules/ekf2/EKF/covariance.cpp`,
+/// `Ekf::predictCovariance` (at 765f2844e93fef99f3b6ae77b102b41728f89ead), with `dt` the
+/// prediction step (`EKF2_PREDICT_US`, default 10000 us in `src/modules/ekf2/module.yaml`):
+/// `gyro_var = sq(EKF2_GYR_NOISE)` enters `sym::PredictCovariance`, whose derivation
+/// (`EKF/python/ekf_derivation/derivation.py`, `predict_covariance`, at
+/// 1263e1a15a0e0dbea210cdcc0864000f5ea8a96a) puts the noise on the rate times `dt`: the angle
+/// variance grows by `EKF2_GYR_NOISE^2 dt^2` per step (the same for `EKF2_ACC_NOISE` and the
+/// velocity); the bias variance by `(dt * EKF2_GYR_B_NOISE)^2` (`gyro_bias_process_noise`;
+/// `EKF2_ACC_B_NOISE` alike). Matching `N^2 dt` and `K^2 dt`: `EKF2_GYR_NOISE = N / sqrt(dt)`,
+/// `EKF2_GYR_B_NOISE = K / sqrt(dt)`; one number for the three axes. `EKF2_PREDICT_US` is
+/// written too, so that the file holds the step its values assume.
+///
+/// # Errors
+///
+/// A [`Fail`] for a filter rate outside `EKF2_PREDICT_US`'s range (1000 to 20000 us: 50 to
+/// 1000 Hz), or a value that is not finite.
+pub fn px4(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
+    let predict_us = match model.filter_rate_hz {
+        Some(f) => (1e6 / f).round(),
+        None => PX4_PREDICT_US,
+    };
+    if !(1000.0..=20000.0).contains(&predict_us) {
+        return Err(Fail(format!(
+            "PX4: filter rate {} Hz gives EKF2_PREDICT_US {predict_us}, outside 1000 to 20000 \
+             (50 to 1000 Hz)",
+            model.filter_rate_hz.unwrap_or(0.0)
+        )));
+    }
+    let dt = predict_us * 1e-6;
+    let (values, sensors) = autopilot(model, horizon, dt, &PX4_NAMES)?;
+    let mut lines = vec![
+        "Onboard parameters for Vehicle 1".to_string(),
+        String::new(),
+    ];
+    lines.extend(document(
+        model,
+        "PX4 EKF2",
+        &[
+            "EKF2 adds (dt * EKF2_GYR_NOISE)^2 to the angle variance and (dt * EKF2_GYR_B_NOISE)^2",
+            "to the bias variance every prediction step dt (PX4-Autopilot ekf2 covariance.cpp,",
+            "predictCovariance; derivation.py); the accelerometer alike. Discrete at the filter's",
+            &format!(
+                "step dt = EKF2_PREDICT_US = {predict_us} us: value = N / sqrt(dt), K / sqrt(dt)."
+            ),
+            "(EKF2 steps an integer number of IMU samples: set EKF2_PREDICT_US to a multiple.)",
+        ],
+        &[&sensors[0], &sensors[1]],
+    ));
+    lines.extend(range_notes(&values));
+    lines.push(String::new());
+    lines.push("Vehicle-Id\tComponent-Id\tName\tValue\tType".into());
+    let mut text = comments(&lines);
+    text += &format!("1\t1\tEKF2_PREDICT_US\t{predict_us}\t6\n");
+    for (name, v, _) in values {
+        text += &format!("1\t1\t{name}\t{}\t9\n", num(v));
+    }
+    Ok(text)
+}
+
+/// ArduPilot EKF3 parameters as a parameter file of `NAME,VALUE` lines with `#` comments, the
+/// form Mission Planner saves and loads (Config > Full Parameter List > Load from file) and
+/// MAVProxy's `param load` reads.
+///
+/// Convention (ArduPilot/ardupilot, `libraries/AP_NavEKF3/AP_NavEKF3_core.cpp`,
+/// `NavEKF3_core::CovariancePrediction`, at 363e7e9eec9bdd54953b1bcc3e6bb71895c3c139): `dt`
+/// is the EKF's step (the IMU samples it averages, about `EKF_TARGET_DT` = 12 ms in
+/// `AP_NavEKF3_core.h`); per step, `daxVar = sq(dt*_gyrNoise)` (`EK3_GYRO_P_NSE`) and
+/// `dvxVar = sq(dt*_accNoise)` (`EK3_ACC_P_NSE`); the delta-angle bias state (the rate bias
+/// times `dt`) gets `sq(sq(dt) * _gyroBiasProcessNoise)` (`EK3_GBIAS_P_NSE`), the
+/// delta-velocity bias `sq(sq(dt) * _accelBiasProcessNoise)` (`EK3_ABIAS_P_NSE`): the rate
+/// bias variance grows by `(dt EK3_GBIAS_P_NSE)^2` per step. Matching `N^2 dt` and `K^2 dt`:
+/// value = `N / sqrt(dt)`, `K / sqrt(dt)`; one number for the three axes.
+///
+/// # Errors
+///
+/// A [`Fail`] for a value that is not finite.
+pub fn ardupilot(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
+    let dt = model.filter_rate_hz.map_or(ARDUPILOT_DT, |f| 1.0 / f);
+    let (values, sensors) = autopilot(model, horizon, dt, &ARDUPILOT_NAMES)?;
+    let mut lines = document(
+        model,
+        "ArduPilot EKF3",
+        &[
+            "EKF3 adds (dt * EK3_GYRO_P_NSE)^2 to the delta-angle variance and (dt^2 *",
+            "EK3_GBIAS_P_NSE)^2 to the delta-angle bias variance every step dt (ArduPilot",
+            "AP_NavEKF3_core.cpp, CovariancePrediction); the accelerometer alike. Discrete at the",
+            &format!(
+                "EKF's step dt = {} s ({} Hz{}): value = N / sqrt(dt), K / sqrt(dt).",
+                short(dt),
+                short(1.0 / dt),
+                if model.filter_rate_hz.is_some() {
+                    ""
+                } else {
+                    ", EKF_TARGET_DT"
+                }
+            ),
+        ],
+        &[&sensors[0], &sensors[1]],
+    );
+    lines.extend(range_notes(&values));
+    let mut text = comments(&lines);
+    for (name, v, _) in values {
+        text += &format!("{name},{}\n", num(v));
+    }
+    Ok(text)
+}

@@ -1,0 +1,449 @@
+//! `imu_ar_cli::export`: the parameter files of an IMU's six axes, read back and checked. The
+//! model comes from real fits of simulated records (white noise, random walk and one or two
+//! Gauss-Markov terms per axis); each file is parsed, its numbers turned back into continuous
+//! `N` and `K` with its target's own convention, a record simulated from them, and its Allan
+//! deviation compared with what the file claims.
+
+use std::collections::HashMap;
+use std::path::PathBuf;
+use std::sync::OnceLock;
+
+use imu_ar::noise::{Estimator, FitConfig, NoiseModel, NoiseType, Octaves};
+use imu_ar::sim::StandardNormal;
+use imu_ar_cli::export::{AxisModel, Format, ImuModel, write};
+use imu_ar_host::composite::Composite;
+use rand_chacha::ChaCha8Rng;
+use rand_core::SeedableRng;
+
+/// The IMU's rate, Hz.
+const RATE: f64 = 100.0;
+
+/// The truth of the six axes: `(N, K, [(sigma, T)])`, SI.
+fn truths() -> [Composite; 6] {
+    let axis = |white: f64, random_walk: f64, gm: &[(f64, f64)]| Composite {
+        dt: 1.0 / RATE,
+        white,
+        quantization: 0.0,
+        gm: gm.to_vec(),
+        random_walk,
+    };
+    [
+        axis(2e-4, 2e-6, &[(3e-5, 50.0)]),
+        axis(3e-4, 1e-6, &[(4e-5, 100.0), (2e-5, 5.0)]),
+        axis(1.5e-4, 3e-6, &[(2e-5, 30.0)]),
+        axis(1e-3, 3e-5, &[(2e-4, 20.0)]),
+        axis(2e-3, 5e-5, &[(3e-4, 100.0), (1e-4, 4.0)]),
+        axis(1.5e-3, 2e-5, &[(1.5e-4, 40.0)]),
+    ]
+}
+
+/// The model of the six axes, fitted once.
+fn model() -> &'static ImuModel {
+    static MODEL: OnceLock<ImuModel> = OnceLock::new();
+    MODEL.get_or_init(|| {
+        let axes = truths().map(|truth| {
+            let x = truth.simulate(1 << 20, 7 + (truth.white * 1e6) as u64);
+            let octaves = Octaves::<32>::overlapping(&x, truth.dt).unwrap();
+            let fit = NoiseModel::<1, 8>::fit(&octaves, None, &FitConfig::new(3)).unwrap();
+            let span = x.len() as f64 * truth.dt;
+            let p0 = fit.random_walk().powi(2) * span;
+            AxisModel::from_noise(&fit, 1.0, truth.dt, p0, 21).unwrap_or_else(|e| panic!("{}", e.0))
+        });
+        ImuModel {
+            axes,
+            rate_hz: RATE,
+            topic: Some("/imu\"0".into()),
+            filter_rate_hz: None,
+        }
+    })
+}
+
+/// A fresh temp directory for one test.
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("imu-ar-export-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The `key: value` (YAML), `NAME,VALUE` (ArduPilot) and tab-separated QGC lines of a file,
+/// comments dropped.
+fn values(text: &str) -> HashMap<String, String> {
+    let mut out = HashMap::new();
+    for line in text.lines() {
+        let line = line.split('#').next().unwrap().trim();
+        if line.is_empty() || line.starts_with('%') {
+            continue;
+        }
+        let fields: Vec<&str> = line.split('\t').collect();
+        let (key, value) = if fields.len() == 5 {
+            (fields[2], fields[3])
+        } else if let Some(kv) = line.split_once(": ") {
+            kv
+        } else if let Some(kv) = line.split_once(',') {
+            kv
+        } else {
+            continue;
+        };
+        out.insert(key.trim().to_string(), value.trim().to_string());
+    }
+    out
+}
+
+fn number(map: &HashMap<String, String>, key: &str) -> f64 {
+    let v = map
+        .get(key)
+        .unwrap_or_else(|| panic!("no {key} in {map:?}"));
+    // A YAML 1.1 float: a point, and a sign on the exponent.
+    let float = v.contains('.') && (v.contains("e-") || v.contains("e+"));
+    assert!(key == "EKF2_PREDICT_US" || float, "{key}: {v}");
+    v.parse().unwrap()
+}
+
+/// The continuous `(N, K)` of the gyroscope and of the accelerometer that `format`'s file
+/// in `dir` stands for, by its target's convention.
+fn continuous(format: Format, text: &str) -> [(f64, f64); 2] {
+    let m = values(text);
+    let n = |k: &str| number(&m, k);
+    match format {
+        Format::Kalibr | Format::OpenVins => [
+            (n("gyroscope_noise_density"), n("gyroscope_random_walk")),
+            (
+                n("accelerometer_noise_density"),
+                n("accelerometer_random_walk"),
+            ),
+        ],
+        Format::OrbSlam3 => {
+            assert_eq!(n("IMU.Frequency"), RATE);
+            [
+                (n("IMU.NoiseGyro"), n("IMU.GyroWalk")),
+                (n("IMU.NoiseAcc"), n("IMU.AccWalk")),
+            ]
+        }
+        // Per sample: Var(step) = 0.5 n^2 dt^2 and w^2 dt^2 (integration_base.h).
+        Format::Vins => {
+            let dt = 1.0 / RATE;
+            let back = |w: f64, b: f64| (w * (dt / 2.0).sqrt(), b * dt.sqrt());
+            [back(n("gyr_n"), n("gyr_w")), back(n("acc_n"), n("acc_w"))]
+        }
+        // (dt value)^2 per prediction step.
+        Format::Px4 => {
+            let dt = n("EKF2_PREDICT_US") * 1e-6;
+            let back = |w: f64, b: f64| (w * dt.sqrt(), b * dt.sqrt());
+            [
+                back(n("EKF2_GYR_NOISE"), n("EKF2_GYR_B_NOISE")),
+                back(n("EKF2_ACC_NOISE"), n("EKF2_ACC_B_NOISE")),
+            ]
+        }
+        Format::ArduPilot => {
+            let dt: f64 = 0.012;
+            let back = |w: f64, b: f64| (w * dt.sqrt(), b * dt.sqrt());
+            [
+                back(n("EK3_GYRO_P_NSE"), n("EK3_GBIAS_P_NSE")),
+                back(n("EK3_ACC_P_NSE"), n("EK3_ABIAS_P_NSE")),
+            ]
+        }
+        Format::StateSpace => unreachable!(),
+    }
+}
+
+/// The six parameter formats.
+const SIX: [Format; 6] = [
+    Format::Kalibr,
+    Format::OpenVins,
+    Format::Vins,
+    Format::OrbSlam3,
+    Format::Px4,
+    Format::ArduPilot,
+];
+
+/// The largest `f` over the three axes of sensor `s` (0 gyro, 1 accelerometer).
+fn worst(s: usize, f: fn(&AxisModel) -> f64) -> f64 {
+    model().axes[3 * s..3 * s + 3]
+        .iter()
+        .map(f)
+        .fold(0.0, f64::max)
+}
+
+fn close(a: f64, b: f64, rel: f64) -> bool {
+    (a - b).abs() <= rel * b.abs()
+}
+
+/// The octaves at which the Allan deviations of `x` disagree with `claim(m)` (an Allan
+/// variance), among those with 8 or more degrees of freedom `nu` (of the overlapping estimator
+/// and the noise type `kind(m)` that dominates the claim there): more than three standard
+/// errors `1 / sqrt(2 nu)` or 10 %, whichever is larger, apart. (The library's check takes
+/// two: an interval that one octave in twenty leaves by chance; this test reads about 130
+/// octaves, so two standard errors would fail it by chance alone.)
+fn agrees(
+    x: &[f64],
+    claim: impl Fn(usize) -> f64,
+    kind: impl Fn(usize) -> NoiseType,
+) -> Vec<String> {
+    let octaves = Octaves::<32>::overlapping(x, 1.0 / RATE).unwrap();
+    let estimator = Estimator::Overlapping { n: x.len() as u64 };
+    let mut bad = Vec::new();
+    for (j, measured) in octaves.avar().iter().enumerate() {
+        let m = 1usize << j;
+        let nu = estimator.edf(m as u64, kind(m));
+        if nu < 8.0 {
+            continue;
+        }
+        let tolerance = (3.0 / (2.0 * nu).sqrt()).max(0.1);
+        let ratio = (measured / claim(m)).sqrt();
+        if (ratio - 1.0).abs() > tolerance {
+            bad.push(format!(
+                "tau {} s: data/claim {ratio:.3}, tolerance {tolerance:.3}",
+                m as f64 / RATE
+            ));
+        }
+    }
+    bad
+}
+
+/// Simulates white noise `n` and random walk `k` and checks its Allan deviation against the
+/// curve they claim.
+fn white_rw_round_trip(n: f64, k: f64, seed: u64) -> Vec<String> {
+    let c = Composite {
+        dt: 1.0 / RATE,
+        white: n,
+        quantization: 0.0,
+        gm: vec![],
+        random_walk: k,
+    };
+    let x = c.simulate(1 << 19, seed);
+    let kind = |m: usize| {
+        let tau = m as f64 / RATE;
+        if n * n / tau >= k * k * tau / 3.0 {
+            NoiseType::WhiteFrequency
+        } else {
+            NoiseType::RandomWalkFrequency
+        }
+    };
+    agrees(&x, |m| c.avar(m as u32), kind)
+}
+
+#[test]
+fn kalibr_values_are_the_models_n_and_k() {
+    let dir = temp_dir("kalibr");
+    let path = write(Format::Kalibr, model(), None, &dir).unwrap_or_else(|e| panic!("{}", e.0));
+    let text = std::fs::read_to_string(path).unwrap();
+    let [(gn, gk), (an, ak)] = continuous(Format::Kalibr, &text);
+    assert!(close(gn, worst(0, |a| a.white_noise), 1e-9));
+    assert!(close(gk, worst(0, |a| a.random_walk), 1e-9));
+    assert!(close(an, worst(1, |a| a.white_noise), 1e-9));
+    assert!(close(ak, worst(1, |a| a.random_walk), 1e-9));
+    assert!(text.contains("rostopic: \"/imu\\\"0\""), "{text}");
+    assert!(text.contains("update_rate: 1.0e+02"), "{text}");
+    // The statement of how far white noise and random walk overbound the model.
+    assert!(text.contains("sqrt(N^2/tau + K^2 tau/3)"), "{text}");
+    assert!(text.contains("export with a horizon"), "{text}");
+}
+
+#[test]
+fn every_format_round_trips_to_the_curve_it_claims_and_writes_the_worst_axis() {
+    let dir = temp_dir("round-trip");
+    let mut failures = Vec::new();
+    for (f, format) in SIX.into_iter().enumerate() {
+        let path = write(format, model(), None, &dir).unwrap_or_else(|e| panic!("{}", e.0));
+        let text = std::fs::read_to_string(path).unwrap();
+        assert!(text.contains("worst (largest)"), "{format}: {text}");
+        for (s, (n, k)) in continuous(format, &text).into_iter().enumerate() {
+            // The worst axis, in the target's convention and back.
+            assert!(
+                close(n, worst(s, |a| a.white_noise), 1e-9),
+                "{format} {s}: N {n}"
+            );
+            assert!(
+                close(k, worst(s, |a| a.random_walk), 1e-9),
+                "{format} {s}: K {k}"
+            );
+            for line in white_rw_round_trip(n, k, 100 + 2 * f as u64 + s as u64) {
+                failures.push(format!("{format} sensor {s}: {line}"));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// The lower Cholesky factor of a small covariance (a zero pivot gives a zero column).
+fn cholesky(a: &[Vec<f64>]) -> Vec<Vec<f64>> {
+    let d = a.len();
+    let mut l = vec![vec![0.0; d]; d];
+    for i in 0..d {
+        for j in 0..=i {
+            let s: f64 = (0..j).map(|k| l[i][k] * l[j][k]).sum();
+            l[i][j] = match (i == j, l[j][j] > 0.0) {
+                (true, _) => (a[i][i] - s).max(0.0).sqrt(),
+                (false, true) => (a[i][j] - s) / l[j][j],
+                (false, false) => 0.0,
+            };
+        }
+    }
+    l
+}
+
+/// `l e` for standard normal `e`.
+fn correlated(l: &[Vec<f64>], rng: &mut ChaCha8Rng, z: &mut StandardNormal) -> Vec<f64> {
+    let e: Vec<f64> = l.iter().map(|_| z.sample(rng)).collect();
+    l.iter()
+        .map(|row| row.iter().zip(&e).map(|(a, b)| a * b).sum())
+        .collect()
+}
+
+/// `n` samples of the sum of the states of `x_{k+1} = phi x_k + w_k`, `Cov(w) = q`, plus white
+/// noise of the measurement variance; the states start from `p0`, the random walk at 0 (its
+/// turn-on variance does not show in the Allan deviation).
+fn state_space_record(axis: &serde_json::Value, n: usize, seed: u64) -> Vec<f64> {
+    let matrix =
+        |key: &str| -> Vec<Vec<f64>> { serde_json::from_value(axis[key].clone()).unwrap() };
+    let (phi, q, mut p0) = (matrix("phi"), matrix("q"), matrix("p0"));
+    let states = axis["states"].as_array().unwrap();
+    if let Some(i) = states.iter().position(|s| s == "random_walk") {
+        p0[i][i] = 0.0;
+    }
+    let r = axis["measurement_variance"].as_f64().unwrap().sqrt();
+    let (lq, lp) = (cholesky(&q), cholesky(&p0));
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut z = StandardNormal::new();
+    let mut x = correlated(&lp, &mut rng, &mut z);
+    (0..n)
+        .map(|_| {
+            let w = correlated(&lq, &mut rng, &mut z);
+            x = phi
+                .iter()
+                .zip(&w)
+                .map(|(row, w)| row.iter().zip(&x).map(|(a, b)| a * b).sum::<f64>() + w)
+                .collect();
+            x.iter().sum::<f64>() + r * z.sample(&mut rng)
+        })
+        .collect()
+}
+
+#[test]
+fn the_state_space_round_trips_to_the_models_allan_deviation() {
+    let dir = temp_dir("state-space");
+    let path = write(Format::StateSpace, model(), None, &dir).unwrap_or_else(|e| panic!("{}", e.0));
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    let axes = doc["axes"].as_array().unwrap();
+    assert_eq!(axes.len(), 6);
+    let mut failures = Vec::new();
+    for (i, (axis, truth)) in axes.iter().zip(model().axes.iter()).enumerate() {
+        assert_eq!(axis["dt"].as_f64().unwrap(), 1.0 / RATE);
+        assert!(!axis["states"].as_array().unwrap().is_empty());
+        let x = state_space_record(axis, 1 << 19, 300 + i as u64);
+        let (n, k) = (truth.white_noise, truth.random_walk);
+        let kind = |m: usize| {
+            let tau = m as f64 / RATE;
+            let (white, walk) = (n * n / tau, k * k * tau / 3.0);
+            let rest = truth.model_avar[m.trailing_zeros() as usize] - white - walk;
+            if rest > white.max(walk) {
+                NoiseType::FlickerFrequency
+            } else if white >= walk {
+                NoiseType::WhiteFrequency
+            } else {
+                NoiseType::RandomWalkFrequency
+            }
+        };
+        let claim = |m: usize| truth.model_avar[m.trailing_zeros() as usize];
+        for line in agrees(&x, claim, kind) {
+            failures.push(format!("axis {i}: {line}"));
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+#[test]
+fn a_horizon_writes_the_smallest_random_walk_that_overbounds_the_model() {
+    let horizon = 600.0;
+    let dir = temp_dir("horizon");
+    for format in SIX {
+        let path =
+            write(format, model(), Some(horizon), &dir).unwrap_or_else(|e| panic!("{}", e.0));
+        let text = std::fs::read_to_string(path).unwrap();
+        assert!(text.contains("K_H/K = "), "{format}: {text}");
+        for (s, (n, kh)) in continuous(format, &text).into_iter().enumerate() {
+            assert!(close(n, worst(s, |a| a.white_noise), 1e-9), "{format} {s}");
+            let k = worst(s, |a| a.random_walk);
+            assert!(kh >= k * (1.0 - 1e-12), "{format} {s}: K_H {kh} < K {k}");
+            // Every axis's model, every octave in [1 s, H]: (AVAR, tau).
+            let rows: Vec<(f64, f64)> = model().axes[3 * s..3 * s + 3]
+                .iter()
+                .flat_map(|a| {
+                    a.model_avar
+                        .iter()
+                        .enumerate()
+                        .map(|(j, v)| (*v, a.dt * 2f64.powi(j as i32)))
+                })
+                .filter(|(_, tau)| (1.0..=horizon).contains(tau))
+                .collect();
+            assert!(rows.len() >= 3 * 9, "{format}: {} octaves", rows.len());
+            let covers = |kh: f64| {
+                rows.iter()
+                    .all(|(v, tau)| n * n / tau + kh * kh * tau / 3.0 >= v * (1.0 - 1e-9))
+            };
+            assert!(
+                covers(kh),
+                "{format} {s}: K_H {kh} does not overbound the model"
+            );
+            // The smallest: 1 % lower breaks an octave (the Gauss-Markov terms raise it).
+            assert!(kh > 1.01 * k, "{format} {s}: K_H {kh}, K {k}");
+            assert!(
+                !covers(0.99 * kh),
+                "{format} {s}: K_H {kh} is not the smallest"
+            );
+        }
+    }
+}
+
+#[test]
+fn the_filter_rate_sets_the_autopilots_step_and_bad_models_are_refused() {
+    let dir = temp_dir("rates");
+    let mut imu = model().clone();
+    imu.filter_rate_hz = Some(250.0);
+    let text = std::fs::read_to_string(
+        write(Format::Px4, &imu, None, &dir).unwrap_or_else(|e| panic!("{}", e.0)),
+    )
+    .unwrap();
+    let m = values(&text);
+    assert_eq!(m["EKF2_PREDICT_US"], "4000");
+    assert!(close(
+        number(&m, "EKF2_GYR_NOISE"),
+        worst(0, |a| a.white_noise) / 0.004f64.sqrt(),
+        1e-12
+    ));
+    let text = std::fs::read_to_string(
+        write(Format::ArduPilot, &imu, None, &dir).unwrap_or_else(|e| panic!("{}", e.0)),
+    )
+    .unwrap();
+    assert!(close(
+        number(&values(&text), "EK3_ABIAS_P_NSE"),
+        worst(1, |a| a.random_walk) / 0.004f64.sqrt(),
+        1e-12
+    ));
+    imu.filter_rate_hz = Some(20.0);
+    assert!(write(Format::Px4, &imu, None, &dir).is_err());
+    // Nothing that is not finite is written.
+    let mut bad = model().clone();
+    bad.axes[4].random_walk = f64::NAN;
+    for format in Format::ALL {
+        assert!(write(format, &bad, None, &dir).is_err(), "{format}");
+        assert!(
+            write(format, model(), Some(f64::INFINITY), &dir).is_err(),
+            "{format}"
+        );
+    }
+    let mut bad = model().clone();
+    bad.topic = Some("/imu\n0".into());
+    assert!(write(Format::Kalibr, &bad, None, &dir).is_err());
+    assert_eq!(
+        Format::list("kalibr,px4,kalibr").unwrap_or_default(),
+        vec![Format::Kalibr, Format::Px4]
+    );
+    assert_eq!(Format::list("all").unwrap_or_default().len(), 7);
+    assert!(Format::list("kalibr,yaml").is_err());
+    assert_eq!(
+        "state-space".parse::<Format>().ok(),
+        Some(Format::StateSpace)
+    );
+}
