@@ -20,6 +20,7 @@ use imu_ar::noise::{FitConfig, Octaves};
 use serde::Serialize;
 
 use crate::error::{Fail, escaped, with_file};
+use crate::export::{AxisModel, Format, ImuModel, write};
 use crate::input::source::{self, AXES, Kind, Request};
 use crate::input::timing::TimingSummary;
 use crate::input::units::{Quantity, Unit};
@@ -75,6 +76,15 @@ pub struct Args {
     /// Directory for the plots and parameter files (created if needed).
     #[arg(long)]
     out: PathBuf,
+    /// The parameter files to write: kalibr, openvins, vins, orbslam3, px4, ardupilot,
+    /// state-space, comma-separated, or all.
+    #[arg(long, default_value = "all")]
+    format: String,
+    /// The time (s) the filter must coast: the six white + random walk formats then carry the
+    /// smallest random walk whose Allan deviation overbounds the model's at every octave from
+    /// 1 s to it [default: the model's random walk, and the files say how far it overbounds].
+    #[arg(long, allow_negative_numbers = true)]
+    horizon: Option<f64>,
     /// Print one JSON object instead of the table.
     #[arg(long)]
     pub json: bool,
@@ -143,6 +153,14 @@ pub fn run(args: &Args) -> Result<Characterisation, Fail> {
         args.gyro_unit.as_deref().map(parse_unit).transpose()?,
         args.accel_unit.as_deref().map(parse_unit).transpose()?,
     ];
+    let formats = Format::list(&args.format)?;
+    if let Some(h) = args.horizon
+        && !(h.is_finite() && h > 0.0)
+    {
+        return Err(Fail(format!(
+            "--horizon {h}: must be a positive number of seconds"
+        )));
+    }
     let columns = columns(args)?;
     std::fs::create_dir_all(&args.out)
         .map_err(|e| Fail(format!("--out {}: cannot create: {e}", args.out.display())))?;
@@ -190,6 +208,7 @@ pub fn run(args: &Args) -> Result<Characterisation, Fail> {
                 .with_oscillators(args.oscillators)
                 .with_ramp(args.ramp),
             units: Units::of(u.si().name),
+            export: true,
         })
         .collect();
     let octaves = axes
@@ -200,13 +219,17 @@ pub fn run(args: &Args) -> Result<Characterisation, Fail> {
         .map_err(|e| with_file(&args.files, e))?;
     let mut results = Vec::new();
     let mut paints = Vec::new();
+    let mut models = Vec::new();
     for i in 0..6 {
         let fail = |e: String| with_file(&args.files, format!("{} ({}): {e}", AXES[i], columns[i]));
         if axes[i].is_constant() {
             return Err(fail("constant (a stuck sensor?): no noise to model".into()));
         }
-        let Fitted { result, paint } =
-            fit_axis(&fits[i], &axes[i], &octaves[i], units[i].to_si).map_err(|Fail(e)| fail(e))?;
+        let Fitted {
+            result,
+            paint,
+            axis,
+        } = fit_axis(&fits[i], &axes[i], &octaves[i], units[i].to_si).map_err(|Fail(e)| fail(e))?;
         results.push(AxisResult {
             axis: AXES[i],
             column: columns[i].clone(),
@@ -214,6 +237,7 @@ pub fn run(args: &Args) -> Result<Characterisation, Fail> {
             model: result,
         });
         paints.push(paint);
+        models.extend(axis);
     }
     let mut files = Vec::new();
     for (name, range, what) in [
@@ -237,6 +261,22 @@ pub fn run(args: &Args) -> Result<Characterisation, Fail> {
         plot::png(&path, (1800, 600), &panels)
             .map_err(|e| Fail(format!("{}: cannot draw: {e}", path.display())))?;
         files.push(path.display().to_string());
+    }
+    let axes: [AxisModel; 6] = models
+        .try_into()
+        .map_err(|_| Fail("an axis has no model for the parameter files".into()))?;
+    let imu = ImuModel {
+        axes,
+        rate_hz: rate,
+        topic: args.topic.clone(),
+        filter_rate_hz: args.filter_rate,
+    };
+    for format in formats {
+        files.push(
+            write(format, &imu, args.horizon, &args.out)?
+                .display()
+                .to_string(),
+        );
     }
     Ok(Characterisation {
         rate_hz: rate,

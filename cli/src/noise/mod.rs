@@ -17,7 +17,7 @@ use serde::Serialize;
 
 use crate::chart;
 use crate::error::Fail;
-use crate::export::StateSpace;
+use crate::export::{AxisModel, StateSpace};
 use crate::input::timing::TimingSummary;
 use crate::input::{Input, check_decimate, check_order, check_rate, check_span, decimated};
 use crate::kalman::{AllanRow, allan_text};
@@ -197,6 +197,7 @@ pub fn run(args: &Args) -> Result<NoiseResult, Fail> {
             .with_oscillators(args.oscillators)
             .with_ramp(args.ramp),
         units: Units::of(&series.unit),
+        export: false,
     };
     let octaves = Octaves::<OCTAVES>::overlapping(&x, 1.0 / rate).map_err(|e| match e {
         NoiseError::Overflow => args.input.fail(
@@ -261,6 +262,8 @@ pub(crate) struct Fitted<'a> {
     pub result: NoiseResult,
     /// Draws the decomposition (the caption empty for the default one).
     pub paint: Paint<'a>,
+    /// The model for the parameter files, when [`Fitting::export`] asks for it.
+    pub axis: Option<AxisModel>,
 }
 
 /// The order `0..=8` (fewer for a short record) that BIC selects for a Burg fit.
@@ -306,6 +309,8 @@ pub(crate) struct Fitting {
     pub config: FitConfig,
     /// The record's unit.
     pub units: Units,
+    /// Whether to give the model for the parameter files too (the record in SI units).
+    pub export: bool,
 }
 
 impl Fitting {
@@ -337,7 +342,23 @@ impl Fitting {
             };
             plot::decomposition(area, &model, octaves, &check, caption)
         });
-        Ok(Fitted { result, paint })
+        // In SI units already (`export` is asked for with the record in SI); the bias
+        // instability is the data's IEEE 952 reading, not the model's.
+        let axis = match self.export {
+            true => {
+                let mut axis =
+                    AxisModel::from_noise(&model, 1.0, 1.0 / self.filter_rate, rw_p0, OCTAVES)?;
+                axis.bias_instability =
+                    (result.bias_instability.value, result.bias_instability.tau_s);
+                Some(axis)
+            }
+            false => None,
+        };
+        Ok(Fitted {
+            result,
+            paint,
+            axis,
+        })
     }
 
     fn caption<const P: usize>(&self, model: &NoiseModel<P, MAX_GM_STATES>) -> String {
