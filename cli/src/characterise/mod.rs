@@ -24,7 +24,7 @@ use crate::export::{AxisModel, Format, ImuModel, write};
 use crate::input::source::{self, AXES, Kind, Request};
 use crate::input::timing::TimingSummary;
 use crate::input::units::{Quantity, Unit};
-use crate::input::{check_rate, check_span, resolve_rate};
+use crate::input::{check_rate, check_span, resolve_rate, summary};
 use crate::method::with_order;
 use crate::noise::units::Units;
 use crate::noise::{Fitted, Fitting, MAX_GM_STATES, NoiseResult, OCTAVES, plot};
@@ -182,10 +182,9 @@ pub fn run(args: &Args) -> Result<Characterisation, Fail> {
     })?;
     progress.finish();
     let n = axes[0].samples();
-    let timing = match read.timing {
-        Some((t, u)) => Some(t.summary(u).map_err(|e| with_file(&args.files, e))?),
-        None => None,
-    };
+    let backward = read.timing.as_ref().map_or(0, |(t, _)| t.dropped());
+    let timing =
+        summary(read.timing, args.rate.is_none()).map_err(|e| with_file(&args.files, e))?;
     let rate = resolve_rate(args.rate, timing.as_ref())?;
     check_span("--rate", rate, n as usize)?;
     let units: Vec<Unit> = (0..6)
@@ -284,7 +283,7 @@ pub fn run(args: &Args) -> Result<Characterisation, Fail> {
         skipped: SkippedCounts {
             undecodable: read.skipped.undecodable,
             non_finite: read.skipped.non_finite,
-            backward: timing.as_ref().map_or(0, |t| t.dropped_backward),
+            backward,
         },
         timing,
         axes: results,

@@ -92,10 +92,7 @@ impl Input {
         if factor != 1.0 {
             x.iter_mut().for_each(|v| *v *= factor);
         }
-        let timing = match read.timing {
-            Some((t, u)) => Some(t.summary(u).map_err(|e| self.fail(e))?),
-            None => None,
-        };
+        let timing = summary(read.timing, want_time).map_err(|e| self.fail(e))?;
         Ok(Series {
             x,
             timing,
@@ -139,6 +136,19 @@ pub fn resolve_rate(given: Option<f64>, timing: Option<&TimingSummary>) -> Resul
                  --time-column)"
                 .into(),
         )),
+    }
+}
+
+/// The timestamps' summary: an error when they give no single rate and it is `needed`
+/// (`--rate` was not given); otherwise such timestamps are not reported.
+pub fn summary(
+    timing: Option<(timing::Timing, timing::TimeUnit)>,
+    needed: bool,
+) -> Result<Option<TimingSummary>, String> {
+    match timing.map(|(t, u)| t.summary(u)) {
+        Some(Err(e)) if needed => Err(e),
+        Some(Err(_)) | None => Ok(None),
+        Some(Ok(s)) => Ok(Some(s)),
     }
 }
 

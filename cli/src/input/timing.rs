@@ -162,7 +162,7 @@ impl Timing {
     }
 
     /// The summary of the stamps taken; an error when they give no rate (fewer than two) or
-    /// several (less than 90 % of the intervals within 50 % of the median).
+    /// several (less than 90 % of the intervals within 25 % of the median).
     pub fn summary(&self, unit: TimeUnit) -> Result<TimingSummary, String> {
         let intervals: u64 = self.intervals.values().sum();
         if intervals == 0 {
@@ -184,9 +184,9 @@ impl Timing {
         for (k, n) in &self.intervals {
             let v = *k as f64 * self.quantum as f64;
             let r = v / median;
-            if r < 0.5 {
+            if r < 0.75 {
                 short += n;
-            } else if r > 1.5 {
+            } else if r > 1.25 {
                 gaps += n;
                 missing += n * ((r.round() as u64).saturating_sub(1));
             } else {
@@ -211,8 +211,8 @@ impl Timing {
         if (regular as f64) < 0.9 * intervals as f64 {
             return Err(format!(
                 "the timestamps show mixed rates: only {regular} of {intervals} intervals lie \
-                 within 50 % of the median interval {:.6e} s ({short} shorter, {gaps} longer); \
-                 one record must have one rate",
+                 within 25 % of the median interval {:.6e} s ({short} shorter, {gaps} longer); \
+                 one record must have one rate (or give --rate)",
                 median * 1e-9
             ));
         }
@@ -229,16 +229,16 @@ pub struct TimingSummary {
     pub rate_hz: f64,
     /// The median interval, s.
     pub median_interval_s: f64,
-    /// The RMS deviation of the regular intervals (within 50 % of the median) from the median,
+    /// The RMS deviation of the regular intervals (within 25 % of the median) from the median,
     /// relative to it.
     pub jitter_rms: f64,
     /// Their largest deviation, relative.
     pub jitter_max: f64,
-    /// Intervals longer than 1.5 times the median.
+    /// Intervals longer than 1.25 times the median.
     pub gaps: u64,
     /// The samples those gaps miss (each gap's interval over the median, rounded, less one).
     pub missing_samples: u64,
-    /// Intervals shorter than half the median.
+    /// Intervals shorter than 0.75 times the median.
     pub short_intervals: u64,
     /// Samples dropped for a timestamp at or before the last one (`--drop-backward`).
     pub dropped_backward: u64,

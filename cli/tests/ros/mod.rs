@@ -1,6 +1,9 @@
 //! What the tests of the ROS readers (`tests/bags.rs`) share: seeded frames, the fixture
 //! script (Python `rosbags`), reading back and comparing bit for bit.
 
+// Each test file uses some of these.
+#![allow(dead_code)]
+
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;

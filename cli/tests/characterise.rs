@@ -1,0 +1,360 @@
+//! `imu-ar characterise` and the readers under every command: a EuRoC file needs no flag but
+//! the column; a bag and an MCAP file of the same data give the same model as the CSV; the
+//! Kalibr file carries the model's N and K; bad recordings exit 2 with one line, and skipped
+//! messages are counted.
+
+mod common;
+mod ros;
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use common::{assert_one_line_failure, imu_ar, json, stderr};
+use imu_ar_cli::input::frame::Frame;
+use rand_chacha::ChaCha8Rng;
+use rand_core::{RngCore, SeedableRng};
+use ros::{fixture, temp_dir, write_csv};
+
+/// A standard normal deviate (Box-Muller).
+fn normal(rng: &mut ChaCha8Rng) -> f64 {
+    let u = |r: &mut ChaCha8Rng| ((r.next_u64() >> 11) as f64 + 0.5) / (1u64 << 53) as f64;
+    let (a, b) = (u(rng), u(rng));
+    (-2.0 * a.ln()).sqrt() * (std::f64::consts::TAU * b).cos()
+}
+
+/// `n` frames of a static IMU at `rate` Hz: white noise, a random walk and a Gauss-Markov term
+/// per axis (gyros in rad/s, accelerometers in m/s^2 about gravity on z), stamps in ns with a
+/// jitter of up to +-20 us.
+fn imu_frames(n: usize, rate: f64, seed: u64) -> Vec<Frame> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let dt = 1.0 / rate;
+    let white = [1e-3, 1.2e-3, 0.8e-3, 2e-2, 2.5e-2, 3e-2];
+    let walk = [2e-5, 1e-5, 3e-5, 4e-4, 2e-4, 5e-4];
+    let mean = [0.01, -0.02, 0.005, 0.1, -0.2, 9.81];
+    let (gm_sigma, gm_t) = ([3e-4, 2e-4, 4e-4, 5e-3, 4e-3, 6e-3], 5.0);
+    let phi: f64 = (-dt / gm_t).exp();
+    let mut rw = [0.0; 6];
+    let mut gm = [0.0; 6];
+    (0..n)
+        .map(|i| {
+            let jitter = (rng.next_u32() % 40_001) as i64 - 20_000;
+            let stamp_ns = 1_403_636_579_758_555_392 + (i as f64 * dt * 1e9) as i64 + jitter;
+            let axes = std::array::from_fn(|k| {
+                rw[k] += walk[k] * dt.sqrt() * normal(&mut rng);
+                gm[k] = phi * gm[k] + gm_sigma[k] * (1.0 - phi * phi).sqrt() * normal(&mut rng);
+                mean[k] + white[k] / dt.sqrt() * normal(&mut rng) + rw[k] + gm[k]
+            });
+            Frame { stamp_ns, axes }
+        })
+        .collect()
+}
+
+/// `frames` as a EuRoC/ASL `imu0/data.csv`.
+fn write_euroc(path: &Path, frames: &[Frame]) {
+    let mut s = String::from(
+        "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],\
+         a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]\n",
+    );
+    for f in frames {
+        write!(s, "{}", f.stamp_ns).unwrap();
+        for v in f.axes {
+            write!(s, ",{v:?}").unwrap();
+        }
+        s.push('\n');
+    }
+    std::fs::write(path, s).unwrap();
+}
+
+fn path(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// `characterise ARGS --json --out DIR`, parsed.
+fn characterise(input: &[&str], out: &Path, extra: &[&str]) -> serde_json::Value {
+    let mut args = vec!["characterise"];
+    args.extend_from_slice(input);
+    args.extend_from_slice(&["--out", path(out), "--json"]);
+    args.extend_from_slice(extra);
+    json(&imu_ar(&args))
+}
+
+#[test]
+fn a_euroc_file_needs_no_flag_but_the_column() {
+    let dir = temp_dir("euroc");
+    let file = dir.join("data.csv");
+    write_euroc(&file, &imu_frames(60_000, 200.0, 1));
+    let noise = json(&imu_ar(&[
+        "noise",
+        path(&file),
+        "--column",
+        "w_RS_S_x",
+        "--json",
+    ]));
+    let rate = noise["rate_hz"].as_f64().unwrap();
+    assert!((rate / 200.0 - 1.0).abs() < 1e-3, "rate {rate}");
+    assert_eq!(noise["timing"]["unit"], "ns");
+    assert_eq!(noise["timing"]["gaps"], 0);
+    // The bracket says rad/s; --unit deg/s converts.
+    let deg = json(&imu_ar(&[
+        "noise",
+        path(&file),
+        "--column",
+        "w_RS_S_x",
+        "--unit",
+        "deg/s",
+        "--json",
+    ]));
+    let ratio = deg["white_noise"].as_f64().unwrap() / noise["white_noise"].as_f64().unwrap();
+    assert!(
+        (ratio - 180.0 / std::f64::consts::PI).abs() < 1e-9,
+        "{ratio}"
+    );
+    // By index, and without the command naming anything but the output.
+    let by_index = json(&imu_ar(&["adev", path(&file), "--column", "1", "--json"]));
+    assert!((by_index["rate_hz"].as_f64().unwrap() - rate).abs() < 1e-9);
+    let all = characterise(&[path(&file)], &dir.join("out"), &[]);
+    assert_eq!(all["axes"].as_array().unwrap().len(), 6);
+    assert_eq!(all["axes"][0]["column"], "w_RS_S_x");
+    assert_eq!(all["axes"][5]["unit"], "m/s^2");
+    assert!((all["rate_hz"].as_f64().unwrap() - rate).abs() < 1e-9);
+}
+
+/// Every number of two JSON values equal to `rel` relative.
+fn assert_close(a: &serde_json::Value, b: &serde_json::Value, rel: f64, at: &str) {
+    use serde_json::Value::*;
+    match (a, b) {
+        (Number(x), Number(y)) => {
+            let (x, y) = (x.as_f64().unwrap(), y.as_f64().unwrap());
+            assert!(
+                (x - y).abs() <= rel * x.abs().max(y.abs()),
+                "{at}: {x} against {y}"
+            );
+        }
+        (Array(x), Array(y)) => {
+            assert_eq!(x.len(), y.len(), "{at}");
+            for (i, (p, q)) in x.iter().zip(y).enumerate() {
+                assert_close(p, q, rel, &format!("{at}[{i}]"));
+            }
+        }
+        (Object(x), Object(y)) => {
+            assert_eq!(x.len(), y.len(), "{at}: keys");
+            for (k, p) in x {
+                assert_close(p, &y[k], rel, &format!("{at}.{k}"));
+            }
+        }
+        _ => assert_eq!(a, b, "{at}"),
+    }
+}
+
+#[test]
+fn a_bag_and_an_mcap_file_give_the_model_of_the_csv() {
+    let dir = temp_dir("same-model");
+    let frames = imu_frames(40_000, 400.0, 2);
+    let csv = dir.join("frames.csv");
+    write_csv(&csv, &frames);
+    let bag = fixture(&dir, "imu.bag", ["ros1", "/imu0", "lz4"], &csv, &[]);
+    let mcap = fixture(&dir, "imu.mcap", ["mcap", "/imu0", "zstd"], &csv, &[]);
+    // The CSV has no unit brackets: the bag's SI units are given.
+    let units = ["--gyro-unit", "rad/s", "--accel-unit", "m/s^2"];
+    let from_csv = characterise(&[path(&csv)], &dir.join("csv"), &units);
+    for (file, name) in [(&bag, "bag"), (&mcap, "mcap")] {
+        let got = characterise(&[path(file), "--topic", "/imu0"], &dir.join(name), &[]);
+        assert_close(&got["axes"], &from_csv["axes"], 1e-12, name);
+        assert_eq!(got["n"], 40_000);
+        // One axis through `noise`, as the CSV's column.
+        let one = json(&imu_ar(&[
+            "noise",
+            path(file),
+            "--topic",
+            "/imu0",
+            "--column",
+            "gz",
+            "--json",
+        ]));
+        let csv_one = json(&imu_ar(&[
+            "noise",
+            path(&csv),
+            "--column",
+            "gz",
+            "--unit",
+            "rad/s",
+            "--json",
+        ]));
+        assert_close(&one["white_noise"], &csv_one["white_noise"], 1e-12, name);
+        assert_close(&one["allan"], &csv_one["allan"], 1e-12, name);
+    }
+}
+
+/// The value of `key:` in a YAML file written by the tool.
+fn yaml_value(text: &str, key: &str) -> f64 {
+    let line = text
+        .lines()
+        .find(|l| l.starts_with(&format!("{key}:")))
+        .unwrap_or_else(|| panic!("no {key}"));
+    let value = line[key.len() + 1..].split('#').next().unwrap().trim();
+    value.parse().unwrap()
+}
+
+#[test]
+fn the_kalibr_file_carries_the_model_n_and_k_in_si() {
+    let dir = temp_dir("kalibr");
+    let file = dir.join("data.csv");
+    write_euroc(&file, &imu_frames(100_000, 200.0, 3));
+    let out = dir.join("out");
+    let model = characterise(&[path(&file)], &out, &["--format", "kalibr"]);
+    let text = std::fs::read_to_string(out.join("imu.yaml")).unwrap();
+    let worst = |axes: std::ops::Range<usize>, key: &str| {
+        axes.map(|i| model["axes"][i]["model"][key].as_f64().unwrap_or(0.0))
+            .fold(0.0, f64::max)
+    };
+    for (key, axes, field) in [
+        ("gyroscope_noise_density", 0..3, "white_noise"),
+        ("gyroscope_random_walk", 0..3, "random_walk"),
+        ("accelerometer_noise_density", 3..6, "white_noise"),
+        ("accelerometer_random_walk", 3..6, "random_walk"),
+    ] {
+        let (got, want) = (yaml_value(&text, key), worst(axes, field));
+        assert!(
+            (got / want - 1.0).abs() < 1e-9,
+            "{key}: {got} against {want}"
+        );
+    }
+    assert!((yaml_value(&text, "update_rate") - 200.0).abs() < 0.2);
+}
+
+/// `imu-ar ARGS` fails with status 2, one line containing `want`, and nothing on stdout.
+fn refused(args: &[&str], want: &str) {
+    let out = imu_ar(args);
+    assert_one_line_failure(&out);
+    assert!(stderr(&out).contains(want), "{args:?}: {}", stderr(&out));
+}
+
+fn bag_of(dir: &Path, name: &str, frames: &[Frame], extra: &[&str]) -> PathBuf {
+    let csv = dir.join(format!("{name}.csv"));
+    write_csv(&csv, frames);
+    fixture(dir, name, ["ros1", "/imu0", "none"], &csv, extra)
+}
+
+#[test]
+fn bad_recordings_exit_2_with_one_line() {
+    let dir = temp_dir("bad");
+    let out = dir.join("out");
+    let frames = imu_frames(5_000, 100.0, 4);
+    let bag = bag_of(&dir, "good.bag", &frames, &["--string-topic", "/chatter"]);
+    let b = path(&bag);
+    let o = path(&out);
+    // A bag without the topic, or without --topic: the IMU topics it has.
+    refused(
+        &["characterise", b, "--topic", "/imu", "--out", o],
+        "IMU topics: /imu0",
+    );
+    refused(&["noise", b, "--column", "gx"], "/imu0");
+    // A truncated bag.
+    let bytes = std::fs::read(&bag).unwrap();
+    let cut = dir.join("cut.bag");
+    std::fs::write(&cut, &bytes[..bytes.len() * 2 / 3]).unwrap();
+    refused(
+        &["characterise", path(&cut), "--topic", "/imu0", "--out", o],
+        "truncated or corrupt bag",
+    );
+    // An MCAP file with an encoding other than CDR.
+    let csv = dir.join("frames.csv");
+    write_csv(&csv, &frames);
+    let json_mcap = fixture(
+        &dir,
+        "json.mcap",
+        ["mcap", "/imu0", "none"],
+        &csv,
+        &["--encoding", "json"],
+    );
+    refused(
+        &[
+            "characterise",
+            path(&json_mcap),
+            "--topic",
+            "/imu0",
+            "--out",
+            o,
+        ],
+        "unknown encoding 'json'",
+    );
+    // Timestamps going backwards: refused, or dropped and counted.
+    let mut back = frames.clone();
+    back[2000].stamp_ns = back[1000].stamp_ns;
+    back[3000].stamp_ns -= 1_000_000_000;
+    let back_bag = bag_of(&dir, "back.bag", &back, &[]);
+    refused(
+        &[
+            "characterise",
+            path(&back_bag),
+            "--topic",
+            "/imu0",
+            "--out",
+            o,
+        ],
+        "2 timestamps are not after the one before",
+    );
+    let dropped = characterise(
+        &[path(&back_bag), "--topic", "/imu0", "--drop-backward"],
+        &out,
+        &[],
+    );
+    assert_eq!(dropped["skipped"]["backward"], 2);
+    assert_eq!(dropped["n"], 4_998);
+    let back_csv = dir.join("back.csv");
+    write_euroc(&back_csv, &back);
+    refused(
+        &["noise", path(&back_csv), "--column", "w_RS_S_x"],
+        "is not after the one before",
+    );
+    // Mixed rates: the second half at twice the rate.
+    let mut mixed = frames.clone();
+    for (i, f) in mixed.iter_mut().enumerate().skip(2500) {
+        f.stamp_ns = frames[2500].stamp_ns + (i as i64 - 2500) * 5_000_000;
+    }
+    let mixed_csv = dir.join("mixed.csv");
+    write_euroc(&mixed_csv, &mixed);
+    refused(
+        &["characterise", path(&mixed_csv), "--out", o],
+        "mixed rates",
+    );
+    let mixed_bag = bag_of(&dir, "mixed.bag", &mixed, &[]);
+    refused(
+        &[
+            "noise",
+            path(&mixed_bag),
+            "--topic",
+            "/imu0",
+            "--column",
+            "ax",
+        ],
+        "mixed rates",
+    );
+}
+
+#[test]
+fn skipped_messages_are_counted_in_the_summary() {
+    let dir = temp_dir("skipped");
+    let mut frames = imu_frames(5_000, 100.0, 5);
+    for i in [10, 20, 4000] {
+        frames[i].axes[4] = f64::NAN;
+    }
+    frames[30].axes[0] = f64::INFINITY;
+    let bag = bag_of(&dir, "nan.bag", &frames, &[]);
+    let got = characterise(&[path(&bag), "--topic", "/imu0"], &dir.join("out"), &[]);
+    assert_eq!(got["skipped"]["non_finite"], 4);
+    assert_eq!(got["n"], 4_996);
+    let text = imu_ar(&[
+        "characterise",
+        path(&bag),
+        "--topic",
+        "/imu0",
+        "--out",
+        path(&dir.join("out")),
+    ]);
+    assert!(
+        String::from_utf8_lossy(&text.stdout).contains("4 not finite"),
+        "{}",
+        String::from_utf8_lossy(&text.stdout)
+    );
+}
