@@ -40,6 +40,9 @@ fn error(file: &Path, line: Option<u64>, problem: impl Into<String>) -> DataErro
     }
 }
 
+/// Picks the indices of the columns to read from a file's header, or says what is wrong.
+pub type Select<'a> = dyn FnMut(&[String]) -> Result<Vec<usize>, String> + 'a;
+
 /// The file name that stands for standard input.
 pub const STDIN: &str = "-";
 
@@ -109,7 +112,7 @@ pub fn parse_column(label: &Path, bytes: &[u8], column: &str) -> Result<Vec<f64>
 /// the line). Returns the number of rows. What [`read_column`] says of files and headers holds.
 pub fn read_rows(
     files: &[PathBuf],
-    select: &mut dyn FnMut(&[String]) -> Result<Vec<usize>, String>,
+    select: &mut Select,
     each: &mut dyn FnMut(&[&str]) -> Result<(), String>,
 ) -> Result<u64, DataError> {
     let progress = std::io::stderr().is_terminal();
@@ -341,7 +344,7 @@ fn stdin() -> Result<&'static [u8], &'static str> {
 fn read_source(
     path: &Path,
     (source, comment_header): (impl Read, Option<Vec<String>>),
-    select: &mut dyn FnMut(&[String]) -> Result<Vec<usize>, String>,
+    select: &mut Select,
     each: &mut dyn FnMut(&[&str]) -> Result<(), String>,
     locate: &dyn Fn(u64) -> Option<u64>,
 ) -> Result<(), DataError> {
