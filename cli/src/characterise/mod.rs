@@ -46,7 +46,7 @@ pub struct Args {
     /// gx .. az].
     #[arg(long, value_delimiter = ',')]
     columns: Option<Vec<String>>,
-    /// The CSV column of the timestamps [default: timestamp, time, t or t_<unit>].
+    /// The CSV column of the timestamps [default: timestamp, time, t or t_UNIT].
     #[arg(long)]
     time_column: Option<String>,
     /// Drop samples whose timestamp is not after the one before (counted).

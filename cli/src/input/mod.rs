@@ -37,7 +37,7 @@ pub struct Input {
     #[arg(long)]
     pub topic: Option<String>,
     /// The CSV column of the timestamps, when --rate is not given [default: the column named
-    /// timestamp, time, t or t_<unit>; its unit from its bracket or suffix (s, ms, us, ns), else
+    /// timestamp, time, t or t_UNIT; its unit from its bracket or suffix (s, ms, us, ns), else
     /// from its magnitude].
     #[arg(long)]
     pub time_column: Option<String>,

@@ -99,7 +99,7 @@ pub enum Step {
 const DISTINCT: usize = 1 << 16;
 
 /// Timestamps taken one by one: their intervals in a histogram (exact for a clock with a few
-/// distinct intervals; rounded to a coarser quantum past [`DISTINCT`] of them).
+/// distinct intervals; rounded to a coarser quantum past 65,536 of them).
 #[derive(Clone, Debug, Default)]
 pub struct Timing {
     first: Option<i64>,
