@@ -358,3 +358,181 @@ fn skipped_messages_are_counted_in_the_summary() {
         String::from_utf8_lossy(&text.stdout)
     );
 }
+
+/// `frames` as CSV with `header` (seven names) and the stamp column written by `stamp`.
+fn write_with(path: &Path, header: &str, frames: &[Frame], stamp: impl Fn(usize) -> String) {
+    let mut s = format!("{header}\n");
+    for (i, f) in frames.iter().enumerate() {
+        s += &stamp(i);
+        for v in f.axes {
+            write!(s, ",{v:?}").unwrap();
+        }
+        s.push('\n');
+    }
+    std::fs::write(path, s).unwrap();
+}
+
+#[test]
+fn time_units_are_stated_or_epoch_sized() {
+    let dir = temp_dir("time-units");
+    let frames = imu_frames(4_000, 250.0, 6);
+    let plain = "timestamp,gx,gy,gz,ax,ay,az";
+    // Microseconds since boot: no unit, no epoch. Refused, not read as seconds.
+    let boot = dir.join("boot.csv");
+    write_with(&boot, plain, &frames, |i| {
+        (263_000_000 + i * 4000).to_string()
+    });
+    refused(
+        &["noise", path(&boot), "--column", "gx"],
+        "does not say its unit",
+    );
+    // Stated in the bracket (msec, usec spelled out), the rate is right.
+    for (bracket, scale) in [("[usec]", 1.0), ("[msec]", 1e-3)] {
+        let file = dir.join("stated.csv");
+        let header = plain.replace("timestamp", &format!("timestamp {bracket}"));
+        write_with(&file, &header, &frames, |i| {
+            format!("{}", (263_000_000.0 + i as f64 * 4000.0) * scale)
+        });
+        let got = json(&imu_ar(&["adev", path(&file), "--column", "gx", "--json"]));
+        assert!(
+            (got["rate_hz"].as_f64().unwrap() / 250.0 - 1.0).abs() < 1e-6,
+            "{bracket}"
+        );
+    }
+    let hours = dir.join("hours.csv");
+    write_with(
+        &hours,
+        &plain.replace("timestamp", "timestamp [h]"),
+        &frames,
+        |i| i.to_string(),
+    );
+    refused(
+        &["noise", path(&hours), "--column", "gx"],
+        "is not a time unit",
+    );
+    // A given rate is checked against the stamps.
+    let euroc = dir.join("euroc.csv");
+    write_euroc(&euroc, &frames);
+    refused(
+        &[
+            "characterise",
+            path(&euroc),
+            "--rate",
+            "400",
+            "--out",
+            path(&dir),
+        ],
+        "--rate 400: the timestamps give",
+    );
+}
+
+#[test]
+fn rows_files_and_flags_that_would_shift_or_mix_units_are_refused() {
+    let dir = temp_dir("shift");
+    let o = dir.join("out");
+    let frames = imu_frames(2_000, 200.0, 7);
+    // One row with a field too many.
+    let good = dir.join("good.csv");
+    write_euroc(&good, &frames);
+    let text = std::fs::read_to_string(&good).unwrap();
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    lines[500] = format!("{},0", lines[500]);
+    let shifted = dir.join("shifted.csv");
+    std::fs::write(&shifted, lines.join("\n")).unwrap();
+    refused(
+        &["characterise", path(&shifted), "--out", path(&o)],
+        "shifted.csv:501: 8 fields, the header has 7",
+    );
+    // A trailing comma on every line is one empty field everywhere: read.
+    let trailing = dir.join("trailing.csv");
+    std::fs::write(&trailing, text.replace('\n', ",\n")).unwrap();
+    let got = characterise(&[path(&trailing)], &o, &["--format", "kalibr"]);
+    assert_eq!(got["n"], 2_000);
+    // Two parts with different unit brackets.
+    let second = dir.join("second.csv");
+    std::fs::write(&second, text.replacen("[rad s^-1]", "[deg s^-1]", 3)).unwrap();
+    refused(
+        &["noise", path(&good), path(&second), "--column", "w_RS_S_x"],
+        "unit brackets differ",
+    );
+    // A flag that contradicts the header, one of the wrong kind, a column named twice.
+    refused(
+        &[
+            "characterise",
+            path(&good),
+            "--gyro-unit",
+            "deg/s",
+            "--out",
+            path(&o),
+        ],
+        "--gyro-unit deg/s: the header of column 'w_RS_S_x' says rad/s",
+    );
+    let plain = dir.join("plain.csv");
+    write_with(&plain, "t_ns,gx,gy,gz,ax,ay,az", &frames, |i| {
+        frames[i].stamp_ns.to_string()
+    });
+    refused(
+        &[
+            "characterise",
+            path(&plain),
+            "--gyro-unit",
+            "m/s^2",
+            "--accel-unit",
+            "g",
+            "--out",
+            path(&o),
+        ],
+        "not a unit of what gx measures",
+    );
+    refused(
+        &[
+            "characterise",
+            path(&good),
+            "--columns",
+            "1,1,3,4,5,6",
+            "--out",
+            path(&o),
+        ],
+        "is named twice",
+    );
+    // A first line of numbers is no header.
+    let headless = dir.join("headless.csv");
+    std::fs::write(&headless, "1,2\n3,4\n").unwrap();
+    refused(
+        &["adev", path(&headless), "--column", "0", "--rate", "1"],
+        "header row",
+    );
+}
+
+#[test]
+fn parameter_files_are_written_all_or_none() {
+    let dir = temp_dir("all-or-none");
+    let file = dir.join("data.csv");
+    write_euroc(&file, &imu_frames(20_000, 200.0, 8));
+    let out = dir.join("out");
+    // PX4's EKF2 cannot step at 10 Hz: no file at all, not the ones before it.
+    refused(
+        &[
+            "characterise",
+            path(&file),
+            "--filter-rate",
+            "10",
+            "--out",
+            path(&out),
+        ],
+        "EKF2_PREDICT_US",
+    );
+    let left: Vec<_> = std::fs::read_dir(&out).map_or(Vec::new(), |d| d.collect());
+    assert!(left.is_empty(), "{left:?}");
+    refused(
+        &[
+            "characterise",
+            path(&file),
+            "--horizon",
+            "0.5",
+            "--out",
+            path(&out),
+        ],
+        "--horizon 0.5",
+    );
+}

@@ -130,7 +130,7 @@ fn a_dash_reads_standard_input() {
             "--method",
             "ls",
         ],
-        &["adev", "-", "--column", "x", "--rate", "100"],
+        &["adev", "-", "--column", "x", "--rate", "1"],
         &["compare", "-", "--column", "x", "--order", "2", "--json"],
         &[
             "kalman", "-", "--column", "x", "--order", "2", "--rate", "100",

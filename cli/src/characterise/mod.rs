@@ -11,7 +11,7 @@
 pub mod stream;
 
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use imu_ar::ArModel;
 use imu_ar::batch::criteria::Criterion;
@@ -155,10 +155,10 @@ pub fn run(args: &Args) -> Result<Characterisation, Fail> {
     ];
     let formats = Format::list(&args.format)?;
     if let Some(h) = args.horizon
-        && !(h.is_finite() && h > 0.0)
+        && !(h.is_finite() && h >= 1.0)
     {
         return Err(Fail(format!(
-            "--horizon {h}: must be a positive number of seconds"
+            "--horizon {h}: must be a number of seconds from 1 (the overbound runs from 1 s)"
         )));
     }
     let columns = columns(args)?;
@@ -167,6 +167,7 @@ pub fn run(args: &Args) -> Result<Characterisation, Fail> {
 
     let mut axes: Vec<AxisStream<OCTAVES>> = (0..6).map(|_| AxisStream::new()).collect();
     let progress = Progress::new();
+    crate::input::csv::quiet_progress();
     let request = Request {
         columns: &columns,
         topic: args.topic.as_deref(),
@@ -238,7 +239,16 @@ pub fn run(args: &Args) -> Result<Characterisation, Fail> {
         paints.push(paint);
         models.extend(axis);
     }
-    let mut files = Vec::new();
+    let axes: [AxisModel; 6] = models
+        .try_into()
+        .map_err(|_| Fail("an axis has no model for the parameter files".into()))?;
+    let imu = ImuModel {
+        axes,
+        rate_hz: rate,
+        topic: args.topic.clone(),
+        filter_rate_hz: args.filter_rate,
+    };
+    let mut files = write_all(&formats, &imu, args.horizon, &args.out)?;
     for (name, range, what) in [
         ("gyro.png", 0..3, "gyro"),
         ("accel.png", 3..6, "accelerometer"),
@@ -261,22 +271,7 @@ pub fn run(args: &Args) -> Result<Characterisation, Fail> {
             .map_err(|e| Fail(format!("{}: cannot draw: {e}", path.display())))?;
         files.push(path.display().to_string());
     }
-    let axes: [AxisModel; 6] = models
-        .try_into()
-        .map_err(|_| Fail("an axis has no model for the parameter files".into()))?;
-    let imu = ImuModel {
-        axes,
-        rate_hz: rate,
-        topic: args.topic.clone(),
-        filter_rate_hz: args.filter_rate,
-    };
-    for format in formats {
-        files.push(
-            write(format, &imu, args.horizon, &args.out)?
-                .display()
-                .to_string(),
-        );
-    }
+
     Ok(Characterisation {
         rate_hz: rate,
         n,
@@ -289,6 +284,35 @@ pub fn run(args: &Args) -> Result<Characterisation, Fail> {
         axes: results,
         files,
     })
+}
+
+/// Writes every file of `formats`, or none: each into a fresh folder in `out` first, moved into
+/// `out` once all are written.
+fn write_all(
+    formats: &[Format],
+    imu: &ImuModel,
+    horizon: Option<f64>,
+    out: &Path,
+) -> Result<Vec<String>, Fail> {
+    let staging = out.join(format!(".imu-ar-{}", std::process::id()));
+    let cannot = |e: std::io::Error| Fail(format!("{}: {e}", out.display()));
+    std::fs::create_dir_all(&staging).map_err(cannot)?;
+    let written: Result<Vec<PathBuf>, Fail> = formats
+        .iter()
+        .map(|f| write(*f, imu, horizon, &staging))
+        .collect();
+    let moved = written.and_then(|paths| {
+        paths
+            .iter()
+            .map(|p| {
+                let to = out.join(p.file_name().unwrap_or_default());
+                std::fs::rename(p, &to).map_err(cannot)?;
+                Ok(to.display().to_string())
+            })
+            .collect()
+    });
+    let _ = std::fs::remove_dir_all(&staging);
+    moved
 }
 
 /// One axis's composite, with the AR part (order by BIC, 0 to [`LAGS`]) from its streamed
@@ -342,7 +366,7 @@ fn columns(args: &Args) -> Result<Vec<String>, Fail> {
         return Ok(c.clone());
     }
     let named = |names: [&str; 6]| names.map(String::from).to_vec();
-    if Kind::of(&args.files[0]) != Kind::Csv {
+    if args.topic.is_some() || Kind::of(&args.files[0]) != Kind::Csv {
         return Ok(named(AXES));
     }
     let header = crate::input::csv::header(&args.files).map_err(|e| Fail(e.to_string()))?;
@@ -385,6 +409,24 @@ fn axis_unit(
         0..3 => (Quantity::AngularRate, "--gyro-unit"),
         _ => (Quantity::Acceleration, "--accel-unit"),
     };
+    if let (Some(r), Some(g)) = (read, given)
+        && r != g
+    {
+        return Err(Fail(format!(
+            "{flag} {}: the header of column '{}' says {}",
+            g.name,
+            escaped(column),
+            r.name
+        )));
+    }
+    if let Some(g) = given
+        && g.quantity != want
+    {
+        return Err(Fail(format!(
+            "{flag} {}: not a unit of what {} measures",
+            g.name, AXES[i]
+        )));
+    }
     let unit = read.or(given).ok_or_else(|| {
         Fail(format!(
             "column '{}': its unit is unknown (no unit bracket in the header); give {flag}",

@@ -6,6 +6,7 @@ use std::fs::File;
 use std::io::{BufReader, IsTerminal, Read, Write};
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::error::escaped;
 
@@ -42,6 +43,14 @@ fn error(file: &Path, line: Option<u64>, problem: impl Into<String>) -> DataErro
 
 /// Picks the indices of the columns to read from a file's header, or says what is wrong.
 pub type Select<'a> = dyn FnMut(&[String]) -> Result<Vec<usize>, String> + 'a;
+
+/// Whether another display shows the progress (`characterise`'s bar).
+static QUIET: AtomicBool = AtomicBool::new(false);
+
+/// Leaves the progress display to the caller: no "read N rows" lines from here on.
+pub fn quiet_progress() {
+    QUIET.store(true, Ordering::Relaxed);
+}
 
 /// The file name that stands for standard input.
 pub const STDIN: &str = "-";
@@ -115,7 +124,7 @@ pub fn read_rows(
     select: &mut Select,
     each: &mut dyn FnMut(&[&str]) -> Result<(), String>,
 ) -> Result<u64, DataError> {
-    let progress = std::io::stderr().is_terminal();
+    let progress = std::io::stderr().is_terminal() && !QUIET.load(Ordering::Relaxed);
     let mut rows = 0u64;
     let mut counted = |cells: &[&str]| {
         rows += 1;
@@ -208,6 +217,16 @@ pub fn split_unit(name: &str) -> (&str, Option<&str>) {
     (name, None)
 }
 
+/// Whether a record holds only numbers (empty trailing cells aside: a line that ends in a comma).
+fn all_numbers(record: &::csv::StringRecord) -> bool {
+    let cells: Vec<&str> = record.iter().map(str::trim).collect();
+    let end = cells
+        .iter()
+        .rposition(|c| !c.is_empty())
+        .map_or(0, |i| i + 1);
+    end > 0 && cells[..end].iter().all(|c| c.parse::<f64>().is_ok())
+}
+
 /// The header of a file whose header is a comment: when the first record that is not a
 /// comment holds only numbers and a comment line comes before it, that comment line without
 /// its `#`. `None` when the file has an ordinary header row (or no comment before its data).
@@ -232,9 +251,7 @@ fn comment_header(source: impl Read) -> Result<Option<Vec<String>>, String> {
             last_comment = Some(names);
             continue;
         }
-        let numeric = record
-            .iter()
-            .all(|c| !c.trim().is_empty() && c.trim().parse::<f64>().is_ok());
+        let numeric = all_numbers(&record);
         return Ok(if numeric { last_comment } else { None });
     }
 }
@@ -366,6 +383,13 @@ fn read_source(
     if header.is_empty() {
         return Err(error(path, None, "empty file (no header row)"));
     }
+    if header.len() > 1 && all_numbers(&::csv::StringRecord::from(header.clone())) {
+        return Err(error(
+            path,
+            Some(1),
+            "the first line holds only numbers: a header row naming the columns is needed",
+        ));
+    }
     let indices = select(&header).map_err(|problem| error(path, None, problem))?;
     let mut record = ::csv::StringRecord::new();
     let mut rows = 0u64;
@@ -379,6 +403,17 @@ fn read_source(
             }
         }
         let line = || record.position().and_then(|p| locate(p.byte()));
+        if record.len() != header.len() {
+            return Err(error(
+                path,
+                line(),
+                format!(
+                    "{} fields, the header has {}: a shifted row would read the wrong columns",
+                    record.len(),
+                    header.len()
+                ),
+            ));
+        }
         let mut cells: Vec<&str> = Vec::with_capacity(indices.len());
         for &i in &indices {
             match record.get(i) {

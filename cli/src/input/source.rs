@@ -202,6 +202,20 @@ fn backward_text(timing: &Timing, at: u64, stamp: i64, last: i64) -> String {
     )
 }
 
+/// Parses `cells` (named by `request.columns`) into `values` and passes them on.
+fn row_values(
+    values: &mut [f64],
+    cells: &[&str],
+    request: &Request,
+    each: &mut dyn FnMut(&[f64]),
+) -> Result<(), String> {
+    for ((v, cell), name) in values.iter_mut().zip(cells).zip(request.columns) {
+        *v = csv::finite(name)(cell)?;
+    }
+    each(values);
+    Ok(())
+}
+
 /// The names a time column goes by.
 fn is_time(name: &str) -> bool {
     let bare = split_unit(name).0.to_ascii_lowercase();
@@ -211,7 +225,7 @@ fn is_time(name: &str) -> bool {
         "t" | "time" | "timestamp" | "stamp" | "sec" | "seconds"
     ) || ["t_", "time_", "timestamp_", "stamp_"].iter().any(|p| {
         bare.strip_prefix(p)
-            .is_some_and(|u| TimeUnit::of(u, Some(u)).is_some())
+            .is_some_and(|u| matches!(TimeUnit::of(u, Some(u)), Ok(Some(_))))
     })
 }
 
@@ -224,6 +238,7 @@ fn csv_stream(
     let mut units: Option<Vec<Option<Unit>>> = None;
     // The time column's index and unit (when the column does not say: by its first value).
     let time: Cell<Option<(usize, Option<TimeUnit>)>> = Cell::new(None);
+    let strict = request.want_time;
     let mut timing = Timing::new();
     let mut values = vec![0.0; request.columns.len()];
     let mut select = |header: &[String]| -> Result<Vec<usize>, String> {
@@ -232,21 +247,40 @@ fn csv_stream(
             .iter()
             .map(|c| position(header, c))
             .collect::<Result<Vec<usize>, String>>()?;
+        if let Some(k) = (1..picks.len()).find(|&k| picks[..k].contains(&picks[k])) {
+            return Err(format!(
+                "column '{}' is named twice",
+                escaped(&header[picks[k]])
+            ));
+        }
         let here: Vec<Option<Unit>> = picks
             .iter()
             .map(|&i| split_unit(&header[i]).1.and_then(Unit::parse))
             .collect();
+        if let Some(first) = &units
+            && *first != here
+        {
+            return Err(
+                "the columns' unit brackets differ from the first file's: one record is in \
+                 one unit"
+                    .into(),
+            );
+        }
         units.get_or_insert(here);
         let t = match request.time_column {
             Some(name) => Some(position(header, name)?),
-            None if request.want_time => (0..header.len()).find(|&i| is_time(&header[i])),
+            None => (0..header.len()).find(|&i| is_time(&header[i])),
+        };
+        let t = match t.map(|i| (i, split_unit(&header[i]))) {
+            Some((i, (name, bracket))) => match TimeUnit::of(name, bracket) {
+                Ok(unit) => Some((i, unit)),
+                Err(e) if strict => return Err(e),
+                Err(_) => None,
+            },
             None => None,
         };
-        time.set(t.map(|i| {
-            let (name, bracket) = split_unit(&header[i]);
-            (i, TimeUnit::of(name, bracket))
-        }));
-        if let Some((i, _)) = time.get() {
+        time.set(t);
+        if let Some((i, _)) = t {
             picks.push(i);
         }
         Ok(picks)
@@ -255,25 +289,42 @@ fn csv_stream(
         let (cells, stamp) = match time.get() {
             Some((i, unit)) => {
                 let (last, cells) = cells.split_last().ok_or("no cells")?;
-                let unit = match unit {
+                let unit = match unit.or_else(|| TimeUnit::by_magnitude(last.parse().ok()?)) {
                     Some(u) => u,
+                    None if strict => {
+                        return Err(format!(
+                            "the time column does not say its unit ([s], [ms], [us] or [ns] \
+                             in its header, or a suffix such as _ns) and its first value '{}' \
+                             is no epoch time; name the unit, or give --rate",
+                            csv::shown(last)
+                        ));
+                    }
                     None => {
-                        let first = last.parse::<f64>().unwrap_or(0.0);
-                        let u = TimeUnit::by_magnitude(first);
-                        time.set(Some((i, Some(u))));
-                        u
+                        // The rate is given: stamps of unknown unit are not read.
+                        time.set(None);
+                        return row_values(&mut values, cells, request, &mut *each);
                     }
                 };
-                (cells, Some(unit.nanoseconds(last)?))
+                time.set(Some((i, Some(unit))));
+                match unit.nanoseconds(last) {
+                    Ok(t) => (cells, Some(t)),
+                    Err(e) if strict => return Err(e),
+                    Err(_) => {
+                        timing.spoil();
+                        return row_values(&mut values, cells, request, &mut *each);
+                    }
+                }
             }
             None => (cells, None),
         };
-        for ((v, cell), name) in values.iter_mut().zip(cells).zip(request.columns) {
-            *v = csv::finite(name)(cell)?;
-        }
         if let Some(t) = stamp
             && let Step::Backward { last } = timing.push(t)
         {
+            if !strict && !request.drop_backward {
+                // The rate is given: the sample stays, the stamps give no rate.
+                timing.spoil();
+                return row_values(&mut values, cells, request, &mut *each);
+            }
             timing.drop_one();
             if !request.drop_backward {
                 return Err(format!(
@@ -283,8 +334,7 @@ fn csv_stream(
             }
             return Ok(());
         }
-        each(&values);
-        Ok(())
+        row_values(&mut values, cells, request, &mut *each)
     };
     csv::read_rows(files, &mut select, &mut row).map_err(|e: DataError| Fail(e.to_string()))?;
     Ok(Read {

@@ -20,30 +20,44 @@ pub enum TimeUnit {
 
 impl TimeUnit {
     /// The unit of a time column named `name` with unit bracket `bracket`: the bracket (`[ns]`,
-    /// `[s]`, ...) or the name's suffix (`t_ns`, `time_s`, ...); `None` when neither says.
-    pub fn of(name: &str, bracket: Option<&str>) -> Option<Self> {
+    /// `[s]`, ...) or the name's suffix (`t_ns`, `time_s`, ...); `None` when neither says, an
+    /// error for a bracket that names no time unit.
+    pub fn of(name: &str, bracket: Option<&str>) -> Result<Option<Self>, String> {
         let unit = match bracket {
             Some(b) => b.trim(),
             None => name.rsplit_once('_').map_or("", |(_, suffix)| suffix),
         };
-        match unit.to_ascii_lowercase().as_str() {
-            "s" | "sec" | "secs" | "seconds" => Some(Self::Seconds),
-            "ms" => Some(Self::Milliseconds),
-            "us" | "\u{b5}s" | "\u{3bc}s" => Some(Self::Microseconds),
-            "ns" | "nsec" | "nsecs" => Some(Self::Nanoseconds),
+        let found = match unit.to_ascii_lowercase().as_str() {
+            "s" | "sec" | "secs" | "second" | "seconds" => Some(Self::Seconds),
+            "ms" | "msec" | "msecs" | "millisecond" | "milliseconds" => Some(Self::Milliseconds),
+            "us" | "usec" | "usecs" | "\u{b5}s" | "\u{3bc}s" | "microsecond" | "microseconds" => {
+                Some(Self::Microseconds)
+            }
+            "ns" | "nsec" | "nsecs" | "nanosecond" | "nanoseconds" => Some(Self::Nanoseconds),
             _ => None,
+        };
+        match (found, bracket) {
+            (None, Some(b)) => Err(format!(
+                "time column '{name}': '[{b}]' is not a time unit (s, ms, us or ns)"
+            )),
+            (found, _) => Ok(found),
         }
     }
 
-    /// The unit of stamps whose first value is `first` when the column does not say: epoch
-    /// times in ms, us or ns by their magnitude (1.7e12, 1.7e15, 1.7e18 in 2024), else seconds.
-    pub fn by_magnitude(first: f64) -> Self {
-        match first.abs() {
-            v if v >= 1e17 => Self::Nanoseconds,
-            v if v >= 1e14 => Self::Microseconds,
-            v if v >= 1e11 => Self::Milliseconds,
-            _ => Self::Seconds,
-        }
+    /// The unit of stamps whose first value is `first` when the column does not say: an epoch
+    /// time (1e9 to 4.1e9 s, that is 2001 to 2099) in s, ms, us or ns by its magnitude; `None`
+    /// for any other value (a clock since boot, say), whose unit cannot be told.
+    pub fn by_magnitude(first: f64) -> Option<Self> {
+        let epoch = |scale: f64| (1e9 * scale..=4.1e9 * scale).contains(&first);
+        [
+            (1.0, Self::Seconds),
+            (1e3, Self::Milliseconds),
+            (1e6, Self::Microseconds),
+            (1e9, Self::Nanoseconds),
+        ]
+        .into_iter()
+        .find(|(scale, _)| epoch(*scale))
+        .map(|(_, u)| u)
     }
 
     /// Its name.
@@ -109,6 +123,7 @@ pub struct Timing {
     /// Interval / quantum -> count.
     intervals: BTreeMap<i64, u64>,
     quantum: i64,
+    spoiled: bool,
 }
 
 impl Timing {
@@ -142,6 +157,11 @@ impl Timing {
         Step::Forward
     }
 
+    /// Marks the stamps as giving no rate (a backward step kept when the rate is given).
+    pub fn spoil(&mut self) {
+        self.spoiled = true;
+    }
+
     /// Counts a sample dropped for its backward stamp.
     pub fn drop_one(&mut self) {
         self.dropped += 1;
@@ -164,6 +184,9 @@ impl Timing {
     /// The summary of the stamps taken; an error when they give no rate (fewer than two) or
     /// several (less than 90 % of the intervals within 25 % of the median).
     pub fn summary(&self, unit: TimeUnit) -> Result<TimingSummary, String> {
+        if self.spoiled {
+            return Err("the timestamps go backwards".into());
+        }
         let intervals: u64 = self.intervals.values().sum();
         if intervals == 0 {
             return Err("fewer than two timestamps: no rate".into());
