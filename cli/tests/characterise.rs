@@ -536,3 +536,58 @@ fn parameter_files_are_written_all_or_none() {
         "--horizon 0.5",
     );
 }
+
+#[test]
+fn uptime_clocks_rounded_stamps_and_unknown_units() {
+    let dir = temp_dir("second-pass");
+    let frames = imu_frames(20_000, 200.0, 9);
+    let plain = "timestamp,gx,gy,gz,ax,ay,az";
+    // A micros() counter past 2e9 looks like epoch seconds: the rate it gives is refused.
+    let uptime = dir.join("uptime.csv");
+    write_with(&uptime, plain, &frames, |i| {
+        (2_000_000_000 + i * 5000).to_string()
+    });
+    refused(
+        &["adev", path(&uptime), "--column", "gx"],
+        "not an IMU's rate",
+    );
+    // Stamps rounded to whole ms: 180 Hz and 400 Hz come out right.
+    for rate in [180.0, 400.0] {
+        let rounded = dir.join("rounded.csv");
+        write_with(&rounded, "t [ms],gx,gy,gz,ax,ay,az", &frames, |i| {
+            ((i as f64 / rate * 1000.0).floor() as i64).to_string()
+        });
+        let got = json(&imu_ar(&[
+            "adev",
+            path(&rounded),
+            "--column",
+            "gx",
+            "--json",
+        ]));
+        let r = got["rate_hz"].as_f64().unwrap();
+        assert!((r / rate - 1.0).abs() < 1e-3, "{rate}: {r}");
+    }
+    // A stated unit that is not converted is not relabelled; gauss is not g.
+    let mrad = dir.join("mrad.csv");
+    write_with(&mrad, "t [s],g [mrad/s],a [mG],x,y,z,w", &frames, |i| {
+        format!("{}", i as f64 / 200.0)
+    });
+    refused(
+        &["noise", path(&mrad), "--column", "g", "--unit", "deg/s"],
+        "is in [mrad/s]",
+    );
+    refused(
+        &["noise", path(&mrad), "--column", "a", "--unit", "m/s^2"],
+        "is in [mG]",
+    );
+    // A parameter file blocked by a directory: none is written.
+    let euroc = dir.join("euroc.csv");
+    write_euroc(&euroc, &frames);
+    let out = dir.join("out");
+    std::fs::create_dir_all(out.join("px4.params")).unwrap();
+    refused(
+        &["characterise", path(&euroc), "--out", path(&out)],
+        "px4.params: is a directory",
+    );
+    assert_eq!(std::fs::read_dir(&out).unwrap().count(), 1);
+}

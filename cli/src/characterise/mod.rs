@@ -302,6 +302,16 @@ fn write_all(
         .map(|f| write(*f, imu, horizon, &staging))
         .collect();
     let moved = written.and_then(|paths| {
+        if let Some(to) = paths
+            .iter()
+            .map(|p| out.join(p.file_name().unwrap_or_default()))
+            .find(|to| to.is_dir())
+        {
+            return Err(Fail(format!(
+                "{}: is a directory; no parameter file was written",
+                to.display()
+            )));
+        }
         paths
             .iter()
             .map(|p| {

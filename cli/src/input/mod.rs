@@ -88,6 +88,13 @@ impl Input {
         };
         let mut x = Vec::new();
         let read = source::stream(&self.files, &request, &mut |v| x.push(v[0]))?;
+        if let (Some(Some(bracket)), Some(to)) = (read.unknown.first(), &self.unit) {
+            return Err(self.fail(format!(
+                "--unit {to}: column '{}' is in [{bracket}], which is not a unit converted here \
+                 (rad/s, deg/s, deg/h, m/s^2, g, mg)",
+                self.column
+            )));
+        }
         let (factor, unit) = convert(read.units.first().copied().flatten(), self.unit.as_deref())?;
         if factor != 1.0 {
             x.iter_mut().for_each(|v| *v *= factor);

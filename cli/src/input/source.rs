@@ -79,6 +79,8 @@ pub struct Request<'a> {
 pub struct Read {
     /// The unit of each column, where its header bracket (or the message's SI units) says it.
     pub units: Vec<Option<Unit>>,
+    /// A header bracket that names no unit known here, per column.
+    pub unknown: Vec<Option<String>>,
     /// The timestamps, when read: their statistics and unit.
     pub timing: Option<(Timing, TimeUnit)>,
     /// Messages skipped (undecodable or not finite), counted.
@@ -187,6 +189,7 @@ fn messages(
     }
     let si = |i: usize| Unit::parse(if i < 3 { "rad/s" } else { "m/s^2" });
     Ok(Read {
+        unknown: vec![None; picks.len()],
         units: picks.iter().map(|&i| si(i)).collect(),
         timing: Some((timing, TimeUnit::Nanoseconds)),
         skipped,
@@ -236,6 +239,7 @@ fn csv_stream(
     each: &mut dyn FnMut(&[f64]),
 ) -> Result<Read, Fail> {
     let mut units: Option<Vec<Option<Unit>>> = None;
+    let mut unknown: Vec<Option<String>> = Vec::new();
     // The time column's index and unit (when the column does not say: by its first value).
     let time: Cell<Option<(usize, Option<TimeUnit>)>> = Cell::new(None);
     let strict = request.want_time;
@@ -267,6 +271,13 @@ fn csv_stream(
             );
         }
         units.get_or_insert(here);
+        unknown = picks
+            .iter()
+            .map(|&i| {
+                let bracket = split_unit(&header[i]).1?;
+                Unit::parse(bracket).is_none().then(|| bracket.to_string())
+            })
+            .collect();
         let t = match request.time_column {
             Some(name) => Some(position(header, name)?),
             None => (0..header.len()).find(|&i| is_time(&header[i])),
@@ -338,6 +349,7 @@ fn csv_stream(
     };
     csv::read_rows(files, &mut select, &mut row).map_err(|e: DataError| Fail(e.to_string()))?;
     Ok(Read {
+        unknown,
         units: units.unwrap_or_default(),
         timing: time
             .get()

@@ -202,26 +202,31 @@ impl Timing {
                 break;
             }
         }
-        let (mut short, mut gaps, mut missing) = (0u64, 0u64, 0u64);
-        let (mut sq, mut regular, mut worst) = (0.0, 0u64, 0.0f64);
-        for (k, n) in &self.intervals {
-            let v = *k as f64 * self.quantum as f64;
-            let r = v / median;
-            if r < 0.75 {
-                short += n;
-            } else if r > 1.25 {
-                gaps += n;
-                missing += n * ((r.round() as u64).saturating_sub(1));
-            } else {
-                regular += n;
-                sq += *n as f64 * (r - 1.0) * (r - 1.0);
-                worst = worst.max((r - 1.0).abs());
+        // Intervals are judged against the median; where that leaves under 90 % regular (stamps
+        // rounded to a coarse clock: 5 and 6 ms at 180 Hz), against the mean interval.
+        let span = self.last.saturating_sub(self.first.unwrap_or(self.last)) as f64;
+        let mut classes = self.classes(median);
+        if (classes.regular as f64) < 0.9 * intervals as f64 {
+            let by_mean = self.classes(span / intervals as f64);
+            if by_mean.regular > classes.regular {
+                classes = by_mean;
             }
         }
-        let span_s = self.last.saturating_sub(self.first.unwrap_or(self.last)) as f64 * 1e-9;
+        let Classes {
+            reference,
+            short,
+            gaps,
+            missing,
+            regular,
+            sum,
+            sq,
+            worst,
+        } = classes;
+        // The rate: the mean of the regular intervals (exact for rounded stamps).
+        let mean = sum / regular.max(1) as f64;
         let summary = TimingSummary {
             unit: unit.name(),
-            rate_hz: 1e9 / median,
+            rate_hz: 1e9 / mean,
             median_interval_s: median * 1e-9,
             jitter_rms: (sq / regular.max(1) as f64).sqrt(),
             jitter_max: worst,
@@ -229,18 +234,65 @@ impl Timing {
             missing_samples: missing,
             short_intervals: short,
             dropped_backward: self.dropped,
-            span_s,
+            span_s: span * 1e-9,
         };
         if (regular as f64) < 0.9 * intervals as f64 {
             return Err(format!(
                 "the timestamps show mixed rates: only {regular} of {intervals} intervals lie \
-                 within 25 % of the median interval {:.6e} s ({short} shorter, {gaps} longer); \
+                 within 25 % of the interval {:.6e} s ({short} shorter, {gaps} longer); \
                  one record must have one rate (or give --rate)",
-                median * 1e-9
+                reference * 1e-9
+            ));
+        }
+        if !(0.01..=1e6).contains(&summary.rate_hz) {
+            return Err(format!(
+                "the timestamps, read as {}, give {:.6e} Hz, not an IMU's rate: state the time \
+                 column's unit in its header ([s], [ms], [us], [ns]), or give --rate",
+                unit.name(),
+                summary.rate_hz
             ));
         }
         Ok(summary)
     }
+}
+
+impl Timing {
+    /// The intervals against `reference` (ns): within 25 % of it regular, else short or gaps.
+    fn classes(&self, reference: f64) -> Classes {
+        let mut c = Classes {
+            reference,
+            ..Classes::default()
+        };
+        for (k, n) in &self.intervals {
+            let v = (*k as f64 + if self.quantum > 1 { 0.5 } else { 0.0 }) * self.quantum as f64;
+            let r = v / reference;
+            if r < 0.75 {
+                c.short += n;
+            } else if r > 1.25 {
+                c.gaps += n;
+                c.missing += n * ((r.round() as u64).saturating_sub(1));
+            } else {
+                c.regular += n;
+                c.sum += *n as f64 * v;
+                c.sq += *n as f64 * (r - 1.0) * (r - 1.0);
+                c.worst = c.worst.max((r - 1.0).abs());
+            }
+        }
+        c
+    }
+}
+
+/// Intervals by class.
+#[derive(Default)]
+struct Classes {
+    reference: f64,
+    short: u64,
+    gaps: u64,
+    missing: u64,
+    regular: u64,
+    sum: f64,
+    sq: f64,
+    worst: f64,
 }
 
 /// What a record's timestamps show.
@@ -248,12 +300,12 @@ impl Timing {
 pub struct TimingSummary {
     /// The unit of the time column (`ns` for a bag's header stamps).
     pub unit: &'static str,
-    /// The rate, the reciprocal of the median interval, Hz.
+    /// The rate, the reciprocal of the mean regular interval, Hz.
     pub rate_hz: f64,
     /// The median interval, s.
     pub median_interval_s: f64,
-    /// The RMS deviation of the regular intervals (within 25 % of the median) from the median,
-    /// relative to it.
+    /// The RMS deviation of the regular intervals (within 25 % of the median, or of the mean
+    /// interval for coarsely rounded stamps) from that reference, relative to it.
     pub jitter_rms: f64,
     /// Their largest deviation, relative.
     pub jitter_max: f64,

@@ -63,11 +63,15 @@ impl Unit {
     /// The unit spelled `name` (spaces and case ignored),
     /// or `None` for a unit not known here.
     pub fn parse(name: &str) -> Option<Self> {
-        let key: String = name
-            .chars()
-            .filter(|c| !c.is_whitespace())
-            .collect::<String>()
-            .to_lowercase();
+        let exact: String = name.chars().filter(|c| !c.is_whitespace()).collect();
+        // g and mg only as written: G and mG are gauss.
+        if exact.eq_ignore_ascii_case("g") || exact.eq_ignore_ascii_case("mg") {
+            return UNITS[4..]
+                .iter()
+                .find(|(spellings, _)| spellings.contains(&exact.as_str()))
+                .map(|(_, u)| *u);
+        }
+        let key = exact.to_lowercase();
         UNITS
             .iter()
             .find(|(spellings, _)| spellings.contains(&key.as_str()))
@@ -115,5 +119,7 @@ mod tests {
         );
         assert!(rad.factor_to(Unit::parse("g").unwrap()).is_err());
         assert_eq!(Unit::parse("counts"), None);
+        assert_eq!(Unit::parse("mG"), None);
+        assert_eq!(Unit::parse("G"), None);
     }
 }
