@@ -25,6 +25,7 @@ use core::fmt;
 
 use crate::model::ModelError;
 
+mod columns;
 pub mod component;
 mod fit;
 mod model;
