@@ -51,18 +51,9 @@ fn imu_frames(n: usize, rate: f64, seed: u64) -> Vec<Frame> {
 
 /// `frames` as a EuRoC/ASL `imu0/data.csv`.
 fn write_euroc(path: &Path, frames: &[Frame]) {
-    let mut s = String::from(
-        "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],\
-         a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]\n",
-    );
-    for f in frames {
-        write!(s, "{}", f.stamp_ns).unwrap();
-        for v in f.axes {
-            write!(s, ",{v:?}").unwrap();
-        }
-        s.push('\n');
-    }
-    std::fs::write(path, s).unwrap();
+    let header = "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],\
+                  a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]";
+    write_with(path, header, frames, |i| frames[i].stamp_ns.to_string());
 }
 
 fn path(p: &Path) -> &str {

@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 use imu_ar::ArModel;
 use imu_ar::batch::criteria::Criterion;
 use imu_ar::batch::levinson_durbin;
-use imu_ar::noise::{FitConfig, Octaves};
+use imu_ar::noise::Octaves;
 use serde::Serialize;
 
 use crate::error::{Fail, escaped, with_file};
@@ -27,7 +27,7 @@ use crate::input::units::{Quantity, Unit};
 use crate::input::{check_rate, check_span, resolve_rate, summary};
 use crate::method::with_order;
 use crate::noise::units::Units;
-use crate::noise::{Fitted, Fitting, MAX_GM_STATES, NoiseResult, OCTAVES, plot};
+use crate::noise::{Fitted, Fitting, ModelArgs, NoiseResult, OCTAVES, plot};
 use crate::output::{Output, json};
 use stream::{AxisStream, LAGS};
 
@@ -61,18 +61,9 @@ pub struct Args {
     /// The accelerometer columns' unit when their header does not say: m/s^2, g or mg.
     #[arg(long)]
     accel_unit: Option<String>,
-    /// The Kalman states the Gauss-Markov terms may take per axis, 0 to 8.
-    #[arg(long, default_value_t = 3, allow_negative_numbers = true)]
-    gm_states: usize,
-    /// Allow second-order Gauss-Markov terms (oscillators).
-    #[arg(long)]
-    oscillators: bool,
-    /// Fit a rate ramp too.
-    #[arg(long)]
-    ramp: bool,
-    /// The filter's rate in Hz for the state-space form [default: the record's].
-    #[arg(long, allow_negative_numbers = true)]
-    filter_rate: Option<f64>,
+    /// The composite's settings, per axis.
+    #[command(flatten)]
+    model: ModelArgs,
     /// Directory for the plots and parameter files (created if needed).
     #[arg(long)]
     out: PathBuf,
@@ -136,19 +127,7 @@ pub fn run(args: &Args) -> Result<Characterisation, Fail> {
     if let Some(r) = args.rate {
         check_rate(r)?;
     }
-    if args.gm_states > MAX_GM_STATES {
-        return Err(Fail(format!(
-            "--gm-states {}: at most {MAX_GM_STATES}",
-            args.gm_states
-        )));
-    }
-    if let Some(f) = args.filter_rate {
-        check_rate(f).map_err(|_| {
-            Fail(format!(
-                "--filter-rate {f}: must be a positive number of Hz"
-            ))
-        })?;
-    }
+    let config = args.model.config()?;
     let given = [
         args.gyro_unit.as_deref().map(parse_unit).transpose()?,
         args.accel_unit.as_deref().map(parse_unit).transpose()?,
@@ -203,10 +182,8 @@ pub fn run(args: &Args) -> Result<Characterisation, Fail> {
         .map(|u| Fitting {
             n: n as usize,
             rate,
-            filter_rate: args.filter_rate.unwrap_or(rate),
-            config: FitConfig::new(args.gm_states)
-                .with_oscillators(args.oscillators)
-                .with_ramp(args.ramp),
+            filter_rate: args.model.filter_rate.unwrap_or(rate),
+            config,
             units: Units::of(u.si().name),
             export: true,
         })
@@ -246,7 +223,7 @@ pub fn run(args: &Args) -> Result<Characterisation, Fail> {
         axes,
         rate_hz: rate,
         topic: args.topic.clone(),
-        filter_rate_hz: args.filter_rate,
+        filter_rate_hz: args.model.filter_rate,
     };
     let mut files = write_all(&formats, &imu, args.horizon, &args.out)?;
     for (name, range, what) in [

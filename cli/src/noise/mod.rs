@@ -43,23 +43,13 @@ pub struct Args {
     /// Sample rate in Hz of the raw record [default: from the timestamps].
     #[arg(long, allow_negative_numbers = true)]
     rate: Option<f64>,
-    /// The Kalman states the Gauss-Markov terms may take, 0 to 8 (an oscillator takes two).
-    #[arg(long, default_value_t = 3, allow_negative_numbers = true)]
-    gm_states: usize,
+    /// The composite's settings.
+    #[command(flatten)]
+    model: ModelArgs,
     /// Order of the AR part (the sensor's short-term colouring), 1 to 32, or 0 for none
     /// [default: the order 0 to 8 that BIC selects].
     #[arg(long, allow_negative_numbers = true)]
     ar_order: Option<usize>,
-    /// Allow second-order Gauss-Markov terms (damped oscillators, two states each) for a
-    /// spectral line between 0.1 Hz and an eighth of the rate.
-    #[arg(long)]
-    oscillators: bool,
-    /// Fit a rate ramp too (in a static record, usually a temperature drift).
-    #[arg(long)]
-    ramp: bool,
-    /// The filter's rate in Hz for `phi`, `q` and `p0` [default: the model's rate].
-    #[arg(long, allow_negative_numbers = true)]
-    filter_rate: Option<f64>,
     /// Average blocks of M samples first; the model's rate becomes rate / M.
     #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     decimate: usize,
@@ -70,6 +60,47 @@ pub struct Args {
     /// PNG file.
     #[arg(long)]
     plot: Option<PathBuf>,
+}
+
+/// The composite's settings that `noise` and `characterise` share.
+#[derive(clap::Args)]
+pub struct ModelArgs {
+    /// The Kalman states the Gauss-Markov terms may take, 0 to 8 (an oscillator takes two).
+    #[arg(long, default_value_t = 3, allow_negative_numbers = true)]
+    gm_states: usize,
+    /// Allow second-order Gauss-Markov terms (damped oscillators, two states each) for a
+    /// spectral line between 0.1 Hz and an eighth of the rate.
+    #[arg(long)]
+    oscillators: bool,
+    /// Fit a rate ramp too (in a static record, usually a temperature drift).
+    #[arg(long)]
+    ramp: bool,
+    /// The filter's rate in Hz for `phi`, `q` and `p0` (and for the PX4 and ArduPilot files)
+    /// [default: the model's rate].
+    #[arg(long, allow_negative_numbers = true)]
+    pub filter_rate: Option<f64>,
+}
+
+impl ModelArgs {
+    /// The fit's settings, once the flags are checked.
+    pub fn config(&self) -> Result<FitConfig, Fail> {
+        if self.gm_states > MAX_GM_STATES {
+            return Err(Fail(format!(
+                "--gm-states {}: at most {MAX_GM_STATES}",
+                self.gm_states
+            )));
+        }
+        if let Some(f) = self.filter_rate {
+            check_rate(f).map_err(|_| {
+                Fail(format!(
+                    "--filter-rate {f}: must be a positive number of Hz"
+                ))
+            })?;
+        }
+        Ok(FitConfig::new(self.gm_states)
+            .with_oscillators(self.oscillators)
+            .with_ramp(self.ramp))
+    }
 }
 
 /// Bias instability: the minimum Allan deviation of the data over 0.664, and where it is.
@@ -164,23 +195,10 @@ pub fn run(args: &Args) -> Result<NoiseResult, Fail> {
         check_rate(r)?;
     }
     check_decimate(args.decimate)?;
-    if args.gm_states > MAX_GM_STATES {
-        return Err(Fail(format!(
-            "--gm-states {}: at most {MAX_GM_STATES}",
-            args.gm_states
-        )));
-    }
+    let config = args.model.config()?;
     if let Some(p) = args.ar_order.filter(|p| *p > 0) {
         check_order("--ar-order", p)?;
     }
-    let filter_rate = match args.filter_rate {
-        Some(f) => Some(check_rate(f).map_err(|_| {
-            Fail(format!(
-                "--filter-rate {f}: must be a positive number of Hz"
-            ))
-        })?),
-        None => None,
-    };
     if let Some(path) = &args.plot {
         plot::check_path(path)?;
     }
@@ -192,10 +210,8 @@ pub fn run(args: &Args) -> Result<NoiseResult, Fail> {
     let fit = Fitting {
         n: x.len(),
         rate,
-        filter_rate: filter_rate.unwrap_or(rate),
-        config: FitConfig::new(args.gm_states)
-            .with_oscillators(args.oscillators)
-            .with_ramp(args.ramp),
+        filter_rate: args.model.filter_rate.unwrap_or(rate),
+        config,
         units: Units::of(&series.unit),
         export: false,
     };
