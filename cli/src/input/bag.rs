@@ -15,8 +15,7 @@
 //! and its bytes), then 37 float64 (orientation, its covariance, angular_velocity, its
 //! covariance, linear_acceleration, its covariance).
 
-use std::fs::File;
-use std::io::Read;
+use crate::input::frame::open_head;
 use std::path::Path;
 
 use rosbag::{ChunkRecord, IndexRecord, MessageRecord, RosBag};
@@ -131,18 +130,9 @@ fn text(e: &rosbag::Error) -> String {
 fn check_header(path: &Path) -> Result<(), DataError> {
     let fail = |problem: String| data_error(path, problem);
     let corrupt = |what: &str| fail(format!("truncated or corrupt bag: {what}"));
-    let mut file = File::open(path).map_err(|e| fail(format!("cannot open: {e}")))?;
-    let len = file
-        .metadata()
-        .map_err(|e| fail(format!("cannot read: {e}")))?
-        .len();
     // The magic, the bag header record's header length; the header record itself is
     // 4096 bytes long in bags written by ROS, 64 KiB is plenty.
-    let mut head = Vec::new();
-    file.by_ref()
-        .take(64 * 1024)
-        .read_to_end(&mut head)
-        .map_err(|e| fail(format!("cannot read: {e}")))?;
+    let (_, len, head) = open_head(path, 64 * 1024)?;
     if !head.starts_with(MAGIC) {
         if MAGIC.starts_with(&head) {
             return Err(corrupt(&format!("{len} bytes, shorter than the magic")));

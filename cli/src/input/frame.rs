@@ -2,6 +2,8 @@
 //! skipped, and what the two readers share: the little-endian and big-endian field access that
 //! cannot panic, and the tally that delivers the finite frames and counts the others.
 
+use std::fs::File;
+use std::io::Read;
 use std::path::Path;
 
 use crate::input::csv::DataError;
@@ -141,6 +143,20 @@ pub(crate) fn data_error(file: &Path, problem: impl Into<String>) -> DataError {
         line: None,
         problem: problem.into(),
     }
+}
+
+/// `path` opened: the file, its length, and its first `head` bytes (fewer in a shorter file),
+/// read; errors name the file.
+pub(crate) fn open_head(path: &Path, head: u64) -> Result<(File, u64, Vec<u8>), DataError> {
+    let fail = |e: std::io::Error, what: &str| data_error(path, format!("cannot {what}: {e}"));
+    let mut file = File::open(path).map_err(|e| fail(e, "open"))?;
+    let len = file.metadata().map_err(|e| fail(e, "read"))?.len();
+    let mut bytes = Vec::new();
+    file.by_ref()
+        .take(head)
+        .read_to_end(&mut bytes)
+        .map_err(|e| fail(e, "read"))?;
+    Ok((file, len, bytes))
 }
 
 /// The message of a topic that is not in the file: the IMU topics it has (`imu`), or all its

@@ -19,8 +19,8 @@
 //! linear_acceleration, its covariance), the first aligned to 8 bytes counted from the end of
 //! the encapsulation header.
 
+use crate::input::frame::open_head;
 use std::collections::HashMap;
-use std::fs::File;
 use std::io::{ErrorKind, Read};
 use std::path::Path;
 
@@ -58,17 +58,8 @@ const MIN_RECORD_LIMIT: u64 = 64 * 1024 * 1024;
 /// another message encoding than cdr, or has no finite message on it.
 pub fn read(path: &Path, topic: &str, each: &mut dyn FnMut(Frame)) -> Result<Skipped, DataError> {
     let fail = |problem: String| data_error(path, problem);
-    let mut file = File::open(path).map_err(|e| fail(format!("cannot open: {e}")))?;
-    let len = file
-        .metadata()
-        .map_err(|e| fail(format!("cannot read: {e}")))?
-        .len();
-    let mut head = Vec::new();
-    (&mut file)
-        .take(::mcap::MAGIC.len() as u64)
-        .read_to_end(&mut head)
-        .map_err(|e| fail(format!("cannot read: {e}")))?;
-    if head != ::mcap::MAGIC {
+    let (mut file, len, head) = open_head(path, ::mcap::MAGIC.len() as u64)?;
+    if head.as_slice() != ::mcap::MAGIC {
         if ::mcap::MAGIC.starts_with(&head) {
             return Err(fail(format!(
                 "truncated or corrupt MCAP file: {len} bytes, shorter than the magic"
