@@ -141,6 +141,40 @@ impl Section0 {
         (a.iter().copied().collect(), energy)
     }
 
+    /// The order-`p` solution of the problem centred on `a0` (shift-consistent `D`):
+    /// `argmin sum lambda^(n-i) (y_i - a^T phi_i)^2 + delta lambda^n (a - a0)^T D (a - a0)`,
+    /// from the normal equations `(R + delta lambda^n D) a = b + delta lambda^n D a0`, and its
+    /// energy `min J + delta lambda^(n+p)`, `min J = yy + delta lambda^n a0^T D a0 - c^T a`
+    /// with `c` the right-hand side.
+    pub fn solve_centred(&self, a0: &[f64]) -> (Vec<f64>, f64) {
+        let p = self.p;
+        let mut r = self.r.clone();
+        let mut c = self.b.clone();
+        let mut prior = 0.0;
+        for k in 0..p {
+            let w = self.delta * self.lambda_n * self.lambda.powi((p - 1 - k) as i32);
+            r[(k, k)] += w;
+            c[k] += w * a0[k];
+            prior += w * a0[k] * a0[k];
+        }
+        let a = r
+            .cholesky()
+            .expect("regularised system is positive definite")
+            .solve(&c);
+        let energy = self.yy + prior - c.dot(&a)
+            + self.delta * self.lambda_n * self.lambda.powi(p as i32);
+        (a.iter().copied().collect(), energy)
+    }
+
+    /// Takes a history sample: it enters the delay line and the regressors' Gram matrix
+    /// (weighted as any row), but adds no equation: its row's desired value is its
+    /// prediction by the centre `a0`, so that in `b = a - a0` it is `(0 - b^T phi)^2`.
+    pub fn push_history(&mut self, y: f64, a0: &[f64]) {
+        let desired = a0.iter().zip(&self.phi).map(|(a, p)| a * p).sum::<f64>();
+        self.push(desired);
+        self.phi[0] = y;
+    }
+
     /// The a-priori error `y - a^T phi` of a coming sample `y` under coefficients `a`.
     pub fn a_priori_error(&self, a: &[f64], y: f64) -> f64 {
         y - a.iter().zip(&self.phi).map(|(a, p)| a * p).sum::<f64>()

@@ -23,6 +23,9 @@ pub enum ConfigError {
     Scale,
     /// The forgetting factor is below the fixed-point lattice's range, `[0.9, 1]`.
     FixedLambda,
+    /// A prior model's coefficient is not finite, or (fixed point) outside the coefficient
+    /// format's range, +-4.
+    Prior,
 }
 
 impl fmt::Display for ConfigError {
@@ -37,6 +40,9 @@ impl fmt::Display for ConfigError {
             Self::Saturation => "saturation limit must be positive",
             Self::Scale => "fixed-point scale must be positive and keep delta representable",
             Self::FixedLambda => "the fixed-point lattice needs lambda in [0.9, 1]",
+            Self::Prior => {
+                "prior coefficients must be finite (and within +-4 for the fixed-point lattice)"
+            }
         })
     }
 }

@@ -9,6 +9,7 @@ use super::fixed_arith::{
     COEF_FRAC, ENERGY_FRAC, ERR_FRAC, MEAN_FRAC, Q, QParams, decay, mean_step, reciprocal, sat_add,
     sat_i32,
 };
+use super::ladder::Ladder;
 use super::lattice::{Core, lattice_accessors};
 use super::shell::{Format, Shell};
 
@@ -285,6 +286,8 @@ impl Format for Q {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct FixedLattice<const P: usize> {
     core: Core<Q, P>,
+    /// The joint-process ladder of a lattice with a prior.
+    ladder: Option<Ladder<Q, P>>,
     shell: Shell<Q, P>,
     /// What the last sample overwrote: enough to rebuild the model from before it.
     undo: Undo<P>,
@@ -300,6 +303,8 @@ struct Undo<const P: usize> {
     f_energy_p: I24F40,
     weight: i64,
     mean: i64,
+    /// The ladder's coefficients and energy, with a prior.
+    ladder: Option<([I3F29; P], I24F40)>,
 }
 
 impl<const P: usize> FixedLattice<P> {
@@ -309,6 +314,7 @@ impl<const P: usize> FixedLattice<P> {
         const { assert!(P > 0, "the model order P must be at least 1") };
         Self {
             core: Self::initial_core(config, channel),
+            ladder: None,
             shell: Shell::new(*channel),
             undo: Undo {
                 kf: [I3F29::ZERO; P],
@@ -316,8 +322,39 @@ impl<const P: usize> FixedLattice<P> {
                 f_energy_p: I24F40::ZERO,
                 weight: 0,
                 mean: 0,
+                ladder: None,
             },
         }
+    }
+
+    /// A lattice that starts from the prior model `a0` (in `f32`, rounded to the coefficient
+    /// format I3F29) with the weight `delta` of `channel`: the problem centred on `a0`, as
+    /// [`Lattice::with_prior`](super::Lattice::with_prior) describes, by the same
+    /// joint-process ladder in fixed point. The ladder's coefficients (the correction
+    /// `a - a0` in the backward errors' basis) share the format of the reflection
+    /// coefficients: a correction beyond +-4 there saturates and restarts the lattice, as
+    /// any saturation does. With `a0 = 0` it is [`FixedLattice::new`], bit for bit.
+    ///
+    /// # Errors
+    ///
+    /// [`ConfigError::Prior`] if an entry of `a0` is not finite or lies outside `(-4, 4)`.
+    pub fn with_prior(
+        config: &FixedConfig,
+        channel: &FixedChannel,
+        a0: &[f32; P],
+    ) -> Result<Self, ConfigError> {
+        let lsb = (1u64 << COEF_FRAC) as f32;
+        let mut centre = [I3F29::ZERO; P];
+        for (c, &a) in centre.iter_mut().zip(a0) {
+            if !(a.is_finite() && a.abs() < 4.0) {
+                return Err(ConfigError::Prior);
+            }
+            // |a| < 4: inside I3F29 (`as` saturates the one value that rounds to 2^31).
+            *c = I3F29::from_bits(libm::roundf(a * lsb) as i32);
+        }
+        let mut lattice = Self::new(config, channel);
+        lattice.ladder = Some(Ladder::new(centre, lattice.core.f_energy_p));
+        Ok(lattice)
     }
 
     fn initial_core(config: &FixedConfig, channel: &FixedChannel) -> Core<Q, P> {
@@ -349,6 +386,7 @@ impl<const P: usize> FixedLattice<P> {
             f_energy_p: self.core.f_energy_p,
             weight: self.shell.moments.weight,
             mean: self.shell.moments.mean,
+            ladder: self.ladder.as_ref().map(|l| (l.c, l.energy)),
         };
         let mut clip = 0u32;
         let m = &mut self.shell.moments;
@@ -368,9 +406,13 @@ impl<const P: usize> FixedLattice<P> {
         } else {
             x
         };
-        let f = self
-            .core
-            .step(&config.params, I5F27::from_bits(y), &mut clip);
+        let y = I5F27::from_bits(y);
+        let ladder = self
+            .ladder
+            .as_mut()
+            .map(|l| l.step(&self.core, &config.params, y, true, &mut clip));
+        let f = self.core.step(&config.params, y, &mut clip);
+        let f = ladder.unwrap_or(f);
         if clip != 0 {
             self.shell.health.clipped = self.shell.health.clipped.saturating_add(u64::from(clip));
             self.restart_after_saturation(config);
@@ -388,6 +430,10 @@ impl<const P: usize> FixedLattice<P> {
         self.core.rewind(&u.kf, &u.kb, u.f_energy_p);
         self.shell.moments.weight = u.weight;
         self.shell.moments.mean = u.mean;
+        if let (Some(l), Some((c, energy))) = (&mut self.ladder, u.ladder) {
+            l.c = c;
+            l.energy = energy;
+        }
         self.restart(config);
     }
 
@@ -403,7 +449,12 @@ impl<const P: usize> FixedLattice<P> {
     /// The exact least-squares coefficients of order `m <= P`, as for the float lattice,
     /// evaluated in `f32` from the fixed-point reflection coefficients.
     pub fn coefficients(&self, m: usize) -> Option<[f32; P]> {
-        coefficients(&self.core, m)
+        coefficients(&self.core, self.ladder.as_ref(), m)
+    }
+
+    /// The order-`P` energy of the published problem: the ladder's with a prior, else `F_P`.
+    fn energy_p(&self) -> I24F40 {
+        self.ladder.as_ref().map_or(self.core.f_energy_p, |l| l.energy)
     }
 
     /// Re-initialises the state (counted as a restart). Unless a restart is already settling,
@@ -412,18 +463,25 @@ impl<const P: usize> FixedLattice<P> {
     /// saturates (counted in [`Health::clipped`](super::Health::clipped)), holding the model
     /// from before that sample.
     pub fn restart(&mut self, config: &FixedConfig) {
-        let core = &self.core;
+        let (core, ladder) = (&self.core, self.ladder.as_ref());
         self.shell
-            .keep(config.dt, core.f_energy_p, || coefficients(core, P));
+            .keep(config.dt, self.energy_p(), || coefficients(core, ladder, P));
         self.core = Self::initial_core(config, self.shell.channel());
+        if let Some(l) = &mut self.ladder {
+            *l = Ladder::new(l.centre, self.core.f_energy_p);
+        }
         self.shell.restart(config.lambda);
     }
 }
 
 /// The coefficients of order `m` of a fixed-point core, in `f32`.
-fn coefficients<const P: usize>(core: &Core<Q, P>, m: usize) -> Option<[f32; P]> {
+fn coefficients<const P: usize>(
+    core: &Core<Q, P>,
+    ladder: Option<&Ladder<Q, P>>,
+    m: usize,
+) -> Option<[f32; P]> {
     let lsb = 1.0 / (1u32 << COEF_FRAC) as f32;
-    core.coefficients(m, |k| k.to_bits() as f32 * lsb)
+    core.coefficients(m, ladder, |k| k.to_bits() as f32 * lsb)
 }
 
 impl<const P: usize> Sealed<f32, P> for FixedLattice<P> {
@@ -434,11 +492,11 @@ impl<const P: usize> Sealed<f32, P> for FixedLattice<P> {
     }
 
     fn energy(&self) -> I24F40 {
-        self.core.f_energy_p
+        self.energy_p()
     }
 
     fn current(&self) -> Option<[f32; P]> {
-        coefficients(&self.core, P)
+        coefficients(&self.core, self.ladder.as_ref(), P)
     }
 }
 

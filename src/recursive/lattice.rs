@@ -1,6 +1,7 @@
 //! The a-priori least-squares lattice with error feedback (EF-LSL), `O(P)` per sample.
 
 use super::arith::{Arith, FloatArith, float_params};
+use super::ladder::Ladder;
 use super::estimator::{Estimator, sealed::Sealed};
 use super::shell::Shell;
 use super::{Channel, Config};
@@ -80,13 +81,13 @@ pub(crate) struct Core<A: Arith, const P: usize> {
     pub(crate) b_energy: [A::Energy; P],
     /// `B_i` prepared for division: computed for step 7 and reused by step 4 of the next
     /// sample.
-    b_recip: [A::Recip; P],
+    pub(crate) b_recip: [A::Recip; P],
     /// `psi_i(n-1)`, i = 0..P-1.
-    bp: [A::Err; P],
+    pub(crate) bp: [A::Err; P],
     /// `gamma_i(n-1)`, i = 0..P-1.
-    gp: [A::Gamma; P],
+    pub(crate) gp: [A::Gamma; P],
     /// `gamma_P(n-1)`.
-    gp_p: A::Gamma,
+    pub(crate) gp_p: A::Gamma,
     /// A-priori forward errors `f_1..f_P` of the last sample; `f_0` is `input`.
     pub(crate) errors: [A::Err; P],
     /// `y_n` of the last sample, the order-0 error.
@@ -197,14 +198,21 @@ impl<A: Arith, const P: usize> Core<A, P> {
     /// The exact least-squares coefficients of order `m <= P`, computed in `T` from the
     /// reflection coefficients of the last `m` samples (converted by `to_t`); see
     /// [`Lattice::coefficients`].
+    ///
+    /// With a ladder (a lattice started from a prior `a0`, see `ladder.rs`), order `P` is the
+    /// centred problem's: `a0 + sum_k c_k(n) B_{k-1}(n-1)`.
     pub(crate) fn coefficients<T: Scalar>(
         &self,
         m: usize,
+        ladder: Option<&Ladder<A, P>>,
         to_t: impl Fn(A::Coef) -> T,
     ) -> Option<[T; P]> {
         if m > P {
             return None;
         }
+        let ladder = ladder.filter(|_| m == P);
+        // The tail of `[1, -b]`, `b = a - a0`, from the ladder's coefficients.
+        let mut beta = [T::ZERO; P];
         // rows[parity][j][..j]: the leading j coefficients of B_j (its last one is 1), for
         // the time being built (written) and the one after it in age (read), alternating.
         // alpha: the tail of A_k (its first one is 1).
@@ -245,9 +253,18 @@ impl<A: Arith, const P: usize> Core<A, P> {
                 for (j, aj) in alpha.iter_mut().enumerate().take(k) {
                     *aj -= kf_k * b_full_prev(j);
                 }
+                if let (0, Some(l)) = (t, ladder) {
+                    let c_k = to_t(l.c.get(k.wrapping_sub(1)).copied().unwrap_or(A::COEF_ZERO));
+                    for (j, bj) in beta.iter_mut().enumerate().take(k) {
+                        *bj -= c_k * b_full_prev(j);
+                    }
+                }
             }
         }
-        Some(alpha.map(|v| -v))
+        Some(match ladder {
+            Some(l) => core::array::from_fn(|j| to_t(l.centre[j]) - beta[j]),
+            None => alpha.map(|v| -v),
+        })
     }
 }
 
@@ -340,6 +357,8 @@ impl<T: FloatArith, const P: usize> Core<T, P> {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Lattice<T: FloatArith, const P: usize> {
     core: Core<T, P>,
+    /// The joint-process ladder of a lattice with a prior.
+    ladder: Option<Ladder<T, P>>,
     shell: Shell<T, P>,
 }
 
@@ -350,8 +369,38 @@ impl<T: FloatArith, const P: usize> Lattice<T, P> {
         const { assert!(P > 0, "the model order P must be at least 1") };
         Self {
             core: Self::initial_core(config, channel),
+            ladder: None,
             shell: Shell::new(*channel),
         }
+    }
+
+    /// A lattice that starts from the prior model `a0` with the weight `delta` of `channel`:
+    /// the problem of the [module docs](super) with its regularisation centred on `a0`,
+    /// `delta lambda^n (a - a0)^T D (a - a0)`. Order `P` (the a-priori error
+    /// [`update`](Estimator::update) returns, [`Estimator::model`], [`Estimator::noise_variance`],
+    /// [`coefficients(P)`](Self::coefficients)) is that problem's, computed by a joint-process
+    /// ladder of `P` more coefficients (about `3 P` more multiplications per sample, and `P`
+    /// for `d_n = y_n - a0^T phi_n`); the lower orders, [`errors`](Self::errors) and
+    /// [`energy`](Self::energy) stay those of the problem centred on 0. With `a0 = 0` it is
+    /// [`Lattice::new`], bit for bit.
+    ///
+    /// # Errors
+    ///
+    /// [`ConfigError::Prior`](super::ConfigError::Prior) if an entry of `a0` is not finite.
+    pub fn with_prior(
+        config: &Config<T>,
+        channel: &Channel<T>,
+        a0: &[T; P],
+    ) -> Result<Self, super::ConfigError> {
+        if !a0.iter().all(|a| a.is_finite()) {
+            return Err(super::ConfigError::Prior);
+        }
+        let core = Self::initial_core(config, channel);
+        Ok(Self {
+            ladder: Some(Ladder::new(*a0, core.f_energy_p)),
+            core,
+            shell: Shell::new(*channel),
+        })
     }
 
     fn initial_core(config: &Config<T>, channel: &Channel<T>) -> Core<T, P> {
@@ -360,6 +409,14 @@ impl<T: FloatArith, const P: usize> Lattice<T, P> {
             channel.delta_lambda_pow(lambda, P),
             core::array::from_fn(|i| channel.delta_lambda_pow(lambda, P - i)),
         )
+    }
+
+    /// Back to the initial state, keeping the prior.
+    fn initialise(&mut self, config: &Config<T>) {
+        self.core = Self::initial_core(config, self.shell.channel());
+        if let Some(l) = &mut self.ladder {
+            *l = Ladder::new(l.centre, self.core.f_energy_p);
+        }
     }
 
     lattice_accessors!(T, T, T, T, "in the input's units", "`F_m(n) / W_n`");
@@ -381,10 +438,17 @@ impl<T: FloatArith, const P: usize> Lattice<T, P> {
     /// B_m(n) = [0; B_{m-1}(n-1)] - kb_m(n) [A_{m-1}(n); 0]
     /// ```
     ///
-    /// with `A_m = [1, -a^(m)]`. `O(m^3/3)` operations, no allocation (see the stack use in
-    /// the [type docs](Lattice)); `None` for `m > P`.
+    /// with `A_m = [1, -a^(m)]`; for a lattice with a prior, order `P` is
+    /// `a0 + sum_k c_k(n) B_{k-1}(n-1)` from the ladder's coefficients `c`. `O(m^3/3)`
+    /// operations, no allocation (see the stack use in the [type docs](Lattice)); `None` for
+    /// `m > P`.
     pub fn coefficients(&self, m: usize) -> Option<[T; P]> {
-        self.core.coefficients(m, |k| k)
+        self.core.coefficients(m, self.ladder.as_ref(), |k| k)
+    }
+
+    /// The order-`P` energy of the published problem: the ladder's with a prior, else `F_P`.
+    fn energy_p(&self) -> T {
+        self.ladder.as_ref().map_or(self.core.f_energy_p, |l| l.energy)
     }
 }
 
@@ -396,7 +460,7 @@ impl<T: FloatArith, const P: usize> Sealed<T, P> for Lattice<T, P> {
     }
 
     fn energy(&self) -> T {
-        self.core.f_energy_p
+        self.energy_p()
     }
 
     fn current(&self) -> Option<[T; P]> {
@@ -409,25 +473,34 @@ impl<T: FloatArith, const P: usize> Estimator<T, P> for Lattice<T, P> {
 
     fn update(&mut self, config: &Config<T>, x: T) -> Option<T> {
         let y = self.shell.intake(config, x)?;
-        let channel = self.shell.channel();
+        let params = float_params(config, self.shell.channel());
         let mut clip = 0;
-        let f = self.core.step(&float_params(config, channel), y, &mut clip);
+        let ladder = self
+            .ladder
+            .as_mut()
+            .map(|l| l.step(&self.core, &params, y, true, &mut clip));
+        let f = self.core.step(&params, y, &mut clip);
+        let e = ladder.unwrap_or(f);
         // A non-finite value anywhere reaches f_P within a sample or two (the reflection
         // coefficients feed the errors), and an overflowing input reaches F_0 and F_P at once.
         let c = &self.core;
-        let check = f + c.f_energy_p + c.f_energy[0];
+        let check = e + f + c.f_energy_p + c.f_energy[0] + self.energy_p();
         if !check.is_finite() {
-            self.core = Self::initial_core(config, channel);
+            self.initialise(config);
             self.shell.restart(config.lambda().to_f64());
             return None;
         }
         if self.shell.weight_full() {
             self.core.halve_energies();
+            if let Some(l) = &mut self.ladder {
+                l.energy *= T::from_f64(0.5);
+            }
             self.shell.halve_weight();
         }
-        let core = &self.core;
-        self.shell
-            .refresh(config.dt(), core.f_energy_p, || core.coefficients(P, |k| k));
-        Some(f)
+        let (core, ladder) = (&self.core, self.ladder.as_ref());
+        self.shell.refresh(config.dt(), self.energy_p(), || {
+            core.coefficients(P, ladder, |k| k)
+        });
+        Some(e)
     }
 }

@@ -40,6 +40,7 @@ mod config;
 mod estimator;
 mod fixed_arith;
 mod fixed_lattice;
+mod ladder;
 mod lattice;
 mod mean;
 mod order;

@@ -73,6 +73,8 @@ pub struct Rls<T: Scalar, const P: usize> {
     energy: T,
     error: T,
     init: RlsInit,
+    /// The prior `a0` the state starts from (and restarts from).
+    centre: [T; P],
     shell: Shell<T, P>,
 }
 
@@ -85,6 +87,29 @@ impl<T: Scalar, const P: usize> Rls<T, P> {
 
     /// A state for `channel` at `a = 0` with the chosen `P_0`.
     pub fn with_init(config: &Config<T>, channel: &Channel<T>, init: RlsInit) -> Self {
+        Self::centred(config, channel, init, [T::ZERO; P])
+    }
+
+    /// A state that starts from the prior model `a0` with the weight `delta` of `channel`
+    /// (and `P_0 = (delta D)^-1`): the problem of the [module docs](super) with its
+    /// regularisation centred on `a0`, `delta lambda^n (a - a0)^T D (a - a0)`. RLS solves it
+    /// from `a = a0` with the same recursion. With `a0 = 0` it is [`Rls::new`].
+    ///
+    /// # Errors
+    ///
+    /// [`ConfigError::Prior`](super::ConfigError::Prior) if an entry of `a0` is not finite.
+    pub fn with_prior(
+        config: &Config<T>,
+        channel: &Channel<T>,
+        a0: &[T; P],
+    ) -> Result<Self, super::ConfigError> {
+        if !a0.iter().all(|a| a.is_finite()) {
+            return Err(super::ConfigError::Prior);
+        }
+        Ok(Self::centred(config, channel, RlsInit::default(), *a0))
+    }
+
+    fn centred(config: &Config<T>, channel: &Channel<T>, init: RlsInit, centre: [T; P]) -> Self {
         const { assert!(P > 0, "the model order P must be at least 1") };
         let mut s = Self {
             a: [T::ZERO; P],
@@ -94,6 +119,7 @@ impl<T: Scalar, const P: usize> Rls<T, P> {
             energy: T::ZERO,
             error: T::ZERO,
             init,
+            centre,
             shell: Shell::new(*channel),
         };
         s.initialise(config);
@@ -102,7 +128,7 @@ impl<T: Scalar, const P: usize> Rls<T, P> {
 
     fn initialise(&mut self, config: &Config<T>) {
         let (lambda, channel) = (config.lambda(), self.shell.channel());
-        self.a = [T::ZERO; P];
+        self.a = self.centre;
         self.ut = [[T::ZERO; P]; P];
         for (k, d) in self.d.iter_mut().enumerate() {
             *d = match self.init {

@@ -1,7 +1,7 @@
 //! The stabilised fast transversal filter (SFTF), `O(P)` per sample, with its divergence
 //! monitor and rescue.
 
-use super::estimator::{Estimator, sealed::Sealed, transversal};
+use super::estimator::{Estimator, sealed::Sealed};
 use super::shell::Shell;
 use super::{Channel, Config};
 use crate::Scalar;
@@ -102,23 +102,58 @@ pub struct Sftf<T: Scalar, const P: usize> {
     error: T,
     /// The backward errors `r_f`, `r_s` of the last sample, for [`Sftf::disagreement`].
     backward: (T, T),
+    /// With a prior: the model's coefficients, apart from the forward predictor `a`.
+    joint: Option<Joint<T, P>>,
     shell: Shell<T, P>,
 }
 
 impl<T: Scalar, const P: usize> Sftf<T, P> {
     /// A filter for `channel` at the initial state of the problem.
     pub fn new(config: &Config<T>, channel: &Channel<T>) -> Self {
+        Self::centred(config, channel, [T::ZERO; P])
+    }
+
+    /// A filter that starts from the prior model `a0` with the weight `delta` of `channel`:
+    /// the problem of the [module docs](super) with its regularisation centred on `a0`,
+    /// `delta lambda^n (a - a0)^T D (a - a0)`. The gain `g` and the predictors `b` depend on
+    /// the regressors only, and `a <- a + eps g` is the RLS update: the filter solves that
+    /// problem from `a = a0` with the same recursion, and a rescue restarts it from `a0`.
+    /// With `a0 = 0` it is [`Sftf::new`].
+    ///
+    /// # Errors
+    ///
+    /// [`ConfigError::Prior`](super::ConfigError::Prior) if an entry of `a0` is not finite.
+    pub fn with_prior(
+        config: &Config<T>,
+        channel: &Channel<T>,
+        a0: &[T; P],
+    ) -> Result<Self, super::ConfigError> {
+        if !a0.iter().all(|a| a.is_finite()) {
+            return Err(super::ConfigError::Prior);
+        }
+        Ok(Self::centred(config, channel, *a0))
+    }
+
+    fn centred(config: &Config<T>, channel: &Channel<T>, centre: [T; P]) -> Self {
         const { assert!(P > 0, "the model order P must be at least 1") };
+        let energy = channel.delta_lambda_pow(config.lambda(), P);
+        let prior = centre.iter().any(|&a| a != T::ZERO);
         Self {
             a: [T::ZERO; P],
             b: [T::ZERO; P],
             g: [T::ZERO; P],
             phi: [T::ZERO; P],
-            energy: channel.delta_lambda_pow(config.lambda(), P),
+            energy,
             beta: channel.delta(),
             gamma: T::ONE,
             error: T::ZERO,
             backward: (T::ZERO, T::ZERO),
+            joint: prior.then_some(Joint {
+                centre,
+                w: centre,
+                energy,
+                error: T::ZERO,
+            }),
             shell: Shell::new(*channel),
         }
     }
@@ -151,13 +186,12 @@ impl<T: Scalar, const P: usize> Sftf<T, P> {
         T::from_f64(if d > 0.0 { d / scale } else { 0.0 })
     }
 
-    /// The forward energy `alpha_n = min J_n + delta lambda^(n+P)`.
+    /// The order-`P` energy `min J_n + delta lambda^(n+P)`: the forward energy `alpha_n`, or
+    /// with a prior the joint-process energy of the centred problem.
     pub fn energy(&self) -> T {
-        self.energy
+        self.published().0
     }
 }
-
-transversal!(Sftf);
 
 impl<T: Scalar, const P: usize> Estimator<T, P> for Sftf<T, P> {
     type Config = Config<T>;
@@ -169,6 +203,20 @@ impl<T: Scalar, const P: usize> Estimator<T, P> for Sftf<T, P> {
         // (and divisible) however long the input is exactly zero; relative to `delta`.
         let floor = self.shell.channel().floor();
 
+        // The joint process (a prior), on the gain `g` and delay line of before the sample.
+        let (gamma, g, phi) = (self.gamma, &self.g, &self.phi);
+        let mut w_sum = T::ZERO;
+        if let Some(j) = &mut self.joint {
+            let e_w = j.w.iter().zip(phi).fold(y, |e, (&w, &p)| e - w * p);
+            let eps_w = gamma * e_w;
+            for (w, &g) in j.w.iter_mut().zip(g) {
+                *w += eps_w * g;
+                w_sum += *w;
+            }
+            j.energy = lambda * j.energy + eps_w * e_w + floor;
+            j.error = e_w;
+            w_sum += j.energy;
+        }
         let e = self
             .a
             .iter()
@@ -206,11 +254,15 @@ impl<T: Scalar, const P: usize> Estimator<T, P> for Sftf<T, P> {
             *b += k * g;
         }
 
-        if !self.healthy(lambda, r_f, r_s, a_sum) {
+        if !self.healthy(lambda, r_f, r_s, a_sum + w_sum) {
             self.shell.restart(lambda.to_f64());
             *self = Self {
                 shell: self.shell,
-                ..Self::new(config, self.shell.channel())
+                ..Self::centred(
+                    config,
+                    self.shell.channel(),
+                    self.joint.map_or([T::ZERO; P], |j| j.centre),
+                )
             };
             return None;
         }
@@ -219,6 +271,9 @@ impl<T: Scalar, const P: usize> Estimator<T, P> for Sftf<T, P> {
             // gain `g = R^-1 phi / lambda`, so `1/gamma - 1 = g^T phi` doubles.
             let half = T::from_f64(0.5);
             self.energy *= half;
+            if let Some(j) = &mut self.joint {
+                j.energy *= half;
+            }
             self.beta *= half;
             for g in &mut self.g {
                 *g = *g + *g;
@@ -228,8 +283,60 @@ impl<T: Scalar, const P: usize> Estimator<T, P> for Sftf<T, P> {
         }
         self.error = e;
         self.backward = (r_f, r_s);
-        self.shell
-            .refresh(config.dt(), self.energy, || Some(self.a));
-        Some(e)
+        let (energy, a, error) = self.published();
+        let a = *a;
+        self.shell.refresh(config.dt(), energy, || Some(a));
+        Some(error)
+    }
+}
+
+/// The joint-process filter of an [`Sftf`] with a prior: the forward predictor `a` makes the
+/// gain and must stay the zero-centred problem's, so the model's coefficients `w` are a second
+/// transversal filter on the same gain, `w <- w + gamma e_w g`, `e_w = y_n - w^T phi_n`, from
+/// `w = a0` (`2 P` multiplications more per sample).
+#[derive(Clone, Copy, Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+struct Joint<T, const P: usize> {
+    centre: [T; P],
+    w: [T; P],
+    /// `E_n = lambda E_{n-1} + gamma e_w^2`, from `delta lambda^P`.
+    energy: T,
+    error: T,
+}
+
+impl<T: Scalar, const P: usize> Sftf<T, P> {
+    /// The order-`P` energy, coefficients and last a-priori error of the published problem.
+    fn published(&self) -> (T, &[T; P], T) {
+        match &self.joint {
+            Some(j) => (j.energy, &j.w, j.error),
+            None => (self.energy, &self.a, self.error),
+        }
+    }
+
+    /// The coefficients `a_1..a_P` after the last sample.
+    pub fn coefficients(&self) -> &[T; P] {
+        self.published().1
+    }
+
+    /// The last a-priori prediction error (what [`Estimator::update`] returned for the last
+    /// sample it took).
+    pub fn error(&self) -> T {
+        self.published().2
+    }
+}
+
+impl<T: Scalar, const P: usize> Sealed<T, P> for Sftf<T, P> {
+    type Format = T;
+
+    fn shell(&self) -> &Shell<T, P> {
+        &self.shell
+    }
+
+    fn energy(&self) -> T {
+        self.published().0
+    }
+
+    fn current(&self) -> Option<[T; P]> {
+        Some(*self.published().1)
     }
 }

@@ -1,0 +1,190 @@
+//! Estimators started from a prior model `a0`: exact in f64 against the direct solve of the
+//! problem centred on `a0`, at every sample; `a0 = 0` is the plain start bit for bit; the
+//! fixed-point lattice within the float lattice's tolerance.
+
+use imu_ar::ArModel;
+use imu_ar::recursive::{
+    Channel, Config, ConfigError, Estimator, FixedChannel, FixedConfig, FixedLattice, Lattice,
+    Rls, Sftf,
+};
+use imu_ar::sim::ArSimulator;
+use imu_ar_host::reference::Section0;
+use rand_chacha::ChaCha8Rng;
+use rand_core::SeedableRng;
+
+const DELTA: f64 = 0.7;
+const TRUTH: [f64; 4] = [1.2, -0.5, 0.1, 0.05];
+
+fn data(n: usize, seed: u64) -> Vec<f64> {
+    let model = ArModel::new(TRUTH, 1.0, 0.0, 0.01).unwrap();
+    let mut sim = ArSimulator::new(model);
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    sim.burn_in(&mut rng, 500);
+    (0..n).map(|_| sim.next(&mut rng)).collect()
+}
+
+/// `max |x - y| / max |y|`.
+fn rel(x: &[f64], y: &[f64]) -> f64 {
+    let scale = y.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let err = x
+        .iter()
+        .zip(y)
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    if err == 0.0 { 0.0 } else { err / scale }
+}
+
+/// The three float estimators from `a0` over `x` (no mean removal), against the direct solve
+/// at every sample `checked`: the worst relative differences of the coefficients, the energy
+/// (`E_n / W_n`, the innovation variance) and the a-priori error, for each estimator.
+fn check<const P: usize>(
+    x: &[f64],
+    lambda: f64,
+    a0: [f64; P],
+    checked: impl Fn(usize) -> bool,
+) -> [[f64; 3]; 3] {
+    let config = Config::new(lambda, 0.01).unwrap().with_demean(false);
+    let channel = Channel::new(DELTA).unwrap();
+    let mut lattice = Lattice::<f64, P>::with_prior(&config, &channel, &a0).unwrap();
+    let mut rls = Rls::<f64, P>::with_prior(&config, &channel, &a0).unwrap();
+    let mut sftf = Sftf::<f64, P>::with_prior(&config, &channel, &a0).unwrap();
+    let mut reference = Section0::new(P, lambda, DELTA);
+    let mut previous = a0.to_vec();
+    let mut worst = [[0.0f64; 3]; 3];
+    let mut w = 0.0;
+    for (n, &y) in x.iter().enumerate() {
+        let err_ref = reference.a_priori_error(&previous, y);
+        reference.push(y);
+        w = lambda * w + 1.0;
+        let errors = [
+            lattice.update(&config, y).expect("lattice update"),
+            rls.update(&config, y).expect("RLS update"),
+            sftf.update(&config, y).expect("SFTF update"),
+        ];
+        let (a_ref, energy_ref) = reference.solve_centred(&a0);
+        previous.clone_from(&a_ref);
+        if !checked(n + 1) {
+            continue;
+        }
+        let models = [
+            lattice.model(&config).expect("lattice model"),
+            rls.model(&config).expect("RLS model"),
+            sftf.model(&config).expect("SFTF model"),
+        ];
+        for ((worst, model), e) in worst.iter_mut().zip(&models).zip(errors) {
+            worst[0] = worst[0].max(rel(model.a(), &a_ref));
+            let variance = energy_ref / w;
+            worst[1] = worst[1].max((model.noise_variance() - variance).abs() / variance);
+            worst[2] = worst[2].max((e - err_ref).abs() / err_ref.abs().max(1e-300));
+        }
+    }
+    for h in [lattice.health(), rls.health(), sftf.health()] {
+        assert_eq!(h.restarts, 0);
+    }
+    worst
+}
+
+fn assert_exact(tag: &str, worst: [[f64; 3]; 3]) {
+    println!("{tag}: {worst:?}");
+    for (name, w) in ["lattice", "RLS", "SFTF"].iter().zip(worst) {
+        for (what, v) in ["a", "innovation variance", "a-priori error"].iter().zip(w) {
+            assert!(v < 1e-9, "{tag}: {name} {what}: relative difference {v:e}");
+        }
+    }
+}
+
+/// Priors near the truth, far from it, and with the wrong sign.
+fn priors<const P: usize>() -> [[f64; P]; 3] {
+    let near = core::array::from_fn(|k| TRUTH.get(k).copied().unwrap_or(0.0) + 0.05);
+    let far = core::array::from_fn(|k| 0.9 - 0.3 * k as f64);
+    let wrong = core::array::from_fn(|k| -TRUTH.get(k).copied().unwrap_or(0.1));
+    [near, far, wrong]
+}
+
+macro_rules! for_orders {
+    ($x:expr, $lambda:expr, $checked:expr, $tag:expr) => {{
+        for a0 in priors::<1>() {
+            assert_exact(&format!("{} p = 1 {a0:?}", $tag), check::<1>($x, $lambda, a0, $checked));
+        }
+        for a0 in priors::<2>() {
+            assert_exact(&format!("{} p = 2 {a0:?}", $tag), check::<2>($x, $lambda, a0, $checked));
+        }
+        for a0 in priors::<4>() {
+            assert_exact(&format!("{} p = 4 {a0:?}", $tag), check::<4>($x, $lambda, a0, $checked));
+        }
+        for a0 in priors::<8>() {
+            assert_exact(&format!("{} p = 8 {a0:?}", $tag), check::<8>($x, $lambda, a0, $checked));
+        }
+    }};
+}
+
+#[test]
+fn exact_at_every_sample_of_the_first_400() {
+    let x = data(400, 1);
+    for lambda in [0.98, 0.999, 1.0] {
+        for_orders!(&x, lambda, |_| true, format!("lambda = {lambda}"));
+    }
+}
+
+#[test]
+fn exact_after_20_000_samples() {
+    let x = data(20_000, 2);
+    for lambda in [0.99, 1.0] {
+        for_orders!(&x, lambda, |n| n % 1000 == 0, format!("n = 2e4, lambda = {lambda}"));
+    }
+}
+
+/// `a0 = 0` is the plain start: every output bit for bit.
+#[test]
+fn a_zero_prior_is_the_plain_start_bit_for_bit() {
+    let x = data(3000, 3);
+    let config = Config::new(0.995f32, 0.01).unwrap();
+    let channel = Channel::new(0.3f32).unwrap();
+    let zero = [0.0f32; 4];
+    let mut plain = (
+        Lattice::<f32, 4>::new(&config, &channel),
+        Rls::<f32, 4>::new(&config, &channel),
+        Sftf::<f32, 4>::new(&config, &channel),
+    );
+    let mut prior = (
+        Lattice::<f32, 4>::with_prior(&config, &channel, &zero).unwrap(),
+        Rls::<f32, 4>::with_prior(&config, &channel, &zero).unwrap(),
+        Sftf::<f32, 4>::with_prior(&config, &channel, &zero).unwrap(),
+    );
+    for &v in &x {
+        let v = v as f32 + 2.0;
+        assert_eq!(plain.0.update(&config, v), prior.0.update(&config, v));
+        assert_eq!(plain.1.update(&config, v), prior.1.update(&config, v));
+        assert_eq!(plain.2.update(&config, v), prior.2.update(&config, v));
+        assert_eq!(plain.0.model(&config), prior.0.model(&config));
+        assert_eq!(plain.1.model(&config), prior.1.model(&config));
+        assert_eq!(plain.2.model(&config), prior.2.model(&config));
+    }
+}
+
+#[test]
+fn a_prior_that_is_not_finite_is_refused() {
+    let config = Config::new(0.99f32, 0.01).unwrap();
+    let channel = Channel::new(0.1f32).unwrap();
+    let bad = [0.5, f32::NAN];
+    assert_eq!(
+        Lattice::<f32, 2>::with_prior(&config, &channel, &bad).err(),
+        Some(ConfigError::Prior)
+    );
+    assert_eq!(
+        Rls::<f32, 2>::with_prior(&config, &channel, &[f32::INFINITY, 0.0]).err(),
+        Some(ConfigError::Prior)
+    );
+    assert_eq!(
+        Sftf::<f32, 2>::with_prior(&config, &channel, &bad).err(),
+        Some(ConfigError::Prior)
+    );
+    let fixed = FixedConfig::new(&config).unwrap();
+    let fixed_channel = FixedChannel::new(&channel, 1.0).unwrap();
+    for a0 in [[0.5, f32::NAN], [4.0, 0.0], [0.0, -4.5]] {
+        assert_eq!(
+            FixedLattice::<2>::with_prior(&fixed, &fixed_channel, &a0).err(),
+            Some(ConfigError::Prior),
+            "{a0:?}"
+        );
+    }
+}
