@@ -188,3 +188,115 @@ fn a_prior_that_is_not_finite_is_refused() {
         );
     }
 }
+
+/// The fixed-point lattice from a prior: within the tolerance of the fixed-point lattice
+/// without one (`fixed.rs`, 1e-5 in the coefficients against the direct solve), on the
+/// section-8 processes scaled to unit RMS, with priors near and away from the fit.
+#[test]
+fn the_fixed_point_lattice_from_a_prior_within_its_tolerance() {
+    use imu_ar_host::fixtures::ar;
+    const N: usize = 200_000;
+    let pw_truth = [2.7607, -3.8106, 2.6535, -0.9238];
+    let processes: [(&str, Vec<f64>, [f64; 4]); 3] = [
+        ("Percival-Walden AR(4)", ar(pw_truth, 1.0, N, 22), pw_truth),
+        ("AR(4) of these tests", data(N, 5), TRUTH),
+        ("GM(0.999)", ar([0.999], 0.05, N, 21), [0.999, 0.0, 0.0, 0.0]),
+    ];
+    for (name, x, truth) in &processes {
+        let rms = (x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64).sqrt();
+        for offset in [0.01, -0.1] {
+            let a0: [f32; 4] = core::array::from_fn(|k| (truth[k] + offset) as f32);
+            for lambda in [0.999, 0.9999] {
+                let delta = (0.1 * rms * rms) as f32;
+                let config = Config::new(lambda as f32, 0.01).unwrap().with_demean(false);
+                let channel = Channel::new(delta).unwrap();
+                let fixed = FixedConfig::new(&config).unwrap();
+                let fixed_channel = FixedChannel::new(&channel, (1.0 / rms) as f32).unwrap();
+                let mut lattice =
+                    FixedLattice::<4>::with_prior(&fixed, &fixed_channel, &a0).unwrap();
+                let mut reference = Section0::new(4, fixed.lambda(), f64::from(delta));
+                // The centre as the lattice holds it (rounded to I3F29).
+                let centre: Vec<f64> = a0
+                    .iter()
+                    .map(|&a| (f64::from(a) * 2f64.powi(29)).round() / 2f64.powi(29))
+                    .collect();
+                let mut err = 0.0f64;
+                for (n, &v) in x.iter().enumerate() {
+                    reference.push(v);
+                    lattice.update(&fixed, v as f32).expect("sample accepted");
+                    // Early, where the prior weighs, and at the end.
+                    if [100, 1000, 10_000, N].contains(&(n + 1)) {
+                        let (a_ref, _) = reference.solve_centred(&centre);
+                        let a = lattice.coefficients(4).unwrap();
+                        err = a
+                            .iter()
+                            .zip(&a_ref)
+                            .fold(err, |m, (a, b)| m.max((f64::from(*a) - b).abs()));
+                    }
+                }
+                let h = lattice.health();
+                assert_eq!((h.saturated, h.clipped, h.restarts), (0, 0, 0), "{h:?}");
+                println!("{name}, a0 offset {offset}, lambda {lambda}: {err:.1e}");
+                assert!(err <= 1e-5, "{name}, offset {offset}, lambda {lambda}: {err:e}");
+            }
+        }
+    }
+}
+
+/// A settled start: the recursions after the start are exact against the direct solve of the
+/// problem centred on the batch fit of the held samples, with the history rows in the prior's
+/// weight and no prewindowed equation.
+#[test]
+fn a_settled_start_is_exact_against_the_direct_solve() {
+    use imu_ar::recursive::Settled;
+    use imu_ar_host::reference::covariance_ls;
+    const N: usize = 40;
+    const P: usize = 4;
+    let x: Vec<f64> = data(3000, 7).iter().map(|v| v * 3.0).collect();
+    for lambda in [0.995, 1.0] {
+        let config = Config::new(lambda, 0.01).unwrap().with_demean(false);
+        let channel = Channel::new(DELTA).unwrap();
+        let mut lattice: Settled<_, f64, N> = Settled::new(Lattice::<f64, P>::new(&config, &channel));
+        let mut rls: Settled<_, f64, N> = Settled::new(Rls::<f64, P>::new(&config, &channel));
+        let mut sftf: Settled<_, f64, N> = Settled::new(Sftf::<f64, P>::new(&config, &channel));
+        // The prior: the covariance-method fit of the held samples, solved independently.
+        let (a0, _) = covariance_ls(&x[..N], P, false);
+        let mut reference = Section0::new(P, lambda, DELTA);
+        for k in (1..=P).rev() {
+            reference.push_history(x[N - k], &a0);
+        }
+        let mut previous = a0.clone();
+        let mut worst = 0.0f64;
+        for (n, &v) in x.iter().enumerate() {
+            let errors = [
+                lattice.update(&config, v),
+                rls.update(&config, v),
+                sftf.update(&config, v),
+            ];
+            if n < N {
+                assert_eq!(errors, [None; 3], "held at n = {n}");
+                continue;
+            }
+            let err_ref = reference.a_priori_error(&previous, v);
+            reference.push(v);
+            let (a_ref, _) = reference.solve_centred(&a0);
+            previous.clone_from(&a_ref);
+            for e in errors {
+                let e = e.expect("accepted");
+                worst = worst.max((e - err_ref).abs() / err_ref.abs().max(1e-300));
+            }
+            for a in [
+                lattice.model(&config).unwrap().a().to_vec(),
+                rls.model(&config).unwrap().a().to_vec(),
+                sftf.model(&config).unwrap().a().to_vec(),
+            ] {
+                worst = worst.max(rel(&a, &a_ref));
+            }
+        }
+        println!("settled start, lambda {lambda}: worst relative difference {worst:.1e}");
+        assert!(worst < 1e-9, "lambda {lambda}: {worst:e}");
+        for h in [lattice.health(), rls.health(), sftf.health()] {
+            assert_eq!((h.samples, h.restarts), (x.len() as u64, 0), "{h:?}");
+        }
+    }
+}

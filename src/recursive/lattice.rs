@@ -473,12 +473,35 @@ impl<T: FloatArith, const P: usize> Estimator<T, P> for Lattice<T, P> {
 
     fn update(&mut self, config: &Config<T>, x: T) -> Option<T> {
         let y = self.shell.intake(config, x)?;
+        self.step(config, y, true)
+    }
+}
+
+impl<T: FloatArith, const P: usize> super::settled::Start<T, P> for Lattice<T, P> {
+    fn screen(&mut self, x: T) -> Option<T> {
+        self.shell.screen(x)
+    }
+
+    fn start(&mut self, config: &Config<T>, a0: &[T; P], history: &[T; P], mean: (T, T, u64)) {
+        self.core = Self::initial_core(config, self.shell.channel());
+        self.ladder = Some(Ladder::new(*a0, self.core.f_energy_p));
+        for &y in history.iter().rev() {
+            self.step(config, y, false);
+        }
+        self.shell.settle(mean.0, mean.1, mean.2);
+    }
+}
+
+impl<T: FloatArith, const P: usize> Lattice<T, P> {
+    /// Takes the centred sample `y`; a history sample (`equation = false`, a settled start)
+    /// goes through the stages and enters the ladder's delay line with `d = 0`.
+    fn step(&mut self, config: &Config<T>, y: T, equation: bool) -> Option<T> {
         let params = float_params(config, self.shell.channel());
         let mut clip = 0;
         let ladder = self
             .ladder
             .as_mut()
-            .map(|l| l.step(&self.core, &params, y, true, &mut clip));
+            .map(|l| l.step(&self.core, &params, y, equation, &mut clip));
         let f = self.core.step(&params, y, &mut clip);
         let e = ladder.unwrap_or(f);
         // A non-finite value anywhere reaches f_P within a sample or two (the reflection

@@ -46,6 +46,17 @@ impl<T: Scalar> RunningMean<T> {
         }
     }
 
+    /// A mean already settled: `mean` with the weight `weight` of the samples behind it
+    /// (`sum lambda^(n-i)`), as if they had been taken one by one.
+    pub fn settled(mean: T, weight: T) -> Self {
+        Self {
+            origin: mean,
+            offset: T::ZERO,
+            weight: WeightSum(weight),
+            started: true,
+        }
+    }
+
     /// The current mean.
     pub fn mean(&self) -> T {
         self.origin + self.offset

@@ -45,6 +45,7 @@ mod lattice;
 mod mean;
 mod order;
 mod rls;
+mod settled;
 mod sftf;
 mod shell;
 
@@ -56,5 +57,6 @@ pub use lattice::Lattice;
 pub use mean::RunningMean;
 pub use order::{OrderRule, OrderSelector};
 pub use rls::{Rls, RlsInit};
+pub use settled::{Settled, Start};
 pub use sftf::Sftf;
 pub use shell::{Health, snapshot_interval};

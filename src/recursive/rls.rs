@@ -149,12 +149,23 @@ impl<T: Scalar, const P: usize> Estimator<T, P> for Rls<T, P> {
 
     fn update(&mut self, config: &Config<T>, x: T) -> Option<T> {
         let y = self.shell.intake(config, x)?;
+        self.step(config, y, true)
+    }
+}
+
+impl<T: Scalar, const P: usize> Rls<T, P> {
+    /// Takes the centred sample `y`; a history sample (`equation = false`, a settled start)
+    /// enters `P` and the delay line with a zero error, so that `a` stays where it is.
+    fn step(&mut self, config: &Config<T>, y: T, equation: bool) -> Option<T> {
         let lambda = config.lambda();
-        let e = self
-            .a
-            .iter()
-            .zip(&self.phi)
-            .fold(y, |e, (&a, &p)| e - a * p);
+        let e = if equation {
+            self.a
+                .iter()
+                .zip(&self.phi)
+                .fold(y, |e, (&a, &p)| e - a * p)
+        } else {
+            T::ZERO
+        };
 
         // Bierman's update of U D U^T with measurement variance lambda, then D /= lambda:
         // f = U^T phi, v = D f.
@@ -219,6 +230,22 @@ impl<T: Scalar, const P: usize> Estimator<T, P> for Rls<T, P> {
         self.shell
             .refresh(config.dt(), self.energy, || Some(self.a));
         Some(e)
+    }
+}
+
+impl<T: Scalar, const P: usize> super::settled::Start<T, P> for Rls<T, P> {
+    fn screen(&mut self, x: T) -> Option<T> {
+        self.shell.screen(x)
+    }
+
+    fn start(&mut self, config: &Config<T>, a0: &[T; P], history: &[T; P], mean: (T, T, u64)) {
+        self.centre = *a0;
+        self.init = RlsInit::ShiftConsistent;
+        self.initialise(config);
+        for &y in history.iter().rev() {
+            self.step(config, y, false);
+        }
+        self.shell.settle(mean.0, mean.1, mean.2);
     }
 }
 

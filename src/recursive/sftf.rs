@@ -198,6 +198,15 @@ impl<T: Scalar, const P: usize> Estimator<T, P> for Sftf<T, P> {
 
     fn update(&mut self, config: &Config<T>, x: T) -> Option<T> {
         let y = self.shell.intake(config, x)?;
+        self.step(config, y, true)
+    }
+}
+
+impl<T: Scalar, const P: usize> Sftf<T, P> {
+    /// Takes the centred sample `y`; a history sample (`equation = false`, a settled start)
+    /// goes through the forward and backward predictors and the gain, and into the joint
+    /// process with a zero error.
+    fn step(&mut self, config: &Config<T>, y: T, equation: bool) -> Option<T> {
         let lambda = config.lambda();
         // Added to both energy updates, as in the lattice: keeps `alpha` and `beta` positive
         // (and divisible) however long the input is exactly zero; relative to `delta`.
@@ -207,7 +216,11 @@ impl<T: Scalar, const P: usize> Estimator<T, P> for Sftf<T, P> {
         let (gamma, g, phi) = (self.gamma, &self.g, &self.phi);
         let mut w_sum = T::ZERO;
         if let Some(j) = &mut self.joint {
-            let e_w = j.w.iter().zip(phi).fold(y, |e, (&w, &p)| e - w * p);
+            let e_w = if equation {
+                j.w.iter().zip(phi).fold(y, |e, (&w, &p)| e - w * p)
+            } else {
+                T::ZERO
+            };
             let eps_w = gamma * e_w;
             for (w, &g) in j.w.iter_mut().zip(g) {
                 *w += eps_w * g;
@@ -287,6 +300,30 @@ impl<T: Scalar, const P: usize> Estimator<T, P> for Sftf<T, P> {
         let a = *a;
         self.shell.refresh(config.dt(), energy, || Some(a));
         Some(error)
+    }
+}
+
+impl<T: Scalar, const P: usize> super::settled::Start<T, P> for Sftf<T, P> {
+    fn screen(&mut self, x: T) -> Option<T> {
+        self.shell.screen(x)
+    }
+
+    fn start(&mut self, config: &Config<T>, a0: &[T; P], history: &[T; P], mean: (T, T, u64)) {
+        *self = Self {
+            shell: self.shell,
+            ..Self::centred(config, self.shell.channel(), *a0)
+        };
+        // The history needs the joint process even for `a0 = 0`.
+        self.joint = Some(Joint {
+            centre: *a0,
+            w: *a0,
+            energy: self.energy,
+            error: T::ZERO,
+        });
+        for &y in history.iter().rev() {
+            self.step(config, y, false);
+        }
+        self.shell.settle(mean.0, mean.1, mean.2);
     }
 }
 

@@ -290,6 +290,28 @@ impl<T: Scalar, const P: usize> Shell<T, P> {
         Some(y)
     }
 
+    /// Screens `x` for a settled start: a rejection is counted; an accepted sample is not
+    /// (it is counted when the estimator starts on it).
+    pub(crate) fn screen(&mut self, x: T) -> Option<T> {
+        match self.channel.screen(x) {
+            Ok(x) => Some(x),
+            Err(why) => {
+                self.health.reject(why);
+                None
+            }
+        }
+    }
+
+    /// Starts the running mean at a settled `mean` of `samples` samples of weight `weight`
+    /// (which count as accepted), with the weight `W_n` of the equations at 0.
+    pub(crate) fn settle(&mut self, mean: T, weight: T, samples: u64) {
+        self.moments = FloatMoments {
+            mean: RunningMean::settled(mean, weight),
+            weight: WeightSum(T::ZERO),
+        };
+        self.health.samples = self.health.samples.saturating_add(samples);
+    }
+
     /// The weight `W_n`.
     pub(crate) fn weight(&self) -> T {
         self.moments.weight.0
