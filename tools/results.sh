@@ -14,8 +14,12 @@ cd "$(dirname "$0")/.."
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 data=${IMU_AR_DATA:-../shared/data/imu}
-cargo build --release -q -p imu-ar-cli
-tool=target/release/imu-ar
+# IMU_AR_TOOL: an `imu-ar` already built (the same numbers in any profile).
+tool=${IMU_AR_TOOL:-}
+if [ -z "$tool" ]; then
+    cargo build --release -q -p imu-ar-cli
+    tool=target/release/imu-ar
+fi
 
 # replace SECTION FILE: put FILE's contents between the section's markers in README.md.
 replace() {
@@ -32,15 +36,18 @@ replace() {
         name=${spec#*:}
         for n in 1000 100000; do
             "$tool" simulate --a "$a" --sigma 1 --n "$n" --seed 11 > "$tmp/sim.csv"
-            for method in ls burg yule-walker rls lattice; do
+            for method in ls burg yule-walker rls lattice "rls settled" "lattice settled"; do
                 extra=()
-                case $method in rls|lattice) extra=(--lambda 1);; esac
-                "$tool" fit "$tmp/sim.csv" --column x --method "$method" --order 4 "${extra[@]}" \
-                    --json | python3 -c 'import json, sys
+                case $method in
+                    rls|lattice) extra=(--lambda 1);;
+                    *settled) extra=(--lambda 1 --settle 500);;
+                esac
+                "$tool" fit "$tmp/sim.csv" --column x --method "${method%% *}" --order 4 \
+                    "${extra[@]}" --json | python3 -c 'import json, sys
 v = json.load(sys.stdin)
 truth = [float(t) for t in sys.argv[1].split(",")]
 err = max(abs(a - t) for a, t in zip(v["a"], truth))
-print("| %s | %d | %s | %.2g |" % (sys.argv[2], v["n"], v["method"], err))' "$a" "$name"
+print("| %s | %d | %s | %.2g |" % (sys.argv[2], v["n"], sys.argv[3], err))' "$a" "$name" "$method"
             done
         done
     done

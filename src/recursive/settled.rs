@@ -17,6 +17,25 @@ pub trait Start<T: Scalar, const P: usize>: Estimator<T, P, Config = Config<T>> 
     /// `history` (newest first, `y_0 .. y_{1-P}`) in the delay line and the running mean
     /// `(mean, weight, samples)` already settled.
     fn start(&mut self, config: &Config<T>, a0: &[T; P], history: &[T; P], mean: (T, T, u64));
+
+    /// Starts on the held samples `held` (accepted ones, oldest first) as [`Settled`] does
+    /// with its `N`: the settled mean, the batch fit as the prior, the last `P` as history.
+    /// For firmware that keeps the samples elsewhere, and for a number of samples known only
+    /// at run time.
+    fn settle(&mut self, config: &Config<T>, held: &[T]) {
+        let lambda = config.lambda();
+        let mean = if config.demean() { mean_of(held) } else { T::ZERO };
+        let a0 = BatchConfig::new(config.dt())
+            .ok()
+            .and_then(|b| covariance::<T, P>(held, &b.with_demean(config.demean())).ok())
+            .map_or([T::ZERO; P], |fit| *fit.model.a());
+        let weight = held.iter().fold(T::ZERO, |w, _| lambda * w + T::ONE);
+        let history: [T; P] = core::array::from_fn(|k| {
+            let i = held.len().checked_sub(k + 1);
+            i.and_then(|i| held.get(i)).map_or(T::ZERO, |&v| v - mean)
+        });
+        self.start(config, &a0, &history, (mean, weight, held.len() as u64));
+    }
 }
 
 /// An estimator with a settled start, the answer to the start of the prewindowed problem at
@@ -124,7 +143,7 @@ impl<E: Start<T, P>, T: Scalar, const P: usize, const N: usize> Estimator<T, P>
             self.len += 1;
         }
         if self.len >= N {
-            self.begin::<P>(config);
+            self.estimator.settle(config, &self.held);
         }
         None
     }
@@ -135,29 +154,6 @@ impl<E: Start<T, P>, T: Scalar, const P: usize, const N: usize> Estimator<T, P>
 
     fn health(&self) -> Health {
         self.estimator.health()
-    }
-}
-
-impl<E, T: Scalar, const N: usize> Settled<E, T, N> {
-    /// The batch fit, the settled mean and the history; then the estimator starts.
-    fn begin<const P: usize>(&mut self, config: &Config<T>)
-    where
-        E: Start<T, P>,
-    {
-        let x = &self.held[..];
-        let lambda = config.lambda();
-        let mean = if config.demean() { mean_of(x) } else { T::ZERO };
-        let a0 = BatchConfig::new(config.dt())
-            .ok()
-            .and_then(|b| covariance::<T, P>(x, &b.with_demean(config.demean())).ok())
-            .map_or([T::ZERO; P], |fit| *fit.model.a());
-        let weight = x.iter().fold(T::ZERO, |w, _| lambda * w + T::ONE);
-        let history: [T; P] = core::array::from_fn(|k| {
-            let i = x.len().checked_sub(k + 1);
-            i.and_then(|i| x.get(i)).map_or(T::ZERO, |&v| v - mean)
-        });
-        self.estimator
-            .start(config, &a0, &history, (mean, weight, x.len() as u64));
     }
 }
 

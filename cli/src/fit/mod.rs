@@ -36,6 +36,19 @@ pub struct Args {
     /// first 1000 samples, or 1 when that is 0].
     #[arg(long, allow_negative_numbers = true)]
     delta: Option<f64>,
+    /// Start the recursive methods from this model, a_1,..,a_P: their regularisation is
+    /// centred on it, `delta lambda^n (a - a0)^T D (a - a0)`.
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    prior_a: Option<Vec<f64>>,
+    /// The weight of `--prior-a`: the `delta` of its term (`--prior-a 0,..,0 --prior-weight D`
+    /// is `--delta D`).
+    #[arg(long, allow_negative_numbers = true, conflicts_with = "delta", requires = "prior_a")]
+    prior_weight: Option<f64>,
+    /// Settled start of the recursive methods (f64 and f32): hold the first N samples, then
+    /// start from their batch fit as the prior, with the running mean settled and no
+    /// prewindowed equation.
+    #[arg(long, conflicts_with = "prior_a")]
+    settle: Option<usize>,
     /// Internal units per sensor unit of `--scalar fixed` [default: 8 / max |x|, so that the
     /// record, offset included, uses half of the +-16 range].
     #[arg(long, allow_negative_numbers = true)]
@@ -196,11 +209,48 @@ pub fn run(args: &Args) -> Result<FitResult, Fail> {
         lambda,
         delta,
         scale,
+        ref prior_a,
+        prior_weight,
+        settle,
         no_demean,
         decimate,
         rate,
         json: _,
     } = *args;
+    let delta = delta.or(prior_weight);
+    if let Some(a) = prior_a {
+        if a.len() != order {
+            return Err(Fail(format!(
+                "--prior-a has {} coefficients; --order {order} needs {order}",
+                a.len()
+            )));
+        }
+        if let Some(v) = a.iter().find(|v| !v.is_finite()) {
+            return Err(Fail(format!("--prior-a {v}: coefficients must be finite")));
+        }
+        if !method.recursive() {
+            return Err(Fail(format!(
+                "--prior-a: only the recursive methods start from a prior, not {}",
+                method.name()
+            )));
+        }
+    }
+    if let Some(n) = settle {
+        if !method.recursive() || matches!(scalar, ScalarKind::Fixed) {
+            return Err(Fail(format!(
+                "--settle: only --method rls, lattice or sftf in f64 or f32 take a settled \
+                 start, not {} in {}",
+                method.name(),
+                scalar.name()
+            )));
+        }
+        if n < 2 * order + 2 {
+            return Err(Fail(format!(
+                "--settle {n}: the batch fit of order {order} needs at least {} samples",
+                2 * order + 2
+            )));
+        }
+    }
     check_order("--order", order)?;
     check_decimate(decimate)?;
     let rate = rate.map(|r| r / decimate as f64);
@@ -240,6 +290,8 @@ pub fn run(args: &Args) -> Result<FitResult, Fail> {
             dt,
             rate,
             default_delta: default,
+            prior: prior_a.clone(),
+            settle,
         };
         match scalar {
             ScalarKind::F64 => with_order!(order, recursive_fit::<f64>(&x, &r)),

@@ -3,7 +3,7 @@
 
 use imu_ar::recursive::{
     Channel, Config, ConfigError, Estimator, FixedChannel, FixedConfig, FixedLattice, FloatArith,
-    Lattice, Rls, Sftf,
+    Lattice, Rls, Sftf, Start,
 };
 
 use super::FitResult;
@@ -21,6 +21,44 @@ pub(super) struct Recursive {
     pub rate: Option<f64>,
     /// Whether `delta` is the default (not given).
     pub default_delta: bool,
+    /// `--prior-a`: the model the estimator starts from.
+    pub prior: Option<Vec<f64>>,
+    /// `--settle N`: samples held for a settled start.
+    pub settle: Option<usize>,
+}
+
+/// An estimator made by `make` (from the prior, if any), run over `x` less `offset`, with a
+/// settled start on the first `--settle` samples if asked; its model and health.
+fn run<T: FloatArith, const P: usize, E: Start<T, P>>(
+    x: &[f64],
+    offset: f64,
+    r: &Recursive,
+    config: &Config<T>,
+    make: impl FnOnce(&[T; P]) -> Result<E, ConfigError>,
+) -> Result<E, Fail> {
+    let prior: [T; P] = match &r.prior {
+        Some(a) => core::array::from_fn(|k| T::from_f64(a.get(k).copied().unwrap_or(0.0))),
+        None => [T::ZERO; P],
+    };
+    let mut estimator = make(&prior).map_err(|e| Fail(format!("--prior-a: {e}")))?;
+    let samples = x.iter().map(|&v| T::from_f64(v - offset));
+    let held = match r.settle {
+        Some(n) => {
+            // The accepted samples among the first n (the rejected ones are counted).
+            let head: Vec<T> = samples
+                .clone()
+                .take(n)
+                .filter_map(|v| estimator.screen(v))
+                .collect();
+            estimator.settle(config, &head);
+            n
+        }
+        None => 0,
+    };
+    for v in samples.skip(held) {
+        estimator.update(config, v);
+    }
+    Ok(estimator)
 }
 
 /// The scale of `--scalar fixed`: given, or the default `8 / max |x|`.
@@ -84,24 +122,17 @@ pub(super) fn recursive_fit<T: FloatArith, const P: usize>(
     };
     let (model, health, reflection) = match r.method {
         Method::Rls => {
-            let mut rls = Rls::<T, P>::new(&config, &channel);
-            for &v in x {
-                rls.update(&config, T::from_f64(v - offset));
-            }
+            let rls = run(x, offset, r, &config, |a0| Rls::<T, P>::with_prior(&config, &channel, a0))?;
             (rls.model(&config), rls.health(), None)
         }
         Method::Sftf => {
-            let mut sftf = Sftf::<T, P>::new(&config, &channel);
-            for &v in x {
-                sftf.update(&config, T::from_f64(v - offset));
-            }
+            let sftf = run(x, offset, r, &config, |a0| Sftf::<T, P>::with_prior(&config, &channel, a0))?;
             (sftf.model(&config), sftf.health(), None)
         }
         _ => {
-            let mut lattice = Lattice::<T, P>::new(&config, &channel);
-            for &v in x {
-                lattice.update(&config, T::from_f64(v - offset));
-            }
+            let lattice = run(x, offset, r, &config, |a0| {
+                Lattice::<T, P>::with_prior(&config, &channel, a0)
+            })?;
             let model = lattice.model(&config);
             let k = model.and_then(|m| m.reflection().ok());
             (model, lattice.health(), k)
@@ -160,7 +191,12 @@ pub(super) fn fixed_fit<const P: usize>(
         }
     })?;
     let offset = centre(x, r.demean);
-    let mut lattice = FixedLattice::<P>::new(&fixed, &fixed_channel);
+    let prior: [f32; P] = match &r.prior {
+        Some(a) => core::array::from_fn(|k| a.get(k).copied().unwrap_or(0.0) as f32),
+        None => [0.0; P],
+    };
+    let mut lattice = FixedLattice::<P>::with_prior(&fixed, &fixed_channel, &prior)
+        .map_err(|e| Fail(format!("--prior-a: {e}")))?;
     for &v in x {
         lattice.update(&fixed, (v - offset) as f32);
     }
