@@ -161,8 +161,8 @@ impl Section0 {
             .cholesky()
             .expect("regularised system is positive definite")
             .solve(&c);
-        let energy = self.yy + prior - c.dot(&a)
-            + self.delta * self.lambda_n * self.lambda.powi(p as i32);
+        let energy =
+            self.yy + prior - c.dot(&a) + self.delta * self.lambda_n * self.lambda.powi(p as i32);
         (a.iter().copied().collect(), energy)
     }
 

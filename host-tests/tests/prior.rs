@@ -4,8 +4,8 @@
 
 use imu_ar::ArModel;
 use imu_ar::recursive::{
-    Channel, Config, ConfigError, Estimator, FixedChannel, FixedConfig, FixedLattice, Lattice,
-    Rls, Sftf,
+    Channel, Config, ConfigError, Estimator, FixedChannel, FixedConfig, FixedLattice, Lattice, Rls,
+    Sftf,
 };
 use imu_ar::sim::ArSimulator;
 use imu_ar_host::reference::Section0;
@@ -103,16 +103,28 @@ fn priors<const P: usize>() -> [[f64; P]; 3] {
 macro_rules! for_orders {
     ($x:expr, $lambda:expr, $checked:expr, $tag:expr) => {{
         for a0 in priors::<1>() {
-            assert_exact(&format!("{} p = 1 {a0:?}", $tag), check::<1>($x, $lambda, a0, $checked));
+            assert_exact(
+                &format!("{} p = 1 {a0:?}", $tag),
+                check::<1>($x, $lambda, a0, $checked),
+            );
         }
         for a0 in priors::<2>() {
-            assert_exact(&format!("{} p = 2 {a0:?}", $tag), check::<2>($x, $lambda, a0, $checked));
+            assert_exact(
+                &format!("{} p = 2 {a0:?}", $tag),
+                check::<2>($x, $lambda, a0, $checked),
+            );
         }
         for a0 in priors::<4>() {
-            assert_exact(&format!("{} p = 4 {a0:?}", $tag), check::<4>($x, $lambda, a0, $checked));
+            assert_exact(
+                &format!("{} p = 4 {a0:?}", $tag),
+                check::<4>($x, $lambda, a0, $checked),
+            );
         }
         for a0 in priors::<8>() {
-            assert_exact(&format!("{} p = 8 {a0:?}", $tag), check::<8>($x, $lambda, a0, $checked));
+            assert_exact(
+                &format!("{} p = 8 {a0:?}", $tag),
+                check::<8>($x, $lambda, a0, $checked),
+            );
         }
     }};
 }
@@ -129,7 +141,12 @@ fn exact_at_every_sample_of_the_first_400() {
 fn exact_after_20_000_samples() {
     let x = data(20_000, 2);
     for lambda in [0.99, 1.0] {
-        for_orders!(&x, lambda, |n| n % 1000 == 0, format!("n = 2e4, lambda = {lambda}"));
+        for_orders!(
+            &x,
+            lambda,
+            |n| n % 1000 == 0,
+            format!("n = 2e4, lambda = {lambda}")
+        );
     }
 }
 
@@ -200,7 +217,11 @@ fn the_fixed_point_lattice_from_a_prior_within_its_tolerance() {
     let processes: [(&str, Vec<f64>, [f64; 4]); 3] = [
         ("Percival-Walden AR(4)", ar(pw_truth, 1.0, N, 22), pw_truth),
         ("AR(4) of these tests", data(N, 5), TRUTH),
-        ("GM(0.999)", ar([0.999], 0.05, N, 21), [0.999, 0.0, 0.0, 0.0]),
+        (
+            "GM(0.999)",
+            ar([0.999], 0.05, N, 21),
+            [0.999, 0.0, 0.0, 0.0],
+        ),
     ];
     for (name, x, truth) in &processes {
         let rms = (x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64).sqrt();
@@ -237,7 +258,10 @@ fn the_fixed_point_lattice_from_a_prior_within_its_tolerance() {
                 let h = lattice.health();
                 assert_eq!((h.saturated, h.clipped, h.restarts), (0, 0, 0), "{h:?}");
                 println!("{name}, a0 offset {offset}, lambda {lambda}: {err:.1e}");
-                assert!(err <= 1e-5, "{name}, offset {offset}, lambda {lambda}: {err:e}");
+                assert!(
+                    err <= 1e-5,
+                    "{name}, offset {offset}, lambda {lambda}: {err:e}"
+                );
             }
         }
     }
@@ -256,7 +280,8 @@ fn a_settled_start_is_exact_against_the_direct_solve() {
     for lambda in [0.995, 1.0] {
         let config = Config::new(lambda, 0.01).unwrap().with_demean(false);
         let channel = Channel::new(DELTA).unwrap();
-        let mut lattice: Settled<_, f64, N> = Settled::new(Lattice::<f64, P>::new(&config, &channel));
+        let mut lattice: Settled<_, f64, N> =
+            Settled::new(Lattice::<f64, P>::new(&config, &channel));
         let mut rls: Settled<_, f64, N> = Settled::new(Rls::<f64, P>::new(&config, &channel));
         let mut sftf: Settled<_, f64, N> = Settled::new(Sftf::<f64, P>::new(&config, &channel));
         // The prior: the covariance-method fit of the held samples, solved independently.

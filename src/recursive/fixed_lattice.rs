@@ -454,7 +454,9 @@ impl<const P: usize> FixedLattice<P> {
 
     /// The order-`P` energy of the published problem: the ladder's with a prior, else `F_P`.
     fn energy_p(&self) -> I24F40 {
-        self.ladder.as_ref().map_or(self.core.f_energy_p, |l| l.energy)
+        self.ladder
+            .as_ref()
+            .map_or(self.core.f_energy_p, |l| l.energy)
     }
 
     /// Re-initialises the state (counted as a restart). Unless a restart is already settling,

@@ -87,14 +87,7 @@ impl<A: Arith, const P: usize> Ladder<A, P> {
             let (bp, gp) = (core.bp[i], core.gp[i]);
             let next = A::predict(e, *c, bp, clip);
             let gbp = A::gain(gp, bp, clip);
-            *c = A::adapt(
-                *c,
-                gbp,
-                next,
-                core.b_energy[i],
-                &core.b_recip[i],
-                clip,
-            );
+            *c = A::adapt(*c, gbp, next, core.b_energy[i], &core.b_recip[i], clip);
             e = next;
         }
         let ge = A::gain(core.gp_p, e, clip);

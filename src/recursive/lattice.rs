@@ -1,8 +1,8 @@
 //! The a-priori least-squares lattice with error feedback (EF-LSL), `O(P)` per sample.
 
 use super::arith::{Arith, FloatArith, float_params};
-use super::ladder::Ladder;
 use super::estimator::{Estimator, sealed::Sealed};
+use super::ladder::Ladder;
 use super::shell::Shell;
 use super::{Channel, Config};
 use crate::Scalar;
@@ -448,7 +448,9 @@ impl<T: FloatArith, const P: usize> Lattice<T, P> {
 
     /// The order-`P` energy of the published problem: the ladder's with a prior, else `F_P`.
     fn energy_p(&self) -> T {
-        self.ladder.as_ref().map_or(self.core.f_energy_p, |l| l.energy)
+        self.ladder
+            .as_ref()
+            .map_or(self.core.f_energy_p, |l| l.energy)
     }
 }
 

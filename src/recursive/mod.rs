@@ -24,6 +24,17 @@
 //! prediction error, `model` the current [`ArModel`](crate::ArModel), `health` what happened to
 //! the samples.
 //!
+//! A start from a known model. Every estimator can start from a prior `a0` instead
+//! (`with_prior`): the regularisation is then centred on it, `delta lambda^n (a - a0)^T D
+//! (a - a0)`, and `a0 = 0` is the problem above. [`Rls`] and [`Sftf`] solve it from `a = a0`
+//! (the SFTF with a second transversal filter on its gain, since its forward predictor makes
+//! the gain); the lattices with a joint-process ladder (the derivation is in `ladder.rs`'s
+//! docs). All four are exact against the direct solve of that problem (`host-tests`, `prior`).
+//! [`Settled`] holds the first `N` samples and starts from their batch fit, with the running
+//! mean settled and no prewindowed equation: at `lambda = 1`, where the start is never
+//! forgotten, that is the difference between 25 times batch least squares and batch least
+//! squares (README, Results).
+//!
 //! Settings are split by what they belong to. A [`Config`] (forgetting factor, sample
 //! interval, mean removal) is validated once and shared by the estimators of all the channels
 //! of a sensor; `update` and `model` take it. A [`Channel`] (initial regularisation `delta`,

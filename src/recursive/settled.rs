@@ -1,8 +1,8 @@
 //! A settled start: the estimator waits for `N` samples, then starts from their batch fit.
 
+use super::Config;
 use super::estimator::{Estimator, sealed::Sealed};
 use super::shell::Health;
-use super::Config;
 use crate::batch::{BatchConfig, covariance};
 use crate::{ArModel, Scalar};
 
@@ -24,7 +24,11 @@ pub trait Start<T: Scalar, const P: usize>: Estimator<T, P, Config = Config<T>> 
     /// at run time.
     fn settle(&mut self, config: &Config<T>, held: &[T]) {
         let lambda = config.lambda();
-        let mean = if config.demean() { mean_of(held) } else { T::ZERO };
+        let mean = if config.demean() {
+            mean_of(held)
+        } else {
+            T::ZERO
+        };
         let a0 = BatchConfig::new(config.dt())
             .ok()
             .and_then(|b| covariance::<T, P>(held, &b.with_demean(config.demean())).ok())
@@ -55,7 +59,7 @@ pub trait Start<T: Scalar, const P: usize>: Estimator<T, P, Config = Config<T>> 
 ///   regressor `[y_{n-1} .. y_{n-P}]` of real samples. No prewindowed equation (the zeros
 ///   before the first sample) is ever in the problem.
 ///
-/// The problem solved from then on is that of [`Lattice::with_prior`] centred on `a0` with the
+/// The problem solved from then on is that of [`Lattice::with_prior`](super::Lattice::with_prior) centred on `a0` with the
 /// history rows added to the prior's weight (see `ladder.rs`); `a0 = 0` and no history is the
 /// plain start. On the Percival-Walden AR(4) at `lambda = 1` and `n = 100,000` (README,
 /// Results) it brings the recursive estimators from 25 times batch least squares to batch
@@ -108,9 +112,7 @@ impl<E, T: Scalar, const N: usize> Settled<E, T, N> {
     }
 }
 
-impl<E: Start<T, P>, T: Scalar, const P: usize, const N: usize> Sealed<T, P>
-    for Settled<E, T, N>
-{
+impl<E: Start<T, P>, T: Scalar, const P: usize, const N: usize> Sealed<T, P> for Settled<E, T, N> {
     type Format = E::Format;
 
     fn shell(&self) -> &super::shell::Shell<E::Format, P> {
@@ -160,5 +162,9 @@ impl<E: Start<T, P>, T: Scalar, const P: usize, const N: usize> Estimator<T, P>
 /// The mean of `x`, summed in `f64`.
 fn mean_of<T: Scalar>(x: &[T]) -> T {
     let sum = x.iter().fold(0.0f64, |s, v| s + v.to_f64());
-    T::from_f64(if x.is_empty() { 0.0 } else { sum / x.len() as f64 })
+    T::from_f64(if x.is_empty() {
+        0.0
+    } else {
+        sum / x.len() as f64
+    })
 }

@@ -42,7 +42,12 @@ pub struct Args {
     prior_a: Option<Vec<f64>>,
     /// The weight of `--prior-a`: the `delta` of its term (`--prior-a 0,..,0 --prior-weight D`
     /// is `--delta D`).
-    #[arg(long, allow_negative_numbers = true, conflicts_with = "delta", requires = "prior_a")]
+    #[arg(
+        long,
+        allow_negative_numbers = true,
+        conflicts_with = "delta",
+        requires = "prior_a"
+    )]
     prior_weight: Option<f64>,
     /// Settled start of the recursive methods (f64 and f32): hold the first N samples, then
     /// start from their batch fit as the prior, with the running mean settled and no

@@ -122,11 +122,15 @@ pub(super) fn recursive_fit<T: FloatArith, const P: usize>(
     };
     let (model, health, reflection) = match r.method {
         Method::Rls => {
-            let rls = run(x, offset, r, &config, |a0| Rls::<T, P>::with_prior(&config, &channel, a0))?;
+            let rls = run(x, offset, r, &config, |a0| {
+                Rls::<T, P>::with_prior(&config, &channel, a0)
+            })?;
             (rls.model(&config), rls.health(), None)
         }
         Method::Sftf => {
-            let sftf = run(x, offset, r, &config, |a0| Sftf::<T, P>::with_prior(&config, &channel, a0))?;
+            let sftf = run(x, offset, r, &config, |a0| {
+                Sftf::<T, P>::with_prior(&config, &channel, a0)
+            })?;
             (sftf.model(&config), sftf.health(), None)
         }
         _ => {
