@@ -325,3 +325,97 @@ fn a_settled_start_is_exact_against_the_direct_solve() {
         }
     }
 }
+
+/// The mean over samples `from..to` of the largest coefficient error against `truth(n)`, of an
+/// f32 lattice started plainly and one started from `a0`.
+fn tracking(
+    x: &[f64],
+    truth: impl Fn(usize) -> [f64; 2],
+    a0: [f32; 2],
+    (lambda, delta): (f32, f32),
+    (from, to): (usize, usize),
+) -> (f64, f64) {
+    let config = Config::new(lambda, 0.01).unwrap();
+    // The plain start with the usual delta, 0.1 times the variance.
+    let mut plain = Lattice::<f32, 2>::new(&config, &Channel::new(0.6).unwrap());
+    let channel = Channel::new(delta).unwrap();
+    let mut prior = Lattice::<f32, 2>::with_prior(&config, &channel, &a0).unwrap();
+    let (mut e_plain, mut e_prior) = (0.0, 0.0);
+    for (n, &v) in x.iter().enumerate().take(to) {
+        plain.update(&config, v as f32);
+        prior.update(&config, v as f32);
+        if n >= from {
+            let t = truth(n);
+            let err = |m: imu_ar::ArModel<f32, 2>| {
+                m.a()
+                    .iter()
+                    .zip(t)
+                    .fold(0.0f64, |e, (a, b)| e.max((f64::from(*a) - b).abs()))
+            };
+            e_plain += err(plain.model(&config).unwrap());
+            e_prior += err(prior.model(&config).unwrap());
+        }
+    }
+    let k = (to - from) as f64;
+    (e_plain / k, e_prior / k)
+}
+
+/// With the right prior the first 1000 samples are better; on the drifting AR(2) of README
+/// (`a` from (1.5, -0.7) to (1.0, -0.7) over 100,000 samples, `lambda = 0.999`), the prior
+/// costs no tracking. The prior's weight `delta = 300` is about that of 50 samples (the
+/// variance of the stationary AR(2) is about 6).
+#[test]
+fn a_correct_prior_helps_the_start_and_costs_no_tracking() {
+    use imu_ar::sim::ArSimulator;
+    let start = [1.5, -0.7];
+    let model = ArModel::new(start, 1.0, 0.0, 0.01).unwrap();
+    let mut sim = ArSimulator::new(model);
+    let mut rng = ChaCha8Rng::seed_from_u64(9);
+    sim.burn_in(&mut rng, 500);
+    let stationary: Vec<f64> = (0..1000).map(|_| sim.next(&mut rng)).collect();
+    let (plain, prior) = tracking(
+        &stationary,
+        |_| start,
+        [1.5, -0.7],
+        (0.999, 300.0),
+        (0, 1000),
+    );
+    println!(
+        "first 1000 samples: mean max coefficient error {plain:.4} plain, {prior:.4} from the truth"
+    );
+    assert!(prior < 0.75 * plain, "{prior} against {plain}");
+
+    // The drifting AR(2): coefficients move linearly over 100,000 samples.
+    const N: usize = 100_000;
+    let end = [1.0, -0.7];
+    let truth = |n: usize| {
+        let s = n as f64 / (N - 1) as f64;
+        [
+            start[0] + s * (end[0] - start[0]),
+            start[1] + s * (end[1] - start[1]),
+        ]
+    };
+    let mut x = Vec::with_capacity(N);
+    let (mut x1, mut x2) = (0.0f64, 0.0f64);
+    let noise: Vec<f64> = {
+        let white = ArModel::new([0.0], 1.0, 0.0, 0.01).unwrap();
+        let mut w = ArSimulator::new(white);
+        (0..N).map(|_| w.next(&mut rng)).collect()
+    };
+    for (n, &w) in noise.iter().enumerate() {
+        let a = truth(n);
+        let v = a[0] * x1 + a[1] * x2 + w;
+        (x1, x2) = (v, x1);
+        x.push(v);
+    }
+    for lambda in [0.99f32, 0.999] {
+        let (plain, prior) = tracking(&x, truth, [1.5, -0.7], (lambda, 300.0), (20_000, N));
+        println!(
+            "drift, lambda {lambda}: tracking error {plain:.4} plain, {prior:.4} from a prior"
+        );
+        assert!(
+            (prior - plain).abs() <= 0.01 * plain,
+            "lambda {lambda}: {prior} against {plain}"
+        );
+    }
+}
