@@ -167,3 +167,35 @@ fn every_kind_of_argument_error_is_one_informative_line() {
         );
     }
 }
+
+/// `--prior-a` with a negative first coefficient is read (clap took `-1.5,0.7` for a flag);
+/// `--settle` over the whole record says so (it said "no finite model"); `--prior-a 0,..,0
+/// --prior-weight D` is `--delta D`; `--gate` reports the outliers.
+#[test]
+fn prior_settle_and_gate_flags() {
+    let file = ar2("prior-flags.csv");
+    let f = file.to_str().unwrap();
+    let base = [
+        "fit", f, "--column", "x", "--method", "lattice", "--order", "2", "--json",
+    ];
+    let with = |extra: &[&str]| {
+        let mut args = base.to_vec();
+        args.extend_from_slice(extra);
+        imu_ar(&args)
+    };
+    let out = with(&["--prior-a", "-1.5,0.7"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let a = with(&["--prior-a", "0,0", "--prior-weight", "3"]);
+    let b = with(&["--delta", "3"]);
+    assert_eq!(stdout(&a), stdout(&b));
+    let out = with(&["--settle", "1000000"]);
+    assert_one_line_failure(&out);
+    assert!(
+        stderr(&out).contains("--settle 1000000"),
+        "{}",
+        stderr(&out)
+    );
+    let out = with(&["--gate", "5"]);
+    assert!(stdout(&out).contains("\"outliers\":"), "{}", stdout(&out));
+    misused(&[&base[..], &["--gate", "0"]].concat(), "--gate 0");
+}

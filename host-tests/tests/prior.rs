@@ -419,3 +419,41 @@ fn a_correct_prior_helps_the_start_and_costs_no_tracking() {
         );
     }
 }
+
+/// A prior far from the data saturates the fixed-point lattice's centred input: it restarts
+/// once and goes on without the prior, instead of restarting again and again and publishing a
+/// wrong model (found by the break pass: a0 = [-3.99, -3.99] gave a = [-0.555, -0.895] after
+/// 14,431 restarts).
+#[test]
+fn a_prior_the_fixed_formats_cannot_carry_is_dropped_after_one_restart() {
+    let model = ArModel::new([1.9f64, -0.95], 1.0, 0.0, 0.01).unwrap();
+    let mut sim = ArSimulator::new(model);
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    sim.burn_in(&mut rng, 1000);
+    let x: Vec<f64> = (0..50_000).map(|_| sim.next(&mut rng)).collect();
+    let max = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let config = Config::new(0.999f32, 0.01).unwrap();
+    let channel = Channel::new(0.01f32 * (max * max) as f32 / 64.0).unwrap();
+    let fixed = FixedConfig::new(&config).unwrap();
+    let fixed_channel = FixedChannel::new(&channel, (8.0 / max) as f32).unwrap();
+    for a0 in [
+        [0.0f32, 0.0],
+        [1.9, -0.95],
+        [-1.9, -0.95],
+        [3.99, 0.0],
+        [-3.99, -3.99],
+    ] {
+        let mut lattice = FixedLattice::<2>::with_prior(&fixed, &fixed_channel, &a0).unwrap();
+        for &v in &x {
+            lattice.update(&fixed, v as f32);
+        }
+        let h = lattice.health();
+        let a = *lattice.model(&fixed).unwrap().a();
+        println!("a0 {a0:?}: {a:?} {h:?}");
+        assert!(h.restarts <= 1, "a0 {a0:?}: {h:?}");
+        assert!(
+            (a[0] - 1.9).abs() < 0.05 && (a[1] + 0.95).abs() < 0.05,
+            "a0 {a0:?}: {a:?}"
+        );
+    }
+}

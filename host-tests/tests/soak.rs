@@ -1,5 +1,6 @@
-//! The soak: the real gyro records looped through the f32 lattice (p = 8, lambda = 0.999) with
-//! injected faults, then compared with the f64 direct solve of the samples it took.
+//! The soak: the real gyro records looped through the f32 lattice (p = 8, lambda = 0.999, the
+//! innovation gate on at 6 sigma) with injected faults, then compared with the f64 direct solve
+//! of the samples it took.
 //!
 //! `cargo test` runs 10^6 samples; `.ci/run` runs 10^8 with an optimised build:
 //!
@@ -7,7 +8,7 @@
 //! IMU_AR_SOAK_SAMPLES=100000000 cargo test -p imu-ar-host --test soak -- --nocapture
 //! ```
 
-use imu_ar::recursive::{Channel, Config, Estimator, Lattice};
+use imu_ar::recursive::{Channel, Config, Estimator, Gate, Lattice};
 use imu_ar_cli::input::csv::read_column;
 use imu_ar_host::fixtures::real_records;
 use imu_ar_host::reference::{Regularisation, Section0};
@@ -48,7 +49,8 @@ fn soak_real_records_with_faults() {
         }
     }
     let delta = 0.01;
-    let config = Config::new(LAMBDA as f32, 0.01).unwrap();
+    let gate = Gate::new(6.0, 16).unwrap();
+    let config = Config::new(LAMBDA as f32, 0.01).unwrap().with_gate(gate);
     let channel = Channel::new(delta as f32)
         .unwrap()
         .with_saturation(LIMIT)
@@ -101,7 +103,13 @@ fn soak_real_records_with_faults() {
         };
         last = x;
         fed += 1;
+        let outliers = lattice.health().outliers;
         let e = lattice.update(&config, x as f32);
+        if e.is_none() {
+            // Only the gate may refuse a finite sample inside the limit, and it counts it.
+            assert_eq!(lattice.health().outliers, outliers + 1, "sample {fed}");
+            continue;
+        }
         assert!(e.is_some_and(f32::is_finite), "sample {fed}: {e:?}");
         let m = *mean.get_or_insert(f64::from(x as f32));
         let y = f64::from(x as f32) - m;
@@ -115,6 +123,8 @@ fn soak_real_records_with_faults() {
     assert_eq!(h.non_finite, injected.non_finite);
     assert_eq!(h.saturated, injected.saturated);
     assert_eq!(h.samples + h.rejected(), fed);
+    // The +-50 deg/s spikes are outliers (unless the gate was open after a stuck run).
+    assert!(h.outliers * 10 >= injected.spikes * 9, "{h:?} {injected:?}");
     let mut worst = 0.0f64;
     for m in 1..=P {
         let (a_ref, _) = reference.solve(m, Regularisation::ShiftConsistent);

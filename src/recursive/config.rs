@@ -23,6 +23,8 @@ pub enum ConfigError {
     Scale,
     /// The forgetting factor is below the fixed-point lattice's range, `[0.9, 1]`.
     FixedLambda,
+    /// The innovation gate's threshold is not positive and finite, or its run bound is 0.
+    Gate,
     /// A prior model's coefficient is not finite, or (fixed point) outside the coefficient
     /// format's range, +-4.
     Prior,
@@ -40,6 +42,7 @@ impl fmt::Display for ConfigError {
             Self::Saturation => "saturation limit must be positive",
             Self::Scale => "fixed-point scale must be positive and keep delta representable",
             Self::FixedLambda => "the fixed-point lattice needs lambda in [0.9, 1]",
+            Self::Gate => "the gate needs k positive and finite and a run bound of at least 1",
             Self::Prior => {
                 "prior coefficients must be finite (and within +-4 for the fixed-point lattice)"
             }
@@ -68,6 +71,56 @@ pub struct Config<T> {
     lambda: T,
     dt: T,
     demean: bool,
+    gate: Option<Gate>,
+}
+
+/// An innovation gate ([`Config::with_gate`]): a sample whose a-priori prediction error
+/// exceeds `k` times the current innovation standard deviation is rejected and counted in
+/// [`Health::outliers`](super::Health::outliers), unless `run` samples in a row have just been
+/// rejected.
+///
+/// The rule, so that a genuine change (a step in the level, a new noise level) is never
+/// rejected for good: after `run` consecutive rejections the gate opens, and it stays open
+/// (every sample is taken) until a sample passes the test again. So at most `run` samples in
+/// a row are ever rejected: a step is taken from its `run + 1`-th sample on, and the
+/// estimator follows it as its forgetting factor says. A rejected sample changes nothing (the
+/// mean, the weight and the state stay as they were); the sample after it is taken as the
+/// next in time (the gate drops samples, as the NaN screening does). The test applies once the
+/// innovation variance stands on a weight `W_n` of at least [`Gate::SETTLED`] samples; before
+/// that every sample is taken.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Gate {
+    k: f32,
+    run: u32,
+}
+
+impl Gate {
+    /// The weight `W_n` from which the gate tests: 20 samples.
+    pub const SETTLED: f32 = 20.0;
+
+    /// A gate at `k` standard deviations (`k > 0`; 4 to 6 is usual) that opens after `run`
+    /// consecutive rejections (`run >= 1`).
+    ///
+    /// # Errors
+    ///
+    /// [`ConfigError::Gate`].
+    pub fn new(k: f32, run: u32) -> Result<Self, ConfigError> {
+        if !(k.is_finite() && k > 0.0 && run >= 1) {
+            return Err(ConfigError::Gate);
+        }
+        Ok(Self { k, run })
+    }
+
+    /// The threshold, in standard deviations.
+    pub fn k(&self) -> f32 {
+        self.k
+    }
+
+    /// The largest number of consecutive rejections.
+    pub fn run(&self) -> u32 {
+        self.run
+    }
 }
 
 impl<T: Scalar> Config<T> {
@@ -88,7 +141,21 @@ impl<T: Scalar> Config<T> {
             lambda,
             dt,
             demean: true,
+            gate: None,
         })
+    }
+
+    /// With an innovation gate (off by default): see [`Gate`].
+    pub fn with_gate(self, gate: Gate) -> Self {
+        Self {
+            gate: Some(gate),
+            ..self
+        }
+    }
+
+    /// The innovation gate, if any.
+    pub fn gate(&self) -> Option<Gate> {
+        self.gate
     }
 
     /// Whether to remove an exponentially weighted running mean (same `lambda`) before the

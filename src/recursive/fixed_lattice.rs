@@ -2,7 +2,7 @@
 
 use fixed::types::{I3F29, I5F27, I24F40, U0F32};
 
-use super::config::{Channel, Config, ConfigError, Rejection};
+use super::config::{Channel, Config, ConfigError, Gate, Rejection};
 use super::estimator::Estimator;
 use super::estimator::sealed::{Sealed, Settings};
 use super::fixed_arith::{
@@ -34,6 +34,8 @@ pub struct FixedConfig {
     lambda: f64,
     dt: f32,
     demean: bool,
+    /// The gate: `k^2` in Q16 (saturated) and the run bound.
+    gate: Option<(u64, Gate)>,
 }
 
 impl FixedConfig {
@@ -69,6 +71,11 @@ impl FixedConfig {
             lambda: f64::from(lambda.to_bits()) / TWO_32,
             dt: config.dt(),
             demean: config.demean(),
+            gate: config.gate().map(|g| {
+                // `as` saturates: a k beyond 2^24 is a gate that never fires.
+                let k2 = libm::round(f64::from(g.k()) * f64::from(g.k()) * 65_536.0) as u64;
+                (k2, g)
+            }),
         })
     }
 
@@ -332,8 +339,11 @@ impl<const P: usize> FixedLattice<P> {
     /// [`Lattice::with_prior`](super::Lattice::with_prior) describes, by the same
     /// joint-process ladder in fixed point. The ladder's coefficients (the correction
     /// `a - a0` in the backward errors' basis) share the format of the reflection
-    /// coefficients: a correction beyond +-4 there saturates and restarts the lattice, as
-    /// any saturation does. With `a0 = 0` it is [`FixedLattice::new`], bit for bit.
+    /// coefficients. A prior the formats cannot carry (the centred input
+    /// `d_n = y_n - a0^T phi_n` beyond +-16, or a correction beyond +-4) saturates: the
+    /// lattice then restarts, as on any saturation, and goes on without the prior (centred on
+    /// 0), so that a prior far from the data never loops on restarts. With `a0 = 0` it is
+    /// [`FixedLattice::new`], bit for bit.
     ///
     /// # Errors
     ///
@@ -371,8 +381,51 @@ impl<const P: usize> FixedLattice<P> {
     /// as saturated and counted). A reading that saturates the state restarts the lattice and
     /// returns the error it made; [`Estimator::update`] returns `None` for it.
     pub fn update_counts(&mut self, config: &FixedConfig, count: i16) -> Option<I5F27> {
-        let x = self.shell.admit(self.shell.channel().screen_count(count))?;
+        let x = self.gated(config, self.shell.channel().screen_count(count))?;
         Some(self.accept(config, x))
+    }
+
+    /// A screened sample through the gate (if any), then counted: `None` for a sample the
+    /// screening or the gate rejected (each counted).
+    #[inline]
+    fn gated(&mut self, config: &FixedConfig, screened: Result<i32, Rejection>) -> Option<i32> {
+        if let (Some((k2, gate)), Ok(x)) = (config.gate, screened) {
+            let outlier = self.outlier(config, k2, x);
+            if !self.shell.pass(&gate, outlier) {
+                return None;
+            }
+        }
+        self.shell.admit(screened)
+    }
+
+    /// Whether the Q27 sample `x` is an outlier: its a-priori error `e` (Q27) against the
+    /// order-`P` energy `E` and the weight `W` (both Q40), `e^2 W > k^2 E` in integers, once
+    /// `W` has reached [`Gate::SETTLED`].
+    fn outlier(&self, config: &FixedConfig, k2: u64, x: i32) -> bool {
+        let m = &self.shell.moments;
+        if m.weight < (Gate::SETTLED as i64) << ENERGY_FRAC {
+            return false;
+        }
+        let mut clip = 0;
+        let y = if !config.demean {
+            x
+        } else if m.started {
+            let mean = ((m.mean >> (MEAN_FRAC - ERR_FRAC - 1)) + 1) >> 1;
+            sat_i32(i64::from(x) - mean, &mut clip)
+        } else {
+            0
+        };
+        let y = I5F27::from_bits(y);
+        let e = match &self.ladder {
+            Some(l) => l.a_priori(&self.core, y),
+            None => self.core.a_priori(y),
+        };
+        let e2 = u128::from(e.to_bits().unsigned_abs()).pow(2);
+        // e^2 (Q54) W (Q40), shifted to Q56, against k^2 (Q16) E (Q40), Q56;
+        // `e^2 W < 2^125`, `k^2 E < 2^96`.
+        let lhs = (e2 * m.weight.unsigned_abs() as u128) >> 38;
+        let rhs = u128::from(k2) * u128::from(self.energy_p().to_bits().unsigned_abs());
+        lhs > rhs
     }
 
     /// One in-range sample `x` (Q27). Any saturation inside (the centred input, an error, an
@@ -435,6 +488,10 @@ impl<const P: usize> FixedLattice<P> {
             l.energy = energy;
         }
         self.restart(config);
+        // A prior the formats cannot carry (`d_n = y_n - a0^T phi_n` beyond +-16, a
+        // correction beyond +-4) would saturate again after every restart: the lattice goes
+        // on without it.
+        self.ladder = None;
     }
 
     lattice_accessors!(
@@ -510,7 +567,7 @@ impl<const P: usize> Estimator<f32, P> for FixedLattice<P> {
     /// channel's own limit. The error comes back in sensor units; a sample that saturated the
     /// state and restarted the lattice returns `None`.
     fn update(&mut self, config: &FixedConfig, x: f32) -> Option<f32> {
-        let x = self.shell.admit(self.shell.channel().screen(x))?;
+        let x = self.gated(config, self.shell.channel().screen(x))?;
         let restarts = self.shell.health.restarts;
         let f = self.accept(config, x);
         let scale = f64::from(self.shell.channel().scale);

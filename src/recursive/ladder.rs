@@ -64,6 +64,19 @@ impl<A: Arith, const P: usize> Ladder<A, P> {
         }
     }
 
+    /// The a-priori error `e_P(n)` of `y_n`, without taking it (for the gate).
+    pub(crate) fn a_priori(&self, core: &Core<A, P>, y: A::Err) -> A::Err {
+        let mut clip = 0;
+        let mut e = y;
+        for (&a, &x) in self.centre.iter().zip(&self.past) {
+            e = A::predict(e, a, x, &mut clip);
+        }
+        for (&c, &bp) in self.c.iter().zip(&core.bp) {
+            e = A::predict(e, c, bp, &mut clip);
+        }
+        e
+    }
+
     /// Takes `y_n` on the state of `core` before [`Core::step`] takes it; returns the
     /// a-priori error `e_P(n)`. A history sample (`equation = false`) enters the delay line
     /// only: `d_n = 0`, so that it adds no equation.

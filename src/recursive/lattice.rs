@@ -159,6 +159,16 @@ impl<A: Arith, const P: usize> Core<A, P> {
         f
     }
 
+    /// The a-priori error `f_P(n)` of `y_n`, without taking it (for the gate): the forward
+    /// chain alone, `P` multiplications.
+    pub(crate) fn a_priori(&self, y: A::Err) -> A::Err {
+        let mut clip = 0;
+        let kf = &self.ring_kf[self.head % P];
+        kf.iter()
+            .zip(&self.bp)
+            .fold(y, |f, (&k, &b)| A::predict(f, k, b, &mut clip))
+    }
+
     /// `kf_1..kf_P` after the last sample.
     pub(crate) fn forward_reflection(&self) -> &[A::Coef; P] {
         &self.ring_kf[self.head % P]
@@ -474,6 +484,14 @@ impl<T: FloatArith, const P: usize> Estimator<T, P> for Lattice<T, P> {
     type Config = Config<T>;
 
     fn update(&mut self, config: &Config<T>, x: T) -> Option<T> {
+        let (core, ladder) = (&self.core, &self.ladder);
+        let a_priori = |y| match ladder {
+            Some(l) => l.a_priori(core, y),
+            None => core.a_priori(y),
+        };
+        if !self.shell.gate(config, x, self.energy_p(), a_priori) {
+            return None;
+        }
         let y = self.shell.intake(config, x)?;
         self.step(config, y, true)
     }

@@ -62,6 +62,15 @@ impl<T: Scalar> RunningMean<T> {
         self.origin + self.offset
     }
 
+    /// What [`center`](Self::center) would return for `x`, without taking `x` into the mean.
+    pub fn peek(&self, x: T) -> T {
+        if self.started {
+            (x - self.origin) - self.offset
+        } else {
+            T::ZERO
+        }
+    }
+
     /// Centres `x` with the mean before it and then takes `x` into the mean.
     ///
     /// ```

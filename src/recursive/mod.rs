@@ -61,7 +61,7 @@ mod sftf;
 mod shell;
 
 pub use arith::FloatArith;
-pub use config::{Channel, Config, ConfigError};
+pub use config::{Channel, Config, ConfigError, Gate};
 pub use estimator::Estimator;
 pub use fixed_lattice::{FixedChannel, FixedConfig, FixedLattice};
 pub use lattice::Lattice;

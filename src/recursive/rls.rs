@@ -148,6 +148,11 @@ impl<T: Scalar, const P: usize> Estimator<T, P> for Rls<T, P> {
     type Config = Config<T>;
 
     fn update(&mut self, config: &Config<T>, x: T) -> Option<T> {
+        let (a, phi) = (&self.a, &self.phi);
+        let a_priori = |y| a.iter().zip(phi).fold(y, |e, (&a, &p)| e - a * p);
+        if !self.shell.gate(config, x, self.energy, a_priori) {
+            return None;
+        }
         let y = self.shell.intake(config, x)?;
         self.step(config, y, true)
     }

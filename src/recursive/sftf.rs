@@ -197,6 +197,14 @@ impl<T: Scalar, const P: usize> Estimator<T, P> for Sftf<T, P> {
     type Config = Config<T>;
 
     fn update(&mut self, config: &Config<T>, x: T) -> Option<T> {
+        let (energy, a, phi) = match &self.joint {
+            Some(j) => (j.energy, &j.w, &self.phi),
+            None => (self.energy, &self.a, &self.phi),
+        };
+        let a_priori = |y| a.iter().zip(phi).fold(y, |e, (&a, &p)| e - a * p);
+        if !self.shell.gate(config, x, energy, a_priori) {
+            return None;
+        }
         let y = self.shell.intake(config, x)?;
         self.step(config, y, true)
     }

@@ -22,12 +22,16 @@ pub struct Health {
     pub restarts: u64,
     /// Internal values saturated to their number format (fixed point only; 0 for floats).
     pub clipped: u64,
+    /// Samples rejected by the innovation gate ([`Config::with_gate`](super::Config::with_gate)).
+    pub outliers: u64,
 }
 
 impl Health {
     /// All rejected samples.
     pub fn rejected(&self) -> u64 {
-        self.non_finite + self.saturated
+        self.non_finite
+            .saturating_add(self.saturated)
+            .saturating_add(self.outliers)
     }
 
     fn reject(&mut self, why: Rejection) {
@@ -113,6 +117,10 @@ pub struct Shell<F: Format, const P: usize> {
     snapshot: Option<ArModel<F::Out, P>>,
     /// Samples to go before a restarted estimator publishes again.
     hold: u32,
+    /// Consecutive samples the gate has rejected.
+    run: u32,
+    /// The gate is open: every sample is taken until one passes the test.
+    open: bool,
 }
 
 /// Largest hold after a restart, in samples: three memories of `lambda = 0.9999`.
@@ -168,7 +176,32 @@ impl<F: Format, const P: usize> Shell<F, P> {
             health: Health::default(),
             snapshot: None,
             hold: 0,
+            run: 0,
+            open: false,
         }
+    }
+
+    /// The gate's decision on a sample whose a-priori error `e` and innovation variance
+    /// `variance` it is told (`outlier`: `e^2 > k^2 variance`, tested only once the variance
+    /// is settled): `false` rejects it (counted), `true` takes it. See
+    /// [`Gate`](super::config::Gate) for the rule.
+    #[inline]
+    pub(crate) fn pass(&mut self, gate: &super::config::Gate, outlier: bool) -> bool {
+        if !outlier {
+            self.run = 0;
+            self.open = false;
+            return true;
+        }
+        if self.open {
+            return true;
+        }
+        self.health.outliers = self.health.outliers.saturating_add(1);
+        self.run = self.run.saturating_add(1);
+        if self.run >= gate.run() {
+            self.open = true;
+            self.run = 0;
+        }
+        false
     }
 
     /// The channel the estimator was made for.
@@ -310,6 +343,48 @@ impl<T: Scalar, const P: usize> Shell<T, P> {
             weight: WeightSum(T::ZERO),
         };
         self.health.samples = self.health.samples.saturating_add(samples);
+    }
+
+    /// The gate's view of `x`: screened (a rejection is counted), then centred with the
+    /// current mean, without taking it in; `None` for a rejected sample.
+    #[inline]
+    pub(crate) fn peek(&mut self, config: &Config<T>, x: T) -> Option<T> {
+        let x = self.screen(x)?;
+        Some(if config.demean() {
+            self.moments.mean.peek(x)
+        } else {
+            x
+        })
+    }
+
+    /// Whether the a-priori error `e` is an outlier for `gate` against the energy `energy`
+    /// (`e^2 > k^2 energy / W_n`), once `W_n` has reached [`Gate::SETTLED`].
+    #[inline]
+    pub(crate) fn outlier(&self, gate: &super::config::Gate, e: T, energy: T) -> bool {
+        let w = self.weight();
+        let k = T::from_f64(f64::from(gate.k()));
+        w >= T::from_f64(f64::from(super::config::Gate::SETTLED)) && e * e * w > k * k * energy
+    }
+
+    /// The gate for a float estimator: `a_priori(y)` is the estimator's a-priori error of
+    /// the centred sample `y`, `energy` its order-`P` energy. `false`: the sample is rejected
+    /// (counted) and must change nothing.
+    #[inline]
+    pub(crate) fn gate(
+        &mut self,
+        config: &Config<T>,
+        x: T,
+        energy: T,
+        a_priori: impl FnOnce(T) -> T,
+    ) -> bool {
+        let Some(gate) = config.gate() else {
+            return true;
+        };
+        let Some(y) = self.peek(config, x) else {
+            return false;
+        };
+        let outlier = self.outlier(&gate, a_priori(y), energy);
+        self.pass(&gate, outlier)
     }
 
     /// The weight `W_n`.

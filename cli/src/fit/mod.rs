@@ -3,6 +3,7 @@
 mod recursive;
 
 use imu_ar::batch::{BatchConfig, BatchError};
+use imu_ar::recursive::Gate;
 use serde::Serialize;
 
 use crate::error::Fail;
@@ -38,7 +39,7 @@ pub struct Args {
     delta: Option<f64>,
     /// Start the recursive methods from this model, a_1,..,a_P: their regularisation is
     /// centred on it, `delta lambda^n (a - a0)^T D (a - a0)`.
-    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     prior_a: Option<Vec<f64>>,
     /// The weight of `--prior-a`: the `delta` of its term (`--prior-a 0,..,0 --prior-weight D`
     /// is `--delta D`).
@@ -54,6 +55,11 @@ pub struct Args {
     /// prewindowed equation.
     #[arg(long, conflicts_with = "prior_a")]
     settle: Option<usize>,
+    /// Innovation gate of the recursive methods: reject (and count) a sample whose a-priori
+    /// error exceeds K innovation standard deviations; after 16 rejections in a row the
+    /// gate opens until a sample passes.
+    #[arg(long, allow_negative_numbers = true)]
+    gate: Option<f64>,
     /// Internal units per sensor unit of `--scalar fixed` [default: 8 / max |x|, so that the
     /// record, offset included, uses half of the +-16 range].
     #[arg(long, allow_negative_numbers = true)]
@@ -107,6 +113,9 @@ pub struct FitResult {
     /// Samples rejected as not finite (recursive methods).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub non_finite: Option<u64>,
+    /// Samples rejected by `--gate` (recursive methods).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub outliers: Option<u64>,
     /// Samples rejected as saturated (fixed point).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub saturated: Option<u64>,
@@ -145,6 +154,7 @@ impl FitResult {
             scale: None,
             restarts: None,
             non_finite: None,
+            outliers: None,
             saturated: None,
             clipped: None,
             rate_hz: None,
@@ -217,6 +227,7 @@ pub fn run(args: &Args) -> Result<FitResult, Fail> {
         ref prior_a,
         prior_weight,
         settle,
+        gate,
         no_demean,
         decimate,
         rate,
@@ -276,7 +287,23 @@ pub fn run(args: &Args) -> Result<FitResult, Fail> {
     if let Some(d) = delta {
         check_delta(d)?;
     }
+    let gate = match gate {
+        Some(k) if !method.recursive() => {
+            return Err(Fail(format!(
+                "--gate {k}: only the recursive methods gate, not {}",
+                method.name()
+            )));
+        }
+        Some(k) => Some(Gate::new(k as f32, 16).map_err(|e| Fail(format!("--gate {k}: {e}")))?),
+        None => None,
+    };
     let x = input.load(decimate)?;
+    if let Some(n) = settle.filter(|&n| n >= x.len()) {
+        return Err(input.fail(format!(
+            "--settle {n}: the record has {} samples; the settled start needs more than it holds",
+            x.len()
+        )));
+    }
     if let Some(r) = rate {
         check_span("--rate", r * decimate as f64, x.len() * decimate)?;
     }
@@ -297,6 +324,7 @@ pub fn run(args: &Args) -> Result<FitResult, Fail> {
             default_delta: default,
             prior: prior_a.clone(),
             settle,
+            gate,
         };
         match scalar {
             ScalarKind::F64 => with_order!(order, recursive_fit::<f64>(&x, &r)),

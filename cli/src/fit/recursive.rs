@@ -3,7 +3,7 @@
 
 use imu_ar::recursive::{
     Channel, Config, ConfigError, Estimator, FixedChannel, FixedConfig, FixedLattice, FloatArith,
-    Lattice, Rls, Sftf, Start,
+    Gate, Lattice, Rls, Sftf, Start,
 };
 
 use super::FitResult;
@@ -25,6 +25,8 @@ pub(super) struct Recursive {
     pub prior: Option<Vec<f64>>,
     /// `--settle N`: samples held for a settled start.
     pub settle: Option<usize>,
+    /// `--gate K`.
+    pub gate: Option<Gate>,
 }
 
 /// An estimator made by `make` (from the prior, if any), run over `x` less `offset`, with a
@@ -70,7 +72,8 @@ pub(super) enum Scale {
 
 /// The configuration in `T`, with an error that says which setting `T` cannot carry.
 fn config_in<T: FloatArith>(r: &Recursive) -> Result<(Config<T>, Channel<T>), Fail> {
-    let config = Config::new(T::from_f64(r.lambda), T::from_f64(r.dt));
+    let config = Config::new(T::from_f64(r.lambda), T::from_f64(r.dt))
+        .map(|c| r.gate.map_or(c, |g| c.with_gate(g)));
     // Checked in the order lambda, delta, interval.
     match (config, Channel::new(T::from_f64(r.delta))) {
         (Ok(config), Ok(channel)) => Ok((config, channel)),
@@ -152,6 +155,7 @@ pub(super) fn recursive_fit<T: FloatArith, const P: usize>(
         delta: Some(r.delta),
         restarts: Some(health.restarts),
         non_finite: Some(health.non_finite),
+        outliers: Some(health.outliers),
         ..FitResult::new(
             r.method.name(),
             r.scalar.name(),
@@ -223,6 +227,7 @@ pub(super) fn fixed_fit<const P: usize>(
         saturated: Some(health.saturated),
         clipped: Some(health.clipped),
         non_finite: Some(health.non_finite),
+        outliers: Some(health.outliers),
         ..FitResult::new("lattice", "fixed", x.len(), mean, a, noise_variance)
     }
     .with_rate(r.rate, r.dt))
