@@ -4,6 +4,8 @@
 //! rejected with the model's own error; and the flash store (`persist/flash.rs`) against a
 //! NOR flash in RAM with power cuts at every byte of a save.
 
+#[path = "persist/arrays.rs"]
+mod arrays;
 #[path = "persist/flash.rs"]
 mod flash;
 

@@ -3,6 +3,7 @@
 //! Every read and write goes through [`In`] and [`Out`], which index with `get` and never
 //! panic; lengths are checked once, up front.
 
+use crate::Scalar;
 use crate::model::ArModel;
 use crate::noise::{Coefficients, GmTerm, NoiseError, NoiseModel, Oscillator};
 
@@ -213,7 +214,7 @@ impl<'a> In<'a> {
 }
 
 macro_rules! ar_record {
-    ($t:ty, $kind:expr, $size:expr) => {
+    ($t:ty, $kind:expr, $array_kind:expr, $size:expr) => {
         impl<const P: usize> Sealed for ArModel<$t, P> {
             const KIND: u8 = $kind;
             const ORDER: usize = P;
@@ -226,27 +227,85 @@ macro_rules! ar_record {
             fn encode(&self, buf: &mut [u8]) -> Result<usize, EncodeError> {
                 self.reflection().map_err(EncodeError::Ar)?;
                 let mut out = Out::begin::<Self>(buf)?;
-                let values = [self.noise_variance(), self.mean(), self.dt()];
-                for v in self.a().iter().chain(&values) {
-                    out.put(&v.to_le_bytes());
-                }
+                put_ar(&mut out, self);
                 Ok(out.finish())
             }
 
             fn decode(bytes: &[u8]) -> Result<Self, DecodeError> {
+                take_ar(&mut In::open::<Self>(bytes)?)
+            }
+        }
+
+        impl<const P: usize, const N: usize> Sealed for [ArModel<$t, P>; N] {
+            const KIND: u8 = $array_kind;
+            const ORDER: usize = P;
+            const CAPACITY: usize = N;
+        }
+
+        impl<const P: usize, const N: usize> Record for [ArModel<$t, P>; N] {
+            const LEN: usize = MIN_LEN + N * $size * (P + 3);
+
+            fn encode(&self, buf: &mut [u8]) -> Result<usize, EncodeError> {
+                const { assert!(N > 0, "an array of at least one model") };
+                for m in self {
+                    m.reflection().map_err(EncodeError::Ar)?;
+                }
+                let mut out = Out::begin::<Self>(buf)?;
+                self.iter().for_each(|m| put_ar(&mut out, m));
+                Ok(out.finish())
+            }
+
+            fn decode(bytes: &[u8]) -> Result<Self, DecodeError> {
+                const { assert!(N > 0, "an array of at least one model") };
                 let mut r = In::open::<Self>(bytes)?;
-                let a = core::array::from_fn(|_| <$t>::from_le_bytes(r.take()));
-                let [variance, mean, dt] = core::array::from_fn(|_| <$t>::from_le_bytes(r.take()));
-                let model = ArModel::new(a, variance, mean, dt).map_err(DecodeError::Ar)?;
-                model.reflection().map_err(DecodeError::Ar)?;
-                Ok(model)
+                let first = take_ar(&mut r)?;
+                let mut error = None;
+                let models = core::array::from_fn(|i| match i {
+                    0 => first,
+                    _ => take_ar(&mut r).unwrap_or_else(|e| {
+                        error.get_or_insert(e);
+                        first
+                    }),
+                });
+                error.map_or(Ok(models), Err)
+            }
+        }
+
+        impl Wire for $t {
+            fn put(self, out: &mut Out<'_>) {
+                out.put(&self.to_le_bytes());
+            }
+
+            fn take(r: &mut In<'_>) -> Self {
+                <$t>::from_le_bytes(r.take())
             }
         }
     };
 }
 
-ar_record!(f32, 1, 4);
-ar_record!(f64, 2, 8);
+/// A value as the layouts store it: IEEE 754, little-endian.
+trait Wire: Scalar {
+    fn put(self, out: &mut Out<'_>);
+    fn take(r: &mut In<'_>) -> Self;
+}
+
+/// An AR payload: `a_1..a_P`, variance, mean, `dt`.
+fn put_ar<T: Wire, const P: usize>(out: &mut Out<'_>, m: &ArModel<T, P>) {
+    let values = [m.noise_variance(), m.mean(), m.dt()];
+    m.a().iter().chain(&values).for_each(|v| v.put(out));
+}
+
+/// The AR payload at the reader, validated: [`ArModel::new`], then stationarity.
+fn take_ar<T: Wire, const P: usize>(r: &mut In<'_>) -> Result<ArModel<T, P>, DecodeError> {
+    let a = core::array::from_fn(|_| T::take(r));
+    let [variance, mean, dt] = core::array::from_fn(|_| T::take(r));
+    let model = ArModel::new(a, variance, mean, dt).map_err(DecodeError::Ar)?;
+    model.reflection().map_err(DecodeError::Ar)?;
+    Ok(model)
+}
+
+ar_record!(f32, 1, 4, 4);
+ar_record!(f64, 2, 5, 8);
 
 impl<const P: usize, const G: usize> Sealed for NoiseModel<P, G> {
     const KIND: u8 = 3;

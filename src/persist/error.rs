@@ -38,7 +38,8 @@ pub enum DecodeError {
         /// The CRC of the bytes read.
         computed: u32,
     },
-    /// A record of another kind (1 `ArModel<f32, P>`, 2 `ArModel<f64, P>`, 3 `NoiseModel`).
+    /// A record of another kind (1 `ArModel<f32, P>`, 2 `ArModel<f64, P>`, 3 `NoiseModel`,
+    /// 4 and 5 arrays of `f32` and `f64` AR models).
     Kind {
         /// The kind stored.
         stored: u8,
@@ -52,7 +53,8 @@ pub enum DecodeError {
         /// The order asked for.
         expected: usize,
     },
-    /// A noise model of another capacity `G` (or an AR record with a non-zero `G` field).
+    /// A noise model of another capacity `G`, an array of another length `N`, or one AR model
+    /// with a non-zero `G` field.
     Capacity {
         /// The capacity stored.
         stored: usize,
@@ -65,8 +67,9 @@ pub enum DecodeError {
         /// Offset of the field in the record.
         offset: usize,
     },
-    /// The bytes are intact but make no valid AR model: a NaN or infinite value, a negative
-    /// variance, a `dt` that is not positive, or a model that is not stationary.
+    /// The bytes are intact but make no valid AR model (of an array, the first invalid one): a
+    /// NaN or infinite value, a negative variance, a `dt` that is not positive, or a model
+    /// that is not stationary.
     Ar(ModelError),
     /// The bytes are intact but make no valid noise model (see
     /// [`NoiseModel::new`](crate::noise::NoiseModel::new)).

@@ -1,6 +1,6 @@
 //! Fitted models that survive a power cycle: a fixed, versioned byte layout with a CRC-32
-//! ([`Record`], for [`ArModel<f32, P>`](crate::ArModel), `ArModel<f64, P>` and
-//! [`NoiseModel<P, G>`](crate::noise::NoiseModel)), and a store in NOR flash that a power cut
+//! ([`Record`], for [`ArModel<f32, P>`](crate::ArModel), `ArModel<f64, P>`, arrays of them
+//! (the axes of an IMU) and [`NoiseModel<P, G>`](crate::noise::NoiseModel)), and a store in NOR flash that a power cut
 //! in the middle of a save cannot damage ([`FlashStore`], over `embedded-storage`'s
 //! `NorFlash`). No allocation; no panic on any input.
 //!
@@ -29,9 +29,9 @@
 //! |---|---|---|
 //! | 0 | 4 | magic `IMAR` (`49 4D 41 52`) |
 //! | 4 | 1 | layout version, [`VERSION`] (1) |
-//! | 5 | 1 | kind: 1 `ArModel<f32, P>`, 2 `ArModel<f64, P>`, 3 `NoiseModel<P, G>` |
+//! | 5 | 1 | kind: 1 `ArModel<f32, P>`, 2 `ArModel<f64, P>`, 3 `NoiseModel<P, G>`, 4 `[ArModel<f32, P>; N]`, 5 `[ArModel<f64, P>; N]` |
 //! | 6 | 2 | `P`, u16 |
-//! | 8 | 2 | `G`, u16 (0 for an AR model) |
+//! | 8 | 2 | `G` of a noise model, `N` of an array, 0 for one AR model; u16 |
 //! | 10 | 2 | `L`, the record's length in bytes, header and CRC included, u16 |
 //! | 12 | `L - 16` | payload, by kind (below) |
 //! | `L - 4` | 4 | CRC-32 of bytes `0..L-4`, u32 (IEEE 802.3, reflected polynomial `0xEDB88320`, initial value and final XOR `0xFFFFFFFF`: zlib's `crc32`) |
@@ -45,6 +45,9 @@
 //! | `12 + s P` | `s` | innovation variance |
 //! | `12 + s (P + 1)` | `s` | mean |
 //! | `12 + s (P + 2)` | `s` | `dt`, s |
+//!
+//! Array of `N >= 1` AR models: their `N` payloads one after the other, `L = 16 + N s (P + 3)`
+//! (184 bytes for the six axes' `[ArModel<f32, 4>; 6]`).
 //!
 //! Noise model, every value `f64`; `L = 88 + 40 G + 8 P`, 200 bytes for `NoiseModel<4, 2>`:
 //!
@@ -111,9 +114,10 @@ pub(crate) mod sealed {
     }
 }
 
-/// A model with a byte layout: [`ArModel<f32, P>`](crate::ArModel), `ArModel<f64, P>` and
-/// [`NoiseModel<P, G>`](crate::noise::NoiseModel) (see the [module docs](self) for the
-/// layouts). Implemented by this crate only.
+/// A model with a byte layout: [`ArModel<f32, P>`](crate::ArModel), `ArModel<f64, P>`,
+/// arrays `[ArModel<T, P>; N]` of either (one record for the axes of an IMU, saved and loaded
+/// together) and [`NoiseModel<P, G>`](crate::noise::NoiseModel); see the
+/// [module docs](self) for the layouts. Implemented by this crate only.
 pub trait Record: Sized + sealed::Sealed {
     /// The record's length in bytes (`L`): `[0u8; ArModel::<f32, 4>::LEN]` holds one.
     const LEN: usize;
@@ -123,7 +127,7 @@ pub trait Record: Sized + sealed::Sealed {
     /// # Errors
     ///
     /// [`EncodeError::Buffer`] for a buffer shorter than [`Record::LEN`];
-    /// [`EncodeError::Ar`] for an AR model that is not stationary; [`EncodeError::Noise`] for
+    /// [`EncodeError::Ar`] for an AR model (of an array, the first) that is not stationary; [`EncodeError::Noise`] for
     /// a noise model [`NoiseModel::new`](crate::noise::NoiseModel::new) refuses (a fitted
     /// one never is). `buf` is untouched then.
     fn encode(&self, buf: &mut [u8]) -> Result<usize, EncodeError>;
