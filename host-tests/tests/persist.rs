@@ -1,13 +1,16 @@
 //! The persisted layouts of `imu_ar::persist`: bit-exact round trips of fixed and random valid
 //! models, the layout pinned byte by byte, every single-bit flip and every truncation of a
 //! record rejected, 10,000 random byte strings rejected, intact records of invalid models
-//! rejected with the model's own error; and the flash store (`persist/flash.rs`) against a
-//! NOR flash in RAM with power cuts at every byte of a save.
+//! rejected with the model's own error; the flash store (`persist/flash.rs`) against a NOR
+//! flash in RAM with power cuts at every byte of a save; and records written by another
+//! encoder from the documented layout (`persist/seeds.rs`).
 
 #[path = "persist/arrays.rs"]
 mod arrays;
 #[path = "persist/flash.rs"]
 mod flash;
+#[path = "persist/seeds.rs"]
+mod seeds;
 
 use imu_ar::ArModel;
 use imu_ar::model::ModelError;
