@@ -8,7 +8,9 @@
 //! ```
 //!
 //! The composite noise model's fit, check, IEEE 952 readings and filter form are called too
-//! (from the firmware's `AllanStream`, with the lattice's model as the AR part).
+//! (from the firmware's `AllanStream`, with the lattice's model as the AR part), and both
+//! models go through the persistence layouts (encoding, decoding bytes the compiler cannot
+//! see) and through a flash store on a NOR flash in RAM.
 //!
 //! It runs as well: the estimators get a short synthetic record and the firmware exits 0 when
 //! every output is finite. Nothing is logged, since the logger has panic paths of its own.
@@ -20,9 +22,11 @@ mod firmware {
 
     use cortex_m_rt::{ExceptionFrame, entry, exception};
     use cortex_m_semihosting::debug;
+    use embedded_storage::nor_flash::{ErrorType, NorFlash, NorFlashErrorKind, ReadNorFlash};
     use imu_ar::allan::AllanStream;
     use imu_ar::model::{ArModel, ModelError};
     use imu_ar::noise::{FitConfig, NoiseError, NoiseModel, Octaves};
+    use imu_ar::persist::{EncodeError, FlashStore, Record};
     use imu_ar::recursive::{Channel, Config, Estimator, FixedChannel, FixedConfig};
     use imu_ar::recursive::{FixedLattice, Lattice, OrderRule, OrderSelector, Rls, Sftf};
 
@@ -86,7 +90,72 @@ mod firmware {
         let order = black_box(selector.order());
         finite &= order <= P;
         finite &= noise::<P>(&allan, lattice.model(config).as_ref());
+        finite &= lattice.model(config).is_some_and(|m| persist(&m));
         finite && black_box(lattice.coefficients(P)).is_some()
+    }
+
+    /// Two erase units of NOR flash in RAM; every access checked, none can panic.
+    struct Ram([u8; 2048]);
+
+    impl ErrorType for Ram {
+        type Error = NorFlashErrorKind;
+    }
+
+    impl ReadNorFlash for Ram {
+        const READ_SIZE: usize = 1;
+
+        fn read(&mut self, offset: u32, bytes: &mut [u8]) -> Result<(), Self::Error> {
+            let at = offset as usize;
+            let range = at..at.saturating_add(bytes.len());
+            let src = self.0.get(range).ok_or(NorFlashErrorKind::OutOfBounds)?;
+            bytes.iter_mut().zip(src).for_each(|(d, s)| *d = *s);
+            Ok(())
+        }
+
+        fn capacity(&self) -> usize {
+            self.0.len()
+        }
+    }
+
+    impl NorFlash for Ram {
+        const WRITE_SIZE: usize = 4;
+        const ERASE_SIZE: usize = 1024;
+
+        fn erase(&mut self, from: u32, to: u32) -> Result<(), Self::Error> {
+            let cells = self.0.get_mut(from as usize..to as usize);
+            cells.ok_or(NorFlashErrorKind::OutOfBounds)?.fill(0xFF);
+            Ok(())
+        }
+
+        fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), Self::Error> {
+            let at = offset as usize;
+            let range = at..at.saturating_add(bytes.len());
+            let dst = self
+                .0
+                .get_mut(range)
+                .ok_or(NorFlashErrorKind::OutOfBounds)?;
+            dst.iter_mut().zip(bytes).for_each(|(d, s)| *d &= *s);
+            Ok(())
+        }
+    }
+
+    /// `model` encoded and decoded (from bytes the compiler cannot see), then saved to and
+    /// loaded from a flash store: whether both give it back. A model that is not stationary
+    /// is refused by the encoder, with a typed error.
+    fn persist<M: Record + PartialEq>(model: &M) -> bool {
+        let mut buf = [0u8; 512];
+        match model.encode(&mut buf) {
+            Ok(_) => {}
+            Err(e) => return matches!(black_box(e), EncodeError::Ar(_)),
+        }
+        let decoded = M::decode(black_box(&buf));
+        let mut flash = Ram([0xFF; 2048]);
+        let Ok(mut store) = FlashStore::new(&mut flash, 0..black_box(2048)) else {
+            return false;
+        };
+        let saved = store.save(model, &mut buf).is_ok();
+        let loaded = store.load::<M>(&mut buf);
+        saved && decoded.as_ref() == Ok(model) && loaded.as_ref() == Ok(model)
     }
 
     /// The composite noise model from the stream, with the lattice's model as its AR part when
@@ -104,10 +173,17 @@ mod firmware {
         let fitted = NoiseModel::<P, 2>::fit(&octaves, ar.as_ref(), &config).and_then(|model| {
             let check = model.check(&octaves)?;
             let form = model.kalman(black_box(0.1), black_box(1e-4))?;
-            Ok((model.ieee952(&octaves), check.explained_up_to(), form))
+            Ok((
+                model.ieee952(&octaves),
+                check.explained_up_to(),
+                form,
+                model,
+            ))
         });
         match fitted {
-            Ok((ieee, _, form)) => ieee.white_noise.is_finite() && form.white_psd.is_finite(),
+            Ok((ieee, _, form, model)) => {
+                ieee.white_noise.is_finite() && form.white_psd.is_finite() && persist(&model)
+            }
             // An AR part the lattice's model cannot give (not stationary) is a typed error.
             Err(e) => matches!(black_box(e), NoiseError::Ar(ModelError::Unstable { .. })),
         }

@@ -7,6 +7,7 @@ pub mod allan;
 pub mod batch;
 pub mod model;
 pub mod noise;
+pub mod persist;
 pub mod recursive;
 pub mod scalar;
 pub mod sensor;

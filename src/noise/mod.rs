@@ -31,6 +31,7 @@ mod fit;
 mod model;
 pub mod nnls;
 mod octaves;
+mod parts;
 
 pub use fit::{FitConfig, OSCILLATOR_CYCLES, OSCILLATOR_MIN_HZ};
 pub use model::{
@@ -38,6 +39,7 @@ pub use model::{
 };
 pub use nnls::NnlsError;
 pub use octaves::{Estimator, NoiseType, Octaves};
+pub use parts::Coefficients;
 
 /// Why a noise model could not be fitted or used.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -79,6 +81,10 @@ pub enum NoiseError {
     Overflow,
     /// The Allan variances span too many decades (about 1e300) for their weights: no model.
     Range,
+    /// A model's parameter is out of range ([`NoiseModel::new`]): a coefficient or `sigma`
+    /// negative or not finite, a correlation time, decay time or frequency not positive and
+    /// finite, or Gauss-Markov terms not by non-decreasing correlation time.
+    Parameter,
     /// The AR part is not a stationary model.
     Ar(ModelError),
     /// The least-squares solve failed.
@@ -119,6 +125,10 @@ impl fmt::Display for NoiseError {
             Self::Range => {
                 f.write_str("the Allan variances span more decades than f64 can weigh (about 300)")
             }
+            Self::Parameter => f.write_str(
+                "a noise model parameter is out of range (a negative or non-finite coefficient \
+                 or sigma, a time or frequency not positive, or Gauss-Markov terms out of order)",
+            ),
             Self::Ar(e) => write!(f, "AR part: {e}"),
             Self::Nnls(e) => write!(f, "least squares: {e:?}"),
         }

@@ -1,6 +1,13 @@
 //! imu-ar on a real board: a WeAct STM32F411 "Black Pill" reading an MPU-6050 over I2C1 and
 //! learning an AR(4) model of every axis online, logged over RTT with defmt.
 //!
+//! The six models are saved every five minutes as one record in the last two flash sectors
+//! (`imu_ar::persist::FlashStore` over the HAL's `embedded-storage` flash driver) and loaded
+//! and logged at boot. A power cut during a save leaves the previous save. One save in about
+//! 680 erases a 128 KiB sector first, which stalls the CPU for 2 to 4 s (the F411's erase
+//! time at 8-bit parallelism): the MPU-6050's FIFO overflows then, and the loop accounts for
+//! the lost samples as for any overflow.
+//!
 //! Wiring (3.3 V logic): MPU-6050 VCC to 3V3, GND to GND, SCL to PB6, SDA to PB7 (the GY-521
 //! breakout has its own pull-ups), AD0 open or to GND (address 0x68).
 //!
@@ -15,12 +22,22 @@
 use cortex_m::peripheral::DWT;
 use cortex_m_rt::entry;
 use defmt_rtt as _;
+use imu_ar::ArModel;
+use imu_ar::persist::{FlashStore, Record, StoreError};
 use imu_ar::recursive::{Channel, Config, Estimator, Lattice};
 use imu_ar::sensor::{AccelUnit, Error, GyroUnit, ImuReader, Mpu6050, Mpu6050Config, RawSample};
 use panic_probe as _;
+use stm32f4xx_hal::flash::{FlashExt, LockedFlash};
 use stm32f4xx_hal::{i2c::I2c, pac, prelude::*};
 
 const NAMES: [&str; 6] = ["gx", "gy", "gz", "ax", "ay", "az"];
+/// The models of the six axes, saved and loaded as one record (184 bytes).
+type Models = [ArModel<f32, 4>; 6];
+/// Where they are kept: sectors 6 and 7 of the STM32F411CE, offsets from the start of flash
+/// (0x0800_0000); `memory.x` keeps the firmware out of them.
+const STORE: core::ops::Range<u32> = 0x4_0000..0x8_0000;
+/// Samples between saves: five minutes at 100 Hz.
+const SAVE_EVERY: u32 = 30_000;
 /// The wait after DEVICE_RESET inside `init` and `recover`.
 const INIT_DELAY_US: u64 = 100_000;
 
@@ -42,6 +59,46 @@ impl Clock {
     }
 }
 
+/// The models saved last, if any.
+fn load(flash: &mut LockedFlash) -> Option<Models> {
+    let mut unlocked = flash.unlocked();
+    let mut buf = [0u8; <Models as Record>::LEN];
+    let loaded = FlashStore::new(&mut unlocked, STORE).and_then(|mut s| s.load(&mut buf));
+    match loaded {
+        Ok(models) => Some(models),
+        Err(StoreError::Empty) => {
+            defmt::info!("no saved models");
+            None
+        }
+        Err(e) => {
+            defmt::warn!("saved models not loaded: {}", defmt::Debug2Format(&e));
+            None
+        }
+    }
+}
+
+/// Saves the six axes' current models, once every axis has one.
+fn save(flash: &mut LockedFlash, axes: &[Lattice<f32, 4>; 6], config: &Config<f32>) {
+    let Some(models) = models(axes, config) else {
+        return;
+    };
+    let mut unlocked = flash.unlocked();
+    let mut buf = [0u8; <Models as Record>::LEN];
+    let saved = FlashStore::new(&mut unlocked, STORE).and_then(|mut s| s.save(&models, &mut buf));
+    match saved {
+        Ok(seq) => defmt::info!("models saved (entry {=u32})", seq),
+        Err(e) => defmt::warn!("models not saved: {}", defmt::Debug2Format(&e)),
+    }
+}
+
+fn models(axes: &[Lattice<f32, 4>; 6], config: &Config<f32>) -> Option<Models> {
+    let mut out = [axes[0].model(config)?; 6];
+    for (slot, lattice) in out.iter_mut().zip(axes) {
+        *slot = lattice.model(config)?;
+    }
+    Some(out)
+}
+
 #[entry]
 fn main() -> ! {
     let dp = pac::Peripherals::take().expect("device peripherals");
@@ -58,6 +115,18 @@ fn main() -> ! {
         cycles: 0,
     };
     let mut delay = cp.SYST.delay(&clocks);
+    let mut flash = LockedFlash::new(dp.FLASH);
+    if let Some(saved) = load(&mut flash) {
+        for (name, m) in NAMES.iter().zip(&saved) {
+            defmt::info!(
+                "{=str}: saved a={=[?]} sigma^2={=f32} mean={=f32}",
+                name,
+                m.a().as_slice(),
+                m.noise_variance(),
+                m.mean()
+            );
+        }
+    }
 
     let mut imu = Mpu6050::new(i2c, 0x68);
     let config = Mpu6050Config::default(); // +-250 deg/s, +-2 g, 44 Hz filter, 100 Hz
@@ -137,6 +206,9 @@ fn main() -> ! {
                     }
                 }
                 defmt::info!("FIFO: {}", imu.fifo_stats());
+            }
+            if samples.is_multiple_of(SAVE_EVERY) {
+                save(&mut flash, &axes, &shared);
             }
         }
     }
