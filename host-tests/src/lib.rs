@@ -9,3 +9,4 @@ pub mod composite;
 pub mod differential;
 pub mod fixtures;
 pub mod reference;
+pub mod thermal;
