@@ -75,7 +75,12 @@ fn f64_against_reference<const N: usize>(
     let mut stage = ThermalBias::new(&config);
     if let Some(p) = prior {
         stage = ThermalBias::with_prior(&config, p).unwrap();
-        reference = reference.with_prior(&p);
+        reference = reference.with_prior(&p).with_start(&p);
+    } else {
+        // Without a prior, the stage starts from the first sample as the constant term.
+        let mut s = [0.0; N];
+        s[0] = data[0].0;
+        reference = reference.with_start(&s);
     }
     let mut c_ref = reference.solve();
     let (mut worst_c, mut worst_e) = (0.0f64, 0.0f64);
@@ -157,7 +162,10 @@ fn f32_against_reference<const N: usize>(data: &[(f64, f64)], lambda: f64, delta
         .unwrap();
     let lambda = f64::from(config.lambda());
     let delta = f64::from(config.delta());
-    let mut reference = ThermalLs::new(N, lambda, RANGE.0, RANGE.1, delta);
+    let mut start = [0.0; N];
+    start[0] = f64::from(data[0].0 as f32);
+    let reference = ThermalLs::new(N, lambda, RANGE.0, RANGE.1, delta);
+    let mut reference = reference.with_start(&start);
     let mut stage = ThermalBias::new(&config);
     let mut c_ref = reference.solve();
     let mut worst = [0.0f64; 4];
@@ -184,9 +192,9 @@ fn f32_against_reference<const N: usize>(data: &[(f64, f64)], lambda: f64, delta
 /// The `f32` stage stays within half the estimate's own standard error of the `f64` solution,
 /// or within 2 % of the noise sigma where that is larger (an estimate informed by 10^5
 /// samples has a standard error of 0.3 % of sigma), at every sample of every profile; on the
-/// profiles where the temperature keeps moving, within 0.3 % of sigma. Measured worst: 0.21
-/// standard errors (after a still spell, as the ramp starts), 0.005 sigma where the standard
-/// error is smallest, 0.0013 sigma on the moving profiles.
+/// profiles where the temperature keeps moving, within 0.3 % of sigma. Measured worst: 0.32
+/// standard errors (a still temperature, memory 10^5 samples, where that is 0.0016 sigma),
+/// 0.0013 sigma on the moving profiles.
 #[test]
 fn f32_stays_within_its_stated_tolerance() {
     let n = 100_000;
@@ -263,19 +271,20 @@ fn a_still_temperature_keeps_the_covariance_bounded() {
         (f32_fit - fitted).abs() < 1e-4,
         "f32 {f32_fit}, f64 {fitted}"
     );
-    // The unidentified directions have relaxed to the prior (0): c is the smallest vector
-    // that fits the held temperature, a multiple of phi(30 deg C).
+    // The unidentified directions have relaxed to the prior, 0: c is about the smallest
+    // vector that fits the held temperature, a multiple of phi(30 deg C) (exactly one if the
+    // regularisation were delta I; it is delta lambda^j, j = 0..N-1, at each sample).
     let phi = ThermalLs::new(N, lambda, RANGE.0, RANGE.1, delta).regressor(30.0);
-    let c = s64.coefficients();
+    let d = *s64.coefficients();
     let norm2: f64 = phi.iter().map(|p| p * p).sum();
-    let along = c.iter().zip(&phi).map(|(c, p)| c * p).sum::<f64>() / norm2;
-    let across: f64 = c
+    let along = d.iter().zip(&phi).map(|(d, p)| d * p).sum::<f64>() / norm2;
+    let across: f64 = d
         .iter()
         .zip(&phi)
-        .map(|(c, p)| (c - along * p).powi(2))
+        .map(|(d, p)| (d - along * p).powi(2))
         .sum::<f64>()
         .sqrt();
-    assert!(across < 1e-3 * along.abs(), "{c:?}");
+    assert!(across < 1e-2 * along.abs(), "{d:?}");
     assert_eq!(s64.health().restarts + s32.health().restarts, 0);
 }
 
