@@ -32,14 +32,13 @@
 //! ([`ThermalBias::with_prior`]); otherwise `p = 0` and `s = [x_1, 0, .., 0]`, a constant
 //! bias equal to the first sample, as the estimators' running mean starts at the first sample
 //! (the first residual is 0, not the whole bias, and the start is forgotten as the data come
-//! in). The first sum is
-//! exponentially weighted least squares. The second is a regularisation that is not forgotten:
-//! every sample adds one pseudo-observation `c_k = p_k` of weight `w`, the coefficients taking
-//! turns, so that in the steady state each coefficient carries a prior weight between
-//! `delta lambda^(N-1)` and `delta` (the `delta lambda^n` start decays into it). This is the
-//! regularised tracking of Gunnarsson ("Combining tracking and regularization in recursive
-//! least squares identification", CDC 1996), `R_n = lambda R_{n-1} + phi phi^T + (1 - lambda)
-//! delta I`, with the full-rank term spread over `N` samples as rank-one terms.
+//! in). The first sum is exponentially weighted least squares. The second is a regularisation
+//! that is not forgotten: every sample adds one pseudo-observation `c_k = p_k` of weight `w`,
+//! the coefficients taking turns, so that in the steady state each coefficient carries a prior
+//! weight between `delta lambda^(N-1)` and `delta` (the `delta lambda^n` start decays into it).
+//! This is the regularised tracking of Gunnarsson ("Combining tracking and regularization in
+//! recursive least squares identification", CDC 1996), `R_n = lambda R_{n-1} + phi phi^T +
+//! (1 - lambda) delta I`, with the full-rank term spread over `N` samples as rank-one terms.
 //!
 //! # A temperature that does not move
 //!
@@ -433,7 +432,12 @@ impl<T: Scalar, const N: usize> ThermalBias<T, N> {
     /// Returns `None`, counts the sample in [`ThermalHealth`] and changes nothing else when
     /// `x` or the temperature is NaN or infinite, or `|x|` reaches the saturation limit. A
     /// temperature outside the range gives the residual at the clamped temperature and is not
-    /// learned from. Never panics; the residual is always finite. `O(N^2)`.
+    /// learned from. The first accepted sample of a stage without a prior sets its start (see
+    /// the [module docs](self)), so its residual is 0. Never panics; the residual is always
+    /// finite. `O(N^2)`.
+    ///
+    /// A numerical breakdown (a non-finite state, out of reach below the magnitude limit)
+    /// would re-initialise the stage and count a restart in [`ThermalHealth::restarts`].
     pub fn update(&mut self, config: &ThermalConfig<T, N>, x: T, celsius: T) -> Option<T> {
         if !(x.is_finite() && celsius.is_finite()) {
             self.health.non_finite = self.health.non_finite.saturating_add(1);
