@@ -14,7 +14,9 @@
 //! Rows: `lattice` (f32 and fixed), `rls` and `sftf` (f32) per sample at p = 1, 2, 4, 8, 16, 32, and at
 //! p = 3, 5, 6, 7 for the f32 lattice and RLS (where one overtakes the other); `extract` per
 //! request of the exact coefficients of order p; `frame6` per six-axis frame of order-4
-//! lattices. Then the state of one channel, `<estimator> <scalar> p=<P> bytes=<N>`
+//! lattices; `thermal` per sample of one axis through the temperature compensation stage
+//! (`imu_ar::thermal::ThermalBias`, p its number of coefficients: degree p - 1) on a
+//! 25 to 45 deg C ramp. Then the state of one channel, `<estimator> <scalar> p=<P> bytes=<N>`
 //! (`size_of` on the target). Last, one fit of the composite noise model from a 20-octave
 //! `AllanStream`, without and with an AR(8) part: `noise fit ... insns/fit=<N> stack=<B>`, and
 //! the bytes of the stream, the model and the octaves.
@@ -31,6 +33,7 @@ mod firmware {
     use cortex_m::peripheral::{SYST, syst::SystClkSource};
     use imu_ar::recursive::{Channel, Config, Estimator, FixedChannel, FixedConfig, FixedLattice};
     use imu_ar::recursive::{Lattice, Rls, Sftf};
+    use imu_ar::thermal::{ThermalBias, ThermalConfig};
     use imu_ar::{
         ArModel,
         allan::AllanStream,
@@ -71,6 +74,8 @@ mod firmware {
         per_tick: u32,
         x: [f32; BATCH],
         counts: [i16; BATCH],
+        /// The die temperature of each sample of `x`, deg C: a ramp from 25 to 45.
+        celsius: [f32; BATCH],
     }
 
     impl Bench {
@@ -183,6 +188,32 @@ mod firmware {
                 black_box(black_box(&state).coefficients(P));
             });
             defmt::info!("extract f32 p={=usize} insns/sample={=u32}", P, n);
+        }
+
+        /// The thermal stage with `N` coefficients, per sample of one axis: instructions, then
+        /// the state's size (the shared `ThermalConfig` not included).
+        fn thermal_f32<const N: usize>(&mut self) {
+            let Ok(config) = ThermalConfig::<f32, N>::new(0.9999, 20.0, 50.0) else {
+                common::exit(false)
+            };
+            let mut state = ThermalBias::new(&config);
+            let (x, celsius) = (self.x, self.celsius);
+            let cell = core::cell::RefCell::new(&mut state);
+            let n = self.insns_per_sample(|i| {
+                black_box(cell.borrow_mut().update(
+                    &config,
+                    black_box(x[i]),
+                    black_box(celsius[i]),
+                ));
+            });
+            defmt::info!("thermal f32 p={=usize} insns/sample={=u32}", N, n);
+            let bytes = core::mem::size_of::<ThermalBias<f32, N>>();
+            defmt::info!("thermal f32 p={=usize} bytes={=usize}", N, bytes);
+            let health = cell.borrow().health();
+            if health.samples != BATCH as u64 || health.restarts > 0 {
+                defmt::error!("thermal f32 p={=usize}: not every sample learned", N);
+                common::exit(false);
+            }
         }
 
         /// One six-axis frame: six order-4 lattices, one sample each.
@@ -305,11 +336,13 @@ mod firmware {
             *v = 0.4 + state;
             *c = (*v * 20.0) as i16;
         }
+        let celsius = core::array::from_fn(|i| 25.0 + 20.0 * i as f32 / BATCH as f32);
         let mut bench = Bench {
             syst: cp.SYST,
             per_tick,
             x,
             counts,
+            celsius,
         };
         macro_rules! orders {
             ($f:ident) => {
@@ -337,6 +370,9 @@ mod firmware {
         between!(rls_f32);
         orders!(extract_f32);
         bench.frame6_f32();
+        bench.thermal_f32::<1>();
+        bench.thermal_f32::<2>();
+        bench.thermal_f32::<4>();
         bench.noise_fit();
         common::exit(per_tick > 0)
     }

@@ -8,9 +8,11 @@
 //! ```
 //!
 //! The composite noise model's fit, check, IEEE 952 readings and filter form are called too
-//! (from the firmware's `AllanStream`, with the lattice's model as the AR part), and both
-//! models go through the persistence layouts (encoding, decoding bytes the compiler cannot
-//! see) and through a flash store on a NOR flash in RAM.
+//! (from the firmware's `AllanStream`, with the lattice's model as the AR part), both models
+//! go through the persistence layouts (encoding, decoding bytes the compiler cannot see) and
+//! through a flash store on a NOR flash in RAM, and the thermal compensation stage's
+//! per-sample path (`ThermalBias::update`, and its bias, compensation and leverage at a
+//! temperature) runs in `f32` and `f64`.
 //!
 //! It runs as well: the estimators get a short synthetic record and the firmware exits 0 when
 //! every output is finite. Nothing is logged, since the logger has panic paths of its own.
@@ -23,12 +25,14 @@ mod firmware {
     use cortex_m_rt::{ExceptionFrame, entry, exception};
     use cortex_m_semihosting::debug;
     use embedded_storage::nor_flash::{ErrorType, NorFlash, NorFlashErrorKind, ReadNorFlash};
+    use imu_ar::Scalar;
     use imu_ar::allan::AllanStream;
     use imu_ar::model::{ArModel, ModelError};
     use imu_ar::noise::{FitConfig, NoiseError, NoiseModel, Octaves};
     use imu_ar::persist::{EncodeError, FlashStore, Record};
     use imu_ar::recursive::{Channel, Config, Estimator, FixedChannel, FixedConfig};
     use imu_ar::recursive::{FixedLattice, Lattice, OrderRule, OrderSelector, Rls, Sftf};
+    use imu_ar::thermal::{ThermalBias, ThermalConfig};
 
     unsafe extern "C" {
         /// Deliberately undefined: referencing it from a live panic path breaks the link.
@@ -189,6 +193,48 @@ mod firmware {
         }
     }
 
+    /// The thermal stage with `N` coefficients over `x` on a temperature ramp that leaves its
+    /// range (and a NaN temperature): whether every residual, bias, compensation and leverage
+    /// is finite.
+    fn thermal<T: Scalar, const N: usize>(x: &[f32]) -> bool {
+        let config = ThermalConfig::<T, N>::new(
+            T::from_f64(black_box(0.999)),
+            T::from_f64(black_box(20.0)),
+            T::from_f64(black_box(50.0)),
+        )
+        .and_then(|c| c.with_delta(T::from_f64(black_box(0.5))));
+        let stage = config.and_then(|c| {
+            ThermalBias::with_prior(&c, [T::from_f64(black_box(0.1)); N])
+                .and_then(|s| s.with_saturation(T::from_f64(black_box(1e3))))
+                .map(|s| (c, s, ThermalBias::new(&c)))
+        });
+        let Ok((config, mut stage, mut plain)) = stage else {
+            return false;
+        };
+        let mut finite = true;
+        for (i, &v) in x.iter().enumerate() {
+            let celsius = if i == 50 {
+                T::from_f64(f64::NAN)
+            } else {
+                T::from_f64(15.0 + 0.08 * i as f64)
+            };
+            let v = T::from_f64(f64::from(v));
+            for s in [&mut stage, &mut plain] {
+                if let Some(r) = s.update(&config, black_box(v), black_box(celsius)) {
+                    finite &= r.is_finite();
+                }
+            }
+        }
+        let t = T::from_f64(black_box(33.0));
+        finite &= stage.bias(&config, t).is_some_and(|b| b.is_finite());
+        finite &= stage.leverage(&config, t).is_some_and(|l| l.is_finite());
+        finite &= stage
+            .compensate(&config, T::from_f64(black_box(0.4)), t)
+            .is_some_and(|r| r.is_finite());
+        finite &= stage.per_kelvin(&config).iter().all(|b| b.is_finite());
+        finite && black_box(stage.health()).rejected() > 0
+    }
+
     #[entry]
     fn main() -> ! {
         let config = match Config::new(black_box(0.99f32), black_box(0.01)) {
@@ -215,7 +261,10 @@ mod firmware {
         x[300] = 5e3;
         let ok = exercise::<1>(&config, &channel, &x)
             & exercise::<4>(&config, &channel, &x)
-            & exercise::<8>(&config, &channel, &x);
+            & exercise::<8>(&config, &channel, &x)
+            & thermal::<f32, 1>(&x)
+            & thermal::<f32, 4>(&x)
+            & thermal::<f64, 4>(&x);
         debug_exit(ok)
     }
 

@@ -12,6 +12,7 @@ pub mod recursive;
 pub mod scalar;
 pub mod sensor;
 pub mod sim;
+pub mod thermal;
 
 pub use model::{ArModel, GaussMarkov, ModelError};
 pub use recursive::Estimator;

@@ -6,9 +6,13 @@
 //! counts per g). Every read of INT_STATUS is 100 ms of sensor time: 10 new samples (100 Hz)
 //! enter the FIFO.
 //!
-//! Each axis is `bias + Gauss-Markov drift + white noise`, quantised to counts. The drift's
-//! sigma and correlation time follow a temperature that ramps from 25 to 45 deg C over 120 s:
-//! `sigma = sigma_25 (1 + 0.01 (T - 25))`, `T_c = T_c25 (1 - 0.01 (T - 25))`.
+//! Each axis is `bias(T) + Gauss-Markov drift + white noise`, quantised to counts, and the
+//! temperature ramps from 25 to 45 deg C over 120 s. The bias is a cubic in `T - 25`
+//! ([`Axis::bias_at`]): over the 20 K it moves by 0.27 to 0.32 deg/s on the gyro axes and by
+//! 24 to 28 mg on the accelerometer axes. The drift's sigma and correlation time follow the
+//! temperature too: `sigma = sigma_25 (1 + 0.01 (T - 25))`, `T_c = T_c25 (1 - 0.01 (T - 25))`.
+//! The data registers hold the temperature of the latest sample (TEMP_OUT, `raw / 340 +
+//! 36.53` deg C, rounded to a count).
 
 use embedded_hal::i2c::{ErrorKind, ErrorType, I2c, NoAcknowledgeSource, Operation};
 use imu_ar::sim::StandardNormal;
@@ -26,7 +30,10 @@ const RAMP_S: f64 = 120.0;
 /// One axis of the simulated sensor.
 #[derive(Clone, Copy)]
 struct Axis {
+    /// The bias at 25 deg C.
     bias: f64,
+    /// The bias's change per K, K^2 and K^3 above 25 deg C.
+    thermal: [f64; 3],
     gm_sigma_25: f64,
     tc_25: f64,
     white: f64,
@@ -34,10 +41,19 @@ struct Axis {
     gm: f64,
 }
 
+impl Axis {
+    /// The bias at `celsius`: `bias + t1 d + t2 d^2 + t3 d^3`, `d = celsius - 25`.
+    fn bias_at(&self, celsius: f64) -> f64 {
+        let d = celsius - 25.0;
+        let [t1, t2, t3] = self.thermal;
+        self.bias + d * (t1 + d * (t2 + d * t3))
+    }
+}
+
 /// The truth of an axis at the current temperature.
 #[derive(Clone, Copy, Debug)]
 pub struct AxisTruth {
-    /// Mean of the output, in units.
+    /// Mean of the output (the bias at the temperature), in units.
     pub mean: f64,
     /// Gauss-Markov sigma, in units.
     pub gm_sigma: f64,
@@ -108,16 +124,18 @@ pub struct SimImu {
 impl SimImu {
     /// A sensor with a fixed seed; `corrupt` spikes every 20th sample by 2000 counts.
     pub fn new(seed: u64, corrupt: bool) -> Self {
-        let gyro = |bias| Axis {
+        let gyro = |bias, thermal| Axis {
             bias,
+            thermal,
             gm_sigma_25: 0.05,
             tc_25: 2.0,
             white: 0.02,
             counts_per_unit: 131.0,
             gm: 0.0,
         };
-        let accel = |bias| Axis {
+        let accel = |bias, thermal| Axis {
             bias,
+            thermal,
             gm_sigma_25: 0.002,
             tc_25: 5.0,
             white: 0.003,
@@ -129,16 +147,17 @@ impl SimImu {
             gm_sigma_25: 0.2,
             tc_25: 1.0,
             white: 0.005,
-            ..gyro(0.2)
+            ..gyro(0.2, [0.012, 2e-4, -6e-6])
         };
+        // Over 20 K: gx +0.32, gy -0.27, gz +0.27 deg/s; ax +28, ay -24, az +28 mg.
         let mut s = Self {
             axes: [
-                gyro(0.5),
-                gyro(-0.3),
+                gyro(0.5, [0.02, -3e-4, 5e-6]),
+                gyro(-0.3, [-0.01, -2.5e-4, 4e-6]),
                 gyro_z,
-                accel(0.01),
-                accel(-0.02),
-                accel(1.0),
+                accel(0.01, [1.5e-3, -1e-5, 2e-7]),
+                accel(-0.02, [-8e-4, -3e-5, 5e-7]),
+                accel(1.0, [2e-3, -5e-5, 1e-6]),
             ],
             rng: ChaCha8Rng::seed_from_u64(seed),
             normal: StandardNormal::new(),
@@ -170,11 +189,12 @@ impl SimImu {
 
     /// The truth of every axis at time `t` (s): the parameters follow the temperature ramp.
     pub fn truth_at(&self, t: f64) -> [AxisTruth; AXES] {
-        let dtemp = temperature_at(t) - 25.0;
+        let celsius = temperature_at(t);
+        let dtemp = celsius - 25.0;
         self.axes.map(|a| {
             let q = 1.0 / a.counts_per_unit;
             AxisTruth {
-                mean: a.bias,
+                mean: a.bias_at(celsius),
                 gm_sigma: a.gm_sigma_25 * (1.0 + 0.01 * dtemp),
                 tc: a.tc_25 * (1.0 - 0.01 * dtemp),
                 white: libm::sqrt(a.white * a.white + q * q / 12.0),
@@ -184,7 +204,8 @@ impl SimImu {
 
     /// Draws the next sample into the data registers and, when enabled, the FIFO.
     fn step(&mut self) {
-        let dtemp = self.temperature() - 25.0;
+        let celsius = self.temperature();
+        let dtemp = celsius - 25.0;
         let mut counts = [0i16; AXES];
         for (i, c) in counts.iter_mut().enumerate() {
             let a = self.axes[i];
@@ -194,7 +215,7 @@ impl SimImu {
             let gm = phi * a.gm + drive;
             self.axes[i].gm = gm;
             let white = a.white * self.normal.sample(&mut self.rng);
-            let mut v = libm::round((a.bias + gm + white) * a.counts_per_unit);
+            let mut v = libm::round((a.bias_at(celsius) + gm + white) * a.counts_per_unit);
             if self.corrupt && self.n % 20 == 19 {
                 v += 2000.0;
             }
@@ -203,7 +224,7 @@ impl SimImu {
         self.t += DT;
         self.n += 1;
         // Data registers 59-72: accel, temperature, gyro (big-endian).
-        let temp_raw = ((self.temperature() - 36.53) * 340.0) as i16;
+        let temp_raw = libm::round((celsius - 36.53) * 340.0) as i16;
         let words = [
             counts[3], counts[4], counts[5], temp_raw, counts[0], counts[1], counts[2],
         ];

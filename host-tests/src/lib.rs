@@ -11,3 +11,4 @@ pub mod differential;
 pub mod fixtures;
 pub mod flash;
 pub mod reference;
+pub mod thermal;

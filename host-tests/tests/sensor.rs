@@ -4,6 +4,7 @@
 
 use imu_ar::sensor::{
     AccelUnit, Error, GyroUnit, IcmAccelRange, IcmGyroRange, ImuReader, RawSample, Replay, Scale,
+    Thermometer,
 };
 
 #[test]
@@ -28,6 +29,17 @@ fn replay_serves_the_record() {
     replay.rewind();
     assert_eq!(replay.remaining(), 5);
     assert_eq!(replay.scale(), scale);
+    // A replay knows no temperature formula unless given the recording chip's.
+    let warm = RawSample {
+        temperature: Some(1325),
+        ..Default::default()
+    };
+    assert_eq!(replay.die_temperature(&warm), None);
+    let replay = replay.with_thermometer(Thermometer::ICM42688);
+    assert_eq!(
+        replay.die_temperature(&warm),
+        Some(Thermometer::ICM42688.celsius(1325))
+    );
 }
 
 /// Issue 24 item 5: a limit at the nominal range never fires (the rail of +-1000 deg/s is

@@ -15,7 +15,7 @@ use embedded_hal_mock::eh1::delay::NoopDelay;
 use embedded_hal_mock::eh1::spi::{Mock as SpiMock, Transaction as Spi};
 use imu_ar::sensor::{
     AccelUnit, Error, GyroUnit, Icm42688, Icm42688Config, IcmAccelRange, IcmGyroRange, ImuReader,
-    Odr, RawSample,
+    Odr, RawSample, Thermometer,
 };
 use sim::icm42688::{self as icm, SimSpi};
 use sim::{Kind, Model, NoDelay, Sim, decode};
@@ -119,6 +119,55 @@ fn icm42688_init_read_and_scale() {
         [1.0, -2.0, 0.0]
     );
     assert!((Icm42688::<SpiMock<u8>>::temperature_celsius(1325) - 35.0016).abs() < 1e-3);
+    assert_eq!(
+        imu.die_temperature(&s),
+        Some(Icm42688::<SpiMock<u8>>::temperature_celsius(1325))
+    );
+    imu.destroy().done();
+}
+
+/// The die temperature through the reader, against DS-000347 rev 1.8: TEMP_DATA reads
+/// `TEMP_DATA / 132.48 + 25` deg C (section 14, registers 0x1D-0x1E), the 8-bit FIFO
+/// temperature `FIFO_TEMP_DATA / 2.07 + 25` (section 6.1), delivered by the reader as 64 times
+/// the 8-bit value (132.48 / 64 = 2.07).
+#[test]
+fn icm42688_die_temperature_is_the_datasheet_formula() {
+    let imu = Icm42688::new(SpiMock::new(&[]));
+    let register: [(i16, f32); 6] = [
+        (0, 25.0),
+        (1325, 35.001_51),
+        (-3312, 0.0),
+        (-8611, -39.998_49),
+        (7949, 85.001_51),
+        (i16::MIN, 25.0 - 32_768.0 / 132.48),
+    ];
+    let fifo: [(i8, f32); 5] = [
+        (0, 25.0),
+        (10, 25.0 + 10.0 / 2.07),
+        (-52, 25.0 - 52.0 / 2.07),
+        (124, 25.0 + 124.0 / 2.07),
+        (i8::MIN + 1, 25.0 - 127.0 / 2.07),
+    ];
+    let rows = register
+        .into_iter()
+        .chain(fifo.map(|(t, c)| (i16::from(t) * 64, c)));
+    for (raw, celsius) in rows {
+        let s = RawSample {
+            temperature: Some(raw),
+            ..Default::default()
+        };
+        let got = imu
+            .die_temperature(&s)
+            .expect("the ICM-42688-P reader knows its formula");
+        assert!((got - celsius).abs() <= 1e-4, "{raw}: {got} vs {celsius}");
+        assert_eq!(
+            got,
+            Icm42688::<SpiMock<u8>>::temperature_celsius(raw),
+            "{raw}"
+        );
+    }
+    assert_eq!(imu.thermometer(), Some(Thermometer::ICM42688));
+    assert_eq!(imu.die_temperature(&RawSample::default()), None);
     imu.destroy().done();
 }
 
@@ -198,6 +247,8 @@ fn icm42688_fifo_packets_malformed_empty_and_partial() {
     assert!(
         (Icm42688::<SpiMock<u8>>::temperature_celsius(640) - (10.0 / 2.07 + 25.0)).abs() < 1e-4
     );
+    let celsius = imu.die_temperature(&out[0]).unwrap();
+    assert!((celsius - (10.0 / 2.07 + 25.0)).abs() < 1e-4, "{celsius}");
     assert_eq!(imu.read_fifo(&mut out), Ok(1));
     assert_eq!((out[0].accel, out[0].gyro), ([9; 3], [9; 3]));
     let stats = imu.fifo_stats();

@@ -15,7 +15,7 @@ use embedded_hal_mock::eh1::delay::NoopDelay;
 use embedded_hal_mock::eh1::i2c::{Mock as I2cMock, Transaction as I2c};
 use imu_ar::sensor::{
     AccelRange, AccelUnit, Dlpf, Error, GyroRange, GyroUnit, ImuReader, Mpu6050, Mpu6050Config,
-    RawSample,
+    RawSample, Thermometer,
 };
 use sim::mpu6050::{self as mpu, SimI2c};
 use sim::{Kind, Model, NoDelay, Sim};
@@ -112,6 +112,42 @@ fn mpu6050_init_read_and_scale() {
     let ms2 = imu.scale().accel(s.accel, AccelUnit::MetersPerSec2)[0];
     assert!((ms2 - 9.80665).abs() < 1e-5);
     assert!((Mpu6050::<I2cMock>::temperature_celsius(3400) - 46.53).abs() < 1e-4);
+    assert_eq!(imu.die_temperature(&s), Some(46.53));
+    imu.destroy().done();
+}
+
+/// The die temperature through the reader, against the register map's formula (RM-MPU-6000A-00
+/// rev 4.2, registers 65-66: `TEMP_OUT / 340 + 36.53`) and the product specification's offset
+/// (PS-MPU-6000A-00 rev 3.4, section 6.4: 35 deg C reads -521 LSB, 340 LSB per deg C). The
+/// FIFO's packets carry no temperature.
+#[test]
+fn mpu6050_die_temperature_is_the_datasheet_formula() {
+    let imu = Mpu6050::new(I2cMock::new(&[]), ADDR);
+    let table: [(i16, f32, f32); 7] = [
+        (-521, 35.0, 0.005), // the specification's offset, to its 3 digits
+        (0, 36.53, 1e-4),
+        (340, 37.53, 1e-4),
+        (3400, 46.53, 1e-4),
+        (-12_420, 36.53 - 12_420.0 / 340.0, 1e-4), // 0.0006 deg C
+        (i16::MIN, 36.53 - 32_768.0 / 340.0, 1e-4),
+        (i16::MAX, 36.53 + 32_767.0 / 340.0, 1e-4),
+    ];
+    for (raw, celsius, tolerance) in table {
+        let s = RawSample {
+            temperature: Some(raw),
+            ..Default::default()
+        };
+        let got = imu
+            .die_temperature(&s)
+            .expect("the MPU-6050 reader knows its formula");
+        assert!(
+            (got - celsius).abs() <= tolerance,
+            "{raw}: {got} vs {celsius}"
+        );
+        assert_eq!(got, Mpu6050::<I2cMock>::temperature_celsius(raw), "{raw}");
+    }
+    assert_eq!(imu.thermometer(), Some(Thermometer::MPU6050));
+    assert_eq!(imu.die_temperature(&RawSample::default()), None);
     imu.destroy().done();
 }
 

@@ -5,7 +5,7 @@
 //! The trait is public only in name: it lives in a private module, so no type outside this
 //! crate can implement it, and its items are not part of the crate's API.
 
-use super::{Error, RawSample, Scale};
+use super::{Error, RawSample, Scale, Thermometer};
 
 /// A register write: the register, then the value.
 pub type Write = (u8, u8);
@@ -70,6 +70,8 @@ pub struct Map {
     /// A register of the configuration that no FIFO reset writes: read back when a FIFO reset
     /// finds the FIFO empty, it fails when the chip has reset itself.
     pub configured: Check,
+    /// The formula of the raw temperature of the chip's samples.
+    pub thermometer: Thermometer,
 }
 
 /// What a FIFO packet turned out to be.

@@ -5,7 +5,7 @@ use embedded_hal::delay::DelayNs;
 
 use super::chip::{CHECK_REGS, Chip};
 use super::fifo::{self, FifoState, MAX_PACKET};
-use super::{Error, FifoStats, ImuReader, RawSample, Scale};
+use super::{Error, FifoStats, ImuReader, RawSample, Scale, Thermometer};
 
 /// A six-axis reader of the chip `C` on its bus: [`Mpu6050`](super::Mpu6050) (I2C) and
 /// [`Icm42688`](super::Icm42688) (SPI) are this driver over their chips, and every method
@@ -195,5 +195,10 @@ impl<C: Chip> ImuReader for Driver<C> {
 
     fn fifo_stats(&self) -> FifoStats {
         self.fifo.stats
+    }
+
+    /// The chip's temperature formula ([`Thermometer::MPU6050`], [`Thermometer::ICM42688`]).
+    fn thermometer(&self) -> Option<Thermometer> {
+        Some(C::MAP.thermometer)
     }
 }

@@ -9,7 +9,7 @@ use embedded_hal::spi::{Operation, SpiDevice};
 
 use super::chip::{Check, Chip, Map, Packet, Write};
 use super::driver::Driver;
-use super::{RawSample, Scale, be_i16, be_i16x3};
+use super::{RawSample, Scale, Thermometer, be_i16, be_i16x3};
 
 /// SPI: bit 7 of the address byte, set for a read.
 const SPI_READ: u8 = 0x80;
@@ -417,8 +417,12 @@ impl<SPI: SpiDevice> Icm42688<SPI> {
 
     /// Temperature in deg C from a raw register value: `raw / 132.48 + 25`. FIFO samples carry
     /// the 8-bit FIFO temperature (`t / 2.07 + 25`) scaled by 64 into the same 16-bit form.
+    /// It is [`Thermometer::ICM42688`], which [`ImuReader::die_temperature`] applies to a
+    /// sample.
+    ///
+    /// [`ImuReader::die_temperature`]: super::ImuReader::die_temperature
     pub fn temperature_celsius(raw: i16) -> f32 {
-        f32::from(raw) / 132.48 + 25.0
+        Thermometer::ICM42688.celsius(raw)
     }
 }
 
@@ -444,6 +448,7 @@ const MAP: Map = Map {
     fifo_start: FIFO_START,
     fifo_on: STREAMING,
     configured: SENSORS_ON,
+    thermometer: Thermometer::ICM42688,
 };
 
 /// The ICM-42688-P on an SPI device: the chip that an [`Icm42688`] drives.

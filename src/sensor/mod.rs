@@ -40,8 +40,8 @@ pub struct RawSample {
     pub accel: [i16; 3],
     /// Gyroscope x, y, z.
     pub gyro: [i16; 3],
-    /// Raw temperature, where the chip reports one with this sample (see the reader's
-    /// `temperature_celsius`).
+    /// Raw temperature, where the chip reports one with this sample: in deg C by
+    /// [`ImuReader::die_temperature`] (or the chip's [`Thermometer`]).
     pub temperature: Option<i16>,
 }
 
@@ -158,6 +158,49 @@ impl Scale {
     pub fn accel(&self, raw: [i16; 3], unit: AccelUnit) -> [f32; 3] {
         let lsb = self.accel_lsb(unit);
         raw.map(|c| f32::from(c) * lsb)
+    }
+}
+
+/// A chip's temperature formula: `celsius = raw / counts_per_celsius + offset_celsius`, the
+/// linear form both datasheets give.
+///
+/// | chip | `counts_per_celsius` | `offset_celsius` | source |
+/// |---|---|---|---|
+/// | MPU-6050 | 340 | 36.53 | RM-MPU-6000A-00 rev 4.2, registers 65-66 (TEMP_OUT) |
+/// | ICM-42688-P | 132.48 | 25 | DS-000347 rev 1.8, TEMP_DATA1/0; the 8-bit FIFO temperature `t / 2.07 + 25`, which the reader delivers as `64 t` (132.48 / 64 = 2.07) |
+///
+/// ```
+/// use imu_ar::sensor::Thermometer;
+///
+/// assert_eq!(Thermometer::MPU6050.celsius(0), 36.53);
+/// assert_eq!(Thermometer::ICM42688.celsius(-3312), 0.0); // -3312 / 132.48 = -25
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Thermometer {
+    /// Counts per degree Celsius.
+    pub counts_per_celsius: f32,
+    /// Degrees Celsius at a raw value of 0.
+    pub offset_celsius: f32,
+}
+
+impl Thermometer {
+    /// The MPU-6050's TEMP_OUT: `raw / 340 + 36.53`.
+    pub const MPU6050: Self = Self {
+        counts_per_celsius: 340.0,
+        offset_celsius: 36.53,
+    };
+
+    /// The ICM-42688-P's TEMP_DATA: `raw / 132.48 + 25`.
+    pub const ICM42688: Self = Self {
+        counts_per_celsius: 132.48,
+        offset_celsius: 25.0,
+    };
+
+    /// The temperature of `raw`, in deg C (rounded once for the division and once for the
+    /// sum, in `f32`).
+    pub fn celsius(&self, raw: i16) -> f32 {
+        f32::from(raw) / self.counts_per_celsius + self.offset_celsius
     }
 }
 
@@ -328,6 +371,35 @@ pub trait ImuReader {
 
     /// FIFO accounting so far.
     fn fifo_stats(&self) -> FifoStats;
+
+    /// The formula of the raw temperature of this reader's samples: the chip's, for
+    /// [`Mpu6050`] and [`Icm42688`]; a [`Replay`]'s when given one
+    /// ([`Replay::with_thermometer`]). `None` by default, for a reader that does not know it.
+    fn thermometer(&self) -> Option<Thermometer> {
+        None
+    }
+
+    /// The die temperature of `sample` in deg C, whichever chip it came from: its
+    /// [`RawSample::temperature`] through [`ImuReader::thermometer`]. `None` where the sample
+    /// carries no temperature (the MPU-6050's FIFO packets hold none: its data registers,
+    /// [`ImuReader::read`], do) or the reader has no formula.
+    ///
+    /// ```
+    /// use imu_ar::sensor::{ImuReader, RawSample, Replay, Scale, Thermometer};
+    ///
+    /// fn celsius(imu: &impl ImuReader, s: &RawSample) -> Option<f32> {
+    ///     imu.die_temperature(s)
+    /// }
+    ///
+    /// let scale = Scale { gyro_counts_per_dps: 131.0, accel_counts_per_g: 16384.0 };
+    /// let s = RawSample { temperature: Some(3400), ..Default::default() };
+    /// let replay = Replay::new(&[], scale).with_thermometer(Thermometer::MPU6050);
+    /// assert_eq!(celsius(&replay, &s), Some(46.53));
+    /// assert_eq!(celsius(&replay, &RawSample::default()), None);
+    /// ```
+    fn die_temperature(&self, sample: &RawSample) -> Option<f32> {
+        Some(self.thermometer()?.celsius(sample.temperature?))
+    }
 }
 
 /// Big-endian `i16` at `b[i..i + 2]`.

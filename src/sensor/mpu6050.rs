@@ -13,7 +13,7 @@ use embedded_hal::i2c::I2c;
 
 use super::chip::{Check, Chip, Map, Packet, Write};
 use super::driver::Driver;
-use super::{RawSample, Scale, be_i16, be_i16x3};
+use super::{RawSample, Scale, Thermometer, be_i16, be_i16x3};
 
 /// Register 25, SMPLRT_DIV: sample rate = gyro output rate / (1 + SMPLRT_DIV).
 const SMPLRT_DIV: u8 = 0x19;
@@ -351,9 +351,12 @@ impl<I2C: I2c> Mpu6050<I2C> {
     }
 
     /// Temperature in deg C from the raw value: `raw / 340 + 36.53` (register map, registers
-    /// 65-66).
+    /// 65-66): [`Thermometer::MPU6050`], which [`ImuReader::die_temperature`] applies to a
+    /// sample.
+    ///
+    /// [`ImuReader::die_temperature`]: super::ImuReader::die_temperature
     pub fn temperature_celsius(raw: i16) -> f32 {
-        f32::from(raw) / 340.0 + 36.53
+        Thermometer::MPU6050.celsius(raw)
     }
 }
 
@@ -379,6 +382,7 @@ const MAP: Map = Map {
     fifo_start: FIFO_START,
     fifo_on: FIFO_ON,
     configured: AWAKE_ON_PLL,
+    thermometer: Thermometer::MPU6050,
 };
 
 /// The MPU-6050 at its address on an I2C bus: the chip that an [`Mpu6050`] drives.

@@ -2,7 +2,7 @@
 
 use core::convert::Infallible;
 
-use super::{Error, FifoStats, ImuReader, RawSample, Scale};
+use super::{Error, FifoStats, ImuReader, RawSample, Scale, Thermometer};
 
 /// Serves the samples of a slice in order, with the sensitivities they were recorded at.
 ///
@@ -43,6 +43,7 @@ pub struct Replay<'a> {
     samples: &'a [RawSample],
     next: usize,
     scale: Scale,
+    thermometer: Option<Thermometer>,
     stats: FifoStats,
 }
 
@@ -53,7 +54,17 @@ impl<'a> Replay<'a> {
             samples,
             next: 0,
             scale,
+            thermometer: None,
             stats: FifoStats::default(),
+        }
+    }
+
+    /// The same replay, its samples' raw temperatures read by `thermometer` (the recording
+    /// chip's: [`ImuReader::die_temperature`] then gives deg C).
+    pub fn with_thermometer(self, thermometer: Thermometer) -> Self {
+        Self {
+            thermometer: Some(thermometer),
+            ..self
         }
     }
 
@@ -96,5 +107,9 @@ impl ImuReader for Replay<'_> {
 
     fn fifo_stats(&self) -> FifoStats {
         self.stats
+    }
+
+    fn thermometer(&self) -> Option<Thermometer> {
+        self.thermometer
     }
 }
