@@ -116,8 +116,9 @@ fn main() -> ! {
     };
     let mut delay = cp.SYST.delay(&clocks);
     let mut flash = LockedFlash::new(dp.FLASH);
-    if let Some(saved) = load(&mut flash) {
-        for (name, m) in NAMES.iter().zip(&saved) {
+    let saved = load(&mut flash);
+    if let Some(saved) = &saved {
+        for (name, m) in NAMES.iter().zip(saved) {
             defmt::info!(
                 "{=str}: saved a={=[?]} sigma^2={=f32} mean={=f32}",
                 name,
@@ -150,8 +151,16 @@ fn main() -> ! {
     let accel = Channel::new(1e-6)
         .and_then(|c| c.with_saturation(scale.accel_saturation(AccelUnit::G)))
         .expect("valid accel channel");
-    let mut axes: [Lattice<f32, 4>; 6] =
-        core::array::from_fn(|i| Lattice::new(&shared, if i < 3 { &gyro } else { &accel }));
+    // The saved models are the prior at boot (their coefficients, with the channel's delta as
+    // the weight); without one, the plain start.
+    let mut axes: [Lattice<f32, 4>; 6] = core::array::from_fn(|i| {
+        let channel = if i < 3 { &gyro } else { &accel };
+        saved
+            .as_ref()
+            .and_then(|s| s.get(i))
+            .and_then(|m| Lattice::with_prior(&shared, channel, m.a()).ok())
+            .unwrap_or_else(|| Lattice::new(&shared, channel))
+    });
     let mut batch = [RawSample::default(); 32];
     let mut samples = 0u32;
     // When a read last accounted for the FIFO: the start of an outage, by the board's clock.
