@@ -14,7 +14,8 @@
 //! Rows: `lattice` (f32 and fixed), `rls` and `sftf` (f32) per sample at p = 1, 2, 4, 8, 16, 32, and at
 //! p = 3, 5, 6, 7 for the f32 lattice and RLS (where one overtakes the other); `extract` per
 //! request of the exact coefficients of order p; `frame6` per six-axis frame of order-4
-//! lattices; `thermal` per sample of one axis through the temperature compensation stage
+//! lattices; `lattice-prior` and `lattice-gated` (f32, p = 4 and 8) per sample of the lattice
+//! from a prior (with its ladder) and behind the innovation gate (k = 5); `thermal` per sample of one axis through the temperature compensation stage
 //! (`imu_ar::thermal::ThermalBias`, p its number of coefficients: degree p - 1) on a
 //! 25 to 45 deg C ramp. Then the state of one channel, `<estimator> <scalar> p=<P> bytes=<N>`
 //! (`size_of` on the target). Last, one fit of the composite noise model from a 20-octave
@@ -32,7 +33,7 @@ mod firmware {
 
     use cortex_m::peripheral::{SYST, syst::SystClkSource};
     use imu_ar::recursive::{Channel, Config, Estimator, FixedChannel, FixedConfig, FixedLattice};
-    use imu_ar::recursive::{Lattice, Rls, Sftf};
+    use imu_ar::recursive::{Gate, Lattice, Rls, Sftf};
     use imu_ar::thermal::{ThermalBias, ThermalConfig};
     use imu_ar::{
         ArModel,
@@ -130,6 +131,24 @@ mod firmware {
                 "lattice",
                 Lattice::<f32, P>::new(&config, &channel),
                 &config,
+            );
+        }
+
+        /// The f32 lattice from a prior (its joint-process ladder), and behind the gate.
+        fn lattice_prior_gated_f32<const P: usize>(&mut self) {
+            let (config, channel) = Self::f32_settings();
+            let Ok(prior) = Lattice::<f32, P>::with_prior(&config, &channel, &[0.1; P]) else {
+                common::exit(false)
+            };
+            self.f32_row("lattice-prior", prior, &config);
+            let Ok(gate) = Gate::new(5.0, 16) else {
+                common::exit(false)
+            };
+            let gated = config.with_gate(gate);
+            self.f32_row(
+                "lattice-gated",
+                Lattice::<f32, P>::new(&gated, &channel),
+                &gated,
             );
         }
 
@@ -369,6 +388,8 @@ mod firmware {
         between!(lattice_f32);
         between!(rls_f32);
         orders!(extract_f32);
+        bench.lattice_prior_gated_f32::<4>();
+        bench.lattice_prior_gated_f32::<8>();
         bench.frame6_f32();
         bench.thermal_f32::<1>();
         bench.thermal_f32::<2>();

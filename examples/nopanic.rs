@@ -30,7 +30,7 @@ mod firmware {
     use imu_ar::model::{ArModel, ModelError};
     use imu_ar::noise::{FitConfig, NoiseError, NoiseModel, Octaves};
     use imu_ar::persist::{EncodeError, FlashStore, Record};
-    use imu_ar::recursive::{Channel, Config, Estimator, FixedChannel, FixedConfig};
+    use imu_ar::recursive::{Channel, Config, Estimator, FixedChannel, FixedConfig, Gate};
     use imu_ar::recursive::{FixedLattice, Lattice, OrderRule, OrderSelector, Rls, Sftf};
     use imu_ar::thermal::{ThermalBias, ThermalConfig};
 
@@ -86,6 +86,30 @@ mod firmware {
         finite &= run(&mut fixed, &fixed_config, x, |_| {});
         for &v in x {
             black_box(fixed.update_counts(&fixed_config, black_box(v as i16)));
+        }
+        // The lattices from a prior, behind the innovation gate (RLS and the SFTF there keep an
+        // overflow-check path this proof does not yet rule out).
+        let Ok(gate) = Gate::new(black_box(5.0), black_box(16)) else {
+            return false;
+        };
+        let gated = config.with_gate(gate);
+        let a0 = [black_box(0.1f32); P];
+        let Ok(mut l) = Lattice::<f32, P>::with_prior(&gated, channel, &a0) else {
+            return false;
+        };
+        finite &= run(&mut l, &gated, x, |_| {});
+        let (Ok(fixed_gated), Ok(fixed_channel)) = (
+            FixedConfig::new(&gated),
+            FixedChannel::new(channel, black_box(2.0)),
+        ) else {
+            return false;
+        };
+        let Ok(mut fixed) = FixedLattice::<P>::with_prior(&fixed_gated, &fixed_channel, &a0) else {
+            return false;
+        };
+        finite &= run(&mut fixed, &fixed_gated, x, |_| {});
+        for &v in x {
+            black_box(fixed.update_counts(&fixed_gated, black_box(v as i16)));
         }
         let mut allan = AllanStream::<12>::new();
         for &v in x {

@@ -420,11 +420,13 @@ impl<const P: usize> FixedLattice<P> {
             Some(l) => l.a_priori(&self.core, y),
             None => self.core.a_priori(y),
         };
-        let e2 = u128::from(e.to_bits().unsigned_abs()).pow(2);
-        // e^2 (Q54) W (Q40), shifted to Q56, against k^2 (Q16) E (Q40), Q56;
-        // `e^2 W < 2^125`, `k^2 E < 2^96`.
-        let lhs = (e2 * m.weight.unsigned_abs() as u128) >> 38;
-        let rhs = u128::from(k2) * u128::from(self.energy_p().to_bits().unsigned_abs());
+        let e = u64::from(e.to_bits().unsigned_abs());
+        // e^2 (Q54) W (Q40), shifted to Q56, against k^2 (Q16) E (Q40), Q56. No product
+        // wraps (`e < 2^32`: `e^2 < 2^64`, `e^2 W < 2^127`, `k^2 E < 2^128`); wrapping
+        // operations say so to the overflow checks.
+        let e2 = u128::from(e.wrapping_mul(e));
+        let lhs = e2.wrapping_mul(u128::from(m.weight.unsigned_abs())) >> 38;
+        let rhs = u128::from(k2).wrapping_mul(u128::from(self.energy_p().to_bits().unsigned_abs()));
         lhs > rhs
     }
 

@@ -515,6 +515,7 @@ impl<T: FloatArith, const P: usize> super::settled::Start<T, P> for Lattice<T, P
 impl<T: FloatArith, const P: usize> Lattice<T, P> {
     /// Takes the centred sample `y`; a history sample (`equation = false`, a settled start)
     /// goes through the stages and enters the ladder's delay line with `d = 0`.
+    #[inline(always)]
     fn step(&mut self, config: &Config<T>, y: T, equation: bool) -> Option<T> {
         let params = float_params(config, self.shell.channel());
         let mut clip = 0;
