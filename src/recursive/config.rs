@@ -325,6 +325,15 @@ impl<T: Scalar> Channel<T> {
     }
 }
 
+/// A float estimator's prior `a0`, checked: every entry finite ([`ConfigError::Prior`]).
+pub(crate) fn finite_prior<T: Scalar, const P: usize>(a0: &[T; P]) -> Result<[T; P], ConfigError> {
+    if a0.iter().all(|a| a.is_finite()) {
+        Ok(*a0)
+    } else {
+        Err(ConfigError::Prior)
+    }
+}
+
 /// Why a sample was not used.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Rejection {

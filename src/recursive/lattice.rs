@@ -402,12 +402,10 @@ impl<T: FloatArith, const P: usize> Lattice<T, P> {
         channel: &Channel<T>,
         a0: &[T; P],
     ) -> Result<Self, super::ConfigError> {
-        if !a0.iter().all(|a| a.is_finite()) {
-            return Err(super::ConfigError::Prior);
-        }
+        let a0 = super::config::finite_prior(a0)?;
         let core = Self::initial_core(config, channel);
         Ok(Self {
-            ladder: Some(Ladder::new(*a0, core.f_energy_p)),
+            ladder: Some(Ladder::new(a0, core.f_energy_p)),
             core,
             shell: Shell::new(*channel),
         })

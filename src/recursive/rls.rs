@@ -103,10 +103,8 @@ impl<T: Scalar, const P: usize> Rls<T, P> {
         channel: &Channel<T>,
         a0: &[T; P],
     ) -> Result<Self, super::ConfigError> {
-        if !a0.iter().all(|a| a.is_finite()) {
-            return Err(super::ConfigError::Prior);
-        }
-        Ok(Self::centred(config, channel, RlsInit::default(), *a0))
+        let a0 = super::config::finite_prior(a0)?;
+        Ok(Self::centred(config, channel, RlsInit::default(), a0))
     }
 
     fn centred(config: &Config<T>, channel: &Channel<T>, init: RlsInit, centre: [T; P]) -> Self {

@@ -128,10 +128,8 @@ impl<T: Scalar, const P: usize> Sftf<T, P> {
         channel: &Channel<T>,
         a0: &[T; P],
     ) -> Result<Self, super::ConfigError> {
-        if !a0.iter().all(|a| a.is_finite()) {
-            return Err(super::ConfigError::Prior);
-        }
-        Ok(Self::centred(config, channel, *a0))
+        let a0 = super::config::finite_prior(a0)?;
+        Ok(Self::centred(config, channel, a0))
     }
 
     fn centred(config: &Config<T>, channel: &Channel<T>, centre: [T; P]) -> Self {
