@@ -1,5 +1,6 @@
 //! Proof that the per-sample paths cannot panic: this firmware calls every estimator's
-//! `update` (and the model hand-over) on inputs the compiler cannot see, and its panic handler
+//! `update` (and the model hand-over) on inputs the compiler cannot see (plain, from a prior
+//! behind the innovation gate, and from a settled start), and its panic handler
 //! calls a function that does not exist. If any panic path survived optimisation, the link
 //! would fail with an undefined `imu_ar_panic_path_is_reachable`.
 //!
@@ -31,7 +32,7 @@ mod firmware {
     use imu_ar::noise::{FitConfig, NoiseError, NoiseModel, Octaves};
     use imu_ar::persist::{EncodeError, FlashStore, Record};
     use imu_ar::recursive::{Channel, Config, Estimator, FixedChannel, FixedConfig, Gate};
-    use imu_ar::recursive::{FixedLattice, Lattice, OrderRule, OrderSelector, Rls, Sftf};
+    use imu_ar::recursive::{FixedLattice, Lattice, OrderRule, OrderSelector, Rls, Settled, Sftf};
     use imu_ar::thermal::{ThermalBias, ThermalConfig};
 
     unsafe extern "C" {
@@ -87,8 +88,7 @@ mod firmware {
         for &v in x {
             black_box(fixed.update_counts(&fixed_config, black_box(v as i16)));
         }
-        // The lattices from a prior, behind the innovation gate (RLS and the SFTF there keep an
-        // overflow-check path this proof does not yet rule out).
+        // Every estimator from a prior, behind the innovation gate.
         let Ok(gate) = Gate::new(black_box(5.0), black_box(16)) else {
             return false;
         };
@@ -98,6 +98,22 @@ mod firmware {
             return false;
         };
         finite &= run(&mut l, &gated, x, |_| {});
+        let (Ok(mut rls), Ok(mut sftf)) = (
+            Rls::<f32, P>::with_prior(&gated, channel, &a0),
+            Sftf::<f32, P>::with_prior(&gated, channel, &a0),
+        ) else {
+            return false;
+        };
+        finite &= run(&mut rls, &gated, x, |_| {});
+        finite &= run(&mut sftf, &gated, x, |_| {});
+        // A settled start on the first 32 samples (their batch fit as the prior).
+        let mut settled: Settled<_, f32, 32> =
+            Settled::new(Lattice::<f32, P>::new(config, channel));
+        finite &= run(&mut settled, config, x, |_| {});
+        let mut settled: Settled<_, f32, 32> = Settled::new(Rls::<f32, P>::new(config, channel));
+        finite &= run(&mut settled, config, x, |_| {});
+        let mut settled: Settled<_, f32, 32> = Settled::new(Sftf::<f32, P>::new(config, channel));
+        finite &= run(&mut settled, config, x, |_| {});
         let (Ok(fixed_gated), Ok(fixed_channel)) = (
             FixedConfig::new(&gated),
             FixedChannel::new(channel, black_box(2.0)),

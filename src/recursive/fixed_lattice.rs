@@ -310,8 +310,8 @@ struct Undo<const P: usize> {
     f_energy_p: I24F40,
     weight: i64,
     mean: i64,
-    /// The ladder's coefficients and energy, with a prior.
-    ladder: Option<([I3F29; P], I24F40)>,
+    /// The ladder's coefficients and energy (kept only with a prior).
+    ladder: ([I3F29; P], I24F40),
 }
 
 impl<const P: usize> FixedLattice<P> {
@@ -329,7 +329,7 @@ impl<const P: usize> FixedLattice<P> {
                 f_energy_p: I24F40::ZERO,
                 weight: 0,
                 mean: 0,
-                ladder: None,
+                ladder: ([I3F29::ZERO; P], I24F40::ZERO),
             },
         }
     }
@@ -434,15 +434,17 @@ impl<const P: usize> FixedLattice<P> {
     /// energy, a coefficient or the weight) invalidates the state: the lattice restarts and
     /// holds the model from before this sample, unless a restart is still settling.
     fn accept(&mut self, config: &FixedConfig, x: i32) -> I5F27 {
+        // Field by field, in place: no copy of the record through the stack.
         let (kf, kb) = self.core.next_slot();
-        self.undo = Undo {
-            kf: *kf,
-            kb: *kb,
-            f_energy_p: self.core.f_energy_p,
-            weight: self.shell.moments.weight,
-            mean: self.shell.moments.mean,
-            ladder: self.ladder.as_ref().map(|l| (l.c, l.energy)),
-        };
+        let u = &mut self.undo;
+        u.kf = *kf;
+        u.kb = *kb;
+        u.f_energy_p = self.core.f_energy_p;
+        u.weight = self.shell.moments.weight;
+        u.mean = self.shell.moments.mean;
+        if let Some(l) = &self.ladder {
+            u.ladder = (l.c, l.energy);
+        }
         let mut clip = 0u32;
         let m = &mut self.shell.moments;
         let weight = decay(m.weight, config.params.lambda.to_bits());
@@ -462,12 +464,16 @@ impl<const P: usize> FixedLattice<P> {
             x
         };
         let y = I5F27::from_bits(y);
+        // The ladder counts its saturations apart: a counter whose address it took would
+        // live in memory through the forward stages too.
+        let mut ladder_clip = 0u32;
         let ladder = self
             .ladder
             .as_mut()
-            .map(|l| l.step(&self.core, &config.params, y, true, &mut clip));
+            .map(|l| l.step(&self.core, &config.params, y, true, &mut ladder_clip));
         let f = self.core.step(&config.params, y, &mut clip);
         let f = ladder.unwrap_or(f);
+        let clip = clip.saturating_add(ladder_clip);
         if clip != 0 {
             self.shell.health.clipped = self.shell.health.clipped.saturating_add(u64::from(clip));
             self.restart_after_saturation(config);
@@ -485,9 +491,8 @@ impl<const P: usize> FixedLattice<P> {
         self.core.rewind(&u.kf, &u.kb, u.f_energy_p);
         self.shell.moments.weight = u.weight;
         self.shell.moments.mean = u.mean;
-        if let (Some(l), Some((c, energy))) = (&mut self.ladder, u.ladder) {
-            l.c = c;
-            l.energy = energy;
+        if let Some(l) = &mut self.ladder {
+            (l.c, l.energy) = u.ladder;
         }
         self.restart(config);
         // A prior the formats cannot carry (`d_n = y_n - a0^T phi_n` beyond +-16, a

@@ -50,6 +50,8 @@ pub(crate) struct Ladder<A: Arith, const P: usize> {
     pub(crate) c: [A::Coef; P],
     /// `E`, the order-`P` energy of the centred problem.
     pub(crate) energy: A::Energy,
+    /// `e_P(n)` of the last sample, the centred problem's a-priori error.
+    pub(crate) error: A::Err,
 }
 
 impl<A: Arith, const P: usize> Ladder<A, P> {
@@ -61,6 +63,7 @@ impl<A: Arith, const P: usize> Ladder<A, P> {
             past: [A::ERR_ZERO; P],
             c: [A::COEF_ZERO; P],
             energy,
+            error: A::ERR_ZERO,
         }
     }
 
@@ -77,10 +80,11 @@ impl<A: Arith, const P: usize> Ladder<A, P> {
         e
     }
 
-    /// Takes `y_n` on the state of `core` before [`Core::step`] takes it; returns the
-    /// a-priori error `e_P(n)`. A history sample (`equation = false`) enters the delay line
-    /// only: `d_n = 0`, so that it adds no equation.
-    #[inline]
+    /// Takes `y_n` on the state of `core` before [`Core::step`] takes it; keeps the
+    /// a-priori error `e_P(n)` in `error` and returns it. A history sample (`equation = false`) enters the delay line
+    /// only: `d_n = 0`, so that it adds no equation. Out of line: a lattice without a prior
+    /// keeps the forward stages' code as it is.
+    #[inline(never)]
     pub(crate) fn step(
         &mut self,
         core: &Core<A, P>,
@@ -109,6 +113,7 @@ impl<A: Arith, const P: usize> Ladder<A, P> {
         if let Some(first) = self.past.first_mut() {
             *first = y;
         }
+        self.error = e;
         e
     }
 }

@@ -121,7 +121,7 @@ impl<A: Arith, const P: usize> Core<A, P> {
     }
 
     /// One sample `y` through all stages; returns `f_P(n)`.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn step(&mut self, params: &A::Params, y: A::Err, clip: &mut u32) -> A::Err {
         // `% P` keeps the indices provably in range: no bounds check on the per-sample path.
         let old = self.head % P;
@@ -367,9 +367,9 @@ impl<T: FloatArith, const P: usize> Core<T, P> {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Lattice<T: FloatArith, const P: usize> {
     core: Core<T, P>,
+    shell: Shell<T, P>,
     /// The joint-process ladder of a lattice with a prior.
     ladder: Option<Ladder<T, P>>,
-    shell: Shell<T, P>,
 }
 
 impl<T: FloatArith, const P: usize> Lattice<T, P> {
@@ -482,12 +482,7 @@ impl<T: FloatArith, const P: usize> Estimator<T, P> for Lattice<T, P> {
     type Config = Config<T>;
 
     fn update(&mut self, config: &Config<T>, x: T) -> Option<T> {
-        let (core, ladder) = (&self.core, &self.ladder);
-        let a_priori = |y| match ladder {
-            Some(l) => l.a_priori(core, y),
-            None => core.a_priori(y),
-        };
-        if !self.shell.gate(config, x, self.energy_p(), a_priori) {
+        if config.gate().is_some() && !self.gate(config, x) {
             return None;
         }
         let y = self.shell.intake(config, x)?;
@@ -511,18 +506,30 @@ impl<T: FloatArith, const P: usize> super::settled::Start<T, P> for Lattice<T, P
 }
 
 impl<T: FloatArith, const P: usize> Lattice<T, P> {
+    /// The gate's decision on `x` (see [`Gate`](super::Gate)): `false` rejects it, counted.
+    /// Out of line: an estimator without a gate pays one test for it.
+    #[inline(never)]
+    fn gate(&mut self, config: &Config<T>, x: T) -> bool {
+        let energy = self.energy_p();
+        let (core, ladder) = (&self.core, &self.ladder);
+        self.shell.gate(config, x, energy, |y| match ladder {
+            Some(l) => l.a_priori(core, y),
+            None => core.a_priori(y),
+        })
+    }
+
     /// Takes the centred sample `y`; a history sample (`equation = false`, a settled start)
     /// goes through the stages and enters the ladder's delay line with `d = 0`.
     #[inline(always)]
     fn step(&mut self, config: &Config<T>, y: T, equation: bool) -> Option<T> {
         let params = float_params(config, self.shell.channel());
         let mut clip = 0;
-        let ladder = self
-            .ladder
-            .as_mut()
-            .map(|l| l.step(&self.core, &params, y, equation, &mut clip));
+        // The ladder keeps its error (no value of its own lives through the stages).
+        if let Some(l) = &mut self.ladder {
+            l.step(&self.core, &params, y, equation, &mut clip);
+        }
         let f = self.core.step(&params, y, &mut clip);
-        let e = ladder.unwrap_or(f);
+        let e = self.ladder.as_ref().map_or(f, |l| l.error);
         // A non-finite value anywhere reaches f_P within a sample or two (the reflection
         // coefficients feed the errors), and an overflowing input reaches F_0 and F_P at once.
         let c = &self.core;

@@ -173,8 +173,12 @@ impl<T: Scalar, const P: usize> Rls<T, P> {
         // Bierman's update of U D U^T with measurement variance lambda, then D /= lambda:
         // f = U^T phi, v = D f.
         let mut f = self.phi;
-        for (j, fj) in f.iter_mut().enumerate().skip(1) {
-            *fj = dot(*fj, &self.ut[j][..j], &self.phi[..j]);
+        #[expect(
+            clippy::needless_range_loop,
+            reason = "enumerate's count carries an overflow check the optimiser keeps (nopanic)"
+        )]
+        for j in 1..P {
+            f[j] = dot(f[j], &self.ut[j][..j], &self.phi[..j]);
         }
         let v: [T; P] = core::array::from_fn(|j| self.d[j] * f[j]);
         let mut gain = v;

@@ -142,7 +142,8 @@ impl<E: Start<T, P>, T: Scalar, const P: usize, const N: usize> Estimator<T, P>
         let x = self.estimator.screen(x)?;
         if let Some(slot) = self.held.get_mut(self.len) {
             *slot = x;
-            self.len += 1;
+            // `len < N` here: the sum cannot saturate.
+            self.len = self.len.saturating_add(1);
         }
         if self.len >= N {
             self.estimator.settle(config, &self.held);
