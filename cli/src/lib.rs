@@ -8,6 +8,7 @@
 //! them for `compare` and `report`, [`output`] prints a result as JSON or text, [`error`] is
 //! the one-line error. The binary (`src/main.rs`) parses the command line and dispatches.
 #![deny(missing_docs)]
+#![forbid(unsafe_code)]
 
 pub mod adev;
 pub mod characterise;

@@ -5,6 +5,7 @@
 //! The reference is a direct solve of the problem an estimator claims to solve (dense linear
 //! algebra from `nalgebra`), never the library's own recursion instantiated at `f64`.
 #![deny(missing_docs)]
+#![forbid(unsafe_code)]
 
 pub mod composite;
 pub mod differential;

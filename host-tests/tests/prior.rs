@@ -206,6 +206,57 @@ fn a_prior_that_is_not_finite_is_refused() {
     }
 }
 
+/// A prior beyond `2 C(P, k)` is refused (a finite 1e160 made the float estimators restart on
+/// every sample, their prediction errors overflowing); one at the bound is taken.
+#[test]
+fn a_prior_beyond_twice_the_binomial_bound_is_refused() {
+    let config = Config::new(0.99f64, 0.01).unwrap();
+    let channel = Channel::new(0.1f64).unwrap();
+    // P = 2: C(2, 1) = 2, C(2, 2) = 1; P = 4: 4, 6, 4, 1.
+    for a0 in [
+        [4.0 + 1e-9, 0.0],
+        [0.0, -2.0 - 1e-9],
+        [1e160, 0.0],
+        [0.0, -1e160],
+    ] {
+        assert_eq!(
+            Lattice::<f64, 2>::with_prior(&config, &channel, &a0).err(),
+            Some(ConfigError::Prior),
+            "{a0:?}"
+        );
+        assert_eq!(
+            Rls::<f64, 2>::with_prior(&config, &channel, &a0).err(),
+            Some(ConfigError::Prior),
+            "{a0:?}"
+        );
+        assert_eq!(
+            Sftf::<f64, 2>::with_prior(&config, &channel, &a0).err(),
+            Some(ConfigError::Prior),
+            "{a0:?}"
+        );
+    }
+    let x = data(2000, 5);
+    let edge = [-4.0, 2.0];
+    let mut lattice = Lattice::<f64, 2>::with_prior(&config, &channel, &edge).unwrap();
+    let mut rls = Rls::<f64, 2>::with_prior(&config, &channel, &edge).unwrap();
+    let mut sftf = Sftf::<f64, 2>::with_prior(&config, &channel, &edge).unwrap();
+    for &v in &x {
+        lattice.update(&config, v);
+        rls.update(&config, v);
+        sftf.update(&config, v);
+    }
+    assert_eq!(lattice.health().restarts, 0);
+    assert_eq!(rls.health().restarts, 0);
+    assert!(lattice.model(&config).is_some() && rls.model(&config).is_some());
+    let wide = [8.0, -12.0, 8.0, -2.0];
+    assert!(Lattice::<f64, 4>::with_prior(&config, &channel, &wide).is_ok());
+    let wider = [8.0, -12.0 - 1e-9, 8.0, -2.0];
+    assert_eq!(
+        Rls::<f64, 4>::with_prior(&config, &channel, &wider).err(),
+        Some(ConfigError::Prior)
+    );
+}
+
 /// The fixed-point lattice from a prior: within the tolerance of the fixed-point lattice
 /// without one (`fixed.rs`, 1e-5 in the coefficients against the direct solve), on the
 /// section-8 processes scaled to unit RMS, with priors near and away from the fit.

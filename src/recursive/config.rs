@@ -25,8 +25,9 @@ pub enum ConfigError {
     FixedLambda,
     /// The innovation gate's threshold is not positive and finite, or its run bound is 0.
     Gate,
-    /// A prior model's coefficient is not finite, or (fixed point) outside the coefficient
-    /// format's range, +-4.
+    /// A prior model's coefficient is not finite, beyond `2 C(P, k)` (twice the largest
+    /// `|a_k|` of an AR(`P`) model with its roots in the unit disc), or (fixed point) outside
+    /// the coefficient format's range, +-4.
     Prior,
 }
 
@@ -44,7 +45,7 @@ impl fmt::Display for ConfigError {
             Self::FixedLambda => "the fixed-point lattice needs lambda in [0.9, 1]",
             Self::Gate => "the gate needs k positive and finite and a run bound of at least 1",
             Self::Prior => {
-                "prior coefficients must be finite (and within +-4 for the fixed-point lattice)"
+                "prior coefficients must be finite, |a_k| <= 2 C(P, k) (and within +-4 for the fixed-point lattice)"
             }
         })
     }
@@ -325,13 +326,23 @@ impl<T: Scalar> Channel<T> {
     }
 }
 
-/// A float estimator's prior `a0`, checked: every entry finite ([`ConfigError::Prior`]).
+/// A float estimator's prior `a0`, checked ([`ConfigError::Prior`]): every entry finite and
+/// `|a_k| <= 2 C(P, k)`, twice the largest `a_k` of any AR(`P`) model whose roots lie in the
+/// unit disc (stable or on the edge of it: `(1 - z^-1)^P` reaches `C(P, k)`). A prior beyond
+/// that predicts with a gain the data cannot have; far enough beyond, its prediction errors
+/// overflow and the estimator would restart on every sample.
 pub(crate) fn finite_prior<T: Scalar, const P: usize>(a0: &[T; P]) -> Result<[T; P], ConfigError> {
-    if a0.iter().all(|a| a.is_finite()) {
-        Ok(*a0)
-    } else {
-        Err(ConfigError::Prior)
+    // k and C(P, k) counted in f64 (exact for every P a model can have): no integer count
+    // with an overflow path.
+    let (mut binomial, mut k) = (1.0f64, 0.0f64);
+    for a in a0 {
+        k += 1.0;
+        binomial = binomial * (P as f64 - k + 1.0) / k;
+        if !(a.is_finite() && a.to_f64().abs() <= 2.0 * binomial) {
+            return Err(ConfigError::Prior);
+        }
     }
+    Ok(*a0)
 }
 
 /// Why a sample was not used.

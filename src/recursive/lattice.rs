@@ -396,7 +396,9 @@ impl<T: FloatArith, const P: usize> Lattice<T, P> {
     ///
     /// # Errors
     ///
-    /// [`ConfigError::Prior`](super::ConfigError::Prior) if an entry of `a0` is not finite.
+    /// [`ConfigError::Prior`](super::ConfigError::Prior) if an entry of `a0` is not finite or
+    /// `|a0_k| > 2 C(P, k)`, twice the largest coefficient of an AR(`P`) model with its roots in
+    /// the unit disc.
     pub fn with_prior(
         config: &Config<T>,
         channel: &Channel<T>,
