@@ -174,13 +174,11 @@ impl<T: Scalar, const P: usize> Rls<T, P> {
 
         // Bierman's update of U D U^T with measurement variance lambda, then D /= lambda:
         // f = U^T phi, v = D f.
+        // The index from a range, not `enumerate`: its count carries an overflow check the
+        // optimiser keeps (nopanic). Column 0 is empty.
         let mut f = self.phi;
-        #[expect(
-            clippy::needless_range_loop,
-            reason = "enumerate's count carries an overflow check the optimiser keeps (nopanic)"
-        )]
-        for j in 1..P {
-            f[j] = dot(f[j], &self.ut[j][..j], &self.phi[..j]);
+        for ((fj, column), j) in f.iter_mut().zip(&self.ut).zip(0..P) {
+            *fj = dot(*fj, &column[..j], &self.phi[..j]);
         }
         let v: [T; P] = core::array::from_fn(|j| self.d[j] * f[j]);
         let mut gain = v;
