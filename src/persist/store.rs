@@ -52,11 +52,15 @@ const SEQUENCE: usize = 8;
 /// - A power cut after the entry's last byte: the new entry is intact and the newest.
 /// - A flash error: [`StoreError::Flash`] with the flash's own error. An erase or write error
 ///   leaves the newest entry untouched, as a power cut does. A read error ends the scan of
-///   that slot at the entry it hit, and the entries before it still count.
+///   that slot at the entry it hit: [`FlashStore::load`] counts the entries before it, and
+///   [`FlashStore::save`] writes and erases nothing (the unread part may hold the newest
+///   entry, whose number or slot the save would otherwise reuse).
 /// - A read-back of the new entry that does not check: [`StoreError::Verify`] (worn or
 ///   failing flash); the previous entry is still the newest.
-/// - Damage at rest (a bit flipped in the newest entry): that entry is no longer intact, and
-///   [`FlashStore::load`] returns the previous one, one save older.
+/// - Damage at rest (a bit flipped in an entry): that entry is no longer intact. Where its
+///   header still reads, the scan steps over it by its length, so that the entries after it
+///   still count: damage in the newest entry returns the previous one, one save older; damage
+///   in an older one changes nothing. Nothing is written after a damaged entry.
 /// - Nothing intact in either slot (erased, or never written by this store):
 ///   [`StoreError::Empty`].
 /// - The newest intact record is of another kind or order, or makes no valid model:
@@ -277,7 +281,13 @@ impl<F: NorFlash> FlashStore<F> {
                 slot: self.slot_len,
             });
         }
-        let scans = [self.scan(0), self.scan(1)];
+        let [mut a, mut b] = [self.scan(0), self.scan(1)];
+        // A slot that cannot be read in full may hide the newest entry: numbering or placing
+        // the new one from what could be read might reuse its number or erase it.
+        if let Some(e) = a.error.take().or(b.error.take()) {
+            return Err(StoreError::Flash(e));
+        }
+        let scans = [a, b];
         let newest = Self::newest(&scans);
         let seq = match newest.and_then(|s| scans.get(s)?.newest) {
             Some((s, ..)) if s.wrapping_add(1) != u32::MAX => s.wrapping_add(1),
@@ -374,8 +384,11 @@ impl<F: NorFlash> FlashStore<F> {
         }
     }
 
-    /// The intact entries of `slot`, in order; the scan ends at an erased magic, a damaged
-    /// entry, a read error or the slot's end.
+    /// The intact entries of `slot`, in order. A damaged entry whose header still reads (a
+    /// bit flipped at rest, or a write cut short after its length) is stepped over by its
+    /// length, so that intact entries after it still count, but nothing is written after it
+    /// (`free` stays `None`); the scan ends at an erased magic, a header that does not read,
+    /// a read error or the slot's end.
     fn scan(&mut self, slot: usize) -> Scan<F::Error> {
         let mut scan = Scan {
             newest: None,
@@ -383,18 +396,22 @@ impl<F: NorFlash> FlashStore<F> {
             error: None,
         };
         let base = self.base(slot);
-        let mut pos = 0usize;
+        let (mut pos, mut damaged) = (0usize, false);
         while pos.saturating_add(MIN_LEN) <= self.slot_len {
             match self.entry(base.saturating_add(pos), self.slot_len.saturating_sub(pos)) {
                 Ok(Entry::Erased) => {
-                    scan.free = Some(pos);
+                    scan.free = Some(pos).filter(|_| !damaged);
                     break;
                 }
                 Ok(Entry::Intact { seq, len }) => {
                     scan.newest = Some((seq, pos, len));
                     pos = pos.saturating_add(self.entry_len(len));
                 }
-                Ok(Entry::Damaged) => break,
+                Ok(Entry::Damaged { len: Some(len) }) => {
+                    damaged = true;
+                    pos = pos.saturating_add(self.entry_len(len));
+                }
+                Ok(Entry::Damaged { len: None }) => break,
                 Err(e) => {
                     scan.error = Some(e);
                     break;
@@ -417,7 +434,7 @@ impl<F: NorFlash> FlashStore<F> {
         }
         let len = match Head::read(head) {
             Ok(h) if self.entry_len(h.len) <= room => h.len,
-            _ => return Ok(Entry::Damaged),
+            _ => return Ok(Entry::Damaged { len: None }),
         };
         // The CRC of the record's first `len - 4` bytes, against its last four, then the
         // sequence number and its complement.
@@ -433,7 +450,7 @@ impl<F: NorFlash> FlashStore<F> {
         Ok(if intact {
             Entry::Intact { seq, len }
         } else {
-            Entry::Damaged
+            Entry::Damaged { len: Some(len) }
         })
     }
 
@@ -515,6 +532,6 @@ enum Entry {
     Erased,
     /// A sequence number and an intact record of `len` bytes.
     Intact { seq: u32, len: usize },
-    /// Anything else.
-    Damaged,
+    /// Anything else; `len` is the record's length where its header still reads.
+    Damaged { len: Option<usize> },
 }

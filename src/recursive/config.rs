@@ -23,7 +23,7 @@ pub enum ConfigError {
     Scale,
     /// The forgetting factor is below the fixed-point lattice's range, `[0.9, 1]`.
     FixedLambda,
-    /// The innovation gate's threshold is not positive and finite, or its run bound is 0.
+    /// The innovation gate's threshold is not finite and at least 1, or its run bound is 0.
     Gate,
     /// A prior model's coefficient is not finite, beyond `2 C(P, k)` (twice the largest
     /// `|a_k|` of an AR(`P`) model with its roots in the unit disc), or (fixed point) outside
@@ -43,7 +43,7 @@ impl fmt::Display for ConfigError {
             Self::Saturation => "saturation limit must be positive",
             Self::Scale => "fixed-point scale must be positive and keep delta representable",
             Self::FixedLambda => "the fixed-point lattice needs lambda in [0.9, 1]",
-            Self::Gate => "the gate needs k positive and finite and a run bound of at least 1",
+            Self::Gate => "the gate needs a finite k of at least 1 and a run bound of at least 1",
             Self::Prior => {
                 "prior coefficients must be finite, |a_k| <= 2 C(P, k) (and within +-4 for the fixed-point lattice)"
             }
@@ -87,8 +87,9 @@ pub struct Config<T> {
 /// estimator follows it as its forgetting factor says. A rejected sample changes nothing (the
 /// mean, the weight and the state stay as they were); the sample after it is taken as the
 /// next in time (the gate drops samples, as the NaN screening does). The test applies once the
-/// innovation variance stands on a weight `W_n` of at least [`Gate::SETTLED`] samples; before
-/// that every sample is taken.
+/// innovation variance stands on a weight `W_n` of at least [`Gate::settled`] samples (20, or
+/// half the memory `1/(1 - lambda)` where that is less: `W_n` never reaches 20 at
+/// `lambda <= 0.95`); before that every sample is taken.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Gate {
@@ -97,17 +98,18 @@ pub struct Gate {
 }
 
 impl Gate {
-    /// The weight `W_n` from which the gate tests: 20 samples.
+    /// The weight `W_n` from which the gate tests, where the memory allows: 20 samples.
     pub const SETTLED: f32 = 20.0;
 
-    /// A gate at `k` standard deviations (`k > 0`; 4 to 6 is usual) that opens after `run`
-    /// consecutive rejections (`run >= 1`).
+    /// A gate at `k` standard deviations (`k >= 1`; 4 to 6 is usual: a gate below one standard
+    /// deviation would reject most samples) that opens after `run` consecutive rejections
+    /// (`run >= 1`).
     ///
     /// # Errors
     ///
     /// [`ConfigError::Gate`].
     pub fn new(k: f32, run: u32) -> Result<Self, ConfigError> {
-        if !(k.is_finite() && k > 0.0 && run >= 1) {
+        if !(k.is_finite() && k >= 1.0 && run >= 1) {
             return Err(ConfigError::Gate);
         }
         Ok(Self { k, run })
@@ -121,6 +123,17 @@ impl Gate {
     /// The largest number of consecutive rejections.
     pub fn run(&self) -> u32 {
         self.run
+    }
+
+    /// The weight `W_n` from which the gate tests at forgetting factor `lambda`:
+    /// [`Gate::SETTLED`], or half the memory `1/(1 - lambda)` where that is less.
+    pub fn settled(lambda: f64) -> f64 {
+        let settled = f64::from(Self::SETTLED);
+        if lambda < 1.0 {
+            settled.min(0.5 / (1.0 - lambda))
+        } else {
+            settled
+        }
     }
 }
 

@@ -34,8 +34,9 @@ pub struct FixedConfig {
     lambda: f64,
     dt: f32,
     demean: bool,
-    /// The gate: `k^2` in Q16 (saturated) and the run bound.
-    gate: Option<(u64, Gate)>,
+    /// The gate: `k^2` in Q16 (saturated), the weight `W_n` from which it tests (Q40), and
+    /// the gate itself.
+    gate: Option<(u64, i64, Gate)>,
 }
 
 impl FixedConfig {
@@ -72,9 +73,14 @@ impl FixedConfig {
             dt: config.dt(),
             demean: config.demean(),
             gate: config.gate().map(|g| {
-                // `as` saturates: a k beyond 2^24 is a gate that never fires.
+                // `as` saturates: a k beyond 2^24 is a gate that never fires. `k >= 1`: k^2
+                // to 2^-17 relative.
                 let k2 = libm::round(f64::from(g.k()) * f64::from(g.k()) * 65_536.0) as u64;
-                (k2, g)
+                // The weight from which it tests, Q40 (at most 20 << 40).
+                let settled = libm::ceil(
+                    Gate::settled(f64::from(config.lambda())) * (1u64 << ENERGY_FRAC) as f64,
+                );
+                (k2, settled as i64, g)
             }),
         })
     }
@@ -389,8 +395,8 @@ impl<const P: usize> FixedLattice<P> {
     /// screening or the gate rejected (each counted).
     #[inline]
     fn gated(&mut self, config: &FixedConfig, screened: Result<i32, Rejection>) -> Option<i32> {
-        if let (Some((k2, gate)), Ok(x)) = (config.gate, screened) {
-            let outlier = self.outlier(config, k2, x);
+        if let (Some((k2, settled, gate)), Ok(x)) = (config.gate, screened) {
+            let outlier = self.outlier(config, (k2, settled), x);
             if !self.shell.pass(&gate, outlier) {
                 return None;
             }
@@ -400,10 +406,10 @@ impl<const P: usize> FixedLattice<P> {
 
     /// Whether the Q27 sample `x` is an outlier: its a-priori error `e` (Q27) against the
     /// order-`P` energy `E` and the weight `W` (both Q40), `e^2 W > k^2 E` in integers, once
-    /// `W` has reached [`Gate::SETTLED`].
-    fn outlier(&self, config: &FixedConfig, k2: u64, x: i32) -> bool {
+    /// `W` has reached [`Gate::settled`] (`settled`, Q40).
+    fn outlier(&self, config: &FixedConfig, (k2, settled): (u64, i64), x: i32) -> bool {
         let m = &self.shell.moments;
-        if m.weight < (Gate::SETTLED as i64) << ENERGY_FRAC {
+        if m.weight < settled {
             return false;
         }
         let mut clip = 0;

@@ -4,7 +4,7 @@
 
 use core::fmt::Debug;
 
-use super::config::{Channel, Config, Rejection};
+use super::config::{Channel, Config, Gate, Rejection};
 use super::mean::RunningMean;
 use crate::{ArModel, Scalar};
 
@@ -184,9 +184,9 @@ impl<F: Format, const P: usize> Shell<F, P> {
     /// The gate's decision on a sample whose a-priori error `e` and innovation variance
     /// `variance` it is told (`outlier`: `e^2 > k^2 variance`, tested only once the variance
     /// is settled): `false` rejects it (counted), `true` takes it. See
-    /// [`Gate`](super::config::Gate) for the rule.
+    /// [`Gate`] for the rule.
     #[inline]
-    pub(crate) fn pass(&mut self, gate: &super::config::Gate, outlier: bool) -> bool {
+    pub(crate) fn pass(&mut self, gate: &Gate, outlier: bool) -> bool {
         if !outlier {
             self.run = 0;
             self.open = false;
@@ -358,12 +358,13 @@ impl<T: Scalar, const P: usize> Shell<T, P> {
     }
 
     /// Whether the a-priori error `e` is an outlier for `gate` against the energy `energy`
-    /// (`e^2 > k^2 energy / W_n`), once `W_n` has reached [`Gate::SETTLED`].
+    /// (`e^2 > k^2 energy / W_n`), once `W_n` has reached [`Gate::settled`].
     #[inline]
-    pub(crate) fn outlier(&self, gate: &super::config::Gate, e: T, energy: T) -> bool {
+    pub(crate) fn outlier(&self, config: &Config<T>, gate: &Gate, e: T, energy: T) -> bool {
         let w = self.weight();
         let k = T::from_f64(f64::from(gate.k()));
-        w >= T::from_f64(f64::from(super::config::Gate::SETTLED)) && e * e * w > k * k * energy
+        let settled = T::from_f64(Gate::settled(config.lambda().to_f64()));
+        w >= settled && e * e * w > k * k * energy
     }
 
     /// The gate for a float estimator: `a_priori(y)` is the estimator's a-priori error of
@@ -383,7 +384,7 @@ impl<T: Scalar, const P: usize> Shell<T, P> {
         let Some(y) = self.peek(config, x) else {
             return false;
         };
-        let outlier = self.outlier(&gate, a_priori(y), energy);
+        let outlier = self.outlier(config, &gate, a_priori(y), energy);
         self.pass(&gate, outlier)
     }
 

@@ -56,8 +56,8 @@ pub struct Args {
     #[arg(long, conflicts_with = "prior_a")]
     settle: Option<usize>,
     /// Innovation gate of the recursive methods: reject (and count) a sample whose a-priori
-    /// error exceeds K innovation standard deviations; after 16 rejections in a row the
-    /// gate opens until a sample passes.
+    /// error exceeds K (at least 1) innovation standard deviations; after 16 rejections in a
+    /// row the gate opens until a sample passes.
     #[arg(long, allow_negative_numbers = true)]
     gate: Option<f64>,
     /// Internal units per sensor unit of `--scalar fixed` [default: 8 / max |x|, so that the

@@ -1,6 +1,5 @@
-//! Hostile probes of the innovation gate, persistence, the thermal stage and the prior /
-//! settled start (red-team pass). Each test states the documented promise it checks; tests
-//! that currently fail against the library are `#[ignore = "defect: ..."]`.
+//! Hostile inputs and faults against the innovation gate, persistence, the thermal stage and
+//! the prior / settled start. Each test states the documented promise it checks.
 
 use imu_ar::ArModel;
 use imu_ar::Scalar;
@@ -91,13 +90,11 @@ fn hostile_f32(n: usize, seed: u64) -> Vec<f32> {
 // 1. The innovation gate
 // ---------------------------------------------------------------------------------------
 
-/// The gate only tests once `W_n >= 20`. With `lambda <= 0.95` the weight
-/// `W_n = (1 - lambda^n)/(1 - lambda)` stays below 20 for ever: a gate configured with
-/// `Config::with_gate` (accepted without error) never rejects anything, even shocks of
-/// 1e6 sigma. Documented literally ("the test applies once ... W_n of at least
-/// Gate::SETTLED"), but nothing refuses or flags the combination.
+/// The gate tests once `W_n` reaches `Gate::settled(lambda)`: 20, or half the memory where
+/// that is less. With `lambda <= 0.95` the weight never reaches 20, and a gate that waited
+/// for 20 samples would never reject anything (it did: shocks of 1e6 sigma all taken).
 #[test]
-fn gate_is_inert_for_lambda_at_or_below_0_95() {
+fn the_gate_fires_at_short_memories() {
     let x = ar([0.9], 1.0, 20_000, 1);
     for lambda in [0.9f32, 0.95, 0.951] {
         let config = Config::new(lambda, 0.01)
@@ -114,11 +111,8 @@ fn gate_is_inert_for_lambda_at_or_below_0_95() {
             lattice.weight(),
             lattice.health().outliers
         );
-        if lambda <= 0.95 {
-            assert_eq!(lattice.health().outliers, 0);
-        } else {
-            assert!(lattice.health().outliers > 0);
-        }
+        // 200 shocks, each rejected.
+        assert!(lattice.health().outliers >= 200, "lambda {lambda}");
     }
     // The fixed-point lattice accepts lambda down to 0.9: the same.
     let config = Config::new(0.9f32, 0.01)
@@ -131,7 +125,7 @@ fn gate_is_inert_for_lambda_at_or_below_0_95() {
         let v = if n % 100 == 50 { v + 30.0 } else { v } as f32;
         lattice.update(&fixed, v);
     }
-    assert_eq!(lattice.health().outliers, 0);
+    assert!(lattice.health().outliers >= 200);
 }
 
 /// Per-sample paths with the gate on hostile input (NaN, infinities, f32::MAX, subnormals,
@@ -191,11 +185,11 @@ fn hostile_gate_run<const P: usize>(k: f32, run: u32, lambda: f32, seed: u64) {
 fn hostile_input_behind_the_gate_p1() {
     for (k, run, lambda, seed) in [
         (5.0, 8, 0.999, 1),
-        (1e-30, 1, 0.99, 2),
+        (1.0, 1, 0.99, 2),
         (1e30, 1, 1.0, 3),
         (f32::MAX, 3, 0.999, 4),
-        (f32::MIN_POSITIVE, u32::MAX, 0.999, 5),
-        (0.5, 1, 1.0, 6),
+        (1.0, u32::MAX, 0.999, 5),
+        (1.5, 1, 1.0, 6),
     ] {
         hostile_gate_run::<1>(k, run, lambda, seed);
     }
@@ -203,11 +197,7 @@ fn hostile_input_behind_the_gate_p1() {
 
 #[test]
 fn hostile_input_behind_the_gate_p32() {
-    for (k, run, lambda, seed) in [
-        (5.0, 8, 0.999, 11),
-        (1e-20, 2, 1.0, 12),
-        (3.0, 1, 0.9999, 13),
-    ] {
+    for (k, run, lambda, seed) in [(5.0, 8, 0.999, 11), (1.0, 2, 1.0, 12), (3.0, 1, 0.9999, 13)] {
         hostile_gate_run::<32>(k, run, lambda, seed);
     }
 }
@@ -407,19 +397,18 @@ fn fixed_and_float_gates_agree_on_the_same_data() {
     }
 }
 
-/// `FixedConfig::new` carries the gate as `k^2` rounded to Q16 (`round(k^2 * 65536)`):
-/// any `k` below 0.00276 becomes `k^2 = 0` (every sample with a non-zero error is an
-/// outlier) and `k = 0.01` becomes `k = 0.01033`. `Gate::new` accepts every `k > 0` and
-/// documents the rule `e^2 > k^2 E / W` for every estimator, the fixed-point lattice included.
-/// On the same record the f32 and the fixed lattice agree exactly at k = 2 and 5 (test
-/// above) but not at small k.
+/// A gate below one standard deviation is refused (it would reject most samples, and the
+/// fixed-point lattice, which carries `k^2` in Q16, turned `k = 0.002` into `k^2 = 0`). From
+/// `k = 1` on, the f32 and the fixed lattice take the same share of samples.
 #[test]
-#[ignore = "defect (minor): the fixed-point gate quantises k^2 to 1/65536; small k deviates from the rule"]
-fn fixed_gate_keeps_small_k() {
+fn a_gate_below_one_sigma_is_refused_and_fixed_agrees_from_one() {
+    for k in [0.002f32, 0.01, 0.999] {
+        assert!(Gate::new(k, 16).is_err(), "k {k}");
+    }
     let x = add(&ar([0.95], 1.0, 100_000, 15), &ar([0.0], 0.5, 100_000, 16));
     let x: Vec<f32> = x.iter().map(|&v| v as f32).collect();
     let mut worst = 0.0f64;
-    for k in [0.002f32, 0.01] {
+    for k in [1.0f32, 1.3] {
         let config = Config::new(0.999f32, 0.01)
             .unwrap()
             .with_gate(Gate::new(k, 1_000_000).unwrap());
@@ -512,25 +501,31 @@ fn fload<const R: usize, const W: usize, const E: usize, M: Record>(
 }
 
 /// A transient read error during `save`'s scan (the second entry of slot 0 unreadable for
-/// the duration of one save) hides the newest entry (seq 1). `save` does not stop: it takes
-/// seq 0 as the newest, erases slot 1 and writes the new model there with seq 1 again,
-/// and returns `Ok(1)`. Once the read error is gone, both slots hold an intact seq 1, the tie
-/// goes to slot 0, and `load` returns the model from *before* the successful save.
-/// Docs: `load` "returns the intact entry with the newest sequence number"; `save` numbers
-/// the new entry "one past the newest"; "a read error ends the scan of that slot at the entry
-/// it hit". A save that reported success is silently lost.
+/// the duration of one save) hid the newest entry (seq 1): the save took seq 0 as the newest,
+/// wrote the new model as seq 1 again in slot 1 and returned `Ok(1)`; once the read error was
+/// gone the tie went to slot 0 and `load` returned the model from before that save. Now the
+/// save refuses, writing nothing; the next one, without the fault, is the newest.
 #[test]
-#[ignore = "defect: a read error during save reuses a sequence number; load later returns the older model"]
 fn flash_transient_read_error_in_save_loses_the_saved_model() {
     let mut flash = RamFlash::<1, 4, 256>::new(2);
     fsave(&mut flash, &store_model(0)).unwrap();
     fsave(&mut flash, &store_model(1)).unwrap();
+    let before = flash.bytes().to_vec();
     // The second entry (bytes 52..104) reads with an error during the next save only.
     flash.fail_reads_at(60..61);
     let saved = fsave(&mut flash, &store_model(2));
     println!("save during the read error: {saved:?}");
-    assert!(saved.is_ok());
+    assert!(matches!(saved, Err(StoreError::Flash(_))), "{saved:?}");
+    assert!(
+        flash.bytes() == &before[..],
+        "the refused save wrote or erased"
+    );
     flash.fail_reads_at(0..0); // the fault is gone
+    assert_eq!(
+        fload::<1, 4, 256, ArModel<f32, 4>>(&mut flash),
+        Ok(store_model(1))
+    );
+    assert_eq!(fsave(&mut flash, &store_model(2)), Ok(2));
     let loaded: Result<ArModel<f32, 4>, _> = fload(&mut flash);
     println!("load afterwards: {loaded:?}");
     assert_eq!(
@@ -546,7 +541,6 @@ fn flash_transient_read_error_in_save_loses_the_saved_model() {
 /// intact entry"). A power cut during that erase then leaves seq 3 as the newest: the last
 /// committed model (seq 4) is gone.
 #[test]
-#[ignore = "defect: save erases the slot of the newest entry when a read error hid it"]
 fn flash_read_error_lets_save_erase_the_newest_entry() {
     let mut flash = RamFlash::<1, 4, 256>::new(2);
     for i in 0..5 {
@@ -792,43 +786,17 @@ fn thermal_residual_stays_finite_in_ill_conditioned_runs() {
 // 4. Prior and settled start
 // ---------------------------------------------------------------------------------------
 
-/// A finite but huge prior (accepted by `with_prior`): does the float estimator ever leave
-/// the restart loop? The fixed-point lattice documents dropping a prior it cannot carry; the
-/// float ones re-initialise "keeping the prior".
+/// A finite but huge prior made the float estimators restart every two or three samples
+/// for ever (and `a0 = 1e10` gave an f32 lattice at a = 61440): it is refused, as beyond
+/// `2 C(P, k)`.
 #[test]
-fn a_huge_finite_prior_restarts_for_ever() {
-    let x = ar([0.9], 1.0, 5000, 9);
+fn a_huge_finite_prior_is_refused() {
     let config = Config::new(0.999f32, 0.01).unwrap();
     let channel = Channel::new(0.1f32).unwrap();
-    for a0 in [1e10f32, 1e20, 1e30, f32::MAX] {
-        let mut lattice = Lattice::<f32, 1>::with_prior(&config, &channel, &[a0]).unwrap();
-        let mut rls = Rls::<f32, 1>::with_prior(&config, &channel, &[a0]).unwrap();
-        let mut sftf = Sftf::<f32, 1>::with_prior(&config, &channel, &[a0]).unwrap();
-        let mut taken = [0u32; 3];
-        for &v in &x {
-            taken[0] += u32::from(lattice.update(&config, v as f32).is_some());
-            taken[1] += u32::from(rls.update(&config, v as f32).is_some());
-            taken[2] += u32::from(sftf.update(&config, v as f32).is_some());
-        }
-        for m in [
-            lattice.model(&config),
-            rls.model(&config),
-            sftf.model(&config),
-        ]
-        .into_iter()
-        .flatten()
-        {
-            assert!(m.a()[0].is_finite() && m.noise_variance().is_finite());
-        }
-        println!(
-            "a0 {a0:e}: taken {taken:?}, restarts {} {} {}, models {:?} {:?} {:?}",
-            lattice.health().restarts,
-            rls.health().restarts,
-            sftf.health().restarts,
-            lattice.model(&config).map(|m| m.a()[0]),
-            rls.model(&config).map(|m| m.a()[0]),
-            sftf.model(&config).map(|m| m.a()[0]),
-        );
+    for a0 in [1e10f32, 1e20, 1e30, f32::MAX, 2.001] {
+        assert!(Lattice::<f32, 1>::with_prior(&config, &channel, &[a0]).is_err());
+        assert!(Rls::<f32, 1>::with_prior(&config, &channel, &[a0]).is_err());
+        assert!(Sftf::<f32, 1>::with_prior(&config, &channel, &[a0]).is_err());
     }
 }
 
@@ -843,7 +811,6 @@ fn a_huge_finite_prior_restarts_for_ever() {
 /// length and CRC-32 check ... and !s matches s". Seq 3 is intact by that definition. (The
 /// docs' damage-at-rest bullet covers only "a bit flipped in the newest entry".)
 #[test]
-#[ignore = "defect: damage in an older entry hides every newer intact entry of its slot"]
 fn flash_damage_in_an_older_entry_hides_the_newest() {
     let mut flash = RamFlash::<1, 4, 256>::new(2);
     for i in 0..4 {
@@ -859,7 +826,6 @@ fn flash_damage_in_an_older_entry_hides_the_newest() {
 /// holding seq 8..11. One bit flipped in seq 8: `load` returns seq 7 (slot 1), four saves
 /// old, while seq 9, 10 and 11 are intact.
 #[test]
-#[ignore = "defect: damage in an older entry hides every newer intact entry of its slot"]
 fn flash_damage_in_the_first_entry_of_a_slot_returns_the_other_slot() {
     let mut flash = RamFlash::<1, 4, 256>::new(2);
     for i in 0..12 {
@@ -1481,7 +1447,7 @@ fn settled_start_on_hostile_warm_ups() {
 /// `lambda = 1` asks for. Docs (Sftf): "stable for lambda > 1 - 1/(2P) on data its order
 /// describes"; README's table requires no restart on such rows (all at lambda < 1).
 #[test]
-#[ignore = "defect (pre-existing SFTF, outside the targets): spurious rescues of the f32 SFTF at lambda = 1"]
+#[ignore = "known: the f32 SFTF is rescued about 130 times per 10^6 samples at exactly lambda = 1 (f64 and lambda < 1: none)"]
 fn sftf_f32_at_lambda_one_is_not_rescued_on_data_its_order_describes() {
     let n = 1_000_000;
     let x = ar([0.8], 1.0, n, 45);
@@ -1521,7 +1487,7 @@ fn sftf_f32_at_lambda_one_is_not_rescued_on_data_its_order_describes() {
 #[test]
 fn fixed_counts_behind_the_gate() {
     let mut rng = ChaCha8Rng::seed_from_u64(61);
-    for (k, run) in [(5.0f32, 4u32), (0.001, 1), (f32::MAX, 2), (3.0, u32::MAX)] {
+    for (k, run) in [(5.0f32, 4u32), (1.0, 1), (f32::MAX, 2), (3.0, u32::MAX)] {
         let config = Config::new(0.999f32, 0.01)
             .unwrap()
             .with_gate(Gate::new(k, run).unwrap());
@@ -1720,11 +1686,11 @@ mod gate_props {
         #[test]
         fn gate_invariants(
             x in prop::collection::vec(value(), 0..3000),
-            k in prop_oneof![Just(5.0f32), 1e-3f32..100.0, Just(f32::MAX), Just(f32::MIN_POSITIVE)],
+            k in prop_oneof![Just(5.0f32), 1.0f32..100.0, Just(f32::MAX), Just(1.0f32)],
             run in prop_oneof![Just(1u32), 1u32..20, Just(u32::MAX)],
             lambda in prop_oneof![Just(1.0f32), 0.95f32..1.0, Just(0.999)],
             demean in any::<bool>(),
-            prior in prop::array::uniform4(-3.9f32..3.9),
+            prior in prop::array::uniform4(-1.9f32..1.9),
             base in prop::sample::select(vec![1.0f32, 1e-6, 1e6]),
             saturation in prop::option::of(prop::sample::select(vec![2.0f32, 50.0, 1e30])),
         ) {
