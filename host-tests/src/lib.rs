@@ -8,6 +8,7 @@
 #![forbid(unsafe_code)]
 
 pub mod composite;
+pub mod crc;
 pub mod differential;
 pub mod fixtures;
 pub mod flash;

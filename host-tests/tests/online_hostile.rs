@@ -10,6 +10,7 @@ use imu_ar::recursive::{
     Settled, Sftf,
 };
 use imu_ar::thermal::{ThermalBias, ThermalConfig};
+use imu_ar_host::crc::reseal;
 use imu_ar_host::fixtures::{add, ar};
 use imu_ar_host::flash::{RamFlash, RamFlashError};
 use rand_chacha::ChaCha8Rng;
@@ -451,27 +452,6 @@ fn a_gate_below_one_sigma_is_refused_and_fixed_agrees_from_one() {
 // ---------------------------------------------------------------------------------------
 // 2. Persistence
 // ---------------------------------------------------------------------------------------
-
-fn crc32(bytes: &[u8]) -> u32 {
-    let mut c = 0xFFFF_FFFFu32;
-    for &b in bytes {
-        c ^= u32::from(b);
-        for _ in 0..8 {
-            c = if c & 1 == 1 {
-                (c >> 1) ^ 0xEDB8_8320
-            } else {
-                c >> 1
-            };
-        }
-    }
-    !c
-}
-
-fn reseal(record: &mut [u8]) {
-    let n = record.len() - 4;
-    let crc = crc32(&record[..n]);
-    record[n..].copy_from_slice(&crc.to_le_bytes());
-}
 
 fn store_model(i: u32) -> ArModel<f32, 4> {
     ArModel::new(

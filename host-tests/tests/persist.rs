@@ -16,31 +16,8 @@ use imu_ar::ArModel;
 use imu_ar::model::ModelError;
 use imu_ar::noise::{Coefficients, GmTerm, NoiseError, NoiseModel, Oscillator};
 use imu_ar::persist::{DecodeError, EncodeError, Record};
+use imu_ar_host::crc::{crc32, reseal};
 use proptest::prelude::*;
-
-/// CRC-32 (IEEE) one bit at a time, independent of the library's nibble table.
-fn crc32(bytes: &[u8]) -> u32 {
-    let mut c = 0xFFFF_FFFFu32;
-    for &b in bytes {
-        c ^= u32::from(b);
-        for _ in 0..8 {
-            c = if c & 1 == 1 {
-                (c >> 1) ^ 0xEDB8_8320
-            } else {
-                c >> 1
-            };
-        }
-    }
-    !c
-}
-
-/// Writes the CRC of `record[..len-4]` into its last four bytes: an intact record of whatever
-/// the bytes say.
-fn reseal(record: &mut [u8]) {
-    let n = record.len() - 4;
-    let crc = crc32(&record[..n]);
-    record[n..].copy_from_slice(&crc.to_le_bytes());
-}
 
 fn encode<M: Record>(m: &M) -> Vec<u8> {
     let mut buf = vec![0u8; M::LEN];
