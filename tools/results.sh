@@ -6,7 +6,8 @@
 #     gyro axis of the ADIS16405 and MPU-6050 records at about 100 Hz and decimated to 10 Hz
 #     and 1 Hz (batch model fitted on the first half, all evaluated on the second),
 #   - handoff: the Kalman hand-off of the ADIS16405 gx axis (`imu-ar kalman`),
-#   - docs/plots: `imu-ar report` on the drifting AR(2) and on gx of both records.
+#   - docs/plots: `imu-ar report` on the drifting AR(2) (with the lattice from its correct
+#     prior) and on gx of both records.
 #
 #   tools/results.sh
 set -euo pipefail
@@ -112,13 +113,14 @@ plots=docs/plots
 mkdir -p "$plots"
 "$tool" simulate --a 1.5,-0.7 --a-end 1.0,-0.7 --sigma 1 --n 100000 --seed 4 > "$tmp/drift.csv"
 "$tool" report "$tmp/drift.csv" --column x --order 2 --lambda 0.999 --rate 1 \
-    --out "$tmp/drift" > /dev/null
+    --prior-a 1.5,-0.7 --prior-weight 300 --out "$tmp/drift" > /dev/null
 "$tool" report "${adis[@]}" --column gx --order 4 --lambda 0.999 --rate 100 --unit deg/s \
     --reference "$data/adis16405_imu1_allan_reference.csv" --out "$tmp/adis" > /dev/null
 "$tool" report "${mpu[@]}" --column gx --order 4 --lambda 0.999 --rate 99.3 --unit deg/s \
     --out "$tmp/mpu" > /dev/null
 cp "$tmp/drift/coefficients.png" "$plots/drift-coefficients.png"
 cp "$tmp/drift/prediction_error.png" "$plots/drift-prediction-error.png"
+cp "$tmp/drift/prior.png" "$plots/drift-prior.png"
 for record in adis mpu; do
     cp "$tmp/$record/psd.png" "$plots/$record-gx-psd.png"
     cp "$tmp/$record/adev.png" "$plots/$record-gx-adev.png"

@@ -53,8 +53,8 @@ enum Command {
     Compare(compare::Args),
     /// The paper's comparison on one record, in PNG plots: coefficient convergence of RLS and
     /// the lattice against the batch fit, one-step prediction error over time, the fitted PSD
-    /// against a Welch periodogram, and Allan deviations of the data and the model. Prints a
-    /// JSON summary.
+    /// against a Welch periodogram, and Allan deviations of the data and the model; with
+    /// --prior-a, a lattice from that prior against the plain start. Prints a JSON summary.
     Report(report::Args),
     /// The Kalman filter hand-off of a batch fit: `Phi`, `Q` and the stationary covariance at
     /// the filter's rate, the Gauss-Markov form of an AR(1), and the Allan check that the model

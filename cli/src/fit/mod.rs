@@ -8,7 +8,7 @@ use serde::Serialize;
 
 use crate::error::Fail;
 use crate::input::{
-    Input, check_decimate, check_delta, check_lambda, check_order, check_rate, check_span,
+    Input, Prior, check_decimate, check_delta, check_lambda, check_order, check_rate, check_span,
     default_delta,
 };
 use crate::method::{DEFAULT_LAMBDA, GaussMarkov, Method, ScalarKind, batch_fit, with_order};
@@ -37,19 +37,9 @@ pub struct Args {
     /// first 1000 samples, or 1 when that is 0].
     #[arg(long, allow_negative_numbers = true)]
     delta: Option<f64>,
-    /// Start the recursive methods from this model, a_1,..,a_P: their regularisation is
-    /// centred on it, `delta lambda^n (a - a0)^T D (a - a0)`.
-    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
-    prior_a: Option<Vec<f64>>,
-    /// The weight of `--prior-a`: the `delta` of its term (`--prior-a 0,..,0 --prior-weight D`
-    /// is `--delta D`).
-    #[arg(
-        long,
-        allow_negative_numbers = true,
-        conflicts_with = "delta",
-        requires = "prior_a"
-    )]
-    prior_weight: Option<f64>,
+    /// The model the recursive methods start from.
+    #[command(flatten)]
+    prior: Prior,
     /// Settled start of the recursive methods (f64 and f32): hold the first N samples, then
     /// start from their batch fit as the prior, with the running mean settled and no
     /// prewindowed equation.
@@ -224,8 +214,7 @@ pub fn run(args: &Args) -> Result<FitResult, Fail> {
         lambda,
         delta,
         scale,
-        ref prior_a,
-        prior_weight,
+        ref prior,
         settle,
         gate,
         no_demean,
@@ -233,23 +222,13 @@ pub fn run(args: &Args) -> Result<FitResult, Fail> {
         rate,
         json: _,
     } = *args;
-    let delta = delta.or(prior_weight);
-    if let Some(a) = prior_a {
-        if a.len() != order {
-            return Err(Fail(format!(
-                "--prior-a has {} coefficients; --order {order} needs {order}",
-                a.len()
-            )));
-        }
-        if let Some(v) = a.iter().find(|v| !v.is_finite()) {
-            return Err(Fail(format!("--prior-a {v}: coefficients must be finite")));
-        }
-        if !method.recursive() {
-            return Err(Fail(format!(
-                "--prior-a: only the recursive methods start from a prior, not {}",
-                method.name()
-            )));
-        }
+    let delta = delta.or(prior.prior_weight);
+    let prior_a = prior.check(order)?;
+    if prior_a.is_some() && !method.recursive() {
+        return Err(Fail(format!(
+            "--prior-a: only the recursive methods start from a prior, not {}",
+            method.name()
+        )));
     }
     if let Some(n) = settle {
         if !method.recursive() || matches!(scalar, ScalarKind::Fixed) {
@@ -322,7 +301,7 @@ pub fn run(args: &Args) -> Result<FitResult, Fail> {
             dt,
             rate,
             default_delta: default,
-            prior: prior_a.clone(),
+            prior: prior_a.map(<[f64]>::to_vec),
             settle,
             gate,
         };

@@ -277,9 +277,55 @@ pub fn check_lambda(lambda: f64) -> Result<(), Fail> {
 
 /// A `--delta` that the f64 estimators can carry (the library's range check).
 pub fn check_delta(delta: f64) -> Result<(), Fail> {
+    check_weight("--delta", delta)
+}
+
+/// A regularisation weight (`flag`) that the f64 estimators can carry.
+fn check_weight(flag: &str, delta: f64) -> Result<(), Fail> {
     Channel::<f64>::new(delta)
         .map(|_| ())
-        .map_err(|e| Fail(format!("--delta {delta}: {e}")))
+        .map_err(|e| Fail(format!("{flag} {delta}: {e}")))
+}
+
+/// A prior model to start a recursive estimator from, and its weight (`fit`, `report`).
+#[derive(clap::Args)]
+pub struct Prior {
+    /// Start from this model, a_1,..,a_P: the regularisation is centred on it,
+    /// `delta lambda^n (a - a0)^T D (a - a0)`.
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    pub prior_a: Option<Vec<f64>>,
+    /// The weight of `--prior-a`: the `delta` of its term (`--prior-a 0,..,0 --prior-weight D`
+    /// is `--delta D`) [default: the --delta in use].
+    #[arg(
+        long,
+        allow_negative_numbers = true,
+        conflicts_with = "delta",
+        requires = "prior_a"
+    )]
+    pub prior_weight: Option<f64>,
+}
+
+impl Prior {
+    /// `--prior-a`, if given, checked against `--order`: `order` coefficients, all finite;
+    /// and `--prior-weight`, if given, a `delta` the estimators can carry.
+    pub fn check(&self, order: usize) -> Result<Option<&[f64]>, Fail> {
+        if let Some(w) = self.prior_weight {
+            check_weight("--prior-weight", w)?;
+        }
+        let Some(a) = &self.prior_a else {
+            return Ok(None);
+        };
+        if a.len() != order {
+            return Err(Fail(format!(
+                "--prior-a has {} coefficients; --order {order} needs {order}",
+                a.len()
+            )));
+        }
+        if let Some(v) = a.iter().find(|v| !v.is_finite()) {
+            return Err(Fail(format!("--prior-a {v}: coefficients must be finite")));
+        }
+        Ok(Some(a))
+    }
 }
 
 /// `rate` (Hz, `flag`) gives finite times over `samples` samples: their span `samples / rate`

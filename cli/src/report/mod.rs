@@ -1,27 +1,35 @@
-//! `imu-ar report`: the paper's comparison on one record, in four PNG plots and a JSON summary.
+//! `imu-ar report`: the paper's comparison on one record, in four PNG plots and a JSON summary;
+//! with `--prior-a`, a fifth: a lattice from that prior against the plain start.
 
 mod plot;
 
 use std::path::{Path, PathBuf};
 
 use imu_ar::batch::{BatchConfig, covariance};
-use imu_ar::recursive::{Channel, Config, Estimator};
+use imu_ar::recursive::{Channel, Config, Estimator, Lattice};
 use serde::Serialize;
 
 use crate::chart::font;
 use crate::error::Fail;
-use crate::input::{check_rate, check_span, csv};
+use crate::input::{Prior, check_rate, check_span, csv};
 use crate::method::with_order;
 use crate::output::finite;
 use crate::predict::{Comparison, predict};
-use plot::{adev_png, coefficients_png, error_png, psd_png};
+use plot::{adev_png, coefficients_png, error_png, prior_png, psd_png};
 
 /// The arguments of `imu-ar report`.
 #[derive(clap::Args)]
+#[command(mut_arg("prior_a", |a| a.help(
+    "Also run a lattice from this model, a_1,..,a_P (its regularisation centred on it, \
+     `delta lambda^n (a - a0)^T D (a - a0)`), and draw it against the plain start in prior.png"
+)))]
 pub struct Args {
     /// The record and the settings.
     #[command(flatten)]
     run: Comparison,
+    /// A prior to start a second lattice from.
+    #[command(flatten)]
+    prior: Prior,
     /// Sample rate in Hz of the raw record.
     #[arg(long, allow_negative_numbers = true)]
     rate: f64,
@@ -64,6 +72,9 @@ pub struct Summary {
     pub batch_a: Vec<f64>,
     /// The lattice's after the last sample.
     pub lattice_a: Option<Vec<f64>>,
+    /// The lattice's from `--prior-a` after the last sample.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub prior_lattice_a: Option<Vec<f64>>,
     /// The PNG files.
     pub files: Vec<String>,
 }
@@ -73,6 +84,7 @@ pub fn run(args: &Args) -> Result<Summary, Fail> {
     check_out(&args.out)?;
     let run = &args.run;
     let rate = check_rate(args.rate)? / run.decimate.max(1) as f64;
+    let prior_a = args.prior.check(run.record.order)?;
     let reference = match &args.reference {
         Some(path) => Some(read_reference(path, &run.record.input.column)?),
         None => None,
@@ -91,6 +103,7 @@ pub fn run(args: &Args) -> Result<Summary, Fail> {
         train: run.train,
         unit: run.record.input.unit.as_deref().unwrap_or("units"),
         reference,
+        prior: prior_a.map(|a| (a, args.prior.prior_weight.unwrap_or(delta))),
         out: &args.out,
     };
     with_order!(run.record.order, report(&r)).map_err(|Fail(e)| run.record.input.fail(e))
@@ -154,6 +167,8 @@ struct Report<'a> {
     unit: &'a str,
     /// Published Allan deviations `(tau_s, adev)` to draw with the data's.
     reference: Option<Vec<(f64, f64)>>,
+    /// `--prior-a` and its weight, the `delta` of the lattice that starts from it.
+    prior: Option<(&'a [f64], f64)>,
     out: &'a Path,
 }
 
@@ -164,8 +179,46 @@ const MIN_SAMPLES: usize = 64;
 type Track<const P: usize> = Vec<(f64, [f64; P])>;
 /// Points per drawn time series: the plots stay small and readable for any record length.
 const POINTS: usize = 400;
+/// Samples of the start that prior.png draws one by one.
+const HEAD: usize = 1000;
 
-/// Writes the four PNGs and returns the summary.
+/// The lattice from `--prior-a`, run next to the plain one, and what prior.png draws of both.
+struct FromPrior<const P: usize> {
+    lattice: Lattice<f64, P>,
+    /// The prior `a0`.
+    a0: [f64; P],
+    /// The weight of the prior (the lattice's `delta`).
+    weight: f64,
+    /// The first [`HEAD`] samples, every one, from time 0: the plain lattice's coefficients
+    /// and this one's.
+    head: (Track<P>, Track<P>),
+    /// This lattice's coefficients over the whole record, sampled as the plain one's.
+    whole: Track<P>,
+}
+
+impl<const P: usize> FromPrior<P> {
+    /// The lattice from `a0` with weight `weight`, and the plain one's start next to it.
+    fn new(
+        config: &Config<f64>,
+        channel: &Channel<f64>,
+        a0: &[f64],
+        weight: f64,
+    ) -> Result<Self, Fail> {
+        let a0: [f64; P] = core::array::from_fn(|k| a0[k]);
+        let lattice = Lattice::<f64, P>::with_prior(config, &Channel::new(weight)?, &a0)?;
+        let start = |l: &Lattice<f64, P>| (0.0, l.coefficients(P).unwrap_or([f64::NAN; P]));
+        let plain = Lattice::<f64, P>::new(config, channel);
+        Ok(Self {
+            head: (vec![start(&plain)], vec![start(&lattice)]),
+            whole: Vec::new(),
+            lattice,
+            a0,
+            weight,
+        })
+    }
+}
+
+/// Writes the four PNGs (five with a prior) and returns the summary.
 fn report<const P: usize>(r: &Report) -> Result<Summary, Fail> {
     let x = r.x;
     if x.len() < MIN_SAMPLES {
@@ -191,6 +244,10 @@ fn report<const P: usize>(r: &Report) -> Result<Summary, Fail> {
     let mut se = [vec![], vec![], vec![]];
     let mut block = [0.0; 3];
     let mut missing = 0usize;
+    let mut from_prior = match r.prior {
+        Some((a0, weight)) => Some(FromPrior::<P>::new(&config, &channel, a0, weight)?),
+        None => None,
+    };
     let mut eval = predict(x, n_train, &train_fit, &config, &channel, |n, e, est| {
         if n >= n_train && (e.rls.is_none() || e.lattice.is_none()) {
             missing += 1;
@@ -209,6 +266,22 @@ fn report<const P: usize>(r: &Report) -> Result<Summary, Fail> {
             coef.0.push((t, *est.rls.coefficients()));
             coef.1.push((t, a_lattice));
         }
+        if let Some(p) = &mut from_prior {
+            p.lattice.update(&config, x[n]);
+            let (head, sampled) = (n < HEAD, (n + 1) % stride == 0);
+            if head || sampled {
+                let t = (n + 1) as f64 * dt;
+                let a = p.lattice.coefficients(P).unwrap_or([f64::NAN; P]);
+                if head {
+                    let a_plain = est.lattice.coefficients(P).unwrap_or([f64::NAN; P]);
+                    p.head.0.push((t, a_plain));
+                    p.head.1.push((t, a));
+                }
+                if sampled {
+                    p.whole.push((t, a));
+                }
+            }
+        }
     });
     let m = x.len() - n_train;
     let mse = [eval.batch, eval.rls, eval.lattice].map(|s| s.mean(m));
@@ -224,12 +297,24 @@ fn report<const P: usize>(r: &Report) -> Result<Summary, Fail> {
         ));
     }
 
-    let files = [
+    let prior_lattice_a = match &from_prior {
+        Some(p) => Some(
+            p.lattice
+                .coefficients(P)
+                .map(|a| a.to_vec())
+                .ok_or_else(|| Fail("the lattice from --prior-a gives no finite model".into()))?,
+        ),
+        None => None,
+    };
+    let mut files = vec![
         coefficients_png::<P>(r, &coef, &train_fit)?,
         error_png(r, &se, &mse, n_train as f64 * dt)?,
         psd_png(r, &whole_fit)?,
         adev_png(r, &whole_fit)?,
     ];
+    if let Some(p) = &from_prior {
+        files.push(prior_png(r, p, &coef.1)?);
+    }
     Ok(Summary {
         order: P,
         lambda: r.lambda,
@@ -244,6 +329,7 @@ fn report<const P: usize>(r: &Report) -> Result<Summary, Fail> {
         reduction_percent: 100.0 * (mse[0] - mse[2]) / mse[0],
         batch_a: train_fit.a().to_vec(),
         lattice_a: lattice.coefficients(P).map(|a| a.to_vec()),
+        prior_lattice_a,
         files: files.iter().map(|f| f.display().to_string()).collect(),
     })
 }

@@ -1,13 +1,16 @@
-//! The four PNG plots of `imu-ar report`.
+//! The PNG plots of `imu-ar report`: four, and prior.png with `--prior-a`.
 
 use std::path::PathBuf;
 
 use imu_ar::ArModel;
 use imu_ar::allan::overlapping_avar;
+use plotters::chart::SeriesAnno;
+use plotters::coord::types::RangedCoordf64;
+use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use rustfft::{FftPlanner, num_complex::Complex};
 
-use super::{Report, Track};
+use super::{FromPrior, Report, Track};
 use crate::chart::{SIZE, builder, draw_err, legend};
 use crate::error::Fail;
 
@@ -39,6 +42,16 @@ fn significant(v: f64) -> String {
     }
 }
 
+/// `v` to 4 significant digits without trailing zeros: 300, 0.822.
+fn short(v: f64) -> String {
+    let s = significant(v);
+    if s.contains('.') && !s.contains('e') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
 /// Range of finite values, widened a little.
 fn span(values: impl Iterator<Item = f64>) -> (f64, f64) {
     let (lo, hi) = values
@@ -53,6 +66,35 @@ fn span(values: impl Iterator<Item = f64>) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
+/// The coefficients of a track after its first tenth (to `t_end`), the transient, which is left
+/// out of the y range.
+fn settled<const P: usize>(s: &Track<P>, t_end: f64) -> impl Iterator<Item = f64> + '_ {
+    s.iter()
+        .filter(move |c| c.0 > 0.1 * t_end)
+        .flat_map(|c| c.1)
+}
+
+/// The time axes of the coefficient plots.
+type TimeChart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// A dashed horizontal line at `a` from time 0 to `t_end`, `dash` its dashes and gaps.
+fn level<'a, 'b, DB: DrawingBackend + 'a>(
+    chart: &'b mut TimeChart<'a, DB>,
+    a: f64,
+    t_end: f64,
+    (size, spacing): (u32, u32),
+    style: ShapeStyle,
+) -> Result<&'b mut SeriesAnno<'a, DB>, Fail> {
+    chart
+        .draw_series(DashedLineSeries::new(
+            [(0.0, a), (t_end, a)],
+            size,
+            spacing,
+            style,
+        ))
+        .map_err(draw_err)
+}
+
 pub(super) fn coefficients_png<const P: usize>(
     r: &Report,
     coef: &(Track<P>, Track<P>),
@@ -62,17 +104,9 @@ pub(super) fn coefficients_png<const P: usize>(
     let root = BitMapBackend::new(&path, SIZE).into_drawing_area();
     root.fill(&WHITE).map_err(draw_err)?;
     let t_end = coef.0.last().map_or(1.0, |c| c.0);
-    // The first tenth of the record is the transient: leave it out of the y range.
-    let settled = |s: &Track<P>| {
-        s.iter()
-            .filter(|c| c.0 > 0.1 * t_end)
-            .flat_map(|c| c.1)
-            .collect::<Vec<_>>()
-    };
     let (lo, hi) = span(
-        settled(&coef.0)
-            .into_iter()
-            .chain(settled(&coef.1))
+        settled(&coef.0, t_end)
+            .chain(settled(&coef.1, t_end))
             .chain(batch.a().iter().copied()),
     );
     let mut chart = builder(
@@ -112,14 +146,7 @@ pub(super) fn coefficients_png<const P: usize>(
             .label(format!("a_{} lattice", k + 1))
             .legend(move |(x, y)| Circle::new((x + 10, y), 3, color.filled()));
         let a = batch.a()[k];
-        chart
-            .draw_series(DashedLineSeries::new(
-                [(0.0, a), (t_end, a)],
-                8,
-                5,
-                color.stroke_width(2),
-            ))
-            .map_err(draw_err)?
+        level(&mut chart, a, t_end, (8, 5), color.stroke_width(2))?
             .label(format!("a_{} batch LS, first part ({a:.3})", k + 1))
             .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color.stroke_width(2)));
     }
@@ -350,6 +377,139 @@ pub(super) fn adev_png<const P: usize>(
             .legend(|(x, y)| Cross::new((x + 10, y), 5, BLACK.stroke_width(2)));
     }
     legend(&mut chart, SeriesLabelPosition::LowerLeft)?;
+    root.present().map_err(draw_err)?;
+    Ok(path.clone())
+}
+
+/// Decimals of the labels of an axis spanning `span`: about two significant digits.
+fn decimals(span: f64) -> usize {
+    (1.0 - span.abs().max(1e-6).log10().floor()).clamp(0.0, 6.0) as usize
+}
+
+/// One panel of prior.png: each `a_k` of the plain lattice and of the lattice from the prior
+/// over time, and, if given, the prior's value; `lo..hi` is the y range.
+fn prior_panel<const P: usize, DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    title: String,
+    (plain, prior): (&Track<P>, &Track<P>),
+    a0: Option<&[f64; P]>,
+    (lo, hi): (f64, f64),
+) -> Result<(), Fail> {
+    let t_end = plain.last().map_or(1.0, |c| c.0);
+    // Room on the right for the last time label.
+    let mut chart = builder(area, title, 70)
+        .margin_right(30)
+        .build_cartesian_2d(0.0..t_end, lo..hi)
+        .map_err(draw_err)?;
+    let d = decimals(t_end);
+    // A tick at 0 computed as 1e-16 is 0.
+    let zero = 1e-9 * (hi - lo);
+    chart
+        .configure_mesh()
+        .light_line_style(WHITE)
+        .x_labels(5)
+        .x_desc("time (s)")
+        .x_label_formatter(&|t| format!("{t:.d$}"))
+        .y_desc("coefficient a_k (1)")
+        .y_label_formatter(&|v| tick(if v.abs() < zero { 0.0 } else { *v }))
+        .draw()
+        .map_err(draw_err)?;
+    let finite = |s: &Track<P>, k: usize| {
+        s.iter()
+            .map(move |c| (c.0, c.1[k]))
+            .filter(|p| p.1.is_finite())
+            .collect::<Vec<_>>()
+    };
+    for k in 0..P {
+        let color = Palette99::pick(k).to_rgba();
+        // The lattice from the prior as a band of opaque light dots under the plain one's
+        // line (a wide line would spike at the sharp turns of the start).
+        let (r, g, b) = color.rgb();
+        let light = |c: u8| 255 - ((255 - u16::from(c)) * 2 / 5) as u8;
+        let band = RGBColor(light(r), light(g), light(b)).filled();
+        chart
+            .draw_series(
+                finite(prior, k)
+                    .into_iter()
+                    .map(|p| Circle::new(p, 2, band)),
+            )
+            .map_err(draw_err)?
+            .label(format!("a_{} from the prior", k + 1))
+            .legend(move |(x, y)| Rectangle::new([(x, y - 2), (x + 20, y + 2)], band));
+        chart
+            .draw_series(LineSeries::new(finite(plain, k), color.stroke_width(1)))
+            .map_err(draw_err)?
+            .label(format!("a_{} plain start", k + 1))
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], color.stroke_width(1)));
+        if let Some(a0) = a0 {
+            let a = a0[k];
+            level(&mut chart, a, t_end, (6, 4), color.stroke_width(1))?
+                .label(format!("a_{} prior ({a})", k + 1))
+                .legend(move |(x, y)| {
+                    DashedPathElement::new([(x, y), (x + 20, y)], 6, 4, color.stroke_width(1))
+                });
+        }
+    }
+    legend(&mut chart, SeriesLabelPosition::MiddleRight)
+}
+
+/// prior.png: the lattice from the prior against the plain lattice, over the first [`HEAD`]
+/// samples one by one (left, with the prior) and over the whole record (right).
+///
+/// [`HEAD`]: super::HEAD
+pub(super) fn prior_png<const P: usize>(
+    r: &Report,
+    prior: &FromPrior<P>,
+    plain: &Track<P>,
+) -> Result<PathBuf, Fail> {
+    let path = r.out.join("prior.png");
+    let root = BitMapBackend::new(&path, SIZE).into_drawing_area();
+    root.fill(&WHITE).map_err(draw_err)?;
+    // A long prior is cut after four coefficients.
+    let mut a0: Vec<String> = prior.a0.iter().take(4).map(|v| v.to_string()).collect();
+    if P > 4 {
+        a0.push("...".into());
+    }
+    let root = root
+        .titled(
+            &format!(
+                "Lattice from the prior a0 = ({}) against the plain start",
+                a0.join(", ")
+            ),
+            ("sans-serif", 20),
+        )
+        .map_err(draw_err)?
+        .titled(
+            &format!(
+                "n = {}, {} Hz, lambda = {}; the prior's weight {}, the plain start's delta {}",
+                r.x.len(),
+                r.rate,
+                r.lambda,
+                short(prior.weight),
+                short(r.delta)
+            ),
+            ("sans-serif", 15),
+        )
+        .map_err(draw_err)?;
+    let (left, right) = root.split_horizontally(SIZE.0 / 2);
+    let head = &prior.head;
+    let range = span(
+        head.0
+            .iter()
+            .chain(&head.1)
+            .flat_map(|c| c.1)
+            .chain(prior.a0),
+    );
+    let title = format!("the first {} samples", head.1.len() - 1);
+    prior_panel(&left, title, (&head.0, &head.1), Some(&prior.a0), range)?;
+    let t_end = plain.last().map_or(1.0, |c| c.0);
+    let range = span(
+        settled(plain, t_end)
+            .chain(settled(&prior.whole, t_end))
+            .chain(prior.a0),
+    );
+    let title = "the whole record".to_string();
+    prior_panel(&right, title, (plain, &prior.whole), None, range)?;
     root.present().map_err(draw_err)?;
     Ok(path.clone())
 }
