@@ -8,6 +8,7 @@
 
 use core::fmt::Debug;
 
+use super::lattice::Core;
 use crate::Scalar;
 
 /// The number formats and the steps of the lattice recursion.
@@ -24,9 +25,10 @@ pub trait Arith: Copy + Debug {
     type Coef: Copy + Debug + PartialEq;
     /// Weighted energies `F`, `B`, positive.
     type Energy: Copy + Debug + PartialEq;
-    /// A divisor prepared once for several divisions by the same energy: the reciprocal for
-    /// floats, the normalised reciprocal for fixed point.
-    type Recip: Copy + Debug;
+    /// What stage `i` keeps from one sample for the next one's update of `kf_{i+1}` (and of a
+    /// ladder coefficient), where the divisor is `B_i(n-1)`: its reciprocal for floats, the
+    /// whole gain `gamma_i(n-1) psi_i(n-1) / B_i(n-1)` for fixed point.
+    type Kept: Copy + Debug;
     /// What the steps need from the configuration (the forgetting factor in its format).
     type Params: Copy + Debug;
 
@@ -52,31 +54,29 @@ pub trait Arith: Copy + Debug {
     /// `x - k y`: an order update of an error.
     fn predict(x: Self::Err, k: Self::Coef, y: Self::Err, clip: &mut u32) -> Self::Err;
 
-    /// Prepares divisions by `energy`.
-    fn recip(energy: Self::Energy) -> Self::Recip;
+    /// What a stage keeps before its first sample, for the backward energy `energy`.
+    fn kept(energy: Self::Energy) -> Self::Kept;
 
-    /// `k + gx e / energy`: the error-feedback update of a reflection coefficient; `recip` is
-    /// `recip(energy)`.
-    fn adapt(
+    /// `k + gx e / B`: the error-feedback update of a reflection (or ladder) coefficient by the
+    /// a-priori error `e`, for `gx = gamma_i(n-1) psi_i(n-1)` and what stage `i` kept for
+    /// `B = B_i(n-1)`.
+    fn feedback(
         k: Self::Coef,
         gx: Self::Err,
         e: Self::Err,
-        energy: Self::Energy,
-        recip: &Self::Recip,
+        kept: &Self::Kept,
         clip: &mut u32,
     ) -> Self::Coef;
 
-    /// The next order's conversion factor `g - gx^2 / energy = g lambda old / energy`, where
-    /// `energy = lambda old + gx^2 / g` is the energy made from `old` by [`Arith::energy`]:
-    /// in `[0, g]`.
-    fn convert(
-        p: &Self::Params,
-        g: Self::Gamma,
-        gx: Self::Err,
-        old: Self::Energy,
-        energy: Self::Energy,
-        recip: &Self::Recip,
-    ) -> Self::Gamma;
+    /// One sample `y` through every stage of `core`; returns `f_P(n)`. The recursion is the
+    /// one of [`Lattice`](super::Lattice); each format writes it in the operations it is
+    /// cheapest in.
+    fn step<const P: usize>(
+        core: &mut Core<Self, P>,
+        params: &Self::Params,
+        y: Self::Err,
+        clip: &mut u32,
+    ) -> Self::Err;
 }
 
 /// [`Arith::Params`] of the float formats.
@@ -99,7 +99,7 @@ macro_rules! impl_arith_float {
             type Gamma = $t;
             type Coef = $t;
             type Energy = $t;
-            type Recip = $t;
+            type Kept = $t;
             type Params = FloatParams<$t>;
 
             const ERR_ZERO: $t = 0.0;
@@ -122,19 +122,23 @@ macro_rules! impl_arith_float {
             }
 
             #[inline(always)]
-            fn recip(energy: $t) -> $t {
+            fn kept(energy: $t) -> $t {
                 1.0 / energy
             }
 
             #[inline(always)]
-            fn adapt(k: $t, gx: $t, e: $t, _: $t, recip: &$t, _: &mut u32) -> $t {
+            fn feedback(k: $t, gx: $t, e: $t, recip: &$t, _: &mut u32) -> $t {
                 k + gx * e * recip
             }
 
             #[inline(always)]
-            fn convert(p: &FloatParams<$t>, g: $t, _: $t, old: $t, _: $t, recip: &$t) -> $t {
-                // The ratio form needs no clamp: `energy >= lambda old` holds after rounding.
-                g * (p.lambda * old) * recip
+            fn step<const P: usize>(
+                core: &mut Core<$t, P>,
+                params: &FloatParams<$t>,
+                y: $t,
+                _: &mut u32,
+            ) -> $t {
+                core.float_step(params, y)
             }
         }
     )*};
@@ -147,7 +151,15 @@ impl_arith_float!(f32, f64);
 /// (`fn run<T: FloatArith>(lattice: &mut Lattice<T, 4>)`) and cannot be implemented outside
 /// this crate.
 pub trait FloatArith:
-    Scalar + Arith<Err = Self, Gamma = Self, Coef = Self, Energy = Self, Params = FloatParams<Self>>
+    Scalar
+    + Arith<
+        Err = Self,
+        Gamma = Self,
+        Coef = Self,
+        Energy = Self,
+        Kept = Self,
+        Params = FloatParams<Self>,
+    >
 {
 }
 

@@ -5,6 +5,7 @@
 use fixed::types::{I2F30, I3F29, I5F27, I24F40, U0F32};
 
 use super::arith::Arith;
+use super::lattice::{Core, Stage};
 
 /// The fixed-point number formats of the lattice, as an [`Arith`] implementation.
 // `pub` in a private module, as `Arith`: reachable by no one outside the crate.
@@ -12,12 +13,14 @@ use super::arith::Arith;
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Q;
 
-/// [`Arith::Params`] of [`Q`]: the forgetting factor and the energy floor.
+/// Energies are floored at 16 LSB (1.5e-11 internal units^2).
+pub(crate) const ENERGY_FLOOR: i64 = 16;
+
+/// [`Arith::Params`] of [`Q`]: the forgetting factor.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct QParams {
     pub(crate) lambda: U0F32,
-    pub(crate) floor: I24F40,
 }
 
 /// Fractional bits of the errors (I5F27).
@@ -53,13 +56,14 @@ fn normalise(x: i32) -> (i32, u32) {
     (x.wrapping_shl(n), n)
 }
 
-/// `x` saturated to `i32`, counting a saturation in `clip`.
+/// `x` saturated to `i32`, counting a saturation in `clip` (a sample's count, far below
+/// `2^32`: it wraps nowhere, and a wrapping add is one instruction).
 #[inline(always)]
 pub(crate) fn sat_i32(x: i64, clip: &mut u32) -> i32 {
     match i32::try_from(x) {
         Ok(v) => v,
         Err(_) => {
-            *clip = clip.saturating_add(1);
+            *clip = clip.wrapping_add(1);
             if x < 0 { i32::MIN } else { i32::MAX }
         }
     }
@@ -69,7 +73,7 @@ pub(crate) fn sat_i32(x: i64, clip: &mut u32) -> i32 {
 #[inline(always)]
 pub(crate) fn sat_add(x: i64, y: i64, clip: &mut u32) -> i64 {
     x.checked_add(y).unwrap_or_else(|| {
-        *clip = clip.saturating_add(1);
+        *clip = clip.wrapping_add(1);
         if y < 0 { i64::MIN } else { i64::MAX }
     })
 }
@@ -93,15 +97,15 @@ pub(crate) fn mean_step(y: i32, (r, lz): (i32, u32)) -> i64 {
     (i64::from(y) * i64::from(r)).wrapping_add(1 << (s - 1)) >> s
 }
 
-/// A positive Q40 energy prepared for division: `(r, lz)` with `1/e_real = r 2^(lz - 53)`,
+/// A positive Q40 energy (at least 1 LSB; the energies of the lattice are floored above
+/// that) prepared for division: `(r, lz)` with `1/e_real = r 2^(lz - 53)`,
 /// `r` in `(2^29, 2^30]` accurate to about 2^-29 relative.
 ///
 /// `e` is normalised by its leading zeros (CLZ) to a mantissa `m` in `[2^31, 2^32)`; a 32/32
 /// hardware division gives `2^48 / m` to 16 bits, and one Newton-Raphson step
 /// `r <- r + r (2^61 - m r) / 2^61` doubles that.
 #[inline(always)]
-pub(crate) fn reciprocal(e: i64) -> (i32, u32) {
-    let e = e.max(1) as u64;
+pub(crate) fn reciprocal(e: u64) -> (i32, u32) {
     let (hi, lo) = ((e >> 32) as u32, e as u32);
     let (m, lz) = if hi != 0 {
         let z = hi.leading_zeros();
@@ -113,43 +117,67 @@ pub(crate) fn reciprocal(e: i64) -> (i32, u32) {
         (lo.wrapping_shl(z), 32 + z)
     };
     // `| 0x8000` changes nothing (the top bit is set) but proves the divisor non-zero.
-    let r0 = (u32::MAX / ((m >> 16) | 0x8000)) << 13; // in (2^29, 2^30]
-    let residual = (1u64 << 61).wrapping_sub(u64::from(m) * u64::from(r0)) as i64;
-    let correction = (i64::from((residual >> 30) as i32) * i64::from(r0 as i32)) >> 31;
-    ((r0 as i32).wrapping_add(correction as i32), lz)
+    let r0 = (u32::MAX / ((m >> 16) | 0x8000)) << 13; // in (2^29, 2^30], within 2^-15
+    // Newton-Raphson on the high word alone: m r0 = 2^61 (1 + d), |d| < 2^-15, so the high
+    // word `2^29 (1 + d)` carries d to 2^-29, and `r0 (1 - d)` is then good to about 2^-29.
+    let high = ((u64::from(m) * u64::from(r0)) >> 32) as u32;
+    // 2^29 - high, times 8, in wrapping arithmetic: |d| 2^32 < 2^18.
+    let d8 = (high << 3).wrapping_neg() as i32;
+    ((r0 as i32).wrapping_add(mul_hi(r0 as i32, d8)), lz)
 }
 
-/// `a b / e` in `Q(out_frac)`, for `a b` in `Q(ab_frac)` and the [`reciprocal`] of a positive
-/// Q40 `e`: both factors normalised, two high-word products, one shift back (relative error
-/// about 2^-28). Saturates (and counts) only beyond 2^61 LSB.
-#[inline(always)]
-fn quotient(
-    a: i32,
-    b: i32,
-    ab_frac: u32,
-    (r, lz): (i32, u32),
-    out_frac: u32,
-    clip: &mut u32,
-) -> i64 {
-    let (an, na) = normalise(a);
-    let (bn, nb) = normalise(b);
-    // q = a b r 2^(na + nb - 64), |q| <= 2^28.
-    let q = mul_hi(mul_hi(an, bn), r);
-    // a b / e in Q(out) = a b r 2^(lz - 53 - ab_frac + out) = q 2^shift.
-    // Every term is below 128: the sums and the difference cannot wrap.
-    let shift = (11u32.wrapping_add(lz).wrapping_add(out_frac) as i32)
-        .wrapping_sub(ab_frac.wrapping_add(na).wrapping_add(nb) as i32);
-    if shift < 0 {
-        // |q| <= 2^28, so anything past 30 gives 0 and the rounded sum fits in 32 bits.
-        let t = shift.unsigned_abs().min(30);
-        i64::from(q.wrapping_add(1 << (t - 1)) >> t)
-    } else if shift <= 32 {
-        i64::from(q) << shift
-    } else {
-        if q != 0 {
-            *clip = clip.saturating_add(1);
+/// A gain `kappa = gx / E`, an error `gx` (Q27) over a positive energy `E` (Q40), kept in
+/// block-floating form for its products with errors: `4 kappa = m 2^-(s + 32)` (the factor 4
+/// turns a Q27 error into a Q29 coefficient step), `|m|` in `[2^25, 2^29]`, or 0.
+///
+/// Made once per energy and sample from the energy's [`reciprocal`], it is all that a
+/// coefficient update needs: `kappa e` is one high-word product (`SMMULR`) and one shift.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Gain {
+    m: i32,
+    s: i32,
+}
+
+impl Gain {
+    /// The gain of a stage before its first sample (`psi(n-1) = 0`).
+    pub(crate) const ZERO: Self = Self { m: 0, s: 0 };
+
+    /// `gx / e`, for `gx` [`normalise`]d (`gx_n = gx 2^na`) and the [`reciprocal`] of `e`.
+    #[inline(always)]
+    fn new((gx_n, na): (i32, u32), (r, lz): (i32, u32)) -> Self {
+        // With gx, e the Q27 and Q40 bits: 4 kappa = gx 2^15 / e, 1/e = r 2^(lz - 93), and
+        // m = gx_n r 2^-32 = gx r 2^(na - 32): 4 kappa = m 2^(lz - na - 46).
+        // |m| <= 2^29; na < 32, lz < 64: no wrap.
+        Self {
+            m: mul_hi(gx_n, r),
+            s: (na as i32).wrapping_add(14).wrapping_sub(lz as i32),
         }
-        i64::from(q.signum()) * i64::MAX
+    }
+
+    /// `kappa x` in `Q(out_frac)`, for a Q27 `x` [`normalise`]d (`x_n = x 2^n`), rounded to
+    /// nearest: `t = m x_n 2^-32` (`|t| <= 2^28`) shifted right by `s + n + 29 - out_frac`.
+    /// `Ok` for a product below `2^28` in magnitude (the shift is to the right), `Err` for a
+    /// larger one (start-up, a shock), exact in `i64`.
+    #[inline(always)]
+    fn times(self, (x_n, n): (i32, u32), out_frac: u32) -> Result<i32, i64> {
+        let t = mul_hi(self.m, x_n);
+        // Every term is below 128 in magnitude: no wrap.
+        let r = self
+            .s
+            .wrapping_add(n as i32)
+            .wrapping_add(29)
+            .wrapping_sub(out_frac as i32);
+        if r > 0 {
+            // `((t >> (r - 1)) + 1) >> 1` is `t / 2^r` rounded to nearest; from `r = 30` on it
+            // is 0 (|t| < 2^29), so the shift is capped at 30.
+            let r = r.unsigned_abs().min(30);
+            Ok(t.wrapping_shr(r.wrapping_sub(1)).wrapping_add(1) >> 1)
+        } else {
+            // |t| <= 2^28: shifted by up to 32 it stays inside i64; anything beyond
+            // saturates where it is added.
+            Err(i64::from(t).wrapping_shl(r.unsigned_abs().min(32)))
+        }
     }
 }
 
@@ -158,7 +186,7 @@ impl Arith for Q {
     type Gamma = I2F30;
     type Coef = I3F29;
     type Energy = I24F40;
-    type Recip = (i32, u32);
+    type Kept = Gain;
     type Params = QParams;
 
     const ERR_ZERO: I5F27 = I5F27::ZERO;
@@ -173,10 +201,15 @@ impl Arith for Q {
 
     #[inline(always)]
     fn energy(p: &QParams, e: I24F40, gx: I5F27, x: I5F27, clip: &mut u32) -> I24F40 {
-        // gx x >= 0 (gx has the sign of x), and so is the sum.
-        let add = mul_shift(gx.to_bits(), x.to_bits(), 2 * ERR_FRAC - ENERGY_FRAC);
-        let e = sat_add(decay(e.to_bits(), p.lambda.to_bits()), add, clip);
-        I24F40::from_bits(e.max(p.floor.to_bits()))
+        // gx x >= 0 (gx has the sign of x, or is 0), and the energy is positive: both terms
+        // are below 2^63, so their sum cannot wrap as a u64.
+        let add = mul_shift(gx.to_bits(), x.to_bits(), 2 * ERR_FRAC - ENERGY_FRAC) as u64;
+        let sum = (decay(e.to_bits(), p.lambda.to_bits()) as u64).wrapping_add(add);
+        let e = i64::try_from(sum).unwrap_or_else(|_| {
+            *clip = clip.wrapping_add(1);
+            i64::MAX
+        });
+        I24F40::from_bits(e.max(ENERGY_FLOOR))
     }
 
     #[inline(always)]
@@ -186,51 +219,67 @@ impl Arith for Q {
     }
 
     #[inline(always)]
-    fn recip(energy: I24F40) -> (i32, u32) {
-        reciprocal(energy.to_bits())
+    fn kept(_: I24F40) -> Gain {
+        Gain::ZERO
     }
 
     #[inline(always)]
-    fn adapt(
-        k: I3F29,
-        gx: I5F27,
-        e: I5F27,
-        _: I24F40,
-        recip: &(i32, u32),
-        clip: &mut u32,
-    ) -> I3F29 {
-        let delta = quotient(
-            gx.to_bits(),
-            e.to_bits(),
-            2 * ERR_FRAC,
-            *recip,
-            COEF_FRAC,
-            clip,
-        );
-        I3F29::from_bits(sat_i32(sat_add(i64::from(k.to_bits()), delta, clip), clip))
+    fn feedback(k: I3F29, _: I5F27, e: I5F27, gain: &Gain, clip: &mut u32) -> I3F29 {
+        let k = k.to_bits();
+        let sum = match gain.times(normalise(e.to_bits()), COEF_FRAC) {
+            Ok(delta) => k.checked_add(delta).ok_or(i64::from(k) + i64::from(delta)),
+            // |k| < 2^31, |delta| < 2^61: the sum is exact.
+            Err(delta) => Err(i64::from(k).wrapping_add(delta)),
+        };
+        I3F29::from_bits(sum.unwrap_or_else(|wide| sat_i32(wide, clip)))
     }
 
+    /// The stages in gain form: what stage `i` keeps between samples is the gain
+    /// `gamma_i psi_i / B_i` of its next `kf` update, which is also the gain of its
+    /// conversion factor, `gamma_{i+1} = gamma_i - (gamma_i psi_i / B_i) gamma_i psi_i`. Two
+    /// reciprocals per stage (`F_i(n)`, `B_i(n)`), three gain products, no other division.
     #[inline(always)]
-    fn convert(
-        _: &QParams,
-        g: I2F30,
-        gx: I5F27,
-        _: I24F40,
-        _: I24F40,
-        recip: &(i32, u32),
-    ) -> I2F30 {
-        let mut ignored = 0;
-        let delta = quotient(
-            gx.to_bits(),
-            gx.to_bits(),
-            2 * ERR_FRAC,
-            *recip,
-            GAMMA_FRAC,
-            &mut ignored,
-        );
-        let g = i64::from(g.to_bits())
-            .saturating_sub(delta)
-            .clamp(0, 1 << GAMMA_FRAC);
-        I2F30::from_bits(g as i32)
+    fn step<const P: usize>(core: &mut Core<Q, P>, p: &QParams, y: I5F27, clip: &mut u32) -> I5F27 {
+        let (old, new) = core.slots();
+        let (mut f, mut psi, mut g) = (y, y, I2F30::ONE);
+        // `old == new` for `P = 1`: the ring is read and written by index.
+        for ((i, stage), error) in (0..P).zip(&mut core.stages).zip(&mut core.errors) {
+            let [kf, kb] = core.ring[old][i];
+            let (bp, gp) = (stage.bp, stage.gp);
+            let gf = Q::gain(gp, f, clip);
+            let fe = Q::energy(p, stage.f_energy, gf, f, clip);
+            let f_next = Q::predict(f, kf, bp, clip);
+            let psi_next = Q::predict(bp, kb, f, clip);
+            let kappa_f = Gain::new(normalise(gf.to_bits()), reciprocal(fe.to_bits() as u64));
+            core.ring[new][i] = [
+                Q::feedback(kf, gf, f_next, &stage.b_kept, clip),
+                Q::feedback(kb, gf, psi_next, &kappa_f, clip),
+            ];
+            let gpsi = Q::gain(g, psi, clip);
+            let be = Q::energy(p, stage.b_energy, gpsi, psi, clip);
+            let gpsi_n = normalise(gpsi.to_bits());
+            let kappa_b = Gain::new(gpsi_n, reciprocal(be.to_bits() as u64));
+            // gpsi^2 / B_i(n) >= 0 (t has the sign of gpsi^2), so the result is at most g.
+            let g_next = match kappa_b.times(gpsi_n, GAMMA_FRAC) {
+                // 0 <= dg, g <= 2^30: no wrap.
+                Ok(dg) => g.to_bits().wrapping_sub(dg).max(0),
+                Err(dg) => i64::from(g.to_bits()).wrapping_sub(dg).max(0) as i32,
+            };
+            *stage = Stage {
+                f_energy: fe,
+                b_energy: be,
+                b_kept: kappa_b,
+                bp: psi,
+                gp: g,
+            };
+            *error = f_next;
+            f = f_next;
+            psi = psi_next;
+            g = I2F30::from_bits(g_next);
+        }
+        let gf = Q::gain(core.gp_p, f, clip);
+        let f_energy_p = Q::energy(p, core.f_energy_p, gf, f, clip);
+        core.finish(f_energy_p, g, y, new);
+        f
     }
 }

@@ -13,8 +13,6 @@ use super::ladder::Ladder;
 use super::lattice::{Core, lattice_accessors};
 use super::shell::{Format, Shell};
 
-/// Energies are floored at 16 LSB (1.5e-11 internal units^2).
-const ENERGY_FLOOR: i64 = 16;
 const TWO_32: f64 = 4_294_967_296.0;
 /// The smallest forgetting factor of the fixed-point lattice: below it, a memory of a few
 /// samples at high orders leaves the formats' precision (the differential tests cover
@@ -65,10 +63,7 @@ impl FixedConfig {
             (libm::round(f64::from(config.lambda()) * TWO_32) as u32).min(FIXED_LAMBDA_MAX_BITS),
         );
         Ok(Self {
-            params: QParams {
-                lambda,
-                floor: I24F40::from_bits(ENERGY_FLOOR),
-            },
+            params: QParams { lambda },
             lambda: f64::from(lambda.to_bits()) / TWO_32,
             dt: config.dt(),
             demean: config.demean(),
@@ -311,8 +306,7 @@ pub struct FixedLattice<const P: usize> {
 #[derive(Clone, Copy, Debug)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 struct Undo<const P: usize> {
-    kf: [I3F29; P],
-    kb: [I3F29; P],
+    slot: [[I3F29; 2]; P],
     f_energy_p: I24F40,
     weight: i64,
     mean: i64,
@@ -330,8 +324,7 @@ impl<const P: usize> FixedLattice<P> {
             ladder: None,
             shell: Shell::new(*channel),
             undo: Undo {
-                kf: [I3F29::ZERO; P],
-                kb: [I3F29::ZERO; P],
+                slot: [[I3F29::ZERO; 2]; P],
                 f_energy_p: I24F40::ZERO,
                 weight: 0,
                 mean: 0,
@@ -441,10 +434,8 @@ impl<const P: usize> FixedLattice<P> {
     /// holds the model from before this sample, unless a restart is still settling.
     fn accept(&mut self, config: &FixedConfig, x: i32) -> I5F27 {
         // Field by field, in place: no copy of the record through the stack.
-        let (kf, kb) = self.core.next_slot();
         let u = &mut self.undo;
-        u.kf = *kf;
-        u.kb = *kb;
+        u.slot = *self.core.next_slot();
         u.f_energy_p = self.core.f_energy_p;
         u.weight = self.shell.moments.weight;
         u.mean = self.shell.moments.mean;
@@ -464,7 +455,7 @@ impl<const P: usize> FixedLattice<P> {
             let mean = ((m.mean >> (MEAN_FRAC - ERR_FRAC - 1)) + 1) >> 1;
             // |x| < 2^31 and |mean| < 2^36: the difference is exact in i64.
             let y = sat_i32(i64::from(x) - mean, &mut clip);
-            m.mean = m.mean.saturating_add(mean_step(y, reciprocal(m.weight)));
+            m.mean = m.mean.saturating_add(mean_step(y, reciprocal(m.weight.max(1).unsigned_abs())));
             y
         } else {
             x
@@ -494,7 +485,7 @@ impl<const P: usize> FixedLattice<P> {
     fn restart_after_saturation(&mut self, config: &FixedConfig) {
         // In place (the state is re-initialised next): no copy of the state on the stack.
         let u = self.undo;
-        self.core.rewind(&u.kf, &u.kb, u.f_energy_p);
+        self.core.rewind(&u.slot, u.f_energy_p);
         self.shell.moments.weight = u.weight;
         self.shell.moments.mean = u.mean;
         if let Some(l) = &mut self.ladder {

@@ -74,8 +74,8 @@ impl<A: Arith, const P: usize> Ladder<A, P> {
         for (&a, &x) in self.centre.iter().zip(&self.past) {
             e = A::predict(e, a, x, &mut clip);
         }
-        for (&c, &bp) in self.c.iter().zip(&core.bp) {
-            e = A::predict(e, c, bp, &mut clip);
+        for (&c, stage) in self.c.iter().zip(&core.stages) {
+            e = A::predict(e, c, stage.bp, &mut clip);
         }
         e
     }
@@ -100,11 +100,11 @@ impl<A: Arith, const P: usize> Ladder<A, P> {
                 e = A::predict(e, a, x, clip);
             }
         }
-        for (i, c) in self.c.iter_mut().enumerate() {
-            let (bp, gp) = (core.bp[i], core.gp[i]);
+        for (c, stage) in self.c.iter_mut().zip(&core.stages) {
+            let (bp, gp) = (stage.bp, stage.gp);
             let next = A::predict(e, *c, bp, clip);
             let gbp = A::gain(gp, bp, clip);
-            *c = A::adapt(*c, gbp, next, core.b_energy[i], &core.b_recip[i], clip);
+            *c = A::feedback(*c, gbp, next, &stage.b_kept, clip);
             e = next;
         }
         let ge = A::gain(core.gp_p, e, clip);

@@ -1,6 +1,6 @@
 //! The a-priori least-squares lattice with error feedback (EF-LSL), `O(P)` per sample.
 
-use super::arith::{Arith, FloatArith, float_params};
+use super::arith::{Arith, FloatArith, FloatParams, float_params};
 use super::estimator::{Estimator, sealed::Sealed};
 use super::ladder::Ladder;
 use super::shell::Shell;
@@ -51,18 +51,36 @@ macro_rules! lattice_accessors {
 
         /// Forward reflection coefficients `kf_1..kf_P` (lattice sign: `kf_1 = a_1` of the
         /// order-1 model, minus the error-filter reflection coefficient).
-        pub fn forward_reflection(&self) -> &[$coef; P] {
+        pub fn forward_reflection(&self) -> [$coef; P] {
             self.core.forward_reflection()
         }
 
         /// Backward reflection coefficients `kb_1..kb_P`.
-        pub fn backward_reflection(&self) -> &[$coef; P] {
+        pub fn backward_reflection(&self) -> [$coef; P] {
             self.core.backward_reflection()
         }
     };
 }
 
 pub(crate) use lattice_accessors;
+
+/// The state stage `i` carries from one sample to the next, kept together so that one
+/// pointer reaches all of it.
+#[derive(Clone, Copy, Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+// `pub` in a private module, as `Core`.
+pub struct Stage<A: Arith> {
+    /// The forward energy `F_i`.
+    pub(crate) f_energy: A::Energy,
+    /// The backward energy `B_i`, holding `B_i(n-1)` between samples.
+    pub(crate) b_energy: A::Energy,
+    /// What the stage keeps for the next sample's update of `kf_{i+1}` ([`Arith::Kept`]).
+    pub(crate) b_kept: A::Kept,
+    /// `psi_i(n-1)`.
+    pub(crate) bp: A::Err,
+    /// `gamma_i(n-1)`.
+    pub(crate) gp: A::Gamma,
+}
 
 /// The lattice recursion of numerics.md section 2.1, written once over the typed steps of
 /// [`Arith`]: the state of all stages, the last sample's errors, and the reflection
@@ -72,31 +90,23 @@ pub(crate) use lattice_accessors;
 /// handling (screening, mean removal, scaling) and outputs.
 #[derive(Clone, Copy, Debug)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub(crate) struct Core<A: Arith, const P: usize> {
-    /// Forward energies `F_0..F_{P-1}`.
-    pub(crate) f_energy: [A::Energy; P],
+// `pub` in a private module, as `Arith`, whose `step` names it: reachable by no one outside
+// the crate.
+pub struct Core<A: Arith, const P: usize> {
+    /// Stages `0..P`.
+    pub(crate) stages: [Stage<A>; P],
     /// `F_P`.
     pub(crate) f_energy_p: A::Energy,
-    /// Backward energies `B_0..B_{P-1}`, holding `B_i(n-1)` between samples.
-    pub(crate) b_energy: [A::Energy; P],
-    /// `B_i` prepared for division: computed for step 7 and reused by step 4 of the next
-    /// sample.
-    pub(crate) b_recip: [A::Recip; P],
-    /// `psi_i(n-1)`, i = 0..P-1.
-    pub(crate) bp: [A::Err; P],
-    /// `gamma_i(n-1)`, i = 0..P-1.
-    pub(crate) gp: [A::Gamma; P],
     /// `gamma_P(n-1)`.
     pub(crate) gp_p: A::Gamma,
     /// A-priori forward errors `f_1..f_P` of the last sample; `f_0` is `input`.
     pub(crate) errors: [A::Err; P],
     /// `y_n` of the last sample, the order-0 error.
     pub(crate) input: A::Err,
-    /// `kf_1..kf_P` (index `m - 1` for order `m`) of the last `P` samples, newest at `head`:
-    /// the current coefficients are updated from one slot into the next, so that keeping the
-    /// history costs no copy.
-    ring_kf: [[A::Coef; P]; P],
-    ring_kb: [[A::Coef; P]; P],
+    /// `[kf_m, kb_m]` (index `m - 1` for order `m`) of the last `P` samples, newest at
+    /// `head`: the current coefficients are updated from one slot into the next, so that
+    /// keeping the history costs no copy.
+    pub(crate) ring: [[[A::Coef; 2]; P]; P],
     head: usize,
 }
 
@@ -105,17 +115,18 @@ impl<A: Arith, const P: usize> Core<A, P> {
     /// unit conversion factors.
     pub(crate) fn new(f0: A::Energy, b: [A::Energy; P]) -> Self {
         Self {
-            f_energy: [f0; P],
+            stages: b.map(|b| Stage {
+                f_energy: f0,
+                b_energy: b,
+                b_kept: A::kept(b),
+                bp: A::ERR_ZERO,
+                gp: A::GAMMA_ONE,
+            }),
             f_energy_p: f0,
-            b_energy: b,
-            b_recip: b.map(A::recip),
-            bp: [A::ERR_ZERO; P],
-            gp: [A::GAMMA_ONE; P],
             gp_p: A::GAMMA_ONE,
             errors: [A::ERR_ZERO; P],
             input: A::ERR_ZERO,
-            ring_kf: [[A::COEF_ZERO; P]; P],
-            ring_kb: [[A::COEF_ZERO; P]; P],
+            ring: [[[A::COEF_ZERO; 2]; P]; P],
             head: 0,
         }
     }
@@ -123,75 +134,58 @@ impl<A: Arith, const P: usize> Core<A, P> {
     /// One sample `y` through all stages; returns `f_P(n)`.
     #[inline(always)]
     pub(crate) fn step(&mut self, params: &A::Params, y: A::Err, clip: &mut u32) -> A::Err {
+        A::step(self, params, y, clip)
+    }
+
+    /// The ring slots of the sample being taken: the one holding the current coefficients
+    /// (read) and the oldest one, which receives the updated coefficients (written).
+    #[inline(always)]
+    pub(crate) fn slots(&self) -> (usize, usize) {
         // `% P` keeps the indices provably in range: no bounds check on the per-sample path.
         let old = self.head % P;
-        let new = (old + P - 1) % P;
-        let (mut f, mut psi, mut g) = (y, y, A::GAMMA_ONE);
-        for i in 0..P {
-            let (kf, kb) = (self.ring_kf[old][i], self.ring_kb[old][i]);
-            let gf = A::gain(self.gp[i], f, clip);
-            let fe = A::energy(params, self.f_energy[i], gf, f, clip);
-            let f_next = A::predict(f, kf, self.bp[i], clip);
-            let psi_next = A::predict(self.bp[i], kb, f, clip);
-            let gbp = A::gain(self.gp[i], self.bp[i], clip);
-            let b = self.b_energy[i];
-            self.ring_kf[new][i] = A::adapt(kf, gbp, f_next, b, &self.b_recip[i], clip);
-            self.ring_kb[new][i] = A::adapt(kb, gf, psi_next, fe, &A::recip(fe), clip);
-            let gpsi = A::gain(g, psi, clip);
-            let be = A::energy(params, b, gpsi, psi, clip);
-            let be_recip = A::recip(be);
-            let g_next = A::convert(params, g, gpsi, b, be, &be_recip);
-            self.f_energy[i] = fe;
-            self.b_energy[i] = be;
-            self.b_recip[i] = be_recip;
-            self.bp[i] = psi;
-            self.gp[i] = g;
-            self.errors[i] = f_next;
-            f = f_next;
-            psi = psi_next;
-            g = g_next;
-        }
-        let gf = A::gain(self.gp_p, f, clip);
-        self.f_energy_p = A::energy(params, self.f_energy_p, gf, f, clip);
-        self.gp_p = g;
+        (old, (old + P - 1) % P)
+    }
+
+    /// The state after a sample's stages: `F_P`, `gamma_P`, the input and the ring's head.
+    #[inline(always)]
+    pub(crate) fn finish(&mut self, f_energy_p: A::Energy, gp_p: A::Gamma, y: A::Err, new: usize) {
+        self.f_energy_p = f_energy_p;
+        self.gp_p = gp_p;
         self.input = y;
         self.head = new;
-        f
     }
 
     /// The a-priori error `f_P(n)` of `y_n`, without taking it (for the gate): the forward
     /// chain alone, `P` multiplications.
     pub(crate) fn a_priori(&self, y: A::Err) -> A::Err {
         let mut clip = 0;
-        let kf = &self.ring_kf[self.head % P];
-        kf.iter()
-            .zip(&self.bp)
-            .fold(y, |f, (&k, &b)| A::predict(f, k, b, &mut clip))
+        self.ring[self.head % P]
+            .iter()
+            .zip(&self.stages)
+            .fold(y, |f, (&[k, _], s)| A::predict(f, k, s.bp, &mut clip))
     }
 
     /// `kf_1..kf_P` after the last sample.
-    pub(crate) fn forward_reflection(&self) -> &[A::Coef; P] {
-        &self.ring_kf[self.head % P]
+    pub(crate) fn forward_reflection(&self) -> [A::Coef; P] {
+        self.ring[self.head % P].map(|[kf, _]| kf)
     }
 
     /// `kb_1..kb_P` after the last sample.
-    pub(crate) fn backward_reflection(&self) -> &[A::Coef; P] {
-        &self.ring_kb[self.head % P]
+    pub(crate) fn backward_reflection(&self) -> [A::Coef; P] {
+        self.ring[self.head % P].map(|[_, kb]| kb)
     }
 
-    /// The ring slot the next sample overwrites (`kf`, `kb`): with `F_P`, all that
-    /// [`Core::rewind`] needs to restore the coefficients from before that sample.
-    pub(crate) fn next_slot(&self) -> (&[A::Coef; P], &[A::Coef; P]) {
-        let next = (self.head % P + P - 1) % P;
-        (&self.ring_kf[next], &self.ring_kb[next])
+    /// The ring slot the next sample overwrites: with `F_P`, all that [`Core::rewind`] needs
+    /// to restore the coefficients from before that sample.
+    pub(crate) fn next_slot(&self) -> &[[A::Coef; 2]; P] {
+        &self.ring[(self.head % P + P - 1) % P]
     }
 
     /// Undoes the last [`Core::step`] as far as [`Core::coefficients`] and `F_P` are
     /// concerned, given what [`Core::next_slot`] returned before it and the `F_P` before it.
-    pub(crate) fn rewind(&mut self, kf: &[A::Coef; P], kb: &[A::Coef; P], f_energy_p: A::Energy) {
+    pub(crate) fn rewind(&mut self, slot: &[[A::Coef; 2]; P], f_energy_p: A::Energy) {
         let last = self.head % P;
-        self.ring_kf[last] = *kf;
-        self.ring_kb[last] = *kb;
+        self.ring[last] = *slot;
         self.head = (last + 1) % P;
         self.f_energy_p = f_energy_p;
     }
@@ -201,7 +195,7 @@ impl<A: Arith, const P: usize> Core<A, P> {
         if m == P {
             Some(self.f_energy_p)
         } else {
-            self.f_energy.get(m).copied()
+            self.stages.get(m).map(|s| s.f_energy)
         }
     }
 
@@ -230,7 +224,7 @@ impl<A: Arith, const P: usize> Core<A, P> {
         let mut alpha = [T::ZERO; P];
         for t in (0..m).rev() {
             let slot = (self.head % P + t) % P;
-            let (kf, kb) = (&self.ring_kf[slot], &self.ring_kb[slot]);
+            let ring = &self.ring[slot];
             alpha = [T::ZERO; P];
             let (first, second) = rows.split_at_mut(1);
             let (older, newer) = if t % 2 == 0 {
@@ -238,8 +232,7 @@ impl<A: Arith, const P: usize> Core<A, P> {
             } else {
                 (&first[0], &mut second[0])
             };
-            let stages = kf.iter().zip(kb).take(m - t);
-            for (k, (&kf_k, &kb_k)) in (1..=P).zip(stages) {
+            for (k, &[kf_k, kb_k]) in (1..=P).zip(ring.iter().take(m - t)) {
                 let (kf_k, kb_k) = (to_t(kf_k), to_t(kb_k));
                 // B_{k-1}(n-t-1), with its trailing 1 (`k >= 1`: no wrap).
                 let b_prev = older.get(k.wrapping_sub(1));
@@ -279,16 +272,58 @@ impl<A: Arith, const P: usize> Core<A, P> {
 }
 
 impl<T: FloatArith, const P: usize> Core<T, P> {
+    /// [`Core::step`] in floats: the recursion as written in [`Lattice`]'s docs.
+    #[inline(always)]
+    pub(crate) fn float_step(&mut self, params: &FloatParams<T>, y: T) -> T {
+        let clip = &mut 0;
+        let (old, new) = self.slots();
+        let (mut f, mut psi, mut g) = (y, y, T::ONE);
+        // `old == new` for `P = 1`: the ring is read and written by index.
+        for ((i, stage), error) in (0..P).zip(&mut self.stages).zip(&mut self.errors) {
+            let [kf, kb] = self.ring[old][i];
+            let (bp, gp, b) = (stage.bp, stage.gp, stage.b_energy);
+            let gf = T::gain(gp, f, clip);
+            let fe = T::energy(params, stage.f_energy, gf, f, clip);
+            let f_next = T::predict(f, kf, bp, clip);
+            let psi_next = T::predict(bp, kb, f, clip);
+            let gbp = T::gain(gp, bp, clip);
+            self.ring[new][i] = [
+                T::feedback(kf, gbp, f_next, &stage.b_kept, clip),
+                T::feedback(kb, gf, psi_next, &(T::ONE / fe), clip),
+            ];
+            let gpsi = T::gain(g, psi, clip);
+            let be = T::energy(params, b, gpsi, psi, clip);
+            let be_recip = T::ONE / be;
+            // The ratio form of `g - gpsi^2 / B_i(n)` needs no clamp: `B_i(n) >= lambda
+            // B_i(n-1)` holds after rounding.
+            let g_next = g * (params.lambda * b) * be_recip;
+            *stage = Stage {
+                f_energy: fe,
+                b_energy: be,
+                b_kept: be_recip,
+                bp: psi,
+                gp: g,
+            };
+            *error = f_next;
+            f = f_next;
+            psi = psi_next;
+            g = g_next;
+        }
+        let gf = T::gain(self.gp_p, f, clip);
+        let f_energy_p = T::energy(params, self.f_energy_p, gf, f, clip);
+        self.finish(f_energy_p, g, y, new);
+        f
+    }
+
     /// Halves every energy (the weight of every past sample), keeping the reflection
     /// coefficients: see `Shell::weight_full`.
     fn halve_energies(&mut self) {
         let half = T::from_f64(0.5);
         self.f_energy_p *= half;
-        for e in self.f_energy.iter_mut().chain(&mut self.b_energy) {
-            *e *= half;
-        }
-        for (r, &b) in self.b_recip.iter_mut().zip(&self.b_energy) {
-            *r = T::recip(b);
+        for stage in &mut self.stages {
+            stage.f_energy *= half;
+            stage.b_energy *= half;
+            stage.b_kept = T::kept(stage.b_energy);
         }
     }
 }
@@ -535,7 +570,7 @@ impl<T: FloatArith, const P: usize> Lattice<T, P> {
         // A non-finite value anywhere reaches f_P within a sample or two (the reflection
         // coefficients feed the errors), and an overflowing input reaches F_0 and F_P at once.
         let c = &self.core;
-        let check = e + f + c.f_energy_p + c.f_energy[0] + self.energy_p();
+        let check = e + f + c.f_energy_p + c.stages[0].f_energy + self.energy_p();
         if !check.is_finite() {
             self.initialise(config);
             self.shell.restart(config.lambda().to_f64());
