@@ -63,7 +63,7 @@ pub fn checksums() -> Option<(u64, u64)> {
             hf.bytes(&e.to_bits().to_le_bytes());
             for v in float
                 .errors()
-                .iter()
+                .into_iter()
                 .chain(float.forward_reflection())
                 .chain(float.backward_reflection())
             {
@@ -80,7 +80,7 @@ pub fn checksums() -> Option<(u64, u64)> {
             }
             for k in fixed
                 .forward_reflection()
-                .iter()
+                .into_iter()
                 .chain(fixed.backward_reflection())
             {
                 hq.bytes(&k.to_bits().to_le_bytes());

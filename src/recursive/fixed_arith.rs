@@ -240,18 +240,20 @@ impl Arith for Q {
     /// reciprocals per stage (`F_i(n)`, `B_i(n)`), three gain products, no other division.
     #[inline(always)]
     fn step<const P: usize>(core: &mut Core<Q, P>, p: &QParams, y: I5F27, clip: &mut u32) -> I5F27 {
-        let (old, new) = core.slots();
+        let new = core.next_head();
         let (mut f, mut psi, mut g) = (y, y, I2F30::ONE);
-        // `old == new` for `P = 1`: the ring is read and written by index.
-        for ((i, stage), error) in (0..P).zip(&mut core.stages).zip(&mut core.errors) {
-            let [kf, kb] = core.ring[old][i];
+        for (kept, stage) in core.ring[new].iter_mut().zip(&core.stages) {
+            *kept = stage.k;
+        }
+        for stage in &mut core.stages {
+            let [kf, kb] = stage.k;
             let (bp, gp) = (stage.bp, stage.gp);
             let gf = Q::gain(gp, f, clip);
             let fe = Q::energy(p, stage.f_energy, gf, f, clip);
             let f_next = Q::predict(f, kf, bp, clip);
             let psi_next = Q::predict(bp, kb, f, clip);
             let kappa_f = Gain::new(normalise(gf.to_bits()), reciprocal(fe.to_bits() as u64));
-            core.ring[new][i] = [
+            let k = [
                 Q::feedback(kf, gf, f_next, &stage.b_kept, clip),
                 Q::feedback(kb, gf, psi_next, &kappa_f, clip),
             ];
@@ -271,8 +273,9 @@ impl Arith for Q {
                 b_kept: kappa_b,
                 bp: psi,
                 gp: g,
+                k,
+                error: f_next,
             };
-            *error = f_next;
             f = f_next;
             psi = psi_next;
             g = I2F30::from_bits(g_next);

@@ -306,7 +306,6 @@ pub struct FixedLattice<const P: usize> {
 #[derive(Clone, Copy, Debug)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 struct Undo<const P: usize> {
-    slot: [[I3F29; 2]; P],
     f_energy_p: I24F40,
     weight: i64,
     mean: i64,
@@ -324,7 +323,6 @@ impl<const P: usize> FixedLattice<P> {
             ladder: None,
             shell: Shell::new(*channel),
             undo: Undo {
-                slot: [[I3F29::ZERO; 2]; P],
                 f_energy_p: I24F40::ZERO,
                 weight: 0,
                 mean: 0,
@@ -435,7 +433,6 @@ impl<const P: usize> FixedLattice<P> {
     fn accept(&mut self, config: &FixedConfig, x: i32) -> I5F27 {
         // Field by field, in place: no copy of the record through the stack.
         let u = &mut self.undo;
-        u.slot = *self.core.next_slot();
         u.f_energy_p = self.core.f_energy_p;
         u.weight = self.shell.moments.weight;
         u.mean = self.shell.moments.mean;
@@ -485,7 +482,7 @@ impl<const P: usize> FixedLattice<P> {
     fn restart_after_saturation(&mut self, config: &FixedConfig) {
         // In place (the state is re-initialised next): no copy of the state on the stack.
         let u = self.undo;
-        self.core.rewind(&u.slot, u.f_energy_p);
+        self.core.rewind(u.f_energy_p);
         self.shell.moments.weight = u.weight;
         self.shell.moments.mean = u.mean;
         if let Some(l) = &mut self.ladder {

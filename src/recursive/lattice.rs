@@ -19,8 +19,8 @@ macro_rules! lattice_accessors {
             "(`f_m(n) = y_n - a^(m)_{n-1}^T phi_n`), ", $units, "; `f_0(n) = y_n` is ",
             "[`input`](Self::input)."
         )]
-        pub fn errors(&self) -> &[$err; P] {
-            &self.core.errors
+        pub fn errors(&self) -> [$err; P] {
+            self.core.stages.map(|s| s.error)
         }
 
         #[doc = concat!(
@@ -80,6 +80,10 @@ pub struct Stage<A: Arith> {
     pub(crate) bp: A::Err,
     /// `gamma_i(n-1)`.
     pub(crate) gp: A::Gamma,
+    /// `[kf_{i+1}, kb_{i+1}]` after the last sample.
+    pub(crate) k: [A::Coef; 2],
+    /// The a-priori forward error `f_{i+1}(n)` of the last sample.
+    pub(crate) error: A::Err,
 }
 
 /// The lattice recursion of numerics.md section 2.1, written once over the typed steps of
@@ -99,13 +103,11 @@ pub struct Core<A: Arith, const P: usize> {
     pub(crate) f_energy_p: A::Energy,
     /// `gamma_P(n-1)`.
     pub(crate) gp_p: A::Gamma,
-    /// A-priori forward errors `f_1..f_P` of the last sample; `f_0` is `input`.
-    pub(crate) errors: [A::Err; P],
     /// `y_n` of the last sample, the order-0 error.
     pub(crate) input: A::Err,
-    /// `[kf_m, kb_m]` (index `m - 1` for order `m`) of the last `P` samples, newest at
-    /// `head`: the current coefficients are updated from one slot into the next, so that
-    /// keeping the history costs no copy.
+    /// `[kf_m, kb_m]` (index `m - 1` for order `m`) of the `P` samples before the last one,
+    /// newest at `head` (the last sample's are in `stages`): a sample writes the coefficients
+    /// it replaces over the oldest slot, and [`Core::rewind`] reads them back.
     pub(crate) ring: [[[A::Coef; 2]; P]; P],
     head: usize,
 }
@@ -121,10 +123,11 @@ impl<A: Arith, const P: usize> Core<A, P> {
                 b_kept: A::kept(b),
                 bp: A::ERR_ZERO,
                 gp: A::GAMMA_ONE,
+                k: [A::COEF_ZERO; 2],
+                error: A::ERR_ZERO,
             }),
             f_energy_p: f0,
             gp_p: A::GAMMA_ONE,
-            errors: [A::ERR_ZERO; P],
             input: A::ERR_ZERO,
             ring: [[[A::COEF_ZERO; 2]; P]; P],
             head: 0,
@@ -137,13 +140,11 @@ impl<A: Arith, const P: usize> Core<A, P> {
         A::step(self, params, y, clip)
     }
 
-    /// The ring slots of the sample being taken: the one holding the current coefficients
-    /// (read) and the oldest one, which receives the updated coefficients (written).
+    /// The ring slot that receives the coefficients a sample replaces: the oldest one.
     #[inline(always)]
-    pub(crate) fn slots(&self) -> (usize, usize) {
-        // `% P` keeps the indices provably in range: no bounds check on the per-sample path.
-        let old = self.head % P;
-        (old, (old + P - 1) % P)
+    pub(crate) fn next_head(&self) -> usize {
+        // `% P` keeps the index provably in range: no bounds check on the per-sample path.
+        (self.head % P + P - 1) % P
     }
 
     /// The state after a sample's stages: `F_P`, `gamma_P`, the input and the ring's head.
@@ -159,33 +160,37 @@ impl<A: Arith, const P: usize> Core<A, P> {
     /// chain alone, `P` multiplications.
     pub(crate) fn a_priori(&self, y: A::Err) -> A::Err {
         let mut clip = 0;
-        self.ring[self.head % P]
+        self.stages
             .iter()
-            .zip(&self.stages)
-            .fold(y, |f, (&[k, _], s)| A::predict(f, k, s.bp, &mut clip))
+            .fold(y, |f, s| A::predict(f, s.k[0], s.bp, &mut clip))
     }
 
     /// `kf_1..kf_P` after the last sample.
     pub(crate) fn forward_reflection(&self) -> [A::Coef; P] {
-        self.ring[self.head % P].map(|[kf, _]| kf)
+        self.stages.map(|s| s.k[0])
     }
 
     /// `kb_1..kb_P` after the last sample.
     pub(crate) fn backward_reflection(&self) -> [A::Coef; P] {
-        self.ring[self.head % P].map(|[_, kb]| kb)
+        self.stages.map(|s| s.k[1])
     }
 
-    /// The ring slot the next sample overwrites: with `F_P`, all that [`Core::rewind`] needs
-    /// to restore the coefficients from before that sample.
-    pub(crate) fn next_slot(&self) -> &[[A::Coef; 2]; P] {
-        &self.ring[(self.head % P + P - 1) % P]
+    /// The reflection coefficients of `t` samples before the last one, `t < P`.
+    fn past(&self, t: usize) -> [[A::Coef; 2]; P] {
+        match t.checked_sub(1) {
+            None => self.stages.map(|s| s.k),
+            Some(t) => self.ring[(self.head % P + t) % P],
+        }
     }
 
     /// Undoes the last [`Core::step`] as far as [`Core::coefficients`] and `F_P` are
-    /// concerned, given what [`Core::next_slot`] returned before it and the `F_P` before it.
-    pub(crate) fn rewind(&mut self, slot: &[[A::Coef; 2]; P], f_energy_p: A::Energy) {
+    /// concerned, given the `F_P` from before it: the coefficients it replaced are read back
+    /// from the ring.
+    pub(crate) fn rewind(&mut self, f_energy_p: A::Energy) {
         let last = self.head % P;
-        self.ring[last] = *slot;
+        for (stage, &k) in self.stages.iter_mut().zip(&self.ring[last]) {
+            stage.k = k;
+        }
         self.head = (last + 1) % P;
         self.f_energy_p = f_energy_p;
     }
@@ -223,8 +228,7 @@ impl<A: Arith, const P: usize> Core<A, P> {
         let mut rows = [[[T::ZERO; P]; P]; 2];
         let mut alpha = [T::ZERO; P];
         for t in (0..m).rev() {
-            let slot = (self.head % P + t) % P;
-            let ring = &self.ring[slot];
+            let ring = self.past(t);
             alpha = [T::ZERO; P];
             let (first, second) = rows.split_at_mut(1);
             let (older, newer) = if t % 2 == 0 {
@@ -276,18 +280,20 @@ impl<T: FloatArith, const P: usize> Core<T, P> {
     #[inline(always)]
     pub(crate) fn float_step(&mut self, params: &FloatParams<T>, y: T) -> T {
         let clip = &mut 0;
-        let (old, new) = self.slots();
         let (mut f, mut psi, mut g) = (y, y, T::ONE);
-        // `old == new` for `P = 1`: the ring is read and written by index.
-        for ((i, stage), error) in (0..P).zip(&mut self.stages).zip(&mut self.errors) {
-            let [kf, kb] = self.ring[old][i];
+        let new = self.next_head();
+        for (kept, stage) in self.ring[new].iter_mut().zip(&self.stages) {
+            *kept = stage.k;
+        }
+        for stage in &mut self.stages {
+            let [kf, kb] = stage.k;
             let (bp, gp, b) = (stage.bp, stage.gp, stage.b_energy);
             let gf = T::gain(gp, f, clip);
             let fe = T::energy(params, stage.f_energy, gf, f, clip);
             let f_next = T::predict(f, kf, bp, clip);
             let psi_next = T::predict(bp, kb, f, clip);
             let gbp = T::gain(gp, bp, clip);
-            self.ring[new][i] = [
+            let k = [
                 T::feedback(kf, gbp, f_next, &stage.b_kept, clip),
                 T::feedback(kb, gf, psi_next, &(T::ONE / fe), clip),
             ];
@@ -303,8 +309,9 @@ impl<T: FloatArith, const P: usize> Core<T, P> {
                 b_kept: be_recip,
                 bp: psi,
                 gp: g,
+                k,
+                error: f_next,
             };
-            *error = f_next;
             f = f_next;
             psi = psi_next;
             g = g_next;

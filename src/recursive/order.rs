@@ -72,7 +72,7 @@ impl<T: FloatArith, const P: usize> OrderSelector<T, P> {
         let lambda = config.lambda();
         let y = lattice.input();
         self.pls0 = lambda * self.pls0 + y * y;
-        for (pi, &f) in self.pls.iter_mut().zip(lattice.errors()) {
+        for (pi, f) in self.pls.iter_mut().zip(lattice.errors()) {
             *pi = lambda * *pi + f * f;
         }
         self.countdown = self.countdown.saturating_sub(1);
