@@ -48,12 +48,12 @@ fn mul_hi(x: i32, y: i32) -> i32 {
 }
 
 /// `(x 2^n, n)` with `n` the redundant sign bits of `x`: `|x 2^n|` in `[2^30, 2^31]` unless
-/// `x` is 0 (`n = 31`).
+/// `x` is 0 (`n = 32`, and 0).
 #[inline(always)]
 fn normalise(x: i32) -> (i32, u32) {
-    // `x ^ (x >> 31)` is non-negative: at least one leading zero, no wrap.
-    let n = (x ^ (x >> 31)).leading_zeros().wrapping_sub(1);
-    (x.wrapping_shl(n), n)
+    // A bit of `x ^ (x << 1)` is set where `x` changes from its sign to its magnitude.
+    let n = (x ^ x.wrapping_shl(1)).leading_zeros();
+    (x.checked_shl(n).unwrap_or(0), n)
 }
 
 /// `x` saturated to `i32`, counting a saturation in `clip` (a sample's count, far below
@@ -63,6 +63,7 @@ pub(crate) fn sat_i32(x: i64, clip: &mut u32) -> i32 {
     match i32::try_from(x) {
         Ok(v) => v,
         Err(_) => {
+            core::hint::cold_path();
             *clip = clip.wrapping_add(1);
             if x < 0 { i32::MIN } else { i32::MAX }
         }
@@ -170,10 +171,11 @@ impl Gain {
             .wrapping_sub(out_frac as i32);
         if r > 0 {
             // `((t >> (r - 1)) + 1) >> 1` is `t / 2^r` rounded to nearest; from `r = 30` on it
-            // is 0 (|t| < 2^29), so the shift is capped at 30.
-            let r = r.unsigned_abs().min(30);
-            Ok(t.wrapping_shr(r.wrapping_sub(1)).wrapping_add(1) >> 1)
+            // is 0 (|t| < 2^29), so the shift is capped there.
+            let k = r.min(30).wrapping_sub(1) as u32;
+            Ok((t >> k).wrapping_add(1) >> 1)
         } else {
+            core::hint::cold_path();
             // |t| <= 2^28: shifted by up to 32 it stays inside i64; anything beyond
             // saturates where it is added.
             Err(i64::from(t).wrapping_shl(r.unsigned_abs().min(32)))
@@ -205,11 +207,14 @@ impl Arith for Q {
         // are below 2^63, so their sum cannot wrap as a u64.
         let add = mul_shift(gx.to_bits(), x.to_bits(), 2 * ERR_FRAC - ENERGY_FRAC) as u64;
         let sum = (decay(e.to_bits(), p.lambda.to_bits()) as u64).wrapping_add(add);
-        let e = i64::try_from(sum).unwrap_or_else(|_| {
-            *clip = clip.wrapping_add(1);
-            i64::MAX
-        });
-        I24F40::from_bits(e.max(ENERGY_FLOOR))
+        match i64::try_from(sum) {
+            Ok(e) => I24F40::from_bits(e.max(ENERGY_FLOOR)),
+            Err(_) => {
+                core::hint::cold_path();
+                *clip = clip.wrapping_add(1);
+                I24F40::MAX
+            }
+        }
     }
 
     #[inline(always)]
