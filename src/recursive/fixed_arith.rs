@@ -13,8 +13,15 @@ use super::lattice::{Core, Stage};
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Q;
 
-/// Energies are floored at 16 LSB (1.5e-11 internal units^2).
+/// Energies are at least 16 LSB (1.5e-11 internal units^2): they start there or above, and
+/// every update adds [`ENERGY_STEP`] to `lambda E`, which keeps them there for `lambda >= 0.9`
+/// (`round(0.9 16) + 2 = 16`).
 pub(crate) const ENERGY_FLOOR: i64 = 16;
+
+/// What every energy update adds, in LSB (the floor's share of the float lattices'
+/// `floor` term): at most `2 / (1 - lambda)` LSB in all, `2^-17` of the energy of a signal
+/// one `2^-11` count in RMS at the longest memory.
+const ENERGY_STEP: i64 = 2;
 
 /// [`Arith::Params`] of [`Q`]: the forgetting factor.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -53,7 +60,8 @@ fn mul_hi(x: i32, y: i32) -> i32 {
 fn normalise(x: i32) -> (i32, u32) {
     // A bit of `x ^ (x << 1)` is set where `x` changes from its sign to its magnitude.
     let n = (x ^ x.wrapping_shl(1)).leading_zeros();
-    (x.checked_shl(n).unwrap_or(0), n)
+    // n = 32 only for x = 0, which any shift leaves 0.
+    (x.wrapping_shl(n), n)
 }
 
 /// `x` saturated to `i32`, counting a saturation in `clip` (a sample's count, far below
@@ -172,7 +180,7 @@ impl Gain {
         if r > 0 {
             // `((t >> (r - 1)) + 1) >> 1` is `t / 2^r` rounded to nearest; from `r = 30` on it
             // is 0 (|t| < 2^29), so the shift is capped there.
-            let k = r.min(30).wrapping_sub(1) as u32;
+            let k = (r - 1).min(29) as u32;
             Ok((t >> k).wrapping_add(1) >> 1)
         } else {
             core::hint::cold_path();
@@ -203,12 +211,15 @@ impl Arith for Q {
 
     #[inline(always)]
     fn energy(p: &QParams, e: I24F40, gx: I5F27, x: I5F27, clip: &mut u32) -> I24F40 {
-        // gx x >= 0 (gx has the sign of x, or is 0), and the energy is positive: both terms
-        // are below 2^63, so their sum cannot wrap as a u64.
-        let add = mul_shift(gx.to_bits(), x.to_bits(), 2 * ERR_FRAC - ENERGY_FRAC) as u64;
-        let sum = (decay(e.to_bits(), p.lambda.to_bits()) as u64).wrapping_add(add);
+        // gx x >= 0 (gx has the sign of x, or is 0), rounded to Q40, plus ENERGY_STEP (in the
+        // rounding constant: no instruction of its own).
+        const SHIFT: u32 = 2 * ERR_FRAC - ENERGY_FRAC;
+        let product = i64::from(gx.to_bits()) * i64::from(x.to_bits());
+        let add = (product + (1 << (SHIFT - 1)) + (ENERGY_STEP << SHIFT)) >> SHIFT;
+        // Both terms are below 2^63: their sum cannot wrap as a u64.
+        let sum = (decay(e.to_bits(), p.lambda.to_bits()) as u64).wrapping_add(add as u64);
         match i64::try_from(sum) {
-            Ok(e) => I24F40::from_bits(e.max(ENERGY_FLOOR)),
+            Ok(e) => I24F40::from_bits(e),
             Err(_) => {
                 core::hint::cold_path();
                 *clip = clip.wrapping_add(1);

@@ -6,7 +6,7 @@ use super::config::{Channel, Config, ConfigError, Gate, Rejection};
 use super::estimator::Estimator;
 use super::estimator::sealed::{Sealed, Settings};
 use super::fixed_arith::{
-    COEF_FRAC, ENERGY_FRAC, ERR_FRAC, MEAN_FRAC, Q, QParams, decay, mean_step, reciprocal, sat_add,
+    COEF_FRAC, ENERGY_FLOOR, ENERGY_FRAC, ERR_FRAC, MEAN_FRAC, Q, QParams, decay, mean_step, reciprocal, sat_add,
     sat_i32,
 };
 use super::ladder::Ladder;
@@ -182,7 +182,7 @@ impl FixedChannel {
     fn delta_lambda_pow(&self, lambda: f64, k: usize) -> I24F40 {
         let v = (0..k).fold(self.delta, |acc, _| acc * lambda);
         // `as` saturates (and maps NaN to 0): no panic path.
-        I24F40::from_bits(libm::round(v * (1u64 << ENERGY_FRAC) as f64) as i64)
+        I24F40::from_bits((libm::round(v * (1u64 << ENERGY_FRAC) as f64) as i64).max(ENERGY_FLOOR))
     }
 
     /// Screens a float sample in sensor units and converts it to Q27 internal units.
