@@ -68,13 +68,14 @@ fn normalise(x: i32) -> (i32, u32) {
 /// `2^32`: it wraps nowhere, and a wrapping add is one instruction).
 #[inline(always)]
 pub(crate) fn sat_i32(x: i64, clip: &mut u32) -> i32 {
-    match i32::try_from(x) {
-        Ok(v) => v,
-        Err(_) => {
-            core::hint::cold_path();
-            *clip = clip.wrapping_add(1);
-            if x < 0 { i32::MIN } else { i32::MAX }
-        }
+    // In range when the high word is the sign of the low one: one compare.
+    let low = x as i32;
+    if (x >> 32) as i32 == low >> 31 {
+        low
+    } else {
+        core::hint::cold_path();
+        *clip = clip.wrapping_add(1);
+        if x < 0 { i32::MIN } else { i32::MAX }
     }
 }
 
@@ -107,14 +108,15 @@ pub(crate) fn mean_step(y: i32, (r, lz): (i32, u32)) -> i64 {
 }
 
 /// A positive Q40 energy (at least 1 LSB; the energies of the lattice are floored above
-/// that) prepared for division: `(r, lz)` with `1/e_real = r 2^(lz - 53)`,
-/// `r` in `(2^29, 2^30]` accurate to about 2^-29 relative.
+/// that) prepared for division: `(r0, d8, lz)`, the parts of its reciprocal `r` (see
+/// [`reciprocal`]) with `1/e_real = r 2^(lz - 53)`, `r` in `(2^29, 2^30]` accurate to about
+/// 2^-29 relative.
 ///
 /// `e` is normalised by its leading zeros (CLZ) to a mantissa `m` in `[2^31, 2^32)`; a 32/32
 /// hardware division gives `2^48 / m` to 16 bits, and one Newton-Raphson step
 /// `r <- r + r (2^61 - m r) / 2^61` doubles that.
 #[inline(always)]
-pub(crate) fn reciprocal(e: u64) -> (i32, u32) {
+fn newton(e: u64) -> (i32, i32, u32) {
     let (hi, lo) = ((e >> 32) as u32, e as u32);
     let (m, lz) = if hi != 0 {
         let z = hi.leading_zeros();
@@ -132,12 +134,32 @@ pub(crate) fn reciprocal(e: u64) -> (i32, u32) {
     let high = ((u64::from(m) * u64::from(r0)) >> 32) as u32;
     // 2^29 - high, times 8, in wrapping arithmetic: |d| 2^32 < 2^18.
     let d8 = (high << 3).wrapping_neg() as i32;
-    ((r0 as i32).wrapping_add(mul_hi(r0 as i32, d8)), lz)
+    (r0 as i32, d8, lz)
 }
 
-/// A gain `kappa = gx / E`, an error `gx` (Q27) over a positive energy `E` (Q40), kept in
-/// block-floating form for its products with errors: `4 kappa = m 2^-(s + 32)` (the factor 4
-/// turns a Q27 error into a Q29 coefficient step), `|m|` in `[2^25, 2^29]`, or 0.
+/// The reciprocal of [`newton`]: `r = r0 + r0 d`.
+#[inline(always)]
+pub(crate) fn reciprocal(e: u64) -> (i32, u32) {
+    let (r0, d8, lz) = newton(e);
+    (r0.wrapping_add(mul_hi(r0, d8)), lz)
+}
+
+/// `-r` for the [`reciprocal`] `r` of `e` (to the same precision): `-r0 - r0 d`.
+#[inline(always)]
+fn negative_reciprocal(e: u64) -> (i32, u32) {
+    let (r0, d8, lz) = newton(e);
+    let n0 = r0.wrapping_neg();
+    (n0.wrapping_add(mul_hi(n0, d8)), lz)
+}
+
+
+
+/// A gain `kappa = gx / E`, an error `gx` (Q27) over a positive energy `E` (Q40), kept
+/// negated in block-floating form for its products with errors: `-4 kappa = m 2^-(s + 32)`
+/// (the factor 4 turns a Q27 error into a Q29 coefficient step), `|m|` in `[2^25, 2^29]`, or
+/// 0. Negated, because it is made from a negative reciprocal, whose product with an error of
+/// either sign is one `SMMULR` (a reciprocal known to be positive is multiplied as unsigned,
+/// in three instructions); the updates subtract it.
 ///
 /// Made once per energy and sample from the energy's [`reciprocal`], it is all that a
 /// coefficient update needs: `kappa e` is one high-word product (`SMMULR`) and one shift.
@@ -152,11 +174,12 @@ impl Gain {
     /// The gain of a stage before its first sample (`psi(n-1) = 0`).
     pub(crate) const ZERO: Self = Self { m: 0, s: 0 };
 
-    /// `gx / e`, for `gx` [`normalise`]d (`gx_n = gx 2^na`) and the [`reciprocal`] of `e`.
+    /// `gx / e`, for `gx` [`normalise`]d (`gx_n = gx 2^na`) and the [`negative_reciprocal`]
+    /// `-r` of `e`.
     #[inline(always)]
     fn new((gx_n, na): (i32, u32), (r, lz): (i32, u32)) -> Self {
         // With gx, e the Q27 and Q40 bits: 4 kappa = gx 2^15 / e, 1/e = r 2^(lz - 93), and
-        // m = gx_n r 2^-32 = gx r 2^(na - 32): 4 kappa = m 2^(lz - na - 46).
+        // m = -gx_n r 2^-32 = -gx r 2^(na - 32): -4 kappa = m 2^(lz - na - 46).
         // |m| <= 2^29; na < 32, lz < 64: no wrap.
         Self {
             m: mul_hi(gx_n, r),
@@ -164,7 +187,7 @@ impl Gain {
         }
     }
 
-    /// `kappa x` in `Q(out_frac)`, for a Q27 `x` [`normalise`]d (`x_n = x 2^n`), rounded to
+    /// `-kappa x` in `Q(out_frac)`, for a Q27 `x` [`normalise`]d (`x_n = x 2^n`), rounded to
     /// nearest: `t = m x_n 2^-32` (`|t| <= 2^28`) shifted right by `s + n + 29 - out_frac`.
     /// `Ok` for a product below `2^28` in magnitude (the shift is to the right), `Err` for a
     /// larger one (start-up, a shock), exact in `i64`.
@@ -242,10 +265,11 @@ impl Arith for Q {
     #[inline(always)]
     fn feedback(k: I3F29, _: I5F27, e: I5F27, gain: &Gain, clip: &mut u32) -> I3F29 {
         let k = k.to_bits();
+        // `times` gives `-kappa e`.
         let sum = match gain.times(normalise(e.to_bits()), COEF_FRAC) {
-            Ok(delta) => k.checked_add(delta).ok_or(i64::from(k) + i64::from(delta)),
-            // |k| < 2^31, |delta| < 2^61: the sum is exact.
-            Err(delta) => Err(i64::from(k).wrapping_add(delta)),
+            Ok(delta) => k.checked_sub(delta).ok_or(i64::from(k) - i64::from(delta)),
+            // |k| < 2^31, |delta| < 2^61: the difference is exact.
+            Err(delta) => Err(i64::from(k).wrapping_sub(delta)),
         };
         I3F29::from_bits(sum.unwrap_or_else(|wide| sat_i32(wide, clip)))
     }
@@ -268,7 +292,10 @@ impl Arith for Q {
             let fe = Q::energy(p, stage.f_energy, gf, f, clip);
             let f_next = Q::predict(f, kf, bp, clip);
             let psi_next = Q::predict(bp, kb, f, clip);
-            let kappa_f = Gain::new(normalise(gf.to_bits()), reciprocal(fe.to_bits() as u64));
+            let kappa_f = Gain::new(
+                normalise(gf.to_bits()),
+                negative_reciprocal(fe.to_bits() as u64),
+            );
             let k = [
                 Q::feedback(kf, gf, f_next, &stage.b_kept, clip),
                 Q::feedback(kb, gf, psi_next, &kappa_f, clip),
@@ -276,12 +303,13 @@ impl Arith for Q {
             let gpsi = Q::gain(g, psi, clip);
             let be = Q::energy(p, stage.b_energy, gpsi, psi, clip);
             let gpsi_n = normalise(gpsi.to_bits());
-            let kappa_b = Gain::new(gpsi_n, reciprocal(be.to_bits() as u64));
-            // gpsi^2 / B_i(n) >= 0 (t has the sign of gpsi^2), so the result is at most g.
+            let kappa_b = Gain::new(gpsi_n, negative_reciprocal(be.to_bits() as u64));
+            // `times` gives -gpsi^2 / B_i(n) <= 0 (t has the sign of -gpsi^2), so the result
+            // is at most g.
             let g_next = match kappa_b.times(gpsi_n, GAMMA_FRAC) {
-                // 0 <= dg, g <= 2^30: no wrap.
-                Ok(dg) => g.to_bits().wrapping_sub(dg).max(0),
-                Err(dg) => i64::from(g.to_bits()).wrapping_sub(dg).max(0) as i32,
+                // dg <= 0, g <= 2^30 and |dg| <= 2^30: no wrap.
+                Ok(dg) => g.to_bits().wrapping_add(dg).max(0),
+                Err(dg) => i64::from(g.to_bits()).wrapping_add(dg).max(0) as i32,
             };
             *stage = Stage {
                 f_energy: fe,
