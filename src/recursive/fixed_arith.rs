@@ -202,9 +202,8 @@ impl Gain {
             .wrapping_sub(out_frac as i32);
         if r > 0 {
             // `((t >> (r - 1)) + 1) >> 1` is `t / 2^r` rounded to nearest; from `r = 30` on it
-            // is 0 (|t| < 2^29), so the shift is capped there.
-            let k = (r - 1).min(29) as u32;
-            Ok((t >> k).wrapping_add(1) >> 1)
+            // is 0 (|t| < 2^29), and so is the unbounded shift's (0 or -1, plus 1, halved).
+            Ok(t.unbounded_shr(r.wrapping_sub(1) as u32).wrapping_add(1) >> 1)
         } else {
             core::hint::cold_path();
             // |t| <= 2^28: shifted by up to 32 it stays inside i64; anything beyond
