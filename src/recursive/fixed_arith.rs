@@ -5,7 +5,7 @@
 use fixed::types::{I2F30, I3F29, I5F27, I24F40, U0F32};
 
 use super::arith::Arith;
-use super::lattice::{Core, Stage};
+use super::lattice::Core;
 
 /// The fixed-point number formats of the lattice, as an [`Arith`] implementation.
 // `pub` in a private module, as `Arith`: reachable by no one outside the crate.
@@ -285,20 +285,8 @@ impl Arith for Q {
             *kept = stage.k;
         }
         for stage in &mut core.stages {
-            let [kf, kb] = stage.k;
-            let (bp, gp) = (stage.bp, stage.gp);
-            let gf = Q::gain(gp, f, clip);
-            let fe = Q::energy(p, stage.f_energy, gf, f, clip);
-            let f_next = Q::predict(f, kf, bp, clip);
-            let psi_next = Q::predict(bp, kb, f, clip);
-            let kappa_f = Gain::new(
-                normalise(gf.to_bits()),
-                negative_reciprocal(fe.to_bits() as u64),
-            );
-            let k = [
-                Q::feedback(kf, gf, f_next, &stage.b_kept, clip),
-                Q::feedback(kb, gf, psi_next, &kappa_f, clip),
-            ];
+            // The backward half first: it needs only `g` and `psi`, so that little stays live
+            // through the forward half.
             let gpsi = Q::gain(g, psi, clip);
             let be = Q::energy(p, stage.b_energy, gpsi, psi, clip);
             let gpsi_n = normalise(gpsi.to_bits());
@@ -310,15 +298,27 @@ impl Arith for Q {
                 Ok(dg) => g.to_bits().wrapping_add(dg).max(0),
                 Err(dg) => i64::from(g.to_bits()).wrapping_add(dg).max(0) as i32,
             };
-            *stage = Stage {
-                f_energy: fe,
-                b_energy: be,
-                b_kept: kappa_b,
-                bp: psi,
-                gp: g,
-                k,
-                error: f_next,
-            };
+            let (bp, gp, kappa_b_old) = (stage.bp, stage.gp, stage.b_kept);
+            stage.b_energy = be;
+            stage.b_kept = kappa_b;
+            stage.bp = psi;
+            stage.gp = g;
+            // The forward half.
+            let [kf, kb] = stage.k;
+            let gf = Q::gain(gp, f, clip);
+            let fe = Q::energy(p, stage.f_energy, gf, f, clip);
+            let f_next = Q::predict(f, kf, bp, clip);
+            let psi_next = Q::predict(bp, kb, f, clip);
+            let kappa_f = Gain::new(
+                normalise(gf.to_bits()),
+                negative_reciprocal(fe.to_bits() as u64),
+            );
+            stage.k = [
+                Q::feedback(kf, gf, f_next, &kappa_b_old, clip),
+                Q::feedback(kb, gf, psi_next, &kappa_f, clip),
+            ];
+            stage.f_energy = fe;
+            stage.error = f_next;
             f = f_next;
             psi = psi_next;
             g = I2F30::from_bits(g_next);
