@@ -8,10 +8,14 @@
 #   - flash per estimator: each `size_*` firmware minus `size_base` (tools/footprint.sh),
 #   - wall time of the `imu-ar` tool on the 1,000,000-row ADIS16405 record (best of 3),
 #   - the same bench built for ARMv7-M without an FPU (thumbv7m-none-eabi, soft-float f32),
-#     run on the same emulated core.
+#     run on the same emulated core,
+#   - the same bench built for ARMv6-M (thumbv6m-none-eabi, the Cortex-M0+), run on the same
+#     emulated core, with the state bytes and the flash of the lattices built for it,
+#   - after target, nofpu and v6m: the sentence of the lattice's per-stage cost on each core
+#     (perf-stage), from the figures in those sections of README.md.
 #
 #   tools/bench-report.sh            all of it
-#   tools/bench-report.sh target     one part: target | host | flash | wall | nofpu
+#   tools/bench-report.sh target     one part: target | host | flash | wall | nofpu | v6m
 set -euo pipefail
 cd "$(dirname "$0")/.."
 only=${1:-all}
@@ -22,6 +26,28 @@ data=${IMU_AR_DATA:-../shared/data/imu}
 # replace SECTION FILE: put FILE's contents between the section's markers in README.md.
 replace() {
     python3 tools/readme.py replace "$1" "$2"
+}
+
+# stage: the per-stage cost of the f32 and fixed-point lattice on each core, from the "Per
+# lattice stage" lines of the perf-target, perf-nofpu and perf-v6m sections (a core whose
+# section has none is left out).
+stage() {
+    PYTHONPATH=tools python3 - > "$tmp/perf-stage.md" <<'PY'
+import re
+from readme import split
+cores = [("perf-target", "Cortex-M4F"), ("perf-nofpu", "ARMv7-M without an FPU"),
+         ("perf-v6m", "ARMv6-M")]
+found = []
+for section, core in cores:
+    m = re.search(r"Per lattice stage.*?\*\*([\d.]+)\*\* instructions in (?:soft-float )?f32, "
+                  r"\*\*([\d.]+)\*\* in fixed point", split(section)[1])
+    if m:
+        found.append(f"{core} **{m.group(1)}** / **{m.group(2)}**")
+print("The lattice grows linearly in `p`, RLS quadratically. One lattice stage, in instructions, "
+      f"f32 / fixed point: {', '.join(found)} (least-squares slopes over p = 1..32; f32 in "
+      "software on the cores without an FPU).")
+PY
+    replace perf-stage "$tmp/perf-stage.md"
 }
 
 if [ "$only" = all ] || [ "$only" = target ]; then
@@ -66,6 +92,7 @@ print(f"State: `AllanStream<20>` {m.group(1)} bytes (kept per axis, fed every sa
       f"`Octaves<20>` {m.group(3)} bytes, `NoiseModel<8, 3>` {m.group(2)} bytes.")
 PY
     replace perf-noise "$tmp/perf-noise.md"
+    stage
 fi
 
 if [ "$only" = all ] || [ "$only" = host ]; then
@@ -153,4 +180,36 @@ print(f"\nPer lattice stage: **{f32:.0f}** instructions in soft-float f32, **{fi
       f"point ({f32 / fixed:.1f} times cheaper).")
 PY
     replace perf-nofpu "$tmp/perf-nofpu.md"
+    stage
+fi
+
+if [ "$only" = all ] || [ "$only" = v6m ]; then
+    rustup target list --installed | grep -qx thumbv6m-none-eabi ||
+        rustup target add thumbv6m-none-eabi
+    cargo run -q --release --target thumbv6m-none-eabi --example bench 2>/dev/null \
+        > "$tmp/v6m.txt"
+    tools/footprint.sh --target thumbv6m-none-eabi \
+        size_base size_lattice_f32 size_lattice_fixed > "$tmp/v6m-sizes.md"
+    PYTHONPATH=tools python3 - "$tmp/v6m.txt" "$tmp/v6m-sizes.md" > "$tmp/perf-v6m.md" <<'PY'
+import re, sys
+from readme import bench_rows, slope, split, table
+text = open(sys.argv[1]).read()
+rows = {k: r for k, r in bench_rows(text).items() if k[0] in ("lattice", "rls")}
+print(table(rows), end="")
+f32, fixed = slope(rows[("lattice", "f32")]), slope(rows[("lattice", "fixed")])
+print(f"\nPer lattice stage: **{f32:.0f}** instructions in soft-float f32, **{fixed:.0f}** in fixed "
+      f"point ({f32 / fixed:.1f} times cheaper).")
+state = table({k: r for k, r in bench_rows(text, "bytes").items() if k[0] == "lattice"})
+# The same rows in the Cortex-M4F's state table (perf-state)?
+same = all(line in split("perf-state")[1].splitlines() for line in state.splitlines()[2:])
+print(f"\nState per channel (bytes{', as on the Cortex-M4F' if same else ''}):\n")
+print(state, end="")
+flash = {k: int(v) for k, v in re.findall(r"\| `(\w+)` \| (\d+) \|", open(sys.argv[2]).read())}
+base = flash["size_base"]
+print(f"\nFlash at p = 8 (`update` and `model`, each `size_*` firmware minus `size_base`, "
+      f"{base} bytes): lattice f32 **{flash['size_lattice_f32'] - base}** bytes, "
+      f"lattice fixed **{flash['size_lattice_fixed'] - base}**.")
+PY
+    replace perf-v6m "$tmp/perf-v6m.md"
+    stage
 fi

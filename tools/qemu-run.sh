@@ -1,5 +1,7 @@
 #!/usr/bin/env bash
 # Run a thumbv7em-none-eabihf firmware ELF on QEMU's emulated Cortex-M4F (Arm MPS2 AN386).
+# Builds for thumbv7m-none-eabi and thumbv6m-none-eabi (Cortex-M3, Cortex-M0+) run on it too:
+# their instructions are a subset of the Cortex-M4F's.
 #
 #   tools/qemu-run.sh path/to/firmware.elf
 #
