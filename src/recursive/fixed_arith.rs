@@ -40,18 +40,77 @@ pub(crate) const ENERGY_FRAC: u32 = 40;
 /// The running mean, Q56 in an `i64` (range +-128 internal units; the mean stays inside +-16).
 pub(crate) const MEAN_FRAC: u32 = 56;
 
+/// `x y`, exact: one `SMULL` where the core has it. ARMv6-M (Cortex-M0/M0+) multiplies 32 by
+/// 32 bits into 32 only, and would call a 64 x 64-bit routine: there it is four 16 x 16-bit
+/// products, the same exact result.
+#[inline(always)]
+fn wide(x: i32, y: i32) -> i64 {
+    #[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
+    {
+        i64::from(x) * i64::from(y)
+    }
+    #[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
+    {
+        // x = xh 2^16 + xl with xl in [0, 2^16): every partial product fits its type.
+        let (xh, xl, yh, yl) = (x >> 16, x & 0xFFFF, y >> 16, y & 0xFFFF);
+        let low = i64::from((xl as u32).wrapping_mul(yl as u32));
+        let middle = i64::from(xh.wrapping_mul(yl)) + i64::from(xl.wrapping_mul(yh));
+        (i64::from(xh.wrapping_mul(yh)) << 32)
+            .wrapping_add(middle << 16)
+            .wrapping_add(low)
+    }
+}
+
+/// `x y` unsigned, exact: one `UMULL`, or on ARMv6-M four 16 x 16-bit products (see [`wide`]).
+#[inline(always)]
+fn wide_unsigned(x: u32, y: u32) -> u64 {
+    #[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
+    {
+        u64::from(x) * u64::from(y)
+    }
+    #[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
+    {
+        let (xh, xl, yh, yl) = (x >> 16, x & 0xFFFF, y >> 16, y & 0xFFFF);
+        let middle = u64::from(xh.wrapping_mul(yl)) + u64::from(xl.wrapping_mul(yh));
+        (u64::from(xh.wrapping_mul(yh)) << 32)
+            .wrapping_add(middle << 16)
+            .wrapping_add(u64::from(xl.wrapping_mul(yl)))
+    }
+}
+
+/// Leading zeros of `x` (32 for 0): one `CLZ` where the core has it; ARMv6-M has none, and
+/// there a binary search in registers is cheaper than the call to the library routine.
+#[inline(always)]
+fn clz(x: u32) -> u32 {
+    #[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
+    {
+        x.leading_zeros()
+    }
+    #[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
+    {
+        let (mut x, mut n) = (x, 0);
+        for bits in [16, 8, 4, 2, 1] {
+            if x >> (32 - bits) == 0 {
+                n += bits;
+                x <<= bits;
+            }
+        }
+        n + u32::from(x == 0)
+    }
+}
+
 /// `x y / 2^s` rounded to nearest (ties up), for a constant `s` in `1..=62`: one `SMULL` and
 /// a rounding shift.
 #[inline(always)]
 fn mul_shift(x: i32, y: i32, s: u32) -> i64 {
-    (i64::from(x) * i64::from(y) + (1 << (s - 1))) >> s
+    (wide(x, y) + (1 << (s - 1))) >> s
 }
 
 /// `x y / 2^32` rounded to nearest: the high word of the product (`SMMULR`).
 #[inline(always)]
 fn mul_hi(x: i32, y: i32) -> i32 {
     // |x y| <= 2^62: the sum cannot overflow and the result fits in an i32.
-    ((i64::from(x) * i64::from(y) + (1 << 31)) >> 32) as i32
+    ((wide(x, y) + (1 << 31)) >> 32) as i32
 }
 
 /// `(x 2^n, n)` with `n` the redundant sign bits of `x`: `|x 2^n|` in `[2^30, 2^31]` unless
@@ -59,7 +118,7 @@ fn mul_hi(x: i32, y: i32) -> i32 {
 #[inline(always)]
 fn normalise(x: i32) -> (i32, u32) {
     // A bit of `x ^ (x << 1)` is set where `x` changes from its sign to its magnitude.
-    let n = (x ^ x.wrapping_shl(1)).leading_zeros();
+    let n = clz((x ^ x.wrapping_shl(1)) as u32);
     // n = 32 only for x = 0, which any shift leaves 0.
     (x.wrapping_shl(n), n)
 }
@@ -93,8 +152,8 @@ pub(crate) fn sat_add(x: i64, y: i64, clip: &mut u32) -> i64 {
 #[inline(always)]
 pub(crate) fn decay(e: i64, lambda: u32) -> i64 {
     let e = e as u64;
-    let low = ((e & 0xFFFF_FFFF) * u64::from(lambda) + (1 << 31)) >> 32;
-    ((e >> 32) * u64::from(lambda) + low) as i64
+    let low = (wide_unsigned(e as u32, lambda) + (1 << 31)) >> 32;
+    (wide_unsigned((e >> 32) as u32, lambda) + low) as i64
 }
 
 /// `y / W` in Q56, for `y` in Q27 and the [`reciprocal`] of a Q40 weight `W >= 1`: one exact
@@ -104,7 +163,7 @@ pub(crate) fn mean_step(y: i32, (r, lz): (i32, u32)) -> i64 {
     // y / W = y r 2^(lz - 53 - 27) real = y r 2^(lz - 24) in Q56; W >= 1 (Q40) gives lz <= 23.
     let s = 24u32.saturating_sub(lz).clamp(1, 24);
     // |y r| < 2^61: the product and the rounding add stay well inside `i64`.
-    (i64::from(y) * i64::from(r)).wrapping_add(1 << (s - 1)) >> s
+    wide(y, r).wrapping_add(1 << (s - 1)) >> s
 }
 
 /// A positive Q40 energy (at least 1 LSB; the energies of the lattice are floored above
@@ -119,19 +178,19 @@ pub(crate) fn mean_step(y: i32, (r, lz): (i32, u32)) -> i64 {
 fn newton(e: u64) -> (i32, i32, u32) {
     let (hi, lo) = ((e >> 32) as u32, e as u32);
     let (m, lz) = if hi != 0 {
-        let z = hi.leading_zeros();
+        let z = clz(hi);
         // `(lo >> 1) >> (31 - z)` is `lo >> (32 - z)` without a shift by 32.
         ((hi << z) | ((lo >> 1) >> (31 - z)), z)
     } else {
         // `lo != 0` here (`e >= 1`), so `z < 32`.
-        let z = lo.leading_zeros();
+        let z = clz(lo);
         (lo.wrapping_shl(z), 32 + z)
     };
     // `| 0x8000` changes nothing (the top bit is set) but proves the divisor non-zero.
     let r0 = (u32::MAX / ((m >> 16) | 0x8000)) << 13; // in (2^29, 2^30], within 2^-15
     // Newton-Raphson on the high word alone: m r0 = 2^61 (1 + d), |d| < 2^-15, so the high
     // word `2^29 (1 + d)` carries d to 2^-29, and `r0 (1 - d)` is then good to about 2^-29.
-    let high = ((u64::from(m) * u64::from(r0)) >> 32) as u32;
+    let high = (wide_unsigned(m, r0) >> 32) as u32;
     // 2^29 - high, times 8, in wrapping arithmetic: |d| 2^32 < 2^18.
     let d8 = (high << 3).wrapping_neg() as i32;
     (r0 as i32, d8, lz)
@@ -236,7 +295,7 @@ impl Arith for Q {
         // gx x >= 0 (gx has the sign of x, or is 0), rounded to Q40, plus ENERGY_STEP (in the
         // rounding constant: no instruction of its own).
         const SHIFT: u32 = 2 * ERR_FRAC - ENERGY_FRAC;
-        let product = i64::from(gx.to_bits()) * i64::from(x.to_bits());
+        let product = wide(gx.to_bits(), x.to_bits());
         let add = (product + (1 << (SHIFT - 1)) + (ENERGY_STEP << SHIFT)) >> SHIFT;
         // Both terms are below 2^63: their sum cannot wrap as a u64.
         let sum = (decay(e.to_bits(), p.lambda.to_bits()) as u64).wrapping_add(add as u64);
