@@ -160,20 +160,20 @@ pub(crate) fn decay(e: i64, lambda: u32) -> i64 {
 /// `SMULL` and one rounding shift (relative error about 2^-29), never out of range.
 #[inline(always)]
 pub(crate) fn mean_step(y: i32, (r, lz): (i32, u32)) -> i64 {
-    // y / W = y r 2^(lz - 53 - 27) real = y r 2^(lz - 24) in Q56; W >= 1 (Q40) gives lz <= 23.
-    let s = 24u32.saturating_sub(lz).clamp(1, 24);
-    // |y r| < 2^61: the product and the rounding add stay well inside `i64`.
+    // y / W = y r 2^(lz - 54 - 27) real = y r 2^(lz - 25) in Q56; W >= 1 (Q40) gives lz <= 23.
+    let s = 25u32.saturating_sub(lz).clamp(1, 25);
+    // |y r| < 2^62: the product and the rounding add stay inside `i64`.
     wide(y, r).wrapping_add(1 << (s - 1)) >> s
 }
 
 /// A positive Q40 energy (at least 1 LSB; the energies of the lattice are floored above
 /// that) prepared for division: `(r0, d8, lz)`, the parts of its reciprocal `r` (see
-/// [`reciprocal`]) with `1/e_real = r 2^(lz - 53)`, `r` in `(2^29, 2^30]` accurate to about
-/// 2^-29 relative.
+/// [`reciprocal`]) with `1/e_real = r 2^(lz - 54)`, `r` in `(2^30, 2^31)` accurate to about
+/// 2^-30 relative.
 ///
 /// `e` is normalised by its leading zeros (CLZ) to a mantissa `m` in `[2^31, 2^32)`; a 32/32
 /// hardware division gives `2^48 / m` to 16 bits, and one Newton-Raphson step
-/// `r <- r + r (2^61 - m r) / 2^61` doubles that.
+/// `r <- r + r (2^62 - m r) / 2^62` doubles that.
 #[inline(always)]
 fn newton(e: u64) -> (i32, i32, u32) {
     let (hi, lo) = ((e >> 32) as u32, e as u32);
@@ -187,13 +187,14 @@ fn newton(e: u64) -> (i32, i32, u32) {
         (lo.wrapping_shl(z), 32 + z)
     };
     // `| 0x8000` changes nothing (the top bit is set) but proves the divisor non-zero.
-    let r0 = (u32::MAX / ((m >> 16) | 0x8000)) << 13; // in (2^29, 2^30], within 2^-15
-    // Newton-Raphson on the high word alone: m r0 = 2^61 (1 + d), |d| < 2^-15, so the high
-    // word `2^29 (1 + d)` carries d to 2^-29, and `r0 (1 - d)` is then good to about 2^-29.
+    // In (2^30, 2^31 - 2^14], within 2^-15 of 2^62 / m.
+    let r0 = (u32::MAX / ((m >> 16) | 0x8000)) << 14;
+    // Newton-Raphson on the high word alone: m r0 = 2^62 (1 + d), |d| < 2^-15, so the high
+    // word `2^30 (1 + d)` carries d to 2^-30, and `r0 (1 - d)` is then good to about 2^-30.
     let high = (wide_unsigned(m, r0) >> 32) as u32;
-    // 2^29 - high, times 8, in wrapping arithmetic: |d| 2^32 < 2^18.
-    let d8 = (high << 3).wrapping_neg() as i32;
-    (r0 as i32, d8, lz)
+    // (2^30 - high) 4 = -d 2^32, in wrapping arithmetic: |d| 2^32 < 2^18.
+    let d4 = (high << 2).wrapping_neg() as i32;
+    (r0 as i32, d4, lz)
 }
 
 /// The reciprocal of [`newton`]: `r = r0 + r0 d`.
@@ -215,7 +216,7 @@ fn negative_reciprocal(e: u64) -> (i32, u32) {
 
 /// A gain `kappa = gx / E`, an error `gx` (Q27) over a positive energy `E` (Q40), kept
 /// negated in block-floating form for its products with errors: `-4 kappa = m 2^-(s + 32)`
-/// (the factor 4 turns a Q27 error into a Q29 coefficient step), `|m|` in `[2^25, 2^29]`, or
+/// (the factor 4 turns a Q27 error into a Q29 coefficient step), `|m|` in `(2^28, 2^30]`, or
 /// 0. Negated, because it is made from a negative reciprocal, whose product with an error of
 /// either sign is one `SMMULR` (a reciprocal known to be positive is multiplied as unsigned,
 /// in three instructions); the updates subtract it.
@@ -237,18 +238,18 @@ impl Gain {
     /// `-r` of `e`.
     #[inline(always)]
     fn new((gx_n, na): (i32, u32), (r, lz): (i32, u32)) -> Self {
-        // With gx, e the Q27 and Q40 bits: 4 kappa = gx 2^15 / e, 1/e = r 2^(lz - 93), and
-        // m = -gx_n r 2^-32 = -gx r 2^(na - 32): -4 kappa = m 2^(lz - na - 46).
-        // |m| <= 2^29; na < 32, lz < 64: no wrap.
+        // With gx, e the Q27 and Q40 bits: 4 kappa = gx 2^15 / e, 1/e = r 2^(lz - 94), and
+        // m = -gx_n r 2^-32 = -gx r 2^(na - 32): -4 kappa = m 2^(lz - na - 47).
+        // |m| <= 2^30; na <= 32, lz < 64: no wrap.
         Self {
             m: mul_hi(gx_n, r),
-            s: (na as i32).wrapping_add(14).wrapping_sub(lz as i32),
+            s: (na as i32).wrapping_add(15).wrapping_sub(lz as i32),
         }
     }
 
     /// `-kappa x` in `Q(out_frac)`, for a Q27 `x` [`normalise`]d (`x_n = x 2^n`), rounded to
-    /// nearest: `t = m x_n 2^-32` (`|t| <= 2^28`) shifted right by `s + n + 29 - out_frac`.
-    /// `Ok` for a product below `2^28` in magnitude (the shift is to the right), `Err` for a
+    /// nearest: `t = m x_n 2^-32` (`|t| <= 2^29`) shifted right by `s + n + 29 - out_frac`.
+    /// `Ok` for a product below `2^29` in magnitude (the shift is to the right), `Err` for a
     /// larger one (start-up, a shock), exact in `i64`.
     #[inline(always)]
     fn times(self, (x_n, n): (i32, u32), out_frac: u32) -> Result<i32, i64> {
@@ -261,11 +262,11 @@ impl Gain {
             .wrapping_sub(out_frac as i32);
         if r > 0 {
             // `((t >> (r - 1)) + 1) >> 1` is `t / 2^r` rounded to nearest; from `r = 30` on it
-            // is 0 (|t| < 2^29), and so is the unbounded shift's (0 or -1, plus 1, halved).
+            // is 0 (|t| <= 2^29), and so is the unbounded shift's (0 or -1, plus 1, halved).
             Ok(t.unbounded_shr(r.wrapping_sub(1) as u32).wrapping_add(1) >> 1)
         } else {
             core::hint::cold_path();
-            // |t| <= 2^28: shifted by up to 32 it stays inside i64; anything beyond
+            // |t| <= 2^29: shifted by up to 32 it stays inside i64; anything beyond
             // saturates where it is added.
             Err(i64::from(t).wrapping_shl(r.unsigned_abs().min(32)))
         }

@@ -253,21 +253,27 @@ impl Format for Q {
 ///
 /// Every product is formed exactly in `i64` (one `SMULL`) and rounded to nearest once; the
 /// `fixed` crate's own `*` rounds toward minus infinity, a bias that the `lambda` recursions
-/// would accumulate over `1/(1 - lambda)` samples. Divisions by an energy use its reciprocal,
-/// computed once per energy and sample: the energy is normalised by its leading zeros (CLZ) to
-/// a 32-bit mantissa `m`, and `r = 2^61 / m` comes from one 32/32-bit `UDIV` and one
-/// Newton-Raphson step. A quotient `a b / e` normalises `a` and `b` (CLZ), takes the high words
-/// of `a b` and of that times `r` (`SMMULR`), and shifts back by the exponents (relative error
-/// about 2^-28). Every result that can leave its format is saturated, and each saturation is
-/// counted in [`Health::clipped`](super::Health::clipped). Host and target compute the same
-/// bits: integer arithmetic only on the per-sample path.
+/// would accumulate over `1/(1 - lambda)` samples. The stages run in gain form: each energy
+/// is inverted once per sample (normalised by its leading zeros to a 32-bit mantissa `m`,
+/// `2^62 / m` from one 32/32-bit `UDIV` and one Newton-Raphson step on the high word) into a
+/// gain `gx / E` in block-floating form (a 32-bit mantissa and a shift), and every
+/// division of the recursion is a product with a gain: the error is normalised (`CLZ`), one
+/// high-word product (`SMMULR`) and one rounding shift (relative error about 2^-28). Stage
+/// `i` keeps the gain `gamma_i psi_i / B_i` between samples: it is the next sample's `kf`
+/// step and, the same sample, the conversion factor's, so the stage divides twice, not
+/// three times. Every energy update adds 2 LSB, which keeps the energies at or above 16 LSB
+/// without a test. Every result that can leave its format is saturated, and each saturation
+/// is counted in [`Health::clipped`](super::Health::clipped). Host and target compute the
+/// same bits: integer arithmetic only on the per-sample path. `docs/fixed-point.md` gives
+/// the cost of each step on the Cortex-M4F, M3 and M0+.
 ///
 /// A sample in which anything saturates (the centred input, an error, an energy, a
 /// coefficient or the weight) restarts the lattice: its state is never published. Where the
 /// float estimators hold a snapshot taken every
 /// [`snapshot_interval`](super::snapshot_interval)`(P)` samples (their breakdown shows only
-/// once the state is lost), the fixed-point lattice keeps what one sample overwrites (`2 P`
-/// reflection coefficients, `F_P`, the weight and the mean) and, on a saturation, holds the
+/// once the state is lost), the fixed-point lattice keeps what one sample overwrites (the
+/// reflection coefficients it replaced stay in the history ring; `F_P`, the weight and the
+/// mean are copied) and, on a saturation, holds the
 /// model from just before that sample: [`Estimator::model`] publishes it for
 /// `3/(1 - lambda)` samples after the restart, through the same shell as the float
 /// estimators (so a lattice that restarts again and again, every few samples, still
