@@ -13,15 +13,10 @@ use super::lattice::Core;
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Q;
 
-/// Energies are at least 16 LSB (1.5e-11 internal units^2): they start there or above, and
-/// every update adds [`ENERGY_STEP`] to `lambda E`, which keeps them there for `lambda >= 0.9`
-/// (`round(0.9 16) + 2 = 16`).
+/// Energies start at or above 16 LSB (1.5e-11 internal units^2). Updated as
+/// `round(lambda E) + gx x`, they never fall below 1 LSB: a rounded decay keeps a positive
+/// energy positive (`round(lambda) = 1` for `lambda >= 0.9`), and the reciprocal needs no more.
 pub(crate) const ENERGY_FLOOR: i64 = 16;
-
-/// What every energy update adds, in LSB (the floor's share of the float lattices'
-/// `floor` term): at most `2 / (1 - lambda)` LSB in all, `2^-17` of the energy of a signal
-/// one `2^-11` count in RMS at the longest memory.
-const ENERGY_STEP: i64 = 2;
 
 /// [`Arith::Params`] of [`Q`]: the forgetting factor.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -212,8 +207,6 @@ fn negative_reciprocal(e: u64) -> (i32, u32) {
     (n0.wrapping_add(mul_hi(n0, d8)), lz)
 }
 
-
-
 /// A gain `kappa = gx / E`, an error `gx` (Q27) over a positive energy `E` (Q40), kept
 /// negated in block-floating form for its products with errors: `-4 kappa = m 2^-(s + 32)`
 /// (the factor 4 turns a Q27 error into a Q29 coefficient step), `|m|` in `(2^28, 2^30]`, or
@@ -293,11 +286,8 @@ impl Arith for Q {
 
     #[inline(always)]
     fn energy(p: &QParams, e: I24F40, gx: I5F27, x: I5F27, clip: &mut u32) -> I24F40 {
-        // gx x >= 0 (gx has the sign of x, or is 0), rounded to Q40, plus ENERGY_STEP (in the
-        // rounding constant: no instruction of its own).
-        const SHIFT: u32 = 2 * ERR_FRAC - ENERGY_FRAC;
-        let product = wide(gx.to_bits(), x.to_bits());
-        let add = (product + (1 << (SHIFT - 1)) + (ENERGY_STEP << SHIFT)) >> SHIFT;
+        // gx x >= 0 (gx has the sign of x, or is 0), rounded to Q40.
+        let add = mul_shift(gx.to_bits(), x.to_bits(), 2 * ERR_FRAC - ENERGY_FRAC);
         // Both terms are below 2^63: their sum cannot wrap as a u64.
         let sum = (decay(e.to_bits(), p.lambda.to_bits()) as u64).wrapping_add(add as u64);
         match i64::try_from(sum) {

@@ -6,8 +6,8 @@ use super::config::{Channel, Config, ConfigError, Gate, Rejection};
 use super::estimator::Estimator;
 use super::estimator::sealed::{Sealed, Settings};
 use super::fixed_arith::{
-    COEF_FRAC, ENERGY_FLOOR, ENERGY_FRAC, ERR_FRAC, MEAN_FRAC, Q, QParams, decay, mean_step, reciprocal, sat_add,
-    sat_i32,
+    COEF_FRAC, ENERGY_FLOOR, ENERGY_FRAC, ERR_FRAC, MEAN_FRAC, Q, QParams, decay, mean_step,
+    reciprocal, sat_add, sat_i32,
 };
 use super::ladder::Ladder;
 use super::lattice::{Core, lattice_accessors};
@@ -458,7 +458,9 @@ impl<const P: usize> FixedLattice<P> {
             let mean = ((m.mean >> (MEAN_FRAC - ERR_FRAC - 1)) + 1) >> 1;
             // |x| < 2^31 and |mean| < 2^36: the difference is exact in i64.
             let y = sat_i32(i64::from(x) - mean, &mut clip);
-            m.mean = m.mean.saturating_add(mean_step(y, reciprocal(m.weight.max(1).unsigned_abs())));
+            m.mean = m
+                .mean
+                .saturating_add(mean_step(y, reciprocal(m.weight.max(1).unsigned_abs())));
             y
         } else {
             x
