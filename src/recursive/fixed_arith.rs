@@ -83,14 +83,15 @@ fn clz(x: u32) -> u32 {
     }
     #[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
     {
-        let (mut x, mut n) = (x, 0);
+        let (mut x, mut n) = (x, 0u32);
         for bits in [16, 8, 4, 2, 1] {
             if x >> (32 - bits) == 0 {
-                n += bits;
+                // Distinct powers of two: the sum is an or, at most 31.
+                n |= bits;
                 x <<= bits;
             }
         }
-        n + u32::from(x == 0)
+        n.wrapping_add(u32::from(x == 0))
     }
 }
 

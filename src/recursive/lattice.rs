@@ -179,7 +179,8 @@ impl<A: Arith, const P: usize> Core<A, P> {
     fn past(&self, t: usize) -> [[A::Coef; 2]; P] {
         match t.checked_sub(1) {
             None => self.stages.map(|s| s.k),
-            Some(t) => self.ring[(self.head % P + t) % P],
+            // `head % P + t < 2 P`: no wrap.
+            Some(t) => self.ring[(self.head % P).wrapping_add(t) % P],
         }
     }
 
