@@ -36,8 +36,7 @@ pub(crate) const ENERGY_FRAC: u32 = 40;
 pub(crate) const MEAN_FRAC: u32 = 56;
 
 /// `x y`, exact: one `SMULL` where the core has it. ARMv6-M (Cortex-M0/M0+) multiplies 32 by
-/// 32 bits into 32 only, and would call a 64 x 64-bit routine: there it is four 16 x 16-bit
-/// products, the same exact result.
+/// 32 bits into 32 only, and would call a 64 x 64-bit routine: there it is [`wide_halves`].
 #[inline(always)]
 fn wide(x: i32, y: i32) -> i64 {
     #[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
@@ -46,17 +45,27 @@ fn wide(x: i32, y: i32) -> i64 {
     }
     #[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
     {
-        // x = xh 2^16 + xl with xl in [0, 2^16): every partial product fits its type.
-        let (xh, xl, yh, yl) = (x >> 16, x & 0xFFFF, y >> 16, y & 0xFFFF);
-        let low = i64::from((xl as u32).wrapping_mul(yl as u32));
-        let middle = i64::from(xh.wrapping_mul(yl)) + i64::from(xl.wrapping_mul(yh));
-        (i64::from(xh.wrapping_mul(yh)) << 32)
-            .wrapping_add(middle << 16)
-            .wrapping_add(low)
+        wide_halves(x, y)
     }
 }
 
-/// `x y` unsigned, exact: one `UMULL`, or on ARMv6-M four 16 x 16-bit products (see [`wide`]).
+/// `x y` from four 16 x 16-bit products, the same exact result as [`wide`] (ARMv6-M).
+#[cfg_attr(
+    not(all(target_arch = "arm", not(target_has_atomic = "32"))),
+    allow(dead_code)
+)]
+#[inline(always)]
+fn wide_halves(x: i32, y: i32) -> i64 {
+    // x = xh 2^16 + xl with xl in [0, 2^16): every partial product fits its type.
+    let (xh, xl, yh, yl) = (x >> 16, x & 0xFFFF, y >> 16, y & 0xFFFF);
+    let low = i64::from((xl as u32).wrapping_mul(yl as u32));
+    let middle = i64::from(xh.wrapping_mul(yl)) + i64::from(xl.wrapping_mul(yh));
+    (i64::from(xh.wrapping_mul(yh)) << 32)
+        .wrapping_add(middle << 16)
+        .wrapping_add(low)
+}
+
+/// `x y` unsigned, exact: one `UMULL`, or on ARMv6-M [`wide_unsigned_halves`].
 #[inline(always)]
 fn wide_unsigned(x: u32, y: u32) -> u64 {
     #[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
@@ -65,16 +74,26 @@ fn wide_unsigned(x: u32, y: u32) -> u64 {
     }
     #[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
     {
-        let (xh, xl, yh, yl) = (x >> 16, x & 0xFFFF, y >> 16, y & 0xFFFF);
-        let middle = u64::from(xh.wrapping_mul(yl)) + u64::from(xl.wrapping_mul(yh));
-        (u64::from(xh.wrapping_mul(yh)) << 32)
-            .wrapping_add(middle << 16)
-            .wrapping_add(u64::from(xl.wrapping_mul(yl)))
+        wide_unsigned_halves(x, y)
     }
 }
 
+/// `x y` unsigned from four 16 x 16-bit products (ARMv6-M).
+#[cfg_attr(
+    not(all(target_arch = "arm", not(target_has_atomic = "32"))),
+    allow(dead_code)
+)]
+#[inline(always)]
+fn wide_unsigned_halves(x: u32, y: u32) -> u64 {
+    let (xh, xl, yh, yl) = (x >> 16, x & 0xFFFF, y >> 16, y & 0xFFFF);
+    let middle = u64::from(xh.wrapping_mul(yl)) + u64::from(xl.wrapping_mul(yh));
+    (u64::from(xh.wrapping_mul(yh)) << 32)
+        .wrapping_add(middle << 16)
+        .wrapping_add(u64::from(xl.wrapping_mul(yl)))
+}
+
 /// Leading zeros of `x` (32 for 0): one `CLZ` where the core has it; ARMv6-M has none, and
-/// there a binary search in registers is cheaper than the call to the library routine.
+/// there [`clz_search`] is cheaper than the call to the library routine.
 #[inline(always)]
 fn clz(x: u32) -> u32 {
     #[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
@@ -83,16 +102,26 @@ fn clz(x: u32) -> u32 {
     }
     #[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
     {
-        let (mut x, mut n) = (x, 0u32);
-        for bits in [16, 8, 4, 2, 1] {
-            if x >> (32 - bits) == 0 {
-                // Distinct powers of two: the sum is an or, at most 31.
-                n |= bits;
-                x <<= bits;
-            }
-        }
-        n.wrapping_add(u32::from(x == 0))
+        clz_search(x)
     }
+}
+
+/// Leading zeros of `x` by a binary search in registers (ARMv6-M).
+#[cfg_attr(
+    not(all(target_arch = "arm", not(target_has_atomic = "32"))),
+    allow(dead_code)
+)]
+#[inline(always)]
+fn clz_search(x: u32) -> u32 {
+    let (mut x, mut n) = (x, 0u32);
+    for bits in [16, 8, 4, 2, 1] {
+        if x >> (32 - bits) == 0 {
+            // Distinct powers of two: the sum is an or, at most 31.
+            n |= bits;
+            x <<= bits;
+        }
+    }
+    n.wrapping_add(u32::from(x == 0))
 }
 
 /// `x y / 2^s` rounded to nearest (ties up), for a constant `s` in `1..=62`: one `SMULL` and
@@ -162,8 +191,8 @@ pub(crate) fn mean_step(y: i32, (r, lz): (i32, u32)) -> i64 {
     wide(y, r).wrapping_add(1 << (s - 1)) >> s
 }
 
-/// A positive Q40 energy (at least 1 LSB; the energies of the lattice are floored above
-/// that) prepared for division: `(r0, d8, lz)`, the parts of its reciprocal `r` (see
+/// A positive Q40 energy (at least 1 LSB, as every energy of the lattice is) prepared for
+/// division: `(r0, d8, lz)`, the parts of its reciprocal `r` (see
 /// [`reciprocal`]) with `1/e_real = r 2^(lz - 54)`, `r` in `(2^30, 2^31)` accurate to about
 /// 2^-30 relative.
 ///
@@ -193,11 +222,12 @@ fn newton(e: u64) -> (i32, i32, u32) {
     (r0 as i32, d4, lz)
 }
 
-/// The reciprocal of [`newton`]: `r = r0 + r0 d`.
+/// The reciprocal of [`newton`]: `r = r0 + r0 d`. For a mantissa of exactly `2^31` (`e` a
+/// power of two) that is `2^31`, one past `i32`: it is saturated to `2^31 - 1` (`2^-31` off).
 #[inline(always)]
 pub(crate) fn reciprocal(e: u64) -> (i32, u32) {
     let (r0, d8, lz) = newton(e);
-    (r0.wrapping_add(mul_hi(r0, d8)), lz)
+    (r0.saturating_add(mul_hi(r0, d8)), lz)
 }
 
 /// `-r` for the [`reciprocal`] `r` of `e` (to the same precision): `-r0 - r0 d`.
@@ -378,5 +408,105 @@ impl Arith for Q {
         let f_energy_p = Q::energy(p, core.f_energy_p, gf, f, clip);
         core.finish(f_energy_p, g, y, new);
         f
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A small deterministic generator (xorshift64*).
+    struct Bits(u64);
+
+    impl Bits {
+        fn next(&mut self) -> u64 {
+            self.0 ^= self.0 >> 12;
+            self.0 ^= self.0 << 25;
+            self.0 ^= self.0 >> 27;
+            self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
+        }
+    }
+
+    const EDGES: [i32; 12] = [
+        0,
+        1,
+        -1,
+        0xFFFF,
+        0x1_0000,
+        -0x1_0000,
+        0x7FFF,
+        -0x8000,
+        i32::MAX,
+        i32::MIN,
+        i32::MAX - 1,
+        i32::MIN + 1,
+    ];
+
+    #[test]
+    fn the_armv6m_products_and_leading_zeros_are_exact() {
+        for &x in &EDGES {
+            for &y in &EDGES {
+                assert_eq!(wide_halves(x, y), i64::from(x) * i64::from(y), "{x} {y}");
+                let (u, v) = (x as u32, y as u32);
+                assert_eq!(wide_unsigned_halves(u, v), u64::from(u) * u64::from(v));
+            }
+            assert_eq!(clz_search(x as u32), (x as u32).leading_zeros(), "{x}");
+        }
+        for k in 0..32 {
+            for x in [1u32 << k, (1u32 << k) - 1, (1u32 << k) | 1] {
+                assert_eq!(clz_search(x), x.leading_zeros(), "{x:#x}");
+            }
+        }
+        let mut bits = Bits(0x9E37_79B9_7F4A_7C15);
+        for _ in 0..2_000_000 {
+            let r = bits.next();
+            let (x, y) = (r as i32, (r >> 32) as i32);
+            assert_eq!(wide_halves(x, y), i64::from(x) * i64::from(y), "{x} {y}");
+            let (u, v) = (x as u32, y as u32);
+            assert_eq!(wide_unsigned_halves(u, v), u64::from(u) * u64::from(v));
+            // Leading zeros of every magnitude, not only of uniform words.
+            let z = u >> (r >> 59);
+            assert_eq!(clz_search(z), z.leading_zeros(), "{z:#x}");
+        }
+    }
+
+    /// `1/e_real` from `(r, lz)`: `r 2^(lz - 54)`.
+    fn inverse((r, lz): (i32, u32)) -> f64 {
+        f64::from(r) * 2f64.powi(lz as i32 - 54)
+    }
+
+    #[test]
+    fn reciprocals_are_positive_and_within_2_to_the_minus_29_at_powers_of_two_and_beyond() {
+        let mut energies: Vec<u64> = (0..63).flat_map(|k| [1u64 << k, (1u64 << k) + 1]).collect();
+        energies.extend((1..63).map(|k| (1u64 << k) - 1));
+        let mut bits = Bits(7);
+        energies.extend((0..200_000).map(|_| bits.next() >> (bits.next() % 63) | 1));
+        for e in energies {
+            let exact = 1.0 / (e as f64 * 2f64.powi(-40));
+            let (r, lz) = reciprocal(e);
+            assert!(r > 0, "reciprocal({e}) = {r}");
+            let relative = (inverse((r, lz)) / exact - 1.0).abs();
+            assert!(relative < 2f64.powi(-29), "reciprocal({e}): {relative:e}");
+            let (n, lz) = negative_reciprocal(e);
+            assert!(n < 0, "negative_reciprocal({e}) = {n}");
+            let relative = (-inverse((n, lz)) / exact - 1.0).abs();
+            assert!(
+                relative < 2f64.powi(-29),
+                "negative_reciprocal({e}): {relative:e}"
+            );
+        }
+    }
+
+    #[test]
+    fn the_mean_step_at_unit_weight_is_the_sample() {
+        // W = 1 (Q40): a power of two, the reciprocal's edge. y / W = y, Q27 to Q56.
+        for y in [1i32, -1, 1 << 27, -(1 << 27), i32::MAX, i32::MIN] {
+            let step = mean_step(y, reciprocal(1 << ENERGY_FRAC));
+            let exact = i64::from(y) << 29;
+            assert!(
+                (step - exact).abs() <= (exact.abs() >> 29) + 1,
+                "{y}: {step} {exact}"
+            );
+        }
     }
 }

@@ -261,9 +261,10 @@ impl Format for Q {
 /// high-word product (`SMMULR`) and one rounding shift (relative error about 2^-28). Stage
 /// `i` keeps the gain `gamma_i psi_i / B_i` between samples: it is the next sample's `kf`
 /// step and, the same sample, the conversion factor's, so the stage divides twice, not
-/// three times. Every energy update adds 2 LSB, which keeps the energies at or above 16 LSB
-/// without a test. Every result that can leave its format is saturated, and each saturation
-/// is counted in [`Health::clipped`](super::Health::clipped). Host and target compute the
+/// three times. The energies start at or above 16 LSB and decay with rounding to nearest,
+/// which never takes a positive energy to 0: they need no floor test. Every result that can
+/// leave its format is saturated, and each saturation is counted in
+/// [`Health::clipped`](super::Health::clipped). Host and target compute the
 /// same bits: integer arithmetic only on the per-sample path. `docs/fixed-point.md` gives
 /// the cost of each step on the Cortex-M4F, M3 and M0+.
 ///
