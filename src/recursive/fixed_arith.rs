@@ -35,93 +35,81 @@ pub(crate) const ENERGY_FRAC: u32 = 40;
 /// The running mean, Q56 in an `i64` (range +-128 internal units; the mean stays inside +-16).
 pub(crate) const MEAN_FRAC: u32 = 56;
 
-/// `x y`, exact: one `SMULL` where the core has it. ARMv6-M (Cortex-M0/M0+) multiplies 32 by
-/// 32 bits into 32 only, and would call a 64 x 64-bit routine: there it is [`wide_halves`].
-#[inline(always)]
-fn wide(x: i32, y: i32) -> i64 {
-    #[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
-    {
+// The three integer primitives the cores differ in: a 32 x 32 -> 64-bit product (signed and
+// unsigned) and the count of leading zeros. One `SMULL`, `UMULL` or `CLZ` where the core has
+// it; ARMv6-M (Cortex-M0/M0+) multiplies 32 by 32 bits into 32 only and has no `CLZ`, so the
+// compiler would call a 64 x 64-bit multiply and a library routine: there the products are
+// formed from four 16 x 16-bit products and the zeros counted by a binary search in registers,
+// with the same exact results.
+#[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
+use armv6m::{clz, wide, wide_unsigned};
+#[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
+use native::{clz, wide, wide_unsigned};
+
+#[cfg_attr(
+    all(target_arch = "arm", not(target_has_atomic = "32")),
+    allow(dead_code)
+)]
+mod native {
+    /// `x y`, exact.
+    #[inline(always)]
+    pub(super) fn wide(x: i32, y: i32) -> i64 {
         i64::from(x) * i64::from(y)
     }
-    #[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
-    {
-        wide_halves(x, y)
-    }
-}
 
-/// `x y` from four 16 x 16-bit products, the same exact result as [`wide`] (ARMv6-M).
-#[cfg_attr(
-    not(all(target_arch = "arm", not(target_has_atomic = "32"))),
-    allow(dead_code)
-)]
-#[inline(always)]
-fn wide_halves(x: i32, y: i32) -> i64 {
-    // x = xh 2^16 + xl with xl in [0, 2^16): every partial product fits its type.
-    let (xh, xl, yh, yl) = (x >> 16, x & 0xFFFF, y >> 16, y & 0xFFFF);
-    let low = i64::from((xl as u32).wrapping_mul(yl as u32));
-    let middle = i64::from(xh.wrapping_mul(yl)) + i64::from(xl.wrapping_mul(yh));
-    (i64::from(xh.wrapping_mul(yh)) << 32)
-        .wrapping_add(middle << 16)
-        .wrapping_add(low)
-}
-
-/// `x y` unsigned, exact: one `UMULL`, or on ARMv6-M [`wide_unsigned_halves`].
-#[inline(always)]
-fn wide_unsigned(x: u32, y: u32) -> u64 {
-    #[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
-    {
+    /// `x y` unsigned, exact.
+    #[inline(always)]
+    pub(super) fn wide_unsigned(x: u32, y: u32) -> u64 {
         u64::from(x) * u64::from(y)
     }
-    #[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
-    {
-        wide_unsigned_halves(x, y)
-    }
-}
 
-/// `x y` unsigned from four 16 x 16-bit products (ARMv6-M).
-#[cfg_attr(
-    not(all(target_arch = "arm", not(target_has_atomic = "32"))),
-    allow(dead_code)
-)]
-#[inline(always)]
-fn wide_unsigned_halves(x: u32, y: u32) -> u64 {
-    let (xh, xl, yh, yl) = (x >> 16, x & 0xFFFF, y >> 16, y & 0xFFFF);
-    let middle = u64::from(xh.wrapping_mul(yl)) + u64::from(xl.wrapping_mul(yh));
-    (u64::from(xh.wrapping_mul(yh)) << 32)
-        .wrapping_add(middle << 16)
-        .wrapping_add(u64::from(xl.wrapping_mul(yl)))
-}
-
-/// Leading zeros of `x` (32 for 0): one `CLZ` where the core has it; ARMv6-M has none, and
-/// there [`clz_search`] is cheaper than the call to the library routine.
-#[inline(always)]
-fn clz(x: u32) -> u32 {
-    #[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
-    {
+    /// Leading zeros of `x` (32 for 0).
+    #[inline(always)]
+    pub(super) fn clz(x: u32) -> u32 {
         x.leading_zeros()
     }
-    #[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
-    {
-        clz_search(x)
-    }
 }
 
-/// Leading zeros of `x` by a binary search in registers (ARMv6-M).
 #[cfg_attr(
     not(all(target_arch = "arm", not(target_has_atomic = "32"))),
     allow(dead_code)
 )]
-#[inline(always)]
-fn clz_search(x: u32) -> u32 {
-    let (mut x, mut n) = (x, 0u32);
-    for bits in [16, 8, 4, 2, 1] {
-        if x >> (32 - bits) == 0 {
-            // Distinct powers of two: the sum is an or, at most 31.
-            n |= bits;
-            x <<= bits;
-        }
+mod armv6m {
+    /// `x y` from four 16 x 16-bit products: `x = xh 2^16 + xl` with `xl` in `[0, 2^16)`, so
+    /// that every partial product fits its type.
+    #[inline(always)]
+    pub(super) fn wide(x: i32, y: i32) -> i64 {
+        let (xh, xl, yh, yl) = (x >> 16, x & 0xFFFF, y >> 16, y & 0xFFFF);
+        let low = i64::from((xl as u32).wrapping_mul(yl as u32));
+        let middle = i64::from(xh.wrapping_mul(yl)) + i64::from(xl.wrapping_mul(yh));
+        (i64::from(xh.wrapping_mul(yh)) << 32)
+            .wrapping_add(middle << 16)
+            .wrapping_add(low)
     }
-    n.wrapping_add(u32::from(x == 0))
+
+    /// `x y` unsigned from four 16 x 16-bit products.
+    #[inline(always)]
+    pub(super) fn wide_unsigned(x: u32, y: u32) -> u64 {
+        let (xh, xl, yh, yl) = (x >> 16, x & 0xFFFF, y >> 16, y & 0xFFFF);
+        let middle = u64::from(xh.wrapping_mul(yl)) + u64::from(xl.wrapping_mul(yh));
+        (u64::from(xh.wrapping_mul(yh)) << 32)
+            .wrapping_add(middle << 16)
+            .wrapping_add(u64::from(xl.wrapping_mul(yl)))
+    }
+
+    /// Leading zeros of `x` (32 for 0) by a binary search.
+    #[inline(always)]
+    pub(super) fn clz(x: u32) -> u32 {
+        let (mut x, mut n) = (x, 0u32);
+        for bits in [16, 8, 4, 2, 1] {
+            if x >> (32 - bits) == 0 {
+                // Distinct powers of two: the sum is an or, at most 31.
+                n |= bits;
+                x <<= bits;
+            }
+        }
+        n.wrapping_add(u32::from(x == 0))
+    }
 }
 
 /// `x y / 2^s` rounded to nearest (ties up), for a constant `s` in `1..=62`: one `SMULL` and
@@ -446,27 +434,27 @@ mod tests {
     fn the_armv6m_products_and_leading_zeros_are_exact() {
         for &x in &EDGES {
             for &y in &EDGES {
-                assert_eq!(wide_halves(x, y), i64::from(x) * i64::from(y), "{x} {y}");
+                assert_eq!(armv6m::wide(x, y), i64::from(x) * i64::from(y), "{x} {y}");
                 let (u, v) = (x as u32, y as u32);
-                assert_eq!(wide_unsigned_halves(u, v), u64::from(u) * u64::from(v));
+                assert_eq!(armv6m::wide_unsigned(u, v), u64::from(u) * u64::from(v));
             }
-            assert_eq!(clz_search(x as u32), (x as u32).leading_zeros(), "{x}");
+            assert_eq!(armv6m::clz(x as u32), (x as u32).leading_zeros(), "{x}");
         }
         for k in 0..32 {
             for x in [1u32 << k, (1u32 << k) - 1, (1u32 << k) | 1] {
-                assert_eq!(clz_search(x), x.leading_zeros(), "{x:#x}");
+                assert_eq!(armv6m::clz(x), x.leading_zeros(), "{x:#x}");
             }
         }
         let mut bits = Bits(0x9E37_79B9_7F4A_7C15);
         for _ in 0..2_000_000 {
             let r = bits.next();
             let (x, y) = (r as i32, (r >> 32) as i32);
-            assert_eq!(wide_halves(x, y), i64::from(x) * i64::from(y), "{x} {y}");
+            assert_eq!(armv6m::wide(x, y), i64::from(x) * i64::from(y), "{x} {y}");
             let (u, v) = (x as u32, y as u32);
-            assert_eq!(wide_unsigned_halves(u, v), u64::from(u) * u64::from(v));
+            assert_eq!(armv6m::wide_unsigned(u, v), u64::from(u) * u64::from(v));
             // Leading zeros of every magnitude, not only of uniform words.
             let z = u >> (r >> 59);
-            assert_eq!(clz_search(z), z.leading_zeros(), "{z:#x}");
+            assert_eq!(armv6m::clz(z), z.leading_zeros(), "{z:#x}");
         }
     }
 

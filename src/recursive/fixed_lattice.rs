@@ -308,8 +308,8 @@ pub struct FixedLattice<const P: usize> {
     undo: Undo<P>,
 }
 
-/// The part of the state one sample overwrites that the model is built from: the oldest
-/// reflection coefficients of the ring, `F_P`, the weight and the mean.
+/// The part of the state one sample overwrites that the model is built from and the ring does
+/// not keep: `F_P`, the weight and the mean.
 #[derive(Clone, Copy, Debug)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 struct Undo<const P: usize> {
