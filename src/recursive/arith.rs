@@ -21,8 +21,13 @@ pub trait Arith: Copy + Debug {
     type Err: Copy + Debug + PartialEq;
     /// Conversion factors `gamma`, in `[0, 1]`.
     type Gamma: Copy + Debug + PartialEq;
-    /// Reflection coefficients `kf`, `kb`.
+    /// Reflection coefficients `kf`, `kb`, as the predictions use them and the model is built
+    /// from.
     type Coef: Copy + Debug + PartialEq;
+    /// A reflection (or ladder) coefficient as its stage accumulates it: the [`Arith::Coef`]
+    /// with guard bits below it, so that the rounding of many small steps does not add up (for
+    /// floats, the `Coef` itself).
+    type Acc: Copy + Debug + PartialEq;
     /// Weighted energies `F`, `B`, positive.
     type Energy: Copy + Debug + PartialEq;
     /// What stage `i` keeps from one sample for the next one's update of `kf_{i+1}` (and of a
@@ -38,6 +43,8 @@ pub trait Arith: Copy + Debug {
     const GAMMA_ONE: Self::Gamma;
     /// Zero reflection coefficient.
     const COEF_ZERO: Self::Coef;
+    /// Zero accumulated coefficient.
+    const ACC_ZERO: Self::Acc;
 
     /// `g x`, the shared product of the energy and coefficient updates.
     fn gain(g: Self::Gamma, x: Self::Err, clip: &mut u32) -> Self::Err;
@@ -54,6 +61,12 @@ pub trait Arith: Copy + Debug {
     /// `x - k y`: an order update of an error.
     fn predict(x: Self::Err, k: Self::Coef, y: Self::Err, clip: &mut u32) -> Self::Err;
 
+    /// The coefficient of an accumulated one: its guard bits dropped.
+    fn coef(k: Self::Acc) -> Self::Coef;
+
+    /// A coefficient with zero guard bits.
+    fn acc(k: Self::Coef) -> Self::Acc;
+
     /// What a stage keeps before its first sample, for the backward energy `energy`.
     fn kept(energy: Self::Energy) -> Self::Kept;
 
@@ -61,12 +74,12 @@ pub trait Arith: Copy + Debug {
     /// a-priori error `e`, for `gx = gamma_i(n-1) psi_i(n-1)` and what stage `i` kept for
     /// `B = B_i(n-1)`.
     fn feedback(
-        k: Self::Coef,
+        k: Self::Acc,
         gx: Self::Err,
         e: Self::Err,
         kept: &Self::Kept,
         clip: &mut u32,
-    ) -> Self::Coef;
+    ) -> Self::Acc;
 
     /// One sample `y` through every stage of `core`; returns `f_P(n)`. The recursion is the
     /// one of [`Lattice`](super::Lattice); each format writes it in the operations it is
@@ -98,6 +111,7 @@ macro_rules! impl_arith_float {
             type Err = $t;
             type Gamma = $t;
             type Coef = $t;
+            type Acc = $t;
             type Energy = $t;
             type Kept = $t;
             type Params = FloatParams<$t>;
@@ -105,6 +119,7 @@ macro_rules! impl_arith_float {
             const ERR_ZERO: $t = 0.0;
             const GAMMA_ONE: $t = 1.0;
             const COEF_ZERO: $t = 0.0;
+            const ACC_ZERO: $t = 0.0;
 
             #[inline(always)]
             fn gain(g: $t, x: $t, _: &mut u32) -> $t {
@@ -119,6 +134,16 @@ macro_rules! impl_arith_float {
             #[inline(always)]
             fn predict(x: $t, k: $t, y: $t, _: &mut u32) -> $t {
                 x - k * y
+            }
+
+            #[inline(always)]
+            fn coef(k: $t) -> $t {
+                k
+            }
+
+            #[inline(always)]
+            fn acc(k: $t) -> $t {
+                k
             }
 
             #[inline(always)]
@@ -156,6 +181,7 @@ pub trait FloatArith:
         Err = Self,
         Gamma = Self,
         Coef = Self,
+        Acc = Self,
         Energy = Self,
         Kept = Self,
         Params = FloatParams<Self>,

@@ -2,7 +2,7 @@
 //! implementation, and the integer steps they are made of. See
 //! [`FixedLattice`](super::FixedLattice) for the formats and the rounding.
 
-use fixed::types::{I2F30, I3F29, I5F27, I24F40, U0F32};
+use fixed::types::{I2F30, I3F29, I3F61, I5F27, I24F40, U0F32};
 
 use super::arith::Arith;
 use super::lattice::Core;
@@ -30,6 +30,9 @@ pub(crate) const ERR_FRAC: u32 = 27;
 const GAMMA_FRAC: u32 = 30;
 /// Fractional bits of the reflection coefficients (I3F29).
 pub(crate) const COEF_FRAC: u32 = 29;
+/// Guard bits below them as a stage accumulates them (I3F61): the high word is the
+/// coefficient.
+const GUARD: u32 = 32;
 /// Fractional bits of the energies and the weight (I24F40).
 pub(crate) const ENERGY_FRAC: u32 = 40;
 /// The running mean, Q56 in an `i64` (range +-128 internal units; the mean stays inside +-16).
@@ -149,6 +152,15 @@ pub(crate) fn sat_i32(x: i64, clip: &mut u32) -> i32 {
         *clip = clip.wrapping_add(1);
         if x < 0 { i32::MIN } else { i32::MAX }
     }
+}
+
+/// `x` saturated to `i64`, counting a saturation in `clip`.
+#[cold]
+fn sat_i64(x: i128, clip: &mut u32) -> i64 {
+    i64::try_from(x).unwrap_or_else(|_| {
+        *clip = clip.wrapping_add(1);
+        if x < 0 { i64::MIN } else { i64::MAX }
+    })
 }
 
 /// `x + y` saturated, counting a saturation in `clip`.
@@ -272,15 +284,49 @@ impl Gain {
             .wrapping_add(n as i32)
             .wrapping_add(29)
             .wrapping_sub(out_frac as i32);
-        if r > 0 {
-            // `((t >> (r - 1)) + 1) >> 1` is `t / 2^r` rounded to nearest; from `r = 30` on it
-            // is 0 (|t| <= 2^29), and so is the unbounded shift's (0 or -1, plus 1, halved).
-            Ok(t.unbounded_shr(r.wrapping_sub(1) as u32).wrapping_add(1) >> 1)
+        if (r.wrapping_sub(1) as u32) < 31 {
+            // 1 <= r <= 31: `((t >> (r - 1)) + 1) >> 1` is `t / 2^r` rounded to nearest.
+            Ok((t >> r.wrapping_sub(1)).wrapping_add(1) >> 1)
+        } else if r > 0 {
+            // From `r = 31` on, `t / 2^r` rounds to 0 (|t| <= 2^29).
+            core::hint::cold_path();
+            Ok(0)
         } else {
             core::hint::cold_path();
             // |t| <= 2^29: shifted by up to 32 it stays inside i64; anything beyond
             // saturates where it is added.
             Err(i64::from(t).wrapping_shl(r.unsigned_abs().min(32)))
+        }
+    }
+
+    /// `-kappa x` in Q61 (a coefficient step with its [`GUARD`] bits), for a Q27 `x`
+    /// [`normalise`]d: `t = m x_n 2^-32` as in [`Gain::times`], times `2^(32 - r)` for
+    /// `r = s + n`. Exact (`t` is the only rounding) for `r` in `1..=31`, the usual case: two
+    /// shifts into the two words. `Err` for any other `r`, a step beyond 2^-29 in magnitude
+    /// (start-up, a shock: exact in `i128`) or below 2^-61 (rounded to nearest).
+    #[inline(always)]
+    fn coefficient_step(self, (x_n, n): (i32, u32)) -> Result<i64, i128> {
+        let t = mul_hi(self.m, x_n);
+        // Both terms are below 128 in magnitude: no wrap.
+        let r = self.s.wrapping_add(n as i32);
+        if (r.wrapping_sub(1) as u32) < GUARD - 1 {
+            // 1 <= r <= 31: t 2^(32 - r) = (t >> r) 2^32 + ((t << (32 - r)) mod 2^32).
+            let low = (t as u32).wrapping_shl(GUARD.wrapping_sub(r as u32));
+            Ok((i64::from(t >> r) << GUARD) | i64::from(low))
+        } else {
+            core::hint::cold_path();
+            Err(if r <= 0 {
+                // t 2^(32 - r), exact; a shift beyond 96 (|t| >= 2^26 unless t = 0)
+                // saturates wherever it is added.
+                i128::from(t) << (GUARD as i32).wrapping_sub(r).min(96)
+            } else if r == GUARD as i32 {
+                i128::from(t)
+            } else {
+                // r > 32: t / 2^(r - 32) rounded to nearest (ties up), 0 from r = 63 on
+                // (|t| <= 2^29).
+                let right = r.wrapping_sub(GUARD as i32) as u32;
+                i128::from(t.unbounded_shr(right.wrapping_sub(1)).wrapping_add(1) >> 1)
+            })
         }
     }
 }
@@ -289,6 +335,7 @@ impl Arith for Q {
     type Err = I5F27;
     type Gamma = I2F30;
     type Coef = I3F29;
+    type Acc = I3F61;
     type Energy = I24F40;
     type Kept = Gain;
     type Params = QParams;
@@ -296,6 +343,7 @@ impl Arith for Q {
     const ERR_ZERO: I5F27 = I5F27::ZERO;
     const GAMMA_ONE: I2F30 = I2F30::ONE;
     const COEF_ZERO: I3F29 = I3F29::ZERO;
+    const ACC_ZERO: I3F61 = I3F61::ZERO;
 
     #[inline(always)]
     fn gain(g: I2F30, x: I5F27, _: &mut u32) -> I5F27 {
@@ -325,21 +373,39 @@ impl Arith for Q {
         I5F27::from_bits(sat_i32(i64::from(x.to_bits()) - ky, clip))
     }
 
+    /// The high word: the guard bits truncated (floor). The error feedback makes the
+    /// coefficient the predictions use, this one, the estimate: a bias of the truncation is
+    /// fed back like any other error.
+    #[inline(always)]
+    fn coef(k: I3F61) -> I3F29 {
+        I3F29::from_bits((k.to_bits() >> GUARD) as i32)
+    }
+
+    #[inline(always)]
+    fn acc(k: I3F29) -> I3F61 {
+        I3F61::from_bits(i64::from(k.to_bits()) << GUARD)
+    }
+
     #[inline(always)]
     fn kept(_: I24F40) -> Gain {
         Gain::ZERO
     }
 
     #[inline(always)]
-    fn feedback(k: I3F29, _: I5F27, e: I5F27, gain: &Gain, clip: &mut u32) -> I3F29 {
+    fn feedback(k: I3F61, _: I5F27, e: I5F27, gain: &Gain, clip: &mut u32) -> I3F61 {
         let k = k.to_bits();
-        // `times` gives `-kappa e`.
-        let sum = match gain.times(normalise(e.to_bits()), COEF_FRAC) {
-            Ok(delta) => k.checked_sub(delta).ok_or(i64::from(k) - i64::from(delta)),
-            // |k| < 2^31, |delta| < 2^61: the difference is exact.
-            Err(delta) => Err(i64::from(k).wrapping_sub(delta)),
+        // `coefficient_step` gives `-kappa e`.
+        let sum = match gain.coefficient_step(normalise(e.to_bits())) {
+            // |delta| < 2^60: below 3.5 in magnitude (a high word inside +-(2^31 - 2^28), one
+            // compare), the coefficient cannot leave its format.
+            Ok(delta) if ((k >> GUARD) as u32).wrapping_add(0x7000_0000) < 0xE000_0000 => {
+                Ok(k.wrapping_sub(delta))
+            }
+            Ok(delta) => Err(i128::from(k) - i128::from(delta)),
+            // |k| < 2^63, |delta| < 2^126: the difference is exact.
+            Err(delta) => Err(i128::from(k) - delta),
         };
-        I3F29::from_bits(sum.unwrap_or_else(|wide| sat_i32(wide, clip)))
+        I3F61::from_bits(sum.unwrap_or_else(|wide| sat_i64(wide, clip)))
     }
 
     /// The stages in gain form: what stage `i` keeps between samples is the gain
@@ -351,7 +417,7 @@ impl Arith for Q {
         let new = core.next_head();
         let (mut f, mut psi, mut g) = (y, y, I2F30::ONE);
         for (kept, stage) in core.ring[new].iter_mut().zip(&core.stages) {
-            *kept = stage.k;
+            *kept = stage.k.map(Q::coef);
         }
         for stage in &mut core.stages {
             // The backward half first: it needs only `g` and `psi`, so that little stays live
@@ -372,20 +438,18 @@ impl Arith for Q {
             stage.b_kept = kappa_b;
             stage.bp = psi;
             stage.gp = g;
-            // The forward half.
-            let [kf, kb] = stage.k;
+            // The forward half. The coefficients are read where they are used: held in
+            // registers from the start, they would push other values onto the stack.
             let gf = Q::gain(gp, f, clip);
             let fe = Q::energy(p, stage.f_energy, gf, f, clip);
-            let f_next = Q::predict(f, kf, bp, clip);
-            let psi_next = Q::predict(bp, kb, f, clip);
+            let f_next = Q::predict(f, Q::coef(stage.k[0]), bp, clip);
+            let psi_next = Q::predict(bp, Q::coef(stage.k[1]), f, clip);
             let kappa_f = Gain::new(
                 normalise(gf.to_bits()),
                 negative_reciprocal(fe.to_bits() as u64),
             );
-            stage.k = [
-                Q::feedback(kf, gf, f_next, &kappa_b_old, clip),
-                Q::feedback(kb, gf, psi_next, &kappa_f, clip),
-            ];
+            stage.k[0] = Q::feedback(stage.k[0], gf, f_next, &kappa_b_old, clip);
+            stage.k[1] = Q::feedback(stage.k[1], gf, psi_next, &kappa_f, clip);
             stage.f_energy = fe;
             stage.error = f_next;
             f = f_next;
@@ -496,5 +560,40 @@ mod tests {
                 "{y}: {step} {exact}"
             );
         }
+    }
+
+    /// A coefficient step in Q61 against `gx x / e` in `f64`: within 2^-26 relative (the
+    /// roundings of the reciprocal, 2^-29, of `m`, 2^-29, and of `t`, 2^-27 for the smallest
+    /// `|t|` of 2^26) or 1 LSB, on every path of `coefficient_step`
+    /// (steps of order 1 and beyond, the usual ones, and those below 2^-61).
+    #[test]
+    fn coefficient_steps_are_gx_x_over_e_on_every_path() {
+        let mut bits = Bits(0x5DEE_CE66_D1CE_4E5B);
+        let mut paths = [0u32; 3];
+        for _ in 0..1_000_000 {
+            let (a, b) = (bits.next(), bits.next());
+            // gx and x of every magnitude and sign (Q27), e of every magnitude (Q40, >= 1).
+            let gx = (a as i32) >> (a >> 59);
+            let x = ((a >> 32) as i32) >> ((b >> 59) & 31);
+            let e = (b >> (b % 64)) | 1;
+            let kappa = Gain::new(normalise(gx), negative_reciprocal(e));
+            let exact = -f64::from(gx) * f64::from(x) / e as f64 * 2f64.powi(61 - 54 + 40);
+            let got = match kappa.coefficient_step(normalise(x)) {
+                Ok(step) => {
+                    paths[0] += 1;
+                    step as f64
+                }
+                Err(step) => {
+                    paths[usize::from(exact.abs() < 1.0) + 1] += 1;
+                    step as f64
+                }
+            };
+            let error = (got - exact).abs();
+            assert!(
+                error <= exact.abs() * 2f64.powi(-26) + 1.0,
+                "gx {gx} x {x} e {e}: {got:e} against {exact:e}"
+            );
+        }
+        assert!(paths.iter().all(|&n| n > 1000), "paths taken: {paths:?}");
     }
 }

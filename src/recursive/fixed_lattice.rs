@@ -1,6 +1,6 @@
 //! The lattice in fixed point: its settings, shared and per channel, and the estimator.
 
-use fixed::types::{I3F29, I5F27, I24F40, U0F32};
+use fixed::types::{I3F29, I3F61, I5F27, I24F40, U0F32};
 
 use super::config::{Channel, Config, ConfigError, Gate, Rejection};
 use super::estimator::Estimator;
@@ -317,7 +317,7 @@ struct Undo<const P: usize> {
     weight: i64,
     mean: i64,
     /// The ladder's coefficients and energy (kept only with a prior).
-    ladder: ([I3F29; P], I24F40),
+    ladder: ([I3F61; P], I24F40),
 }
 
 impl<const P: usize> FixedLattice<P> {
@@ -333,7 +333,7 @@ impl<const P: usize> FixedLattice<P> {
                 f_energy_p: I24F40::ZERO,
                 weight: 0,
                 mean: 0,
-                ladder: ([I3F29::ZERO; P], I24F40::ZERO),
+                ladder: ([I3F61::ZERO; P], I24F40::ZERO),
             },
         }
     }
@@ -549,8 +549,9 @@ fn coefficients<const P: usize>(
     ladder: Option<&Ladder<Q, P>>,
     m: usize,
 ) -> Option<[f32; P]> {
-    let lsb = 1.0 / (1u32 << COEF_FRAC) as f32;
-    core.coefficients(m, ladder, |k| k.to_bits() as f32 * lsb)
+    let lsb = 1.0 / f64::from(1u32 << COEF_FRAC);
+    let a = core.coefficients(m, ladder, |k| f64::from(k.to_bits()) * lsb)?;
+    Some(a.map(|a| a as f32))
 }
 
 impl<const P: usize> Sealed<f32, P> for FixedLattice<P> {

@@ -47,7 +47,7 @@ pub(crate) struct Ladder<A: Arith, const P: usize> {
     /// `y_{n-1} .. y_{n-P}`.
     past: [A::Err; P],
     /// `c_1..c_P`.
-    pub(crate) c: [A::Coef; P],
+    pub(crate) c: [A::Acc; P],
     /// `E`, the order-`P` energy of the centred problem.
     pub(crate) energy: A::Energy,
     /// `e_P(n)` of the last sample, the centred problem's a-priori error.
@@ -61,7 +61,7 @@ impl<A: Arith, const P: usize> Ladder<A, P> {
         Self {
             centre,
             past: [A::ERR_ZERO; P],
-            c: [A::COEF_ZERO; P],
+            c: [A::ACC_ZERO; P],
             energy,
             error: A::ERR_ZERO,
         }
@@ -75,7 +75,7 @@ impl<A: Arith, const P: usize> Ladder<A, P> {
             e = A::predict(e, a, x, &mut clip);
         }
         for (&c, stage) in self.c.iter().zip(&core.stages) {
-            e = A::predict(e, c, stage.bp, &mut clip);
+            e = A::predict(e, A::coef(c), stage.bp, &mut clip);
         }
         e
     }
@@ -102,7 +102,7 @@ impl<A: Arith, const P: usize> Ladder<A, P> {
         }
         for (c, stage) in self.c.iter_mut().zip(&core.stages) {
             let (bp, gp) = (stage.bp, stage.gp);
-            let next = A::predict(e, *c, bp, clip);
+            let next = A::predict(e, A::coef(*c), bp, clip);
             let gbp = A::gain(gp, bp, clip);
             *c = A::feedback(*c, gbp, next, &stage.b_kept, clip);
             e = next;

@@ -81,7 +81,7 @@ pub struct Stage<A: Arith> {
     /// `gamma_i(n-1)`.
     pub(crate) gp: A::Gamma,
     /// `[kf_{i+1}, kb_{i+1}]` after the last sample.
-    pub(crate) k: [A::Coef; 2],
+    pub(crate) k: [A::Acc; 2],
     /// The a-priori forward error `f_{i+1}(n)` of the last sample.
     pub(crate) error: A::Err,
 }
@@ -123,7 +123,7 @@ impl<A: Arith, const P: usize> Core<A, P> {
                 b_kept: A::kept(b),
                 bp: A::ERR_ZERO,
                 gp: A::GAMMA_ONE,
-                k: [A::COEF_ZERO; 2],
+                k: [A::ACC_ZERO; 2],
                 error: A::ERR_ZERO,
             }),
             f_energy_p: f0,
@@ -162,23 +162,23 @@ impl<A: Arith, const P: usize> Core<A, P> {
         let mut clip = 0;
         self.stages
             .iter()
-            .fold(y, |f, s| A::predict(f, s.k[0], s.bp, &mut clip))
+            .fold(y, |f, s| A::predict(f, A::coef(s.k[0]), s.bp, &mut clip))
     }
 
     /// `kf_1..kf_P` after the last sample.
     pub(crate) fn forward_reflection(&self) -> [A::Coef; P] {
-        self.stages.map(|s| s.k[0])
+        self.stages.map(|s| A::coef(s.k[0]))
     }
 
     /// `kb_1..kb_P` after the last sample.
     pub(crate) fn backward_reflection(&self) -> [A::Coef; P] {
-        self.stages.map(|s| s.k[1])
+        self.stages.map(|s| A::coef(s.k[1]))
     }
 
     /// The reflection coefficients of `t` samples before the last one, `t < P`.
     fn past(&self, t: usize) -> [[A::Coef; 2]; P] {
         match t.checked_sub(1) {
-            None => self.stages.map(|s| s.k),
+            None => self.stages.map(|s| s.k.map(A::coef)),
             // `head % P + t < 2 P`: no wrap.
             Some(t) => self.ring[(self.head % P).wrapping_add(t) % P],
         }
@@ -186,11 +186,11 @@ impl<A: Arith, const P: usize> Core<A, P> {
 
     /// Undoes the last [`Core::step`] as far as [`Core::coefficients`] and `F_P` are
     /// concerned, given the `F_P` from before it: the coefficients it replaced are read back
-    /// from the ring.
+    /// from the ring (without guard bits: what the model is built from).
     pub(crate) fn rewind(&mut self, f_energy_p: A::Energy) {
         let last = self.head % P;
         for (stage, &k) in self.stages.iter_mut().zip(&self.ring[last]) {
-            stage.k = k;
+            stage.k = k.map(A::acc);
         }
         self.head = (last + 1) % P;
         self.f_energy_p = f_energy_p;
@@ -262,7 +262,10 @@ impl<A: Arith, const P: usize> Core<A, P> {
                     *aj -= kf_k * b_full_prev(j);
                 }
                 if let (0, Some(l)) = (t, ladder) {
-                    let c_k = to_t(l.c.get(k.wrapping_sub(1)).copied().unwrap_or(A::COEF_ZERO));
+                    let c_k = to_t(
+                        l.c.get(k.wrapping_sub(1))
+                            .map_or(A::COEF_ZERO, |&c| A::coef(c)),
+                    );
                     for (j, bj) in beta.iter_mut().enumerate().take(k) {
                         *bj -= c_k * b_full_prev(j);
                     }
