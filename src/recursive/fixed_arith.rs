@@ -240,7 +240,7 @@ fn negative_reciprocal(e: u64) -> (i32, u32) {
 
 /// A gain `kappa = gx / E`, an error `gx` (Q27) over a positive energy `E` (Q40), kept
 /// negated in block-floating form for its products with errors: `-4 kappa = m 2^-(s + 32)`
-/// (the factor 4 turns a Q27 error into a Q29 coefficient step), `|m|` in `(2^28, 2^30]`, or
+/// (the factor 4 turns a Q27 error into a Q29 coefficient step), `|m|` in `[2^28, 2^30]`, or
 /// 0. Negated, because it is made from a negative reciprocal, whose product with an error of
 /// either sign is one `SMMULR` (a reciprocal known to be positive is multiplied as unsigned,
 /// in three instructions); the updates subtract it.
@@ -317,8 +317,9 @@ impl Gain {
             core::hint::cold_path();
             Err(if r <= 0 {
                 // t 2^(32 - r), exact; a shift beyond 96 (|t| >= 2^26 unless t = 0)
-                // saturates wherever it is added.
-                i128::from(t) << (GUARD as i32).wrapping_sub(r).min(96)
+                // saturates wherever it is added. (The shift is at least 32 here; the clamp
+                // bounds it for the compiler, which then needs no overflow check.)
+                i128::from(t) << (GUARD as i32).wrapping_sub(r).clamp(32, 96)
             } else if r == GUARD as i32 {
                 i128::from(t)
             } else {
@@ -403,7 +404,7 @@ impl Arith for Q {
             }
             Ok(delta) => Err(i128::from(k) - i128::from(delta)),
             // |k| < 2^63, |delta| < 2^126: the difference is exact.
-            Err(delta) => Err(i128::from(k) - delta),
+            Err(delta) => Err(i128::from(k).wrapping_sub(delta)),
         };
         I3F61::from_bits(sum.unwrap_or_else(|wide| sat_i64(wide, clip)))
     }

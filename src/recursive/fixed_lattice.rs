@@ -248,6 +248,7 @@ impl Format for Q {
 /// | errors `f`, `psi`, input `y` | [`I5F27`] | +-16 | 7.5e-9 |
 /// | conversion factors `gamma` | [`I2F30`](fixed::types::I2F30) | +-2 (kept in [0, 1]) | 9.3e-10 |
 /// | reflection coefficients `kf`, `kb` | [`I3F29`] | +-4 | 1.9e-9 |
+/// | the same, as a stage accumulates them | [`I3F61`] | +-4 | 4.3e-19 |
 /// | energies `F`, `B`, weight `W` | [`I24F40`] | +-8.4e6 | 9.1e-13 |
 /// | forgetting factor `lambda` | [`U0F32`] | [0, 1) | 2.3e-10 |
 ///
@@ -267,6 +268,13 @@ impl Format for Q {
 /// [`Health::clipped`](super::Health::clipped). Host and target compute the
 /// same bits: integer arithmetic only on the per-sample path. `docs/fixed-point.md` gives
 /// the cost of each step on the Cortex-M4F, M3 and M0+.
+///
+/// A coefficient moves by one small step per sample, and a step rounded to I3F29 would add
+/// its rounding to the coefficient every time: over a memory of `1/(1 - lambda)` samples that
+/// random walk reaches tens of LSB. Each coefficient (and each ladder coefficient) therefore
+/// accumulates its steps with 32 guard bits, as an I3F61; its high word, the I3F29 value, is
+/// what the predictions use and the model is built from. The transversal coefficients of the
+/// model are evaluated from the reflection coefficients in `f64` and rounded once to `f32`.
 ///
 /// A sample in which anything saturates (the centred input, an error, an energy, a
 /// coefficient or the weight) restarts the lattice: its state is never published. Where the
@@ -346,8 +354,10 @@ impl<const P: usize> FixedLattice<P> {
     /// coefficients. A prior the formats cannot carry (the centred input
     /// `d_n = y_n - a0^T phi_n` beyond +-16, or a correction beyond +-4) saturates: the
     /// lattice then restarts, as on any saturation, and goes on without the prior (centred on
-    /// 0), so that a prior far from the data never loops on restarts. With `a0 = 0` it is
-    /// [`FixedLattice::new`], bit for bit.
+    /// 0), so that a prior far from the data never loops on restarts. With `a0 = 0` it gives
+    /// the errors, restarts and coefficients of [`FixedLattice::new`] (a zero coefficient may
+    /// come out as `+0.0` for `-0.0`); a saturation is then counted in
+    /// [`Health::clipped`](super::Health::clipped) by the ladder as well as by the lattice.
     ///
     /// # Errors
     ///
