@@ -273,8 +273,7 @@ impl Format for Q {
 /// its rounding to the coefficient every time: over a memory of `1/(1 - lambda)` samples that
 /// random walk reaches tens of LSB. Each coefficient (and each ladder coefficient) therefore
 /// accumulates its steps with 32 guard bits, as an I3F61; its high word, the I3F29 value, is
-/// what the predictions use and the model is built from. The transversal coefficients of the
-/// model are evaluated from the reflection coefficients in `f64` and rounded once to `f32`.
+/// what the predictions use and the model is built from.
 ///
 /// A sample in which anything saturates (the centred input, an error, an energy, a
 /// coefficient or the weight) restarts the lattice: its state is never published. Where the
@@ -559,9 +558,8 @@ fn coefficients<const P: usize>(
     ladder: Option<&Ladder<Q, P>>,
     m: usize,
 ) -> Option<[f32; P]> {
-    let lsb = 1.0 / f64::from(1u32 << COEF_FRAC);
-    let a = core.coefficients(m, ladder, |k| f64::from(k.to_bits()) * lsb)?;
-    Some(a.map(|a| a as f32))
+    let lsb = 1.0 / (1u32 << COEF_FRAC) as f32;
+    core.coefficients(m, ladder, |k| k.to_bits() as f32 * lsb)
 }
 
 impl<const P: usize> Sealed<f32, P> for FixedLattice<P> {
