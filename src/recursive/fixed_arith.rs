@@ -288,7 +288,7 @@ impl Gain {
             // 1 <= r <= 31: `((t >> (r - 1)) + 1) >> 1` is `t / 2^r` rounded to nearest.
             Ok((t >> r.wrapping_sub(1)).wrapping_add(1) >> 1)
         } else if r > 0 {
-            // From `r = 31` on, `t / 2^r` rounds to 0 (|t| <= 2^29).
+            // From `r = 32` on (as from 31), `t / 2^r` rounds to 0 (|t| <= 2^29).
             core::hint::cold_path();
             Ok(0)
         } else {
@@ -302,8 +302,9 @@ impl Gain {
     /// `-kappa x` in Q61 (a coefficient step with its [`GUARD`] bits), for a Q27 `x`
     /// [`normalise`]d: `t = m x_n 2^-32` as in [`Gain::times`], times `2^(32 - r)` for
     /// `r = s + n`. Exact (`t` is the only rounding) for `r` in `1..=31`, the usual case: two
-    /// shifts into the two words. `Err` for any other `r`, a step beyond 2^-29 in magnitude
-    /// (start-up, a shock: exact in `i128`) or below 2^-61 (rounded to nearest).
+    /// shifts into the two words. `Err` for any other `r`: a step of 2^-3 or more in magnitude
+    /// (`r <= 0`, with `|t| >= 2^26` unless 0: start-up, a shock; exact in `i128`) or of 2^-32
+    /// or less (`r >= 32`: rounded to nearest).
     #[inline(always)]
     fn coefficient_step(self, (x_n, n): (i32, u32)) -> Result<i64, i128> {
         let t = mul_hi(self.m, x_n);
