@@ -2,12 +2,21 @@
 # The cost of `imu-ar characterise` on a long recording: a generated static IMU, six axes at
 # 400 Hz for 4 hours (5.76 M messages), as a EuRoC CSV and as a ROS 1 bag (written by the
 # Python package rosbags), each characterised by the release build; wall time and peak
-# memory (maximum resident set) from GNU time.
+# memory (maximum resident set) from GNU time, as the table perf-characterise of
+# docs/recordings.md.
 #
 #   tools/characterise-bench.sh [DIR]      (DIR: where the recordings go, default /tmp)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 dir=${1:-/tmp}/imu-ar-bench
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+
+# replace SECTION FILE: put FILE's contents between the section's markers, in whichever of
+# README.md and docs/*.md holds them.
+replace() {
+    python3 tools/readme.py replace "$1" "$2"
+}
 mkdir -p "$dir"
 n=$((4 * 3600 * 400))
 if [ ! -f "$dir/imu.csv" ]; then
@@ -36,14 +45,26 @@ fi
 if [ ! -f "$dir/imu.bag" ]; then
     # The script's CSV header: t_ns,gx,gy,gz,ax,ay,az.
     sed '1s/.*/t_ns,gx,gy,gz,ax,ay,az/' "$dir/imu.csv" > "$dir/plain.csv"
-    python3 cli/tests/fixtures/write_imu.py "$dir/imu.bag" ros1 /imu0 lz4 "$dir/plain.csv"
+    python3 cli/tests/fixtures/write_ros.py one "$dir/imu.bag" ros1 /imu0 lz4 "$dir/plain.csv"
     rm "$dir/plain.csv"
 fi
 cargo build --release -p imu-ar-cli --quiet
-for input in "imu.csv" "imu.bag --topic /imu0"; do
-    set -- $input
-    /usr/bin/time -f "$1: %e s wall, %M kB peak resident" \
-        target/release/imu-ar characterise "$dir/$1" "${@:2}" --out "$dir/out" > "$dir/out.txt"
-    head -n 1 "$dir/out.txt"
-done
-ls -l "$dir/imu.csv" "$dir/imu.bag" | awk '{print $5, $9}'
+{
+    echo "| input | size | wall (s) | peak resident (MB) |"
+    echo "|---|---|---|---|"
+    for input in "EuRoC CSV=imu.csv" "ROS 1 bag, lz4 chunks=imu.bag --topic /imu0"; do
+        label=${input%%=*}
+        # shellcheck disable=SC2086
+        set -- ${input#*=}
+        /usr/bin/time -o "$tmp/time.txt" -f "%e %M" \
+            target/release/imu-ar characterise "$dir/$1" "${@:2}" --out "$dir/out" > "$dir/out.txt"
+        head -n 1 "$dir/out.txt" >&2
+        read -r wall kib < "$tmp/time.txt"
+        bytes=$(stat -c %s "$dir/$1")
+        # Sizes in MB of 10^6 bytes; GNU time's %M is in KiB.
+        printf '| %s | %d MB | %.1f | %d |\n' "$label" $(((bytes + 500000) / 1000000)) "$wall" \
+            $(((kib * 1024 + 500000) / 1000000))
+    done
+} > "$tmp/perf-characterise.md"
+cat "$tmp/perf-characterise.md"
+replace perf-characterise "$tmp/perf-characterise.md"

@@ -1,8 +1,9 @@
 //! The ROS readers (`input::bag`, `input::mcap`) against files written by the Python package
-//! `rosbags` (`cli/tests/fixtures/write_imu.py`; `pip install rosbags`): every frame back bit
-//! for bit, for every compression; each error's text; what is skipped; and no panic on
-//! truncated, bit-flipped or random bytes. The read speed: `cargo test --release -p imu-ar-cli
-//! --test bags -- --ignored --nocapture`.
+//! `rosbags` (committed fixtures, `cli/tests/fixtures/write_ros.py`): every frame back bit for
+//! bit, for every compression; each error's text; what is skipped; and no panic on truncated,
+//! bit-flipped or random bytes, all derived in Rust from the committed files. The read speed
+//! (it writes its files with the script): `cargo test --release -p imu-ar-cli --test bags --
+//! --ignored --nocapture`.
 
 mod ros;
 
@@ -17,18 +18,28 @@ use ros::*;
 
 #[test]
 fn every_frame_back_bit_for_bit() {
-    let dir = temp_dir("round-trip");
-    let want = frames(4000, 1);
+    let want = round_trip_frames();
     for (format, compressions) in [
         ("ros1", ["none", "bz2", "lz4"]),
         ("mcap", ["none", "zstd", "lz4"]),
     ] {
         for compression in compressions {
-            let path = imu_file(&dir, format, compression, &want);
+            let path = fixture(&format!("frames-{compression}.{}", extension(format)));
             let (got, result) = collect(reader(format), &path, "/imu");
             assert_eq!(result, Ok(Skipped::default()), "{format} {compression}");
             assert_bits(&got, &want, &format!("{format} {compression}"));
         }
+    }
+    // The static-IMU frames the commands' tests read (tests/characterise.rs).
+    for name in ["noise.bag", "noise-bz2.bag", "noise-zstd.mcap"] {
+        let read = if name.ends_with(".bag") {
+            bag::read
+        } else {
+            mcap_reader::read
+        };
+        let (got, result) = collect(read, &fixture(name), "/imu0");
+        assert_eq!(result, Ok(Skipped::default()), "{name}");
+        assert_bits(&got, &noise_frames(), name);
     }
 }
 
@@ -92,32 +103,18 @@ fn big_endian_cdr_and_every_frame_id_alignment() {
 
 #[test]
 fn an_absent_topic_lists_the_imu_topics() {
-    let dir = temp_dir("absent");
-    let csv = dir.join("f.csv");
-    write_csv(&csv, &frames(10, 3));
-    let chatter = ["--string-topic", "/chatter"];
     for (format, imu) in [("ros1", "sensor_msgs/Imu"), ("mcap", "sensor_msgs/msg/Imu")] {
         let ext = extension(format);
         let read = reader(format);
-        let path = fixture(
-            &dir,
-            &format!("a.{ext}"),
-            [format, "/imu0", "none"],
-            &csv,
-            &chatter,
-        );
+        // The IMU on /imu0, strings on /chatter.
+        let path = fixture(&format!("chatter.{ext}"));
         assert_eq!(
             problem(&path, read(&path, "/imu", &mut |_| {})),
             format!("no {imu} messages on topic '/imu' (IMU topics: /imu0)")
         );
-        let strings = ["--string-topic", "/a", "--string-topic", "/b"];
-        let path = fixture(
-            &dir,
-            &format!("b.{ext}"),
-            [format, "-", "none"],
-            &csv,
-            &strings,
-        );
+        assert_bits(&collect(read, &path, "/imu0").0, &frames(10, 3), "/imu0");
+        // Strings on /a and /b only.
+        let path = fixture(&format!("strings.{ext}"));
         assert_eq!(
             problem(&path, read(&path, "/imu", &mut |_| {})),
             format!("no {imu} messages on topic '/imu' (no IMU topics; topics: /a, /b)")
@@ -127,10 +124,6 @@ fn an_absent_topic_lists_the_imu_topics() {
 
 #[test]
 fn a_topic_of_another_type_is_named() {
-    let dir = temp_dir("type");
-    let csv = dir.join("f.csv");
-    write_csv(&csv, &frames(10, 4));
-    let string = ["--string-topic", "/imu"];
     for (format, want) in [
         (
             "ros1",
@@ -141,28 +134,25 @@ fn a_topic_of_another_type_is_named() {
             "topic '/imu' has type std_msgs/msg/String, not sensor_msgs/msg/Imu",
         ),
     ] {
-        let name = format!("t.{}", extension(format));
-        let path = fixture(&dir, &name, [format, "/imu0", "lz4"], &csv, &string);
+        // A string on /imu, the IMU on /imu0.
+        let path = fixture(&format!("string-on-imu.{}", extension(format)));
         let (got, result) = collect(reader(format), &path, "/imu");
         assert_eq!(problem(&path, result), want);
         assert!(got.is_empty());
         // The IMU topic of the same file reads.
-        assert_eq!(collect(reader(format), &path, "/imu0").0.len(), 10);
+        assert_bits(
+            &collect(reader(format), &path, "/imu0").0,
+            &frames(10, 4),
+            format,
+        );
     }
 }
 
 #[test]
 fn other_mcap_encodings_are_refused() {
     let dir = temp_dir("encoding");
-    let csv = dir.join("f.csv");
-    write_csv(&csv, &frames(10, 5));
-    let path = fixture(
-        &dir,
-        "json.mcap",
-        ["mcap", "/imu", "none"],
-        &csv,
-        &["--encoding", "json"],
-    );
+    // The IMU channel declared as json (its bytes are CDR).
+    let path = fixture("json.mcap");
     assert_eq!(
         problem(&path, mcap_reader::read(&path, "/imu", &mut |_| {})),
         "unknown encoding 'json' on topic '/imu' (supported: cdr)"
@@ -186,15 +176,14 @@ fn other_mcap_encodings_are_refused() {
 #[test]
 fn truncated_files_are_errors_even_after_frames() {
     let dir = temp_dir("truncated");
-    let want = frames(4000, 6);
+    let want = round_trip_frames();
     for (format, compression, start) in [
         ("ros1", "none", "truncated or corrupt bag: "),
         ("ros1", "lz4", "truncated or corrupt bag: "),
         ("mcap", "none", "truncated or corrupt MCAP file: "),
         ("mcap", "zstd", "truncated or corrupt MCAP file: "),
     ] {
-        let path = imu_file(&dir, format, compression, &want);
-        let bytes = std::fs::read(&path).unwrap();
+        let bytes = fixture_bytes(&format!("frames-{compression}.{}", extension(format)));
         let cut = dir.join("cut");
         let n = bytes.len();
         for at in [
@@ -226,11 +215,11 @@ fn truncated_files_are_errors_even_after_frames() {
         }
     }
     // A bag whose second chunk is damaged: the first chunk's frames, then the error.
-    let path = imu_file(&dir, "ros1", "none", &want);
-    let mut bytes = std::fs::read(&path).unwrap();
+    let mut bytes = fixture_bytes("frames-none.bag");
     let chunks: Vec<usize> = find_all(&bytes, b"compression=none");
     assert!(chunks.len() >= 2, "{} chunks", chunks.len());
     bytes[chunks[1] + 12..chunks[1] + 16].copy_from_slice(b"nope");
+    let path = dir.join("damaged-chunk.bag");
     std::fs::write(&path, &bytes).unwrap();
     let (got, result) = collect(bag::read, &path, "/imu");
     let p = problem(&path, result);
@@ -261,9 +250,8 @@ fn other_files_are_named() {
         problem(&path, mcap_reader::read(&path, "/imu", &mut |_| {})),
         "not an MCAP file (it does not start with the MCAP magic)"
     );
-    let want = frames(10, 8);
-    let bag_path = imu_file(&dir, "ros1", "none", &want);
-    let mcap_path = imu_file(&dir, "mcap", "none", &want);
+    let bag_path = fixture("frames-none.bag");
+    let mcap_path = fixture("frames-none.mcap");
     assert_eq!(
         problem(&bag_path, mcap_reader::read(&bag_path, "/imu", &mut |_| {})),
         "not an MCAP file: a ROS 1 bag (read it as a bag)"
@@ -286,7 +274,8 @@ fn non_finite_and_undecodable_messages_are_counted() {
     want[7].axes[5] = f64::INFINITY;
     want[8].axes[2] = f64::NEG_INFINITY;
     for format in ["ros1", "mcap"] {
-        let path = imu_file(&dir, format, "none", &want);
+        let name = format!("non-finite.{}", extension(format));
+        let path = fixture(&name);
         let (got, result) = collect(reader(format), &path, "/imu");
         let skipped = Skipped {
             undecodable: 0,
@@ -301,10 +290,11 @@ fn non_finite_and_undecodable_messages_are_counted() {
         assert_bits(&got, &finite, format);
 
         // frame_id "imu_link" given another length: that message no longer decodes.
-        let mut bytes = std::fs::read(&path).unwrap();
-        let ids = find_all(&bytes, b"imu_link");
+        let mut bytes = fixture_bytes(&name);
+        let ids = frame_ids(&bytes);
         let len_at = ids[10] - 4;
         bytes[len_at..len_at + 4].copy_from_slice(&1000u32.to_le_bytes());
+        let path = dir.join(&name);
         std::fs::write(&path, &bytes).unwrap();
         let (got, result) = collect(reader(format), &path, "/imu");
         assert_eq!(
@@ -323,24 +313,29 @@ fn non_finite_and_undecodable_messages_are_counted() {
 fn no_decodable_message_is_an_error() {
     let dir = temp_dir("none");
     for format in ["ros1", "mcap"] {
-        let empty = imu_file(&dir, format, "none", &[]);
+        let ext = extension(format);
+        let empty = fixture(&format!("empty.{ext}"));
         assert_eq!(
             problem(&empty, reader(format)(&empty, "/imu", &mut |_| {})),
             "no decodable messages on '/imu' (0 undecodable)"
         );
-        let path = imu_file(&dir, format, "none", &frames(1, 10));
-        let mut bytes = std::fs::read(&path).unwrap();
-        let at = find_all(&bytes, b"imu_link")[0] - 4;
+        let one = fixture(&format!("one.{ext}"));
+        assert_bits(
+            &collect(reader(format), &one, "/imu").0,
+            &frames(1, 10),
+            "one",
+        );
+        let mut bytes = fixture_bytes(&format!("one.{ext}"));
+        let at = frame_ids(&bytes)[0] - 4;
         bytes[at..at + 4].copy_from_slice(&u32::MAX.to_le_bytes());
+        let path = dir.join(format!("one.{ext}"));
         std::fs::write(&path, &bytes).unwrap();
         assert_eq!(
             problem(&path, reader(format)(&path, "/imu", &mut |_| {})),
             "no decodable messages on '/imu' (1 undecodable)"
         );
-        let mut nan = frames(2, 11);
-        nan[0].axes[1] = f64::NAN;
-        nan[1].axes[4] = f64::NAN;
-        let path = imu_file(&dir, format, "none", &nan);
+        // Two frames, each with a NaN.
+        let path = fixture(&format!("all-nan.{ext}"));
         assert_eq!(
             problem(&path, reader(format)(&path, "/imu", &mut |_| {})),
             "no finite messages on '/imu' (0 undecodable, 2 with a NaN or infinite axis)"
@@ -351,18 +346,16 @@ fn no_decodable_message_is_an_error() {
 #[test]
 fn damaged_bytes_never_panic() {
     let dir = temp_dir("fuzz");
-    let want = frames(40, 12);
-    let mut seeds = Vec::new();
-    for (format, compression) in [
-        ("ros1", "none"),
-        ("ros1", "bz2"),
-        ("ros1", "lz4"),
-        ("mcap", "none"),
-        ("mcap", "zstd"),
-        ("mcap", "lz4"),
-    ] {
-        seeds.push(std::fs::read(imu_file(&dir, format, compression, &want)).unwrap());
-    }
+    let seeds: Vec<Vec<u8>> = [
+        "frames-none.bag",
+        "frames-bz2.bag",
+        "frames-lz4.bag",
+        "frames-none.mcap",
+        "frames-zstd.mcap",
+        "frames-lz4.mcap",
+    ]
+    .map(fixture_bytes)
+    .into();
     let mut rng = ChaCha8Rng::seed_from_u64(13);
     let path = dir.join("mutant");
     let mut outcomes = [0usize; 2];
@@ -421,8 +414,40 @@ fn damaged_bytes_never_panic() {
     );
 }
 
+/// `frames` written by the fixture script (`write_ros.py one`, Python's rosbags) as `format`
+/// with `compression` on `/imu`: for the read-speed test only, which no CI step runs.
+fn written_by_python(
+    dir: &std::path::Path,
+    format: &str,
+    compression: &str,
+    frames: &[Frame],
+) -> std::path::PathBuf {
+    let mut csv = String::from("t_ns,gx,gy,gz,ax,ay,az\n");
+    for f in frames {
+        csv += &f.stamp_ns.to_string();
+        for v in f.axes {
+            csv += &format!(",{v:?}");
+        }
+        csv.push('\n');
+    }
+    let csv_path = dir.join("frames.csv");
+    std::fs::write(&csv_path, csv).unwrap();
+    let out = dir.join(format!("speed-{compression}.{}", extension(format)));
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/write_ros.py");
+    let status = std::process::Command::new("python3")
+        .args([script, "one"])
+        .arg(&out)
+        .args([format, "/imu", compression])
+        .arg(&csv_path)
+        .status()
+        .expect("python3 with rosbags (pip install rosbags==0.11.9)");
+    assert!(status.success(), "write_ros.py one {format} {compression}");
+    out
+}
+
 #[test]
-#[ignore = "writes 1 M messages with Python (minutes); run with --release --ignored --nocapture"]
+#[ignore = "writes 1 M messages with Python's rosbags (minutes): pip install rosbags==0.11.9, then \
+            run with --release --ignored --nocapture"]
 fn read_speed() {
     let dir = temp_dir("speed");
     let n = 1_000_000;
@@ -433,7 +458,7 @@ fn read_speed() {
         ("mcap", "none"),
         ("mcap", "zstd"),
     ] {
-        let path = imu_file(&dir, format, compression, &want);
+        let path = written_by_python(&dir, format, compression, &want);
         let size = std::fs::metadata(&path).unwrap().len();
         let before = rss_anon_kb();
         let mut peak = before;

@@ -7,13 +7,13 @@ mod common;
 mod ros;
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use common::{assert_one_line_failure, imu_ar, json, stderr};
 use imu_ar_cli::input::frame::Frame;
 use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
-use ros::{fixture, temp_dir, write_csv};
+use ros::{edited_bag, fixture, fixture_bytes, noise_frames, temp_dir};
 
 /// A standard normal deviate (Box-Muller).
 fn normal(rng: &mut ChaCha8Rng) -> f64 {
@@ -140,18 +140,21 @@ fn assert_close(a: &serde_json::Value, b: &serde_json::Value, rel: f64, at: &str
 #[test]
 fn a_bag_and_an_mcap_file_give_the_model_of_the_csv() {
     let dir = temp_dir("same-model");
-    let frames = imu_frames(40_000, 400.0, 2);
+    let frames = noise_frames();
     let csv = dir.join("frames.csv");
-    write_csv(&csv, &frames);
-    let bag = fixture(&dir, "imu.bag", ["ros1", "/imu0", "lz4"], &csv, &[]);
-    let mcap = fixture(&dir, "imu.mcap", ["mcap", "/imu0", "zstd"], &csv, &[]);
+    write_with(&csv, "t_ns,gx,gy,gz,ax,ay,az", &frames, |i| {
+        frames[i].stamp_ns.to_string()
+    });
+    // The same frames, written by Python's rosbags (tests/fixtures/write_ros.py).
+    let bag = fixture("noise-bz2.bag");
+    let mcap = fixture("noise-zstd.mcap");
     // The CSV has no unit brackets: the bag's SI units are given.
     let units = ["--gyro-unit", "rad/s", "--accel-unit", "m/s^2"];
     let from_csv = characterise(&[path(&csv)], &dir.join("csv"), &units);
     for (file, name) in [(&bag, "bag"), (&mcap, "mcap")] {
         let got = characterise(&[path(file), "--topic", "/imu0"], &dir.join(name), &[]);
         assert_close(&got["axes"], &from_csv["axes"], 1e-12, name);
-        assert_eq!(got["n"], 40_000);
+        assert_eq!(got["n"], 1_200);
         // One axis through `noise`, as the CSV's column.
         let one = json(&imu_ar(&[
             "noise",
@@ -220,18 +223,13 @@ fn refused(args: &[&str], want: &str) {
     assert!(stderr(&out).contains(want), "{args:?}: {}", stderr(&out));
 }
 
-fn bag_of(dir: &Path, name: &str, frames: &[Frame], extra: &[&str]) -> PathBuf {
-    let csv = dir.join(format!("{name}.csv"));
-    write_csv(&csv, frames);
-    fixture(dir, name, ["ros1", "/imu0", "none"], &csv, extra)
-}
-
 #[test]
 fn bad_recordings_exit_2_with_one_line() {
     let dir = temp_dir("bad");
     let out = dir.join("out");
-    let frames = imu_frames(5_000, 100.0, 4);
-    let bag = bag_of(&dir, "good.bag", &frames, &["--string-topic", "/chatter"]);
+    // 1200 frames at 100 Hz on /imu0, strings on /chatter.
+    let frames = noise_frames();
+    let bag = fixture("noise.bag");
     let b = path(&bag);
     let o = path(&out);
     // A bag without the topic, or without --topic: the IMU topics it has.
@@ -241,7 +239,7 @@ fn bad_recordings_exit_2_with_one_line() {
     );
     refused(&["noise", b, "--column", "gx"], "/imu0");
     // A truncated bag.
-    let bytes = std::fs::read(&bag).unwrap();
+    let bytes = fixture_bytes("noise.bag");
     let cut = dir.join("cut.bag");
     std::fs::write(&cut, &bytes[..bytes.len() * 2 / 3]).unwrap();
     refused(
@@ -249,21 +247,13 @@ fn bad_recordings_exit_2_with_one_line() {
         "truncated or corrupt bag",
     );
     // An MCAP file with an encoding other than CDR.
-    let csv = dir.join("frames.csv");
-    write_csv(&csv, &frames);
-    let json_mcap = fixture(
-        &dir,
-        "json.mcap",
-        ["mcap", "/imu0", "none"],
-        &csv,
-        &["--encoding", "json"],
-    );
+    let json_mcap = fixture("json.mcap");
     refused(
         &[
             "characterise",
             path(&json_mcap),
             "--topic",
-            "/imu0",
+            "/imu",
             "--out",
             o,
         ],
@@ -271,9 +261,9 @@ fn bad_recordings_exit_2_with_one_line() {
     );
     // Timestamps going backwards: refused, or dropped and counted.
     let mut back = frames.clone();
-    back[2000].stamp_ns = back[1000].stamp_ns;
-    back[3000].stamp_ns -= 1_000_000_000;
-    let back_bag = bag_of(&dir, "back.bag", &back, &[]);
+    back[600].stamp_ns = back[300].stamp_ns;
+    back[900].stamp_ns -= 1_000_000_000;
+    let back_bag = edited_bag(&dir, "noise.bag", "back.bag", &back);
     refused(
         &[
             "characterise",
@@ -291,7 +281,7 @@ fn bad_recordings_exit_2_with_one_line() {
         &[],
     );
     assert_eq!(dropped["skipped"]["backward"], 2);
-    assert_eq!(dropped["n"], 4_998);
+    assert_eq!(dropped["n"], 1_198);
     let back_csv = dir.join("back.csv");
     write_euroc(&back_csv, &back);
     refused(
@@ -300,8 +290,8 @@ fn bad_recordings_exit_2_with_one_line() {
     );
     // Mixed rates: the second half at twice the rate.
     let mut mixed = frames.clone();
-    for (i, f) in mixed.iter_mut().enumerate().skip(2500) {
-        f.stamp_ns = frames[2500].stamp_ns + (i as i64 - 2500) * 5_000_000;
+    for (i, f) in mixed.iter_mut().enumerate().skip(600) {
+        f.stamp_ns = frames[600].stamp_ns + (i as i64 - 600) * 5_000_000;
     }
     let mixed_csv = dir.join("mixed.csv");
     write_euroc(&mixed_csv, &mixed);
@@ -309,7 +299,7 @@ fn bad_recordings_exit_2_with_one_line() {
         &["characterise", path(&mixed_csv), "--out", o],
         "mixed rates",
     );
-    let mixed_bag = bag_of(&dir, "mixed.bag", &mixed, &[]);
+    let mixed_bag = edited_bag(&dir, "noise.bag", "mixed.bag", &mixed);
     refused(
         &[
             "noise",
@@ -326,15 +316,15 @@ fn bad_recordings_exit_2_with_one_line() {
 #[test]
 fn skipped_messages_are_counted_in_the_summary() {
     let dir = temp_dir("skipped");
-    let mut frames = imu_frames(5_000, 100.0, 5);
-    for i in [10, 20, 4000] {
+    let mut frames = noise_frames();
+    for i in [10, 20, 1000] {
         frames[i].axes[4] = f64::NAN;
     }
     frames[30].axes[0] = f64::INFINITY;
-    let bag = bag_of(&dir, "nan.bag", &frames, &[]);
+    let bag = edited_bag(&dir, "noise.bag", "nan.bag", &frames);
     let got = characterise(&[path(&bag), "--topic", "/imu0"], &dir.join("out"), &[]);
     assert_eq!(got["skipped"]["non_finite"], 4);
-    assert_eq!(got["n"], 4_996);
+    assert_eq!(got["n"], 1_196);
     let text = imu_ar(&[
         "characterise",
         path(&bag),
