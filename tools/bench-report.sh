@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Regenerates the "Performance" section of README.md (between the BEGIN/END perf-* markers)
-# from these runs, about 6 minutes:
+# Regenerates the guide docs/performance.md (between the BEGIN/END perf-* markers) from these
+# runs, about 6 minutes:
 #   - instructions per sample and state bytes per channel on the emulated Cortex-M4F
 #     (`cargo qemu bench`), with the per-stage slope and the order where the lattice overtakes
 #     RLS,
@@ -12,7 +12,9 @@
 #   - the same bench built for ARMv6-M (thumbv6m-none-eabi, the Cortex-M0+), run on the same
 #     emulated core, with the state bytes and the flash of the lattices built for it,
 #   - after target, nofpu and v6m: the sentence of the lattice's per-stage cost on each core
-#     (perf-stage), from the figures in those sections of README.md.
+#     (perf-stage), from the figures in those sections of docs/performance.md,
+#   - after target: the README's headline figures (`tools/readme-tables.sh headline`), which
+#     read the perf-target and perf-state tables.
 #
 #   tools/bench-report.sh            all of it
 #   tools/bench-report.sh target     one part: target | host | flash | wall | nofpu | v6m
@@ -23,7 +25,8 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 data=${IMU_AR_DATA:-../shared/data/imu}
 
-# replace SECTION FILE: put FILE's contents between the section's markers in README.md.
+# replace SECTION FILE: put FILE's contents between the section's markers, in whichever of
+# README.md and docs/*.md holds them.
 replace() {
     python3 tools/readme.py replace "$1" "$2"
 }
@@ -93,6 +96,7 @@ print(f"State: `AllanStream<20>` {m.group(1)} bytes (kept per axis, fed every sa
 PY
     replace perf-noise "$tmp/perf-noise.md"
     stage
+    tools/readme-tables.sh headline
 fi
 
 if [ "$only" = all ] || [ "$only" = host ]; then

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Regenerates the measured tables of README.md (between the BEGIN/END markers) from runs:
+# Regenerates the measured blocks (between the BEGIN/END markers) of README.md and of the
+# guides under docs/ from runs:
 #   - f32 and fixed-point accuracy of the lattice (host-tests/tests/recursive_f32.rs, fixed.rs),
 #   - the demo's output and footprint (`cargo qemu demo`, tools/footprint.sh),
 #   - `imu-ar compare` on a drifting AR(2),
@@ -7,12 +8,14 @@
 #     two AR(1) hand-offs, its decomposition plot (docs/plots/adis-gx-noise.png) and the one of
 #     the ax axis (docs/plots/adis-ax-noise.png),
 #   - the SFTF against the lattice and RLS: instructions per sample on the target (`cargo qemu
-#     bench`) and restarts per 10^6 samples (host-tests/tests/sftf.rs).
+#     bench`) and restarts per 10^6 samples (host-tests/tests/sftf.rs),
+#   - the README's headline figures (headline), from the blocks above and the performance
+#     tables; last in `all`, and run by tools/bench-report.sh after the tables it reads.
 #
 # The performance tables are written by tools/bench-report.sh.
 #
 #   tools/readme-tables.sh            all of them (about 3 minutes)
-#   tools/readme-tables.sh accuracy   one group: accuracy | demo | compare | sftf | noise
+#   tools/readme-tables.sh accuracy   one group: accuracy | demo | compare | sftf | noise | headline
 #   tools/readme-tables.sh check-demo FILE   exit 1 when the README's demo-output block differs
 #                                            from the demo output in FILE (CI)
 set -euo pipefail
@@ -21,7 +24,8 @@ only=${1:-all}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 
-# replace SECTION FILE: put FILE's contents between the section's markers in README.md.
+# replace SECTION FILE: put FILE's contents between the section's markers, in whichever of
+# README.md and docs/*.md holds them.
 replace() {
     python3 tools/readme.py replace "$1" "$2"
 }
@@ -49,22 +53,24 @@ for name in headers.values():
 PY
 }
 
-# test_tables TEST HEADER=SECTION...: runs a host test in release and puts the tables it prints
-# into their README sections.
+# test_tables TEST HEADER=SECTION...: runs a host test in release and writes the tables it
+# prints into $tmp/SECTION.md, for `replace SECTION` (the section names stay literal, for
+# `python3 tools/readme.py markers`).
 test_tables() {
-    local test=$1 pair
+    local test=$1
     shift
     cargo test --release -p imu-ar-host --test "$test" -- --nocapture --test-threads 1 \
         > "$tmp/$test.txt" 2>/dev/null
     tables "$tmp/$test.txt" "$@"
-    for pair in "$@"; do
-        replace "${pair#*=}" "$tmp/${pair#*=}.md"
-    done
 }
 
 if [ "$only" = all ] || [ "$only" = accuracy ]; then
     test_tables recursive_f32 "| process |=f32-accuracy" "| record |=real-accuracy"
+    replace f32-accuracy "$tmp/f32-accuracy.md"
+    replace real-accuracy "$tmp/real-accuracy.md"
     test_tables fixed "| process |=fixed-accuracy" "| record |=fixed-real"
+    replace fixed-accuracy "$tmp/fixed-accuracy.md"
+    replace fixed-real "$tmp/fixed-real.md"
 fi
 
 # demo_block: the README's demo-output block from the demo's output on stdin.
@@ -126,6 +132,8 @@ for est in ("sftf", "lattice", "rls"):
 PY
     replace sftf-cost "$tmp/sftf-cost.md"
     test_tables sftf "| process (10^6 samples) |=sftf-restarts" "| record (six axes=sftf-real"
+    replace sftf-restarts "$tmp/sftf-restarts.md"
+    replace sftf-real "$tmp/sftf-real.md"
 fi
 
 if [ "$only" = all ] || [ "$only" = noise ]; then
@@ -200,4 +208,66 @@ with open(f"{tmp}/noise-axes.md", "w") as out:
 PY
     replace noise-handoff "$tmp/noise-handoff.md"
     replace noise-axes "$tmp/noise-axes.md"
+fi
+
+if [ "$only" = all ] || [ "$only" = headline ]; then
+    # The README's headline figures, each read from the block of a guide that measures it.
+    PYTHONPATH=tools python3 - > "$tmp/headline.md" <<'PY'
+import re
+import textwrap
+from readme import split
+
+def rows(section, n=0):
+    """The rows of the section's n-th markdown table, as {header: cell}."""
+    tables, current = [], None
+    for line in split(section)[1].splitlines():
+        if line.startswith("|"):
+            cells = [c.strip() for c in line.strip().strip("|").split("|")]
+            if current is None:
+                current = {"header": cells, "rows": []}
+                tables.append(current)
+            elif not set("".join(cells)) <= set("-:"):
+                current["rows"].append(dict(zip(current["header"], cells)))
+        else:
+            current = None
+    return tables[n]["rows"]
+
+def row(section, estimator, scalar):
+    return next(r for r in rows(section) if (r["estimator"], r["scalar"]) == (estimator, scalar))
+
+def largest(cells):
+    """The cell of the largest number (as written in the table)."""
+    return max((c for c in cells if c), key=float)
+
+p = "p = 4"
+insns, fixed = row("perf-target", "lattice", "f32")[p], row("perf-target", "lattice", "fixed")[p]
+state = row("perf-state", "lattice", "f32")[p]
+f32 = largest([r["lattice f32"] for r in rows("f32-accuracy")]
+              + [r["lattice f32, p = 1..8"] for r in rows("real-accuracy")])
+fix = largest([r[k] for r in rows("fixed-accuracy") for k in r if k.startswith("p = ")]
+              + [r["fixed, p = 1..8"] for r in rows("fixed-real")])
+lower = sorted(float(r["lattice vs batch"].split()[0]) for r in rows("compare"))
+gyros = [r for r in rows("noise-axes") if r["axis"] in ("gx", "gy", "gz")]
+every = [r for r in gyros if "every tau" in r["Allan check holds up to"]]
+def item(text):
+    """A list item wrapped at 100 columns, never inside a bold figure or a link's text."""
+    keep = lambda m: m.group(0).replace(" ", "\xa0")
+    text = re.sub(r"\*\*[^*]+\*\*|\[[^]]+\]", keep, text)
+    print(textwrap.fill(text, 100, subsequent_indent="  ", break_long_words=False,
+                        break_on_hyphens=False).replace("\xa0", " "))
+
+item(f"- An order-4 `f32` lattice costs **{insns}** instructions per sample on the Cortex-M4F "
+      f"and keeps **{state}** bytes of state per axis; the fixed-point lattice, **{fixed}** "
+      "instructions ([Performance](docs/performance.md)).")
+item(f"- The `f32` lattice's coefficients stay within **{f32}** of an `f64` direct solve of the "
+      "same problem, on simulated processes and on every axis of two real records; the "
+      f"fixed-point lattice's within **{fix}** ([Online estimation](docs/estimators.md#accuracy-in-f32)).")
+item(f"- On an AR(2) whose dynamics drift, the lattice's mean squared one-step prediction error is "
+      f"**{lower[0]:.1f} %** to **{lower[-1]:.1f} %** below that of a batch fit "
+      "([Batch against recursive](docs/estimators.md#batch-against-recursive-one-step-prediction-error)).")
+item(f"- The composite noise model explains the Allan deviation of **{len(every)} of {len(gyros)}** "
+      "gyro axes of the two real records at every averaging time "
+      "([Noise model](docs/noise-model.md#the-composite-noise-model)).")
+PY
+    replace headline "$tmp/headline.md"
 fi

@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
-# Regenerates the README "Results" tables from the `imu-ar` tool's JSON, and the plots README
-# shows (docs/plots), in about 4 minutes:
+# Regenerates the tables of docs/results.md and docs/noise-model.md from the `imu-ar` tool's
+# JSON, and the plots docs/results.md shows (docs/plots), in about 4 minutes:
 #   - results-sim: a stationary AR(4) with known coefficients, every estimator against truth,
 #   - results-real: batch LS against RLS and the lattice, one-step prediction MSE, on every
 #     gyro axis of the ADIS16405 and MPU-6050 records at about 100 Hz and decimated to 10 Hz
 #     and 1 Hz (batch model fitted on the first half, all evaluated on the second),
-#   - handoff: the Kalman hand-off of the ADIS16405 gx axis (`imu-ar kalman`),
+#   - handoff: the Kalman hand-off of the ADIS16405 gx axis (`imu-ar kalman`, in
+#     docs/noise-model.md),
 #   - docs/plots: `imu-ar report` on the drifting AR(2) (with the lattice from its correct
 #     prior) and on gx of both records.
 #
@@ -22,7 +23,8 @@ if [ -z "$tool" ]; then
     tool=target/release/imu-ar
 fi
 
-# replace SECTION FILE: put FILE's contents between the section's markers in README.md.
+# replace SECTION FILE: put FILE's contents between the section's markers, in whichever of
+# README.md and docs/*.md holds them.
 replace() {
     python3 tools/readme.py replace "$1" "$2"
 }
@@ -108,7 +110,8 @@ for name, v in zip(names, fits):
 PY
 replace handoff "$tmp/handoff.md"
 
-# The plots README shows: the drifting AR(2), and gx of each real record at its full rate.
+# The plots docs/results.md shows: the drifting AR(2), and gx of each real record at its full
+# rate.
 plots=docs/plots
 mkdir -p "$plots"
 "$tool" simulate --a 1.5,-0.7 --a-end 1.0,-0.7 --sigma 1 --n 100000 --seed 4 > "$tmp/drift.csv"

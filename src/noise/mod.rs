@@ -19,7 +19,7 @@
 //! is not per-sample work. On the emulated Cortex-M4F one fit from a 20-octave
 //! [`AllanStream`](crate::allan::AllanStream) with a budget of three Gauss-Markov states takes
 //! about 70 million instructions (82 million with an AR(8) part) and 34 KiB of stack
-//! (`cargo qemu bench`, README "Performance").
+//! (`cargo qemu bench`, [Performance](crate::guide::performance)).
 
 use core::fmt;
 

@@ -33,7 +33,7 @@
 //! [`Settled`] holds the first `N` samples and starts from their batch fit, with the running
 //! mean settled and no prewindowed equation: at `lambda = 1`, where the start is never
 //! forgotten, that is the difference between 25 times batch least squares and batch least
-//! squares (README, Results).
+//! squares ([Results](crate::guide::results)).
 //!
 //! Settings are split by what they belong to. A [`Config`] (forgetting factor, sample
 //! interval, mean removal) is validated once and shared by the estimators of all the channels

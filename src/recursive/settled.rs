@@ -61,8 +61,8 @@ pub trait Start<T: Scalar, const P: usize>: Estimator<T, P, Config = Config<T>> 
 ///
 /// The problem solved from then on is that of [`Lattice::with_prior`](super::Lattice::with_prior) centred on `a0` with the
 /// history rows added to the prior's weight (see `ladder.rs`); `a0 = 0` and no history is the
-/// plain start. On the Percival-Walden AR(4) at `lambda = 1` and `n = 100,000` (README,
-/// Results) it brings the recursive estimators from 25 times batch least squares to batch
+/// plain start. On the Percival-Walden AR(4) at `lambda = 1` and `n = 100,000`
+/// ([Results](crate::guide::results)) it brings the recursive estimators from 25 times batch least squares to batch
 /// least squares.
 ///
 /// ```

@@ -381,9 +381,12 @@ impl Fitting {
         let ar = model
             .ar()
             .map_or(String::new(), |_| format!(", AR({P}) part"));
+        let unit = &self.units.name;
         format!(
-            "Allan deviation (n = {}, {} Hz{ar}), in {}",
-            self.n, self.rate, self.units.name
+            "Allan deviation in {unit} (n = {}, {} Hz{ar}): N = {:.4e} {unit}/sqrt(Hz)",
+            self.n,
+            self.rate,
+            model.white_noise()
         )
     }
 

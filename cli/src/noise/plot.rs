@@ -201,8 +201,18 @@ fn components<const P: usize, const G: usize, const L: usize>(
             curve(model.quantization(), &|m| component::quantization(dt, m)),
         ));
     }
+    // With an AR part, the model's N is the white term and the AR part's white equivalent
+    // together (`NoiseModel::white_noise`, the caption's N): each is labelled as what it is.
+    let total = model.white_noise();
+    let ar_white = (total * total - model.white_term() * model.white_term())
+        .max(0.0)
+        .sqrt();
     if model.white_term() > 0.0 {
-        let label = format!("white noise N = {}", g(model.white_term()));
+        let label = if model.ar().is_some() {
+            format!("white beside the AR part N_w = {}", g(model.white_term()))
+        } else {
+            format!("white noise N = {}", g(model.white_term()))
+        };
         out.push((
             label,
             curve(model.white_term(), &|m| component::white(dt, m)),
@@ -212,7 +222,7 @@ fn components<const P: usize, const G: usize, const L: usize>(
         let mut avar = vec![0.0; len];
         component::ar_octaves(ar, &mut avar).map_err(|e| Fail(format!("AR part: {e}")))?;
         out.push((
-            format!("AR({P}) part"),
+            format!("AR({P}) part, white equivalent N_ar = {}", g(ar_white)),
             avar.iter().map(|v| v.sqrt()).collect(),
         ));
     }
