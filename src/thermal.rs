@@ -60,7 +60,7 @@
 //! as [`Rls`](crate::recursive::Rls) does: `P` stays symmetric and positive definite by
 //! construction. About `3 N^2` multiplications and `3 N` divisions per sample.
 //!
-//! Measured against an `f64` direct solve of the problem above (host-tests/tests/thermal.rs,
+//! Measured against an `f64` direct solve of the problem above (host-tests/tests/host/thermal.rs,
 //! 25 to 45 deg C ramps, cycles, steps and still spells, `lambda` 0.999 to 1, `delta` 0.01 and
 //! 1): the `f64` coefficients agree to `1e-9` at every sample (measured: `2e-10`). In `f32`
 //! the fitted bias and the residual stay within 0.0013 noise sigma of the reference's where the

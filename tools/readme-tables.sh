@@ -1,14 +1,14 @@
 #!/usr/bin/env bash
 # Regenerates the measured blocks (between the BEGIN/END markers) of README.md and of the
 # guides under docs/ from runs:
-#   - f32 and fixed-point accuracy of the lattice (host-tests/tests/recursive_f32.rs, fixed.rs),
+#   - f32 and fixed-point accuracy of the lattice (host-tests/tests/host/recursive_f32.rs, fixed.rs),
 #   - the demo's output and footprint (`cargo qemu demo`, tools/footprint.sh),
 #   - `imu-ar compare` on a drifting AR(2),
 #   - `imu-ar noise` on every axis of both real records, the ADIS16405 gx composite next to the
 #     two AR(1) hand-offs, its decomposition plot (docs/plots/adis-gx-noise.png) and the one of
 #     the ax axis (docs/plots/adis-ax-noise.png),
 #   - the SFTF against the lattice and RLS: instructions per sample on the target (`cargo qemu
-#     bench`) and restarts per 10^6 samples (host-tests/tests/sftf.rs),
+#     bench`) and restarts per 10^6 samples (host-tests/tests/host/sftf.rs),
 #   - the README's headline figures (headline), from the blocks above and the performance
 #     tables; last in `all`, and run by tools/bench-report.sh after the tables it reads.
 #
@@ -59,7 +59,7 @@ PY
 test_tables() {
     local test=$1
     shift
-    cargo test --release -p imu-ar-host --test "$test" -- --nocapture --test-threads 1 \
+    cargo test --release -p imu-ar-host --test host -- "$test::" --nocapture --test-threads 1 \
         > "$tmp/$test.txt" 2>/dev/null
     tables "$tmp/$test.txt" "$@"
 }

@@ -1,5 +1,5 @@
 //! The differential check of the fixed-point lattice against the f64 lattice, shared by the
-//! property test (`tests/differential.rs`) and the `fixed_differential` fuzz target.
+//! property test (`host-tests/tests/host/differential.rs`) and the `fixed_differential` fuzz target.
 //!
 //! Between restarts the fixed lattice must agree with an f64 lattice fed the same samples
 //! (restarted where the fixed one restarts), to [`TOL`] on the coefficients and the mean; a

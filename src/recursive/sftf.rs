@@ -8,7 +8,7 @@ use crate::Scalar;
 
 /// The monitor's threshold `tau` on the disagreement of the two backward errors
 /// ([`Sftf::disagreement`]): `1e-2` in single precision, `1e-6` in double. The largest
-/// disagreement of the healthy runs of `host-tests/tests/sftf.rs` is printed in the table of
+/// disagreement of the healthy runs of `host-tests/tests/host/sftf.rs` is printed in the table of
 /// [the SFTF head to head](crate::guide::estimators) next to their restarts; the worst is the Percival-Walden AR(4) (`cond R ~ 1e6`).
 fn tau<T: Scalar>() -> T {
     if T::EPSILON > T::from_f64(1e-10) {

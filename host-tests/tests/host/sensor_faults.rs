@@ -8,7 +8,7 @@
 //! reader works: a 1 kHz MPU-6050 on 400 kHz I2C writes a sample every ~13 transfers) or
 //! corrupts the bytes of a chosen read (a bit error on the wire).
 
-mod sim;
+use crate::sim;
 
 use std::cell::RefCell;
 use std::rc::Rc;

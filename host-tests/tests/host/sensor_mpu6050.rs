@@ -3,8 +3,8 @@
 //! happen), then against the register-level simulator (`sim`): each defect of issue 24 that
 //! the simulator reproduces, and a long run with random bus faults.
 
-mod common;
-mod sim;
+use crate::common;
+use crate::sim;
 
 use std::cell::RefCell;
 use std::rc::Rc;

@@ -2,10 +2,10 @@
 //! `rosbags` (committed fixtures, `cli/tests/fixtures/write_ros.py`): every frame back bit for
 //! bit, for every compression; each error's text; what is skipped; and no panic on truncated,
 //! bit-flipped or random bytes, all derived in Rust from the committed files. The read speed
-//! (it writes its files with the script): `cargo test --release -p imu-ar-cli --test bags --
+//! (it writes its files with the script): `cargo test --release -p imu-ar-cli --test cli -- bags::
 //! --ignored --nocapture`.
 
-mod ros;
+use crate::ros;
 
 use std::collections::BTreeMap;
 use std::time::Instant;
@@ -30,7 +30,7 @@ fn every_frame_back_bit_for_bit() {
             assert_bits(&got, &want, &format!("{format} {compression}"));
         }
     }
-    // The static-IMU frames the commands' tests read (tests/characterise.rs).
+    // The static-IMU frames the commands' tests read (characterise.rs).
     for name in ["noise.bag", "noise-bz2.bag", "noise-zstd.mcap"] {
         let read = if name.ends_with(".bag") {
             bag::read

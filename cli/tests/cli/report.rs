@@ -4,14 +4,14 @@
 use std::path::Path;
 use std::process::Output;
 
-mod common;
+use crate::common;
 
 use common::{drift_record, imu_ar, json, misused, simulated, temp_file};
 
 #[test]
 fn report_writes_four_pngs_and_a_summary() {
     let file = drift_record("report.csv", "20000");
-    let out = std::env::temp_dir().join(format!("imu-ar-cli-{}-report", std::process::id()));
+    let out = crate::common::temp_path("cli-report");
     let (f, o) = (file.to_str().unwrap(), out.to_str().unwrap());
     let report = |extra: &[&'static str]| {
         let mut args = vec!["report", f, "--column", "x", "--order", "2", "--out", o];
@@ -48,7 +48,7 @@ fn report_writes_four_pngs_and_a_summary() {
 #[test]
 fn report_and_compare_agree_on_the_sftf() {
     let file = drift_record("report-sftf.csv", "20000");
-    let out = std::env::temp_dir().join(format!("imu-ar-cli-{}-sftf", std::process::id()));
+    let out = crate::common::temp_path("cli-sftf");
     let (f, o) = (file.to_str().unwrap(), out.to_str().unwrap());
     let common = ["--column", "x", "--order", "2", "--lambda", "0.99"];
     let report = json(&imu_ar(
@@ -228,7 +228,7 @@ fn kalman_refuses_a_filter_step_beyond_u32() {
 #[test]
 fn report_creates_out_only_for_good_input() {
     let file = simulated("report-short.csv", "0.5", "50", "3");
-    let out = std::env::temp_dir().join(format!("imu-ar-cli-{}-never", std::process::id()));
+    let out = crate::common::temp_path("cli-never");
     let (f, o) = (file.to_str().unwrap(), out.to_str().unwrap());
     misused(
         &[

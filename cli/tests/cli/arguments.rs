@@ -1,7 +1,7 @@
 //! The command line of `imu-ar`: a missing or bad argument is named on one line of stderr;
 //! `-h`, `--help` and `--version` print to stdout.
 
-mod common;
+use crate::common;
 
 use common::{ar2, assert_one_line_failure, command, imu_ar, misused, stderr, stdout, temp_file};
 

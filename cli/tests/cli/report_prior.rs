@@ -1,7 +1,7 @@
 //! `imu-ar report --prior-a`: the lattice from a prior next to the plain one, prior.png and
 //! `prior_lattice_a`, and the prior's checks (those of `fit`).
 
-mod common;
+use crate::common;
 
 use common::{drift_record, imu_ar, json, misused};
 
@@ -10,8 +10,7 @@ use common::{drift_record, imu_ar, json, misused};
 #[test]
 fn report_draws_the_lattice_from_a_prior() {
     let file = drift_record("report-prior.csv", "20000");
-    let dir =
-        |name: &str| std::env::temp_dir().join(format!("imu-ar-cli-{}-{name}", std::process::id()));
+    let dir = |name: &str| crate::common::temp_path(name);
     let (with, without) = (dir("prior"), dir("no-prior"));
     let f = file.to_str().unwrap();
     let report = |out: &std::path::Path, extra: &[&str]| {
@@ -88,7 +87,7 @@ fn report_draws_the_lattice_from_a_prior() {
 #[test]
 fn report_refuses_a_bad_prior() {
     let file = drift_record("report-bad-prior.csv", "2000");
-    let out = std::env::temp_dir().join(format!("imu-ar-cli-{}-bad-prior", std::process::id()));
+    let out = crate::common::temp_path("cli-bad-prior");
     let (f, o) = (file.to_str().unwrap(), out.to_str().unwrap());
     let base = [
         "report", f, "--column", "x", "--order", "2", "--rate", "100", "--out", o,

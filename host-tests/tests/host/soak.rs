@@ -5,7 +5,7 @@
 //! `cargo test` runs 10^6 samples; `.ci/run` runs 10^8 with an optimised build:
 //!
 //! ```sh
-//! IMU_AR_SOAK_SAMPLES=100000000 cargo test -p imu-ar-host --test soak -- --nocapture
+//! IMU_AR_SOAK_SAMPLES=100000000 cargo test -p imu-ar-host --test host -- soak:: --nocapture
 //! ```
 
 use imu_ar::recursive::{Channel, Config, Estimator, Gate, Lattice};

@@ -5,6 +5,7 @@
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// The `imu-ar` binary of this package, to be given arguments.
 pub fn command() -> Command {
@@ -16,9 +17,17 @@ pub fn imu_ar(args: &[&str]) -> Output {
     command().args(args).output().expect("run imu-ar")
 }
 
+/// A path in the temp directory ending in `name`, not given out before in this process (the
+/// tests share one process and run in parallel).
+pub fn temp_path(name: &str) -> PathBuf {
+    static CALLS: AtomicUsize = AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, Ordering::Relaxed);
+    std::env::temp_dir().join(format!("imu-ar-cli-{}-{call}-{name}", std::process::id()))
+}
+
 /// A file in the temp directory with the given contents.
 pub fn temp_file(name: &str, contents: impl AsRef<[u8]>) -> PathBuf {
-    let path = std::env::temp_dir().join(format!("imu-ar-cli-{}-{name}", std::process::id()));
+    let path = temp_path(name);
     std::fs::write(&path, contents).unwrap();
     path
 }

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-mod common;
+use crate::common;
 
 use common::{column_file, imu_ar, misused, simulated, temp_file};
 

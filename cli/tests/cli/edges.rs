@@ -3,7 +3,7 @@
 //! line and problem, nothing on stdout; no NaN or infinity in any output; no result that is
 //! wrong but looks fine.
 
-mod common;
+use crate::common;
 
 use common::{
     ar2, assert_one_line_failure, fit_burg, imu_ar, no_nan_inf, stderr, stdout, temp_file,
@@ -141,7 +141,7 @@ fn compare_refuses_a_tiny_delta() {
 #[test]
 fn report_refuses_a_tiny_delta() {
     let file = ar2("rep-delta.csv");
-    let dir = std::env::temp_dir().join(format!("imu-ar-edges-{}-rep", std::process::id()));
+    let dir = crate::common::temp_path("edges-rep");
     let out = imu_ar(&[
         "report",
         file.to_str().unwrap(),
@@ -249,7 +249,7 @@ fn echoed_control_characters_are_escaped() {
 fn delta_out_of_range_is_refused_naming_delta() {
     let file = ar2("delta-range.csv");
     let f = file.to_str().unwrap();
-    let dir = std::env::temp_dir().join(format!("imu-ar-edges-{}-delta", std::process::id()));
+    let dir = crate::common::temp_path("edges-delta");
     for delta in ["1e-320", "1e300", "0", "-1", "inf"] {
         for args in [
             vec![
@@ -288,7 +288,7 @@ fn delta_out_of_range_is_refused_naming_delta() {
 fn subnormal_rates_are_refused_naming_rate() {
     let file = ar2("rate-range.csv");
     let f = file.to_str().unwrap();
-    let dir = std::env::temp_dir().join(format!("imu-ar-edges-{}-rate", std::process::id()));
+    let dir = crate::common::temp_path("edges-rate");
     let cases: [Vec<&str>; 6] = [
         vec![
             "kalman", f, "--column", "x", "--order", "1", "--rate", "1e-308",
@@ -351,7 +351,7 @@ fn simulate_sigma_range() {
 fn decimate_beyond_record_says_no_sample_is_left() {
     let file = ar2("dec-all.csv");
     let f = file.to_str().unwrap();
-    let dir = std::env::temp_dir().join(format!("imu-ar-edges-{}-dec", std::process::id()));
+    let dir = crate::common::temp_path("edges-dec");
     let cases: [Vec<&str>; 5] = [
         vec![
             "fit", f, "--column", "x", "--method", "burg", "--order", "1",

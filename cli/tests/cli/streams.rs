@@ -4,7 +4,7 @@
 use std::io::{Read, Write};
 use std::process::{Output, Stdio};
 
-mod common;
+use crate::common;
 
 use common::{ar2, command, imu_ar, stderr, stdout, temp_file};
 
@@ -111,7 +111,7 @@ fn a_dash_reads_standard_input() {
     let file = ar2("stdin.csv");
     let csv = std::fs::read(&file).unwrap();
     let f = file.to_str().unwrap();
-    let dir = std::env::temp_dir().join(format!("imu-ar-cli-{}-stdin", std::process::id()));
+    let dir = crate::common::temp_path("cli-stdin");
     let d = dir.to_str().unwrap();
     let cases: [&[&str]; 7] = [
         &[
@@ -174,7 +174,7 @@ fn standard_input_is_read_once() {
         "stdin-table.csv",
         "channel,tau_s,adev\nx,0.01,1.0\ny,0.01,7.0\nx,0.1,0.5\n",
     );
-    let dir = std::env::temp_dir().join(format!("imu-ar-cli-{}-table", std::process::id()));
+    let dir = crate::common::temp_path("cli-table");
     let d = dir.to_str().unwrap();
     let report = |reference| {
         let mut args = vec![

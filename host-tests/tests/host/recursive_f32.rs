@@ -130,7 +130,7 @@ fn section_8_processes_after_two_million_samples() {
                 "| {name} | {p} | {lambda} | {:.1e} | {:.1e} | {sftf} |",
                 e.lattice, e.rls
             );
-            // The SFTF under-fitting a resonance diverges (tests/sftf.rs); elsewhere it holds.
+            // The SFTF under-fitting a resonance diverges (sftf.rs); elsewhere it holds.
             if p == 4 {
                 assert_eq!(e.sftf_rescues, 0, "{name}, lambda {lambda}: SFTF rescued");
                 assert!(

@@ -1,6 +1,6 @@
 //! Error messages that must name the right thing.
 
-mod common;
+use crate::common;
 
 use common::{imu_ar, simulated, stderr};
 

@@ -7,7 +7,7 @@ use imu_ar_host::composite::Composite;
 use imu_ar_host::fixtures::{AXES, real_records};
 use serde_json::Value;
 
-mod common;
+use crate::common;
 
 use common::{column_file, imu_ar, json, misused, stdout, temp_file};
 
@@ -205,7 +205,7 @@ fn hands_a_simulated_composite_to_a_filter_at_its_rate() {
 #[test]
 fn draws_the_decomposition_plot() {
     let (_, path) = composite_record("noise-plot.csv");
-    let png = std::env::temp_dir().join(format!("imu-ar-noise-{}.png", std::process::id()));
+    let png = crate::common::temp_path("noise.png");
     let out = imu_ar(&[
         "noise",
         path.to_str().unwrap(),

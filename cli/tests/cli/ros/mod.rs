@@ -31,7 +31,7 @@ pub fn fixture_bytes(name: &str) -> Vec<u8> {
 
 /// An empty directory for one test's files.
 pub fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("imu-ar-bags-{}-{name}", std::process::id()));
+    let dir = crate::common::temp_path(name);
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir

@@ -3,7 +3,7 @@
 
 use imu_ar_host::fixtures::data_dir;
 
-mod common;
+use crate::common;
 
 use common::{column_file, drift_record, fit_json, imu_ar, json, simulated, temp_file};
 

@@ -3,8 +3,8 @@
 //! Kalibr file carries the model's N and K; bad recordings exit 2 with one line, and skipped
 //! messages are counted.
 
-mod common;
-mod ros;
+use crate::common;
+use crate::ros;
 
 use std::fmt::Write as _;
 use std::path::Path;
