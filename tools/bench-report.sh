@@ -4,7 +4,7 @@
 #   - instructions per sample and state bytes per channel on the emulated Cortex-M4F
 #     (`cargo qemu bench`), with the per-stage slope and the order where the lattice overtakes
 #     RLS,
-#   - nanoseconds per sample on the host (criterion, host-tests/benches/per_sample.rs),
+#   - nanoseconds per sample on the host (criterion, bench/benches/per_sample.rs),
 #   - flash per estimator: each `size_*` firmware minus `size_base` (tools/footprint.sh),
 #   - wall time of the `imu-ar` tool on the 1,000,000-row ADIS16405 record (best of 3),
 #   - the same bench built for ARMv7-M without an FPU (thumbv7m-none-eabi, soft-float f32),
@@ -100,7 +100,7 @@ PY
 fi
 
 if [ "$only" = all ] || [ "$only" = host ]; then
-    cargo bench -q -p imu-ar-host --bench per_sample > /dev/null
+    cargo bench -q -p imu-ar-bench --bench per_sample > /dev/null
     python3 - > "$tmp/perf-host.md" <<'PY'
 import json, os
 orders = [1, 2, 4, 8, 16, 32]

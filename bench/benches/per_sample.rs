@@ -1,4 +1,4 @@
-//! Host cost per sample of the recursive cores: `cargo bench -p imu-ar-host --bench per_sample`.
+//! Host cost per sample of the recursive cores: `cargo bench -p imu-ar-bench --bench per_sample`.
 //!
 //! The rows of the target's `cargo qemu bench`, and the f64 cores: each iteration feeds a block
 //! of 1000 samples of an AR(2) record (as raw counts for the fixed-point lattice; an AR(1) for
