@@ -18,6 +18,8 @@
 #   tools/readme-tables.sh accuracy   one group: accuracy | demo | compare | sftf | noise | headline
 #   tools/readme-tables.sh check-demo FILE   exit 1 when the README's demo-output block differs
 #                                            from the demo output in FILE (CI)
+#   README_CHECK=1 tools/readme-tables.sh GROUP   check the group's blocks instead of writing
+#                                                 them (CI: headline)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 only=${1:-all}
@@ -26,8 +28,13 @@ trap 'rm -rf "$tmp"' EXIT
 
 # replace SECTION FILE: put FILE's contents between the section's markers, in whichever of
 # README.md and docs/*.md holds them.
+# With README_CHECK=1, check instead: exit 1 with a diff when the block differs (CI).
 replace() {
-    python3 tools/readme.py replace "$1" "$2"
+    if [ -n "${README_CHECK:-}" ]; then
+        python3 tools/readme.py check "$1" "$2"
+    else
+        python3 tools/readme.py replace "$1" "$2"
+    fi
 }
 
 # tables OUTPUT HEADER=SECTION...: the markdown tables of a test's output, by header cell, into
