@@ -382,11 +382,15 @@ impl Fitting {
             .ar()
             .map_or(String::new(), |_| format!(", AR({P}) part"));
         let unit = &self.units.name;
+        let n = model.white_noise();
+        let n = if n > 0.0 {
+            format!(": N = {n:.4e} {unit}/sqrt(Hz)")
+        } else {
+            String::new()
+        };
         format!(
-            "Allan deviation in {unit} (n = {}, {} Hz{ar}): N = {:.4e} {unit}/sqrt(Hz)",
-            self.n,
-            self.rate,
-            model.white_noise()
+            "Allan deviation in {unit} (n = {}, {} Hz{ar}){n}",
+            self.n, self.rate
         )
     }
 

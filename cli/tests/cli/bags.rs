@@ -30,6 +30,12 @@ fn every_frame_back_bit_for_bit() {
             assert_bits(&got, &want, &format!("{format} {compression}"));
         }
     }
+    // Eight MCAP chunks, more than the reader reads at once.
+    let path = fixture("chunks.mcap");
+    assert!(std::fs::metadata(&path).unwrap().len() > 256 * 1024);
+    let (got, result) = collect(mcap_reader::read, &path, "/imu");
+    assert_eq!(result, Ok(Skipped::default()), "chunks.mcap");
+    assert_bits(&got, &frames(800, 13), "chunks.mcap");
     // The static-IMU frames the commands' tests read (characterise.rs).
     for name in ["noise.bag", "noise-bz2.bag", "noise-zstd.mcap"] {
         let read = if name.ends_with(".bag") {

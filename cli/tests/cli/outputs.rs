@@ -13,7 +13,8 @@ use common::{column_file, drift_record, fit_json, imu_ar, json, simulated, temp_
     ignore = "needs the real records (../shared/data/imu or IMU_AR_DATA)"
 )]
 fn adev_reproduces_the_published_adis16405_table() {
-    let dir = data_dir().expect("the real records: ../shared/data/imu or IMU_AR_DATA (see README)");
+    let dir = data_dir()
+        .expect("the real records: ../shared/data/imu or IMU_AR_DATA (see docs/reliability.md)");
     let part1 = dir.join("adis16405_imu1_part1.csv");
     let part2 = dir.join("adis16405_imu1_part2.csv");
     let reference =

@@ -1,6 +1,6 @@
 //! The fixed-point lattice against the f64 direct solve of numerics.md section 0, on the
 //! section-8 processes and on both real records as raw counts; and at the edges of its formats.
-//! Prints the table that `tools/readme-tables.sh` puts into README.md.
+//! Prints the table that `tools/readme-tables.sh` puts into docs/estimators.md.
 
 use imu_ar::recursive::{Channel, Config, Estimator, FixedChannel, FixedConfig, FixedLattice};
 use imu_ar_cli::input::csv::read_column;
@@ -79,8 +79,8 @@ fn section_8_processes_after_a_million_samples() {
     ignore = "needs the real records (../shared/data/imu or IMU_AR_DATA)"
 )]
 fn real_records_as_raw_counts() {
-    let records =
-        real_records().expect("the real records: ../shared/data/imu or IMU_AR_DATA (see README)");
+    let records = real_records()
+        .expect("the real records: ../shared/data/imu or IMU_AR_DATA (see docs/reliability.md)");
     println!(
         "| record | axis | counts per unit | lambda | fixed, p = 1..8 | median of 10 | clipped |"
     );

@@ -1,6 +1,6 @@
 //! The f32 recursive cores against the f64 direct solve of numerics.md section 0: the four
 //! processes of section 8 and both real records. The test prints the table that
-//! `tools/accuracy-table.sh` puts into README.md.
+//! `tools/readme-tables.sh` puts into docs/estimators.md.
 
 use imu_ar::recursive::{Channel, Config, Estimator, Lattice, Rls, Sftf};
 use imu_ar_cli::input::csv::read_column;
@@ -180,8 +180,8 @@ fn rls_error<const P: usize>(
     ignore = "needs the real records (../shared/data/imu or IMU_AR_DATA)"
 )]
 fn real_records_every_axis() {
-    let records =
-        real_records().expect("the real records: ../shared/data/imu or IMU_AR_DATA (see README)");
+    let records = real_records()
+        .expect("the real records: ../shared/data/imu or IMU_AR_DATA (see docs/reliability.md)");
     println!("| record | axis | lambda | lattice f32, p = 1..8 | RLS f32, p = 1..8 |");
     println!("|---|---|---|---|---|");
     for record in &records {

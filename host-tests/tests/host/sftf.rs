@@ -2,7 +2,7 @@
 //! records: where it diverges the monitor fires, every output stays finite and the published
 //! model is the last good one; where it does not, it never fires. The tests print the restarts
 //! per 10^6 samples of SFTF, lattice and RLS that `tools/readme-tables.sh sftf` puts into
-//! README.md.
+//! docs/estimators.md.
 
 use imu_ar::ArModel;
 use imu_ar::recursive::{
@@ -267,8 +267,8 @@ fn section_8_cases() {
     ignore = "needs the real records (../shared/data/imu or IMU_AR_DATA)"
 )]
 fn real_records_every_axis() {
-    let records =
-        real_records().expect("the real records: ../shared/data/imu or IMU_AR_DATA (see README)");
+    let records = real_records()
+        .expect("the real records: ../shared/data/imu or IMU_AR_DATA (see docs/reliability.md)");
     println!(
         "| record (six axes, mean removed) | p | lambda | samples | SFTF f32 | SFTF f64 \
          | lattice f32 | RLS f32 |"

@@ -35,8 +35,8 @@ struct Injected {
     ignore = "needs the real records (../shared/data/imu or IMU_AR_DATA)"
 )]
 fn soak_real_records_with_faults() {
-    let records =
-        real_records().expect("the real records: ../shared/data/imu or IMU_AR_DATA (see README)");
+    let records = real_records()
+        .expect("the real records: ../shared/data/imu or IMU_AR_DATA (see docs/reliability.md)");
     let total: u64 = std::env::var("IMU_AR_SOAK_SAMPLES")
         .ok()
         .and_then(|s| s.parse().ok())
