@@ -420,51 +420,28 @@ fn damaged_bytes_never_panic() {
     );
 }
 
-/// `frames` written by the fixture script (`write_ros.py one`, Python's rosbags) as `format`
-/// with `compression` on `/imu`: for the read-speed test only, which no CI step runs.
-fn written_by_python(
-    dir: &std::path::Path,
-    format: &str,
-    compression: &str,
-    frames: &[Frame],
-) -> std::path::PathBuf {
-    let mut csv = String::from("t_ns,gx,gy,gz,ax,ay,az\n");
-    for f in frames {
-        csv += &f.stamp_ns.to_string();
-        for v in f.axes {
-            csv += &format!(",{v:?}");
-        }
-        csv.push('\n');
-    }
-    let csv_path = dir.join("frames.csv");
-    std::fs::write(&csv_path, csv).unwrap();
-    let out = dir.join(format!("speed-{compression}.{}", extension(format)));
-    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/write_ros.py");
-    let status = std::process::Command::new("python3")
-        .args([script, "one"])
-        .arg(&out)
-        .args([format, "/imu", compression])
-        .arg(&csv_path)
-        .status()
-        .expect("python3 with rosbags (pip install rosbags==0.11.9)");
-    assert!(status.success(), "write_ros.py one {format} {compression}");
-    out
+/// The file `speed-{compression}.{ext}` of `IMU_AR_SPEED_DIR`, which the fixture script wrote
+/// from `frames(1_000_000, 14)` (the test starts no program):
+/// `python3 cli/tests/fixtures/write_ros.py one DIR/speed-none.bag ros1 /imu none FRAMES.csv`.
+fn speed_file(format: &str, compression: &str) -> std::path::PathBuf {
+    let dir = std::env::var_os("IMU_AR_SPEED_DIR")
+        .expect("IMU_AR_SPEED_DIR: the folder of the speed files");
+    std::path::Path::new(&dir).join(format!("speed-{compression}.{}", extension(format)))
 }
 
 #[test]
-#[ignore = "writes 1 M messages with Python's rosbags (minutes): pip install rosbags==0.11.9, then \
-            run with --release --ignored --nocapture"]
+#[ignore = "reads 1 M-message files from IMU_AR_SPEED_DIR (written beforehand by \
+            tests/fixtures/write_ros.py one); run with --release --ignored --nocapture"]
 fn read_speed() {
-    let dir = temp_dir("speed");
     let n = 1_000_000;
-    let want = frames(n, 14);
+    let first = frames(1, 14)[0];
     for (format, compression) in [
         ("ros1", "none"),
         ("ros1", "lz4"),
         ("mcap", "none"),
         ("mcap", "zstd"),
     ] {
-        let path = written_by_python(&dir, format, compression, &want);
+        let path = speed_file(format, compression);
         let size = std::fs::metadata(&path).unwrap().len();
         let before = rss_anon_kb();
         let mut peak = before;
@@ -473,6 +450,12 @@ fn read_speed() {
         let start = Instant::now();
         let result = reader(format)(&path, "/imu", &mut |f| {
             count += 1;
+            if count == 1 {
+                assert_eq!(
+                    f.stamp_ns, first.stamp_ns,
+                    "the speed file holds frames(1_000_000, 14)"
+                );
+            }
             check ^= f.axes[0].to_bits();
             if count.is_multiple_of(100_000) {
                 peak = peak.max(rss_anon_kb());
@@ -489,6 +472,5 @@ fn read_speed() {
             secs / (n as f64 / 1e6),
             peak.saturating_sub(before)
         );
-        std::fs::remove_file(&path).unwrap();
     }
 }
