@@ -213,20 +213,32 @@ mod firmware {
         let Ok(octaves) = Octaves::from_stream(allan, black_box(0.01)) else {
             return false;
         };
-        let config = FitConfig::new(black_box(2)).with_oscillators(black_box(true));
-        let fitted = NoiseModel::<P, 2>::fit(&octaves, ar.as_ref(), &config).and_then(|model| {
+        let config = FitConfig::new(black_box(2))
+            .with_oscillators(black_box(true))
+            .with_identification(black_box(true));
+        let fitted = NoiseModel::<P, 2>::identify(&octaves, ar.as_ref(), &config).and_then(|fit| {
+            let model = fit.model;
             let check = model.check(&octaves)?;
+            let whole = model.check_whole(&octaves)?;
             let form = model.kalman(black_box(0.1), black_box(1e-4))?;
+            let uncertainty = model.uncertainty(&octaves)?;
             Ok((
                 model.ieee952(&octaves),
-                check.explained_up_to(),
+                check.explained_up_to().or(whole.explained_up_to()),
                 form,
                 model,
+                uncertainty
+                    .white_noise
+                    .high
+                    .max(uncertainty.random_walk.high),
             ))
         });
         match fitted {
-            Ok((ieee, _, form, model)) => {
-                ieee.white_noise.is_finite() && form.white_psd.is_finite() && persist(&model)
+            Ok((ieee, _, form, model, high)) => {
+                ieee.white_noise.is_finite()
+                    && form.white_psd.is_finite()
+                    && !high.is_nan()
+                    && persist(&model)
             }
             // An AR part the lattice's model cannot give (not stationary) is a typed error.
             Err(e) => matches!(black_box(e), NoiseError::Ar(ModelError::Unstable { .. })),

@@ -11,7 +11,7 @@ pub(super) fn compact(columns: &mut [Column], x: &[f64]) -> usize {
     let mut kept = 0;
     for c in 0..columns.len() {
         let column = columns[c];
-        let term = matches!(column, Column::GaussMarkov(_) | Column::Oscillator(_));
+        let term = matches!(column, Column::GaussMarkov(_) | Column::Oscillator(..));
         let zero_term = term && x.get(c).is_none_or(|v| *v <= 0.0);
         if !zero_term {
             if let Some(slot) = columns.get_mut(kept) {
@@ -28,7 +28,7 @@ pub(super) fn states(columns: &[Column]) -> usize {
     columns.iter().fold(0usize, |n, c| {
         n.saturating_add(match c {
             Column::GaussMarkov(_) => 1,
-            Column::Oscillator(_) => 2,
+            Column::Oscillator(..) => 2,
             _ => 0,
         })
     })

@@ -22,6 +22,7 @@ pub struct FitConfig {
     quantization: bool,
     ramp: bool,
     oscillators: bool,
+    identify: bool,
 }
 
 impl FitConfig {
@@ -34,6 +35,21 @@ impl FitConfig {
             quantization: true,
             ramp: false,
             oscillators: false,
+            identify: false,
+        }
+    }
+
+    /// Whether terms are identified (default: no): added one at a time while each lowers the
+    /// misfit by more than an information criterion charges for it, their correlation times
+    /// (an oscillator's frequency and decay) refined off the grid, a Gauss-Markov term that
+    /// the record cannot tell from a random walk taken as one (see [`NoiseModel::identify`]).
+    /// Without, every state of the budget is spent on the grid's best terms, as a pure curve
+    /// fit: a model that explains the Allan curve, whose parameters may not be the sensor's.
+    /// The identification is checked by the campaign of `host-tests` (`campaign`).
+    pub const fn with_identification(self, on: bool) -> Self {
+        Self {
+            identify: on,
+            ..self
         }
     }
 
@@ -70,7 +86,8 @@ impl FitConfig {
     /// Whether the model may have second-order Gauss-Markov terms (damped oscillators, two
     /// states each; default: no), for a spectral line below the AR part's reach: candidates
     /// at `f = 0.371 / tau` for every octave from `8 dt`, down to [`OSCILLATOR_MIN_HZ`],
-    /// decaying over [`OSCILLATOR_CYCLES`] periods.
+    /// decaying over [`OSCILLATOR_CYCLES`] periods; identified, a term's frequency and decay
+    /// are then refined.
     pub const fn with_oscillators(self, on: bool) -> Self {
         Self {
             oscillators: on,
@@ -91,6 +108,14 @@ pub const OSCILLATOR_CYCLES: f64 = 10.0;
 /// terms fit as well within a record's reach, for one state instead of two.
 pub const OSCILLATOR_MIN_HZ: f64 = 0.1;
 
+/// How far inside the record a Gauss-Markov term's correlation time must lie to be told from
+/// a random walk: `T <= tau_max / 16`. Its Allan deviation peaks at `1.89 T` and falls beyond;
+/// with `T` longer, that fall would rest on the last three octaves alone, whose overlapping
+/// estimates hold about 1, 2 and 4 degrees of freedom where a random walk dominates (Riley's
+/// formula): a bend there is as likely the noise of the estimate. Over the record, such a term
+/// is a random walk (`K^2 = 2 sigma^2 / T`, its form for `tau << T`).
+pub const RECORD_OCTAVES: f64 = 16.0;
+
 /// A column of the fit: a component of unit parameter.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(super) enum Column {
@@ -101,19 +126,26 @@ pub(super) enum Column {
     Ramp,
     Ar,
     GaussMarkov(f64),
-    Oscillator(f64),
+    /// Frequency (Hz) and decay time (s).
+    Oscillator(f64, f64),
 }
 
 /// Weighted solves before and after the reduction to the state budget.
 const PASSES: usize = 3;
 
-/// The weighted problem over the octaves: data, the AR part's curve and the row weights.
-struct Problem<'a, const P: usize, const L: usize> {
-    octaves: &'a Octaves<L>,
-    ar: Option<&'a ArModel<f64, P>>,
-    ar_curve: [f64; L],
+/// The weighted problem over the octaves: data, the AR part's curve, the row weights and the
+/// correlation of each row with the one before.
+pub(super) struct Problem<'a, const P: usize, const L: usize> {
+    pub(super) octaves: &'a Octaves<L>,
+    pub(super) ar: Option<&'a ArModel<f64, P>>,
+    pub(super) ar_curve: [f64; L],
     /// `sqrt(nu_j) / AVAR_j` of the reference curve.
-    weight: [f64; L],
+    pub(super) weight: [f64; L],
+    /// The correlation of octave `j`'s estimate with octave `j - 1`'s
+    /// ([`super::Estimator::octave_correlation`]); 0 for the first.
+    pub(super) rho: [f64; L],
+    /// Whether the rows are taken as correlated (identification) or independent.
+    pub(super) correlated: bool,
 }
 
 impl<const P: usize, const G: usize> NoiseModel<P, G> {
@@ -168,6 +200,43 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
         ar: Option<&ArModel<f64, P>>,
         config: &FitConfig,
     ) -> Result<Self, NoiseError> {
+        Self::identify(octaves, ar, config).map(|fit| fit.model)
+    }
+
+    /// [`NoiseModel::fit`], and whether the budget of states, not the data, limited the
+    /// model.
+    ///
+    /// Identification ([`FitConfig::with_identification`]) works on the rows
+    /// whitened for the correlation between neighbouring octaves
+    /// ([`super::Estimator::octave_correlation`]), so that the weighted misfit `chi^2` is that
+    /// of independent rows of unit variance:
+    ///
+    /// 1. It starts from white noise (and the AR part, if given).
+    /// 2. It adds, one at a time, the candidate (quantisation, random walk, ramp, a
+    ///    Gauss-Markov term at a grid correlation time from `dt` to [`RECORD_OCTAVES`]
+    ///    times less than the longest `tau`, an
+    ///    oscillator) that lowers `chi^2 + ln(L) k` most, `k` its parameters (1; 2 for a
+    ///    Gauss-Markov term; 3 for an oscillator) and `L` the octaves (BIC), as long as one
+    ///    lowers it. The new term's correlation time (an oscillator's frequency and decay
+    ///    time) is refined by golden-section search between its grid neighbours.
+    /// 3. When a candidate would pass but the budget has no state left for it,
+    ///    [`Identified::budget_limited`] says so.
+    /// 4. Then each term is tried without: dropped, or, for a Gauss-Markov term, replaced by
+    ///    the random walk that it is over the record (`K^2 = 2 sigma^2 / T` where
+    ///    `tau << T`), while that lowers the criterion: a term of a few samples is kept only
+    ///    where the first octaves need it, and is otherwise the white noise it is at longer
+    ///    `tau` (`N^2 = 2 sigma^2 T`).
+    /// 5. Last, every correlation time is refined again and the weights refined as in
+    ///    [`NoiseModel::fit`].
+    ///
+    /// # Errors
+    ///
+    /// As [`NoiseModel::fit`].
+    pub fn identify<const L: usize>(
+        octaves: &Octaves<L>,
+        ar: Option<&ArModel<f64, P>>,
+        config: &FitConfig,
+    ) -> Result<Identified<P, G>, NoiseError> {
         if config.gm_states > G {
             return Err(NoiseError::Budget {
                 requested: config.gm_states,
@@ -201,7 +270,7 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
             ),
             None => None,
         };
-        let model = Self::fit_unit(&scaled, ar.as_ref(), config)?;
+        let (model, budget_limited) = Self::fit_unit(&scaled, ar.as_ref(), config)?;
         // A model of no noise at all for data with some: the weights spanned more than f64
         // can hold.
         let mut curve = [0.0; L];
@@ -209,7 +278,10 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
         if curve.iter().all(|v| *v == 0.0) {
             return Err(NoiseError::Range);
         }
-        model.scaled(exponent)
+        Ok(Identified {
+            model: model.scaled(exponent)?,
+            budget_limited,
+        })
     }
 
     /// [`NoiseModel::fit`] in the scaled units.
@@ -217,13 +289,15 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
         octaves: &Octaves<L>,
         ar: Option<&ArModel<f64, P>>,
         config: &FitConfig,
-    ) -> Result<Self, NoiseError> {
+    ) -> Result<(Self, bool), NoiseError> {
         let data = octaves.avar();
         let mut problem = Problem {
             octaves,
             ar,
             ar_curve: [0.0; L],
             weight: [0.0; L],
+            rho: [0.0; L],
+            correlated: config.identify,
         };
         if let Some(ar) = ar {
             component::ar_octaves(ar, &mut problem.ar_curve[..data.len().min(L)])
@@ -255,22 +329,30 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
         }
         let mut t = octaves.dt();
         let longest = octaves.tau(data.len().saturating_sub(1));
+        let longest = if config.identify {
+            longest / RECORD_OCTAVES
+        } else {
+            longest
+        };
         while t <= longest * (1.0 + 1e-9) && push(Column::GaussMarkov(t)) {
             t *= libm::exp2(config.spacing);
         }
         for j in (3..data.len()).filter(|_| config.oscillators) {
             let f = 0.371 / octaves.tau(j);
-            if f < OSCILLATOR_MIN_HZ || !push(Column::Oscillator(f)) {
+            if f < OSCILLATOR_MIN_HZ || !push(Column::Oscillator(f, OSCILLATOR_CYCLES / f)) {
                 break;
             }
         }
         let fixed = fixed_columns.iter().flatten().count();
 
-        let fit = problem.refine(head(columns, n), None)?;
-        n = compact(head_mut(columns, n), &fit.1);
-        n = problem.reduce(columns, fixed, n, config.gm_states)?;
-        let fit = problem.refine(head(columns, n), Some(&fit.0))?;
-        let full = fit.0;
+        let (full, budget_limited) = if config.identify {
+            problem.identify(head(columns, n), config.gm_states, config.spacing)?
+        } else {
+            let fit = problem.refine(head(columns, n), None)?;
+            n = compact(head_mut(columns, n), &fit.1);
+            n = problem.reduce(columns, fixed, n, config.gm_states)?;
+            (problem.refine(head(columns, n), Some(&fit.0))?.0, false)
+        };
         let mut model = Self::default_at(octaves.dt());
         (
             model.quantization,
@@ -297,7 +379,7 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
             .iter_mut()
             .zip(full.oscillators())
             .for_each(|(d, s)| *d = *s);
-        Ok(model)
+        Ok((model, budget_limited))
     }
 
     /// The model with every variance times `2^exponent`.
@@ -348,7 +430,7 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
 
 impl<const P: usize, const L: usize> Problem<'_, P, L> {
     /// The unit Allan variance of `column` at octave `j`.
-    fn unit(&self, column: Column, j: usize) -> f64 {
+    pub(super) fn unit(&self, column: Column, j: usize) -> f64 {
         let (dt, m) = (self.octaves.dt(), 1u64 << j.min(63));
         match column {
             Column::Quantization => component::quantization(dt, m),
@@ -358,14 +440,13 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
             Column::Ar => self.ar_curve.get(j).copied().unwrap_or(0.0),
             Column::GaussMarkov(t) => component::gauss_markov(dt, t, m),
             // The candidates' poles are inside the unit circle by construction.
-            Column::Oscillator(f) => {
-                component::oscillator(dt, f, OSCILLATOR_CYCLES / f, j).unwrap_or(0.0)
-            }
+            Column::Oscillator(f, t) => component::oscillator(dt, f, t, j).unwrap_or(0.0),
         }
     }
 
-    /// Row weights `sqrt(nu) / AVAR` from the data (no model yet) or from `model`.
-    fn reweight<const G: usize>(&mut self, model: Option<&NoiseModel<P, G>>) {
+    /// Row weights `sqrt(nu) / AVAR` from the data (no model yet) or from `model`, and the
+    /// rows' correlations.
+    pub(super) fn reweight<const G: usize>(&mut self, model: Option<&NoiseModel<P, G>>) {
         let data = self.octaves.avar();
         let floor = data
             .iter()
@@ -377,8 +458,11 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
             // A fitted model's AR part is the (stationary) one given: this cannot fail.
             let _ = model.avar_octaves(&mut curve[..data.len().min(L)]);
         }
+        let estimator = self.octaves.estimator();
         let rows = data.iter().zip(&curve).zip(self.weight.iter_mut());
-        for (j, ((d, c), weight)) in indexed(rows) {
+        let rows = rows.zip(self.rho.iter_mut());
+        let mut previous = 0.0;
+        for (j, (((d, c), weight), rho)) in indexed(rows) {
             let m = 1u64 << j.min(63);
             let (kind, reference) = match model {
                 Some(model) if *c > 0.0 => (model.dominant(m).0, *c),
@@ -386,12 +470,34 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
             };
             let nu = self.octaves.edf(j, kind);
             *weight = libm::sqrt(nu) / reference;
+            // A row without an estimate, or after one, is uncorrelated.
+            *rho = if !self.correlated || j == 0 || previous == 0.0 || *weight == 0.0 {
+                0.0
+            } else {
+                estimator.octave_correlation(kind)
+            };
+            previous = *weight;
+        }
+    }
+
+    /// `v` (weighted rows) whitened in place for the rows' correlation: with the rows a Markov
+    /// chain of neighbour correlations `rho_j`, `(v_j - rho_j v_(j-1)) / sqrt(1 - rho_j^2)`
+    /// are uncorrelated.
+    pub(super) fn whiten(&self, v: &mut [f64]) {
+        let rows = v.len().min(L);
+        for j in (1..rows).rev() {
+            let rho = self.rho.get(j).copied().unwrap_or(0.0);
+            if let (Some(&before), true) = (v.get(j - 1), rho != 0.0)
+                && let Some(vj) = v.get_mut(j)
+            {
+                *vj = (*vj - rho * before) / libm::sqrt(1.0 - rho * rho);
+            }
         }
     }
 
     /// Weights from `start` (the data when `None`), then [`PASSES`] solves, each weighted by
     /// the model of the one before.
-    fn refine(
+    pub(super) fn refine(
         &mut self,
         columns: &[Column],
         start: Option<&Full<P>>,
@@ -406,10 +512,15 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
     }
 
     /// Solves the weighted NNLS over `columns`: the model and the parameters (variances).
-    fn solve(&self, columns: &[Column]) -> Result<(Full<P>, [f64; MAX]), NoiseError> {
+    pub(super) fn solve(&self, columns: &[Column]) -> Result<(Full<P>, [f64; MAX]), NoiseError> {
         let (x, _) = self.nnls(columns)?;
+        Ok((self.model_of(columns, &x)?, x))
+    }
+
+    /// The model of the parameters (variances) `x` of `columns`.
+    pub(super) fn model_of(&self, columns: &[Column], x: &[f64]) -> Result<Full<P>, NoiseError> {
         let mut model = Full::<P>::default_at(self.octaves.dt());
-        for (column, &v) in columns.iter().zip(&x) {
+        for (column, &v) in columns.iter().zip(x) {
             let root = libm::sqrt(v);
             match *column {
                 Column::Quantization => model.quantization = root,
@@ -434,26 +545,26 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
                         model.gm_len = model.gm_len.saturating_add(1);
                     }
                 }
-                Column::Oscillator(f) if v > 0.0 => {
+                Column::Oscillator(f, t) if v > 0.0 => {
                     if let Some(slot) = model.osc.get_mut(model.osc_len) {
                         *slot = Oscillator {
                             sigma: root,
                             frequency: f,
-                            decay_time: OSCILLATOR_CYCLES / f,
+                            decay_time: t,
                         };
                         model.osc_len = model.osc_len.saturating_add(1);
                     }
                 }
-                Column::GaussMarkov(_) | Column::Oscillator(_) => {}
+                Column::GaussMarkov(_) | Column::Oscillator(..) => {}
             }
         }
         sort_by_correlation_time(&mut model.gm[..model.gm_len.min(MAX)]);
-        Ok((model, x))
+        Ok(model)
     }
 
     /// The weighted NNLS over `columns`: the parameters (variances) and the weighted residual
     /// norm.
-    fn nnls(&self, columns: &[Column]) -> Result<([f64; MAX], f64), NoiseError> {
+    pub(super) fn nnls(&self, columns: &[Column]) -> Result<([f64; MAX], f64), NoiseError> {
         let rows = self.octaves.avar().len();
         let mut a = [[[0.0; L]; L]; 2];
         let a = &mut a.as_flattened_mut()[..columns.len().min(2 * L)];
@@ -463,6 +574,7 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
             for (j, (v, w)) in cells {
                 *v = w * self.unit(*column, j);
             }
+            self.whiten(&mut col[..rows.min(L)]);
             // The norm scaled by the largest entry, so that squares neither overflow nor
             // underflow.
             let big = col.iter().fold(0.0f64, |m, v| m.max(libm::fabs(*v)));
@@ -480,6 +592,7 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
         for ((bj, d), w) in weighted {
             *bj = w * d;
         }
+        self.whiten(&mut b[..rows.min(L)]);
         let mut work = [[[0.0; L]; L]; 2];
         let work = work.as_flattened_mut();
         let mut x = [0.0; MAX];
@@ -540,7 +653,19 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
 }
 
 /// The model while it is fitted: room for a term at every column.
-type Full<const P: usize> = NoiseModel<P, MAX>;
+pub(super) type Full<const P: usize> = NoiseModel<P, MAX>;
 
 /// The most columns (the limit of [`nnls::nnls`]).
-const MAX: usize = nnls::MAX_COLUMNS;
+pub(super) const MAX: usize = nnls::MAX_COLUMNS;
+
+/// A model identified by [`NoiseModel::identify`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Identified<const P: usize, const G: usize> {
+    /// The model.
+    pub model: NoiseModel<P, G>,
+    /// Whether a term that the data call for was left out for want of states: the budget,
+    /// not the data, limited the model (its random walk, say, then also carries what a
+    /// Gauss-Markov term would have taken).
+    pub budget_limited: bool,
+}

@@ -28,18 +28,24 @@ use crate::model::ModelError;
 mod columns;
 pub mod component;
 mod fit;
+mod identify;
 mod model;
 pub mod nnls;
 mod octaves;
 mod parts;
+mod uncertainty;
 
-pub use fit::{FitConfig, OSCILLATOR_CYCLES, OSCILLATOR_MIN_HZ};
+pub use fit::{FitConfig, Identified, OSCILLATOR_CYCLES, OSCILLATOR_MIN_HZ, RECORD_OCTAVES};
 pub use model::{
     AllanRow, Check, GmState, GmTerm, Ieee952, KalmanForm, NoiseModel, Oscillator, OscillatorState,
+    QuantizationStates,
 };
 pub use nnls::NnlsError;
 pub use octaves::{Estimator, NoiseType, Octaves};
 pub use parts::Coefficients;
+pub use uncertainty::{
+    Interval, MAX_PARAMETERS, OscillatorUncertainty, TermUncertainty, Uncertainty,
+};
 
 /// Why a noise model could not be fitted or used.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

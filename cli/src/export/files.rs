@@ -1,10 +1,11 @@
 //! The YAML files: Kalibr's `imu.yaml`, the OpenVINS IMU chain, VINS-Mono and ORB-SLAM3 (OpenCV
 //! YAML), and what every single-number file shares: the worst axis, its comments and the
-//! horizon statement.
+//! statement of the white noise and random walk written, the smallest overbound of the model
+//! up to a horizon.
 
 use std::ops::Range;
 
-use super::bound::{self, FROM_TAU};
+use super::bound::{self, FROM_TAU, Limit, Overbound};
 use super::{AXIS_NAMES, AxisModel, ImuModel};
 use crate::error::Fail;
 
@@ -47,15 +48,16 @@ impl Sensor {
     }
 }
 
-/// What a single-number file says of one sensor: the continuous `N` and `K` (or `K_H`) it
-/// stands for, and its comment lines.
+/// What a single-number file says of one sensor: the continuous `N_H` and `K_H` it stands
+/// for, and its comment lines.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Written {
-    /// `N` written: the largest axis's, SI/sqrt(Hz).
+    /// `N_H` written: the smallest overbound's white noise, SI/sqrt(Hz).
     pub n: f64,
-    /// `K` written: the largest axis's, or `K_H` with a horizon, SI/s/sqrt(Hz).
+    /// `K_H` written: the smallest overbound's random walk, SI/s/sqrt(Hz).
     pub k: f64,
-    /// The comments: per-axis values, which axis is written, the horizon statement.
+    /// The comments: per-axis values, which axis sets the references, the overbound and its
+    /// reach.
     pub lines: Vec<String>,
 }
 
@@ -146,8 +148,112 @@ pub fn document(
     lines
 }
 
-/// The sensor's written `N` and `K` (or `K_H` with `horizon`) and their comments.
-pub fn written(model: &ImuModel, sensor: &Sensor, horizon: Option<f64>) -> Written {
+/// The overbound of some axes of a sensor up to a horizon: the references it starts from, and
+/// the octaves it covers.
+struct Bounded {
+    /// The reference white noise: the model's `N`, or a floor when it has none.
+    n_ref: f64,
+    /// The reference random walk: the model's `K`, or a floor when it has none.
+    k_ref: f64,
+    /// What the floors taken for a zero `N` and a zero `K` are.
+    floors: Vec<String>,
+    /// The octaves `(axis index, tau, model AVAR)` in `[1 s, H]`, as given to the overbound.
+    rows: Vec<(usize, f64, f64)>,
+    /// The pair written.
+    bound: Overbound,
+}
+
+/// The smallest overbound from `(n, k)` of the model of `axes` at every octave in `[1 s, h]`.
+/// A zero `n` or `k` is replaced by its floor: for `K`, [`bound::k_floor`] at the longest octave
+/// in range; for `N`, [`bound::n_floor`] at the shortest (or, when the model has neither,
+/// [`bound::FLOOR_RISE`] of its Allan deviation there, as white noise).
+fn bounded(n: f64, k: f64, axes: &[(usize, &AxisModel)], h: f64) -> Result<Bounded, Fail> {
+    // A model without K: the upper end of K's 95 % interval, the largest random walk the data
+    // leave room for, of the axes.
+    let k_high = axes
+        .iter()
+        .filter_map(|(_, a)| a.random_walk_interval.map(|i| i.1))
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .max_by(f64::total_cmp);
+    let rows: Vec<(usize, f64, f64)> = bound::octaves(axes, h).collect();
+    let first = rows.iter().map(|r| r.1).min_by(f64::total_cmp).unwrap_or(h);
+    let last = rows.iter().map(|r| r.1).max_by(f64::total_cmp).unwrap_or(h);
+    let rise = 100.0 * bound::FLOOR_RISE;
+    let mut floors = Vec::new();
+    let n_ref = if n > 0.0 {
+        n
+    } else if k > 0.0 {
+        let floor = bound::n_floor(k, first);
+        floors.push(format!(
+            "The model has no white noise: N is taken as {} (never zero), the white noise that \
+             raises the random-walk curve by {rise} % at tau = {} s, the shortest octave from \
+             {FROM_TAU} s.",
+            short(floor),
+            short(first)
+        ));
+        floor
+    } else {
+        // Neither: white noise at FLOOR_RISE of the model's Allan deviation at the first
+        // octave in range, or at the model's first octave.
+        let (tau, avar) = rows
+            .iter()
+            .filter(|r| r.1 == first)
+            .map(|r| (r.1, r.2))
+            .max_by(|p, q| p.1.total_cmp(&q.1))
+            .or_else(|| axes.first().map(|(_, a)| (a.dt, a.model_avar[0])))
+            .unwrap_or((0.0, 0.0));
+        let floor = bound::FLOOR_RISE * (avar * tau).sqrt();
+        floors.push(format!(
+            "The model has no white noise and no random walk: N is taken as {} (never zero), \
+             white noise at {rise} % of the model's Allan deviation at tau = {} s.",
+            short(floor),
+            short(tau)
+        ));
+        floor
+    };
+    let k_ref = if k > 0.0 {
+        k
+    } else if let Some(high) = k_high {
+        floors.push(format!(
+            "The model has no random walk: K is taken as {} (never zero), the upper end of its 95 % \
+             interval, the largest random walk the record leaves room for.",
+            short(high)
+        ));
+        high
+    } else {
+        let floor = bound::k_floor(n_ref, last);
+        floors.push(format!(
+            "The model has no random walk: K is taken as {} (never zero), the random walk that \
+             raises the white curve by {rise} % at tau = {} s, the longest octave up to H.",
+            short(floor),
+            short(last)
+        ));
+        floor
+    };
+    let pairs: Vec<(f64, f64)> = rows.iter().map(|r| (r.1, r.2)).collect();
+    let bound = bound::smallest_overbound(n_ref, k_ref, &pairs).ok_or_else(|| {
+        Fail(format!(
+            "no white noise and random walk overbound the model (N {n_ref}, K {k_ref}): its Allan \
+             deviation is zero or not finite"
+        ))
+    })?;
+    Ok(Bounded {
+        n_ref,
+        k_ref,
+        floors,
+        rows,
+        bound,
+    })
+}
+
+/// The sensor's written `N_H` and `K_H` (the smallest overbound of the model of its axes from
+/// 1 s to `horizon`, or without one to the model's longest octave) and their comments.
+///
+/// # Errors
+///
+/// A [`Fail`] when no overbound can be formed (a model whose Allan deviation is zero or not
+/// finite).
+pub fn written(model: &ImuModel, sensor: &Sensor, horizon: Option<f64>) -> Result<Written, Fail> {
     let axes: Vec<(usize, &AxisModel)> = sensor.axes.clone().map(|i| (i, &model.axes[i])).collect();
     let worst = |f: fn(&AxisModel) -> f64| {
         axes.iter()
@@ -156,85 +262,120 @@ pub fn written(model: &ImuModel, sensor: &Sensor, horizon: Option<f64>) -> Writt
     };
     let (n, n_axis) = worst(|a| a.white_noise);
     let (k, k_axis) = worst(|a| a.random_walk);
+    let longest = bound::longest_octave(&axes).unwrap_or(FROM_TAU);
+    let h = horizon.unwrap_or(longest);
     let u = sensor.unit;
     let mut lines = vec![
         String::new(),
         format!(
             "{} per axis: continuous N ({u}/sqrt(Hz)), K ({u}/s/sqrt(Hz)), bias instability B \
-             ({u}) at its tau (none of these files has a term for B):",
+             ({u}) at its tau (none of these files has a term for B), and the overbound N_H, K_H \
+             of the axis alone (see below):",
             sensor.name
         ),
     ];
+    let interval = |i: Option<(f64, f64)>| {
+        i.map_or(String::new(), |(lo, hi)| {
+            format!(" [{}, {}]", short(lo), short(hi))
+        })
+    };
+    lines.push(
+        "  (N and K with their 95 % intervals, from the Allan variances' sampling distribution)"
+            .into(),
+    );
     for &(i, a) in &axes {
-        let mut line = format!(
-            "  {}: N = {}, K = {}, B = {} at tau = {} s",
+        let alone = bounded(a.white_noise, a.random_walk, &[(i, a)], h)?.bound;
+        lines.push(format!(
+            "  {}: N = {}{}, K = {}{}, B = {} at tau = {} s; alone: N_H = {}, K_H = {}",
             AXIS_NAMES[i],
             short(a.white_noise),
+            interval(a.white_noise_interval),
             short(a.random_walk),
+            interval(a.random_walk_interval),
             short(a.bias_instability.0),
-            short(a.bias_instability.1)
-        );
-        if let Some(h) = horizon {
-            let (kh, _) = bound::horizon_random_walk(a.white_noise, a.random_walk, &[(i, a)], h);
-            line += &format!(" (alone: K_H = {})", short(kh));
-        }
-        lines.push(line);
+            short(a.bias_instability.1),
+            short(alone.n),
+            short(alone.k)
+        ));
     }
     lines.push(format!(
-        "One number for the three axes: the worst (largest) is written: N of {}, K of {}.",
+        "One number for the three axes: from the worst (largest) fitted values, N of {} and K of \
+         {}, over the model of all three axes.",
         AXIS_NAMES[n_axis], AXIS_NAMES[k_axis]
     ));
-    let written_k = match horizon {
-        None => k,
-        Some(h) => {
-            let (kh, at) = bound::horizon_random_walk(n, k, &axes, h);
-            lines.extend(horizon_lines(k, kh, at, h));
-            kh
-        }
-    };
-    lines.extend(reach_lines(n, written_k, &axes, horizon.is_some()));
-    Written {
-        n,
-        k: written_k,
+    let b = bounded(n, k, &axes, h)?;
+    lines.extend(overbound_lines(n, k, &b, h, horizon.is_some()));
+    lines.extend(reach_lines(b.bound.n, b.bound.k, &axes));
+    Ok(Written {
+        n: b.bound.n,
+        k: b.bound.k,
         lines,
-    }
+    })
 }
 
-/// The statement of the random walk `K_H` raised from `k` for the horizon `h`.
-fn horizon_lines(k: f64, kh: f64, at: Option<(usize, f64)>, h: f64) -> Vec<String> {
-    let factor = if k > 0.0 {
-        format!("K_H/K = {}", short(kh / k))
+/// The statement of the overbound `b` of the model up to `h`, from the fitted `n` and `k`.
+fn overbound_lines(n: f64, k: f64, b: &Bounded, h: f64, asked: bool) -> Vec<String> {
+    let Overbound {
+        n: nh,
+        k: kh,
+        limits,
+    } = b.bound;
+    let first = b.rows.iter().map(|r| r.1).min_by(f64::total_cmp);
+    let last = b.rows.iter().map(|r| r.1).max_by(f64::total_cmp);
+    let which = if asked {
+        "the horizon asked for"
     } else {
-        "the model has no random walk: K_H stands alone".to_string()
+        "the model's longest octave"
     };
     let mut lines = vec![format!(
-        "Horizon H = {h} s: the random walk written is K_H = {} ({factor}; K = {}), the \
-         smallest K_H >= K with sqrt(N^2/tau + K_H^2 tau/3) at or above the model's Allan \
-         deviation of every axis at every octave tau in [{FROM_TAU} s, H]",
-        short(kh),
-        short(k)
-    )];
-    lines.push(match at {
-        Some((i, tau)) => format!(
-            "(set by {} at tau = {} s): it stands in for the bias instability (Gauss-Markov \
-             terms) that this file cannot hold, a checked choice instead of a rule of thumb.",
-            AXIS_NAMES[i],
-            short(tau)
-        ),
-        None => {
-            "(K_H = K: white noise and random walk already overbound the model there).".to_string()
+        "White noise and random walk: the smallest overbound of the model's Allan deviation from \
+         tau = {FROM_TAU} s to H = {} s, {which} (log N_H/N + log K_H/K minimal), every axis at \
+         every octave{}:",
+        short(h),
+        match (first, last) {
+            (Some(f), Some(l)) => format!(" ({} s to {} s)", short(f), short(l)),
+            _ => String::new(),
         }
+    )];
+    let ratio = |x: f64, of: f64, name: &str, floored: bool| {
+        let over = if floored { "floor" } else { name };
+        format!("{name}_H/{over} = {}", short(x / of))
+    };
+    lines.push(format!(
+        "  N_H = {} (fitted N = {}, {}), K_H = {} (fitted K = {}, {}).",
+        short(nh),
+        short(n),
+        ratio(nh, b.n_ref, "N", n <= 0.0),
+        short(kh),
+        short(k),
+        ratio(kh, b.k_ref, "K", k <= 0.0)
+    ));
+    let octave = |j: usize| {
+        let (i, tau, _) = b.rows[j];
+        format!("the model at tau = {} s ({})", short(tau), AXIS_NAMES[i])
+    };
+    lines.push(match limits {
+        _ if b.rows.is_empty() => format!(
+            "  No octave of the model lies in [{FROM_TAU} s, H]: N and K written as fitted."
+        ),
+        [Limit::White, Limit::RandomWalk] => "  N_H = N and K_H = K: the fitted white noise and \
+                                              random walk already overbound the model there."
+            .to_string(),
+        [Limit::White, Limit::Octave(j)] => format!("  N_H = N; K_H set by {}.", octave(j)),
+        [Limit::RandomWalk, Limit::Octave(j)] => format!("  K_H = K; N_H set by {}.", octave(j)),
+        [Limit::Octave(p), Limit::Octave(q)] => {
+            format!("  Set by {} and {}.", octave(p), octave(q))
+        }
+        _ => String::new(),
     });
+    lines.extend(b.floors.iter().cloned());
+    lines.retain(|l| !l.is_empty());
     lines
 }
 
 /// The statement of how far the curve of `(n, k)` overbounds the model of `axes`.
-fn reach_lines(n: f64, k: f64, axes: &[(usize, &AxisModel)], raised: bool) -> Vec<String> {
-    let curve = if raised {
-        "With K_H, sqrt(N^2/tau + K_H^2 tau/3)"
-    } else {
-        "The file's white noise and random walk, sqrt(N^2/tau + K^2 tau/3),"
-    };
+fn reach_lines(n: f64, k: f64, axes: &[(usize, &AxisModel)]) -> Vec<String> {
+    let curve = "With N_H and K_H, sqrt(N_H^2/tau + K_H^2 tau/3)";
     let r = bound::reach(n, k, axes);
     let Some(last) = r.last else {
         return vec![format!(
@@ -259,8 +400,8 @@ fn reach_lines(n: f64, k: f64, axes: &[(usize, &AxisModel)], raised: bool) -> Ve
     }];
     if let Some((short_by, tau, i)) = r.shortfall {
         lines.push(format!(
-            "{} it falls short by up to {:.1} % (of the Allan deviation, {} at tau = {} \
-             s){}.",
+            "{} it falls short by up to {:.1} % (of the Allan deviation, {} at tau = {} s); a \
+             filter that must coast longer: export with a longer horizon.",
             if r.up_to.is_some() {
                 "Beyond,"
             } else {
@@ -269,11 +410,6 @@ fn reach_lines(n: f64, k: f64, axes: &[(usize, &AxisModel)], raised: bool) -> Ve
             100.0 * short_by,
             AXIS_NAMES[i],
             short(tau),
-            if raised {
-                ""
-            } else {
-                "; a filter that must coast longer: export with a horizon"
-            }
         ));
     }
     lines
@@ -282,8 +418,8 @@ fn reach_lines(n: f64, k: f64, axes: &[(usize, &AxisModel)], raised: bool) -> Ve
 /// The written values of both sensors, checked finite.
 fn both(model: &ImuModel, horizon: Option<f64>) -> Result<[Written; 2], Fail> {
     let out = [
-        written(model, &GYRO, horizon),
-        written(model, &ACCEL, horizon),
+        written(model, &GYRO, horizon)?,
+        written(model, &ACCEL, horizon)?,
     ];
     for (w, s) in out.iter().zip([&GYRO, &ACCEL]) {
         finite(&format!("{} N", s.name), w.n)?;

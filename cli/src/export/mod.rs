@@ -6,11 +6,13 @@
 //! Each target's convention (units, continuous or discrete, per axis or one number for all,
 //! how its filter uses the number) is cited from its own source where its file is written
 //! ([`files`] and [`params`]). Six of the formats take white noise `N` and random walk `K`
-//! alone, one number per sensor: the largest (worst) axis is written, and the file says which.
-//! None of them has a bias-instability (Gauss-Markov) term: without a horizon the file states
-//! how far its white + random-walk curve overbounds the model's Allan deviation; with a
-//! horizon `H` it carries the smallest random walk `K_H >= K` that overbounds it at every
-//! octave in `[1 s, H]` ([`bound`]). The state-space file always carries the full composite.
+//! alone, one number per sensor, for the three axes together. None of them has a
+//! bias-instability (Gauss-Markov) term: they carry the smallest pair `(N_H, K_H)`, `N_H >= N`
+//! and `K_H >= K` of the worst axis, whose curve `sqrt(N_H^2/tau + K_H^2 tau/3)` overbounds the
+//! model's Allan deviation of every axis at every octave in `[1 s, H]` (`log N_H/N + log K_H/K`
+//! minimal, [`bound`]), `H` the horizon asked for or else the model's longest octave; never a
+//! zero. The files state it with the fitted `N` and `K`. The state-space file always carries
+//! the full composite.
 
 pub mod bound;
 pub mod files;
@@ -48,6 +50,10 @@ pub struct AxisModel {
     pub model_avar: Vec<f64>,
     /// The full composite at the filter's rate.
     pub state_space: StateSpace,
+    /// The 95 % interval of `N` (SI), when the fit gave one.
+    pub white_noise_interval: Option<(f64, f64)>,
+    /// The 95 % interval of `K` (SI), when the fit gave one; from 0 for a model without `K`.
+    pub random_walk_interval: Option<(f64, f64)>,
 }
 
 impl AxisModel {
@@ -99,6 +105,8 @@ impl AxisModel {
             dt: model.dt(),
             model_avar: avar,
             state_space: StateSpace::of(&form, s2),
+            white_noise_interval: None,
+            random_walk_interval: None,
         };
         axis.check("the model")?;
         Ok(axis)
@@ -276,14 +284,15 @@ impl FromStr for Format {
 }
 
 /// Writes the file of `format` into `dir` and returns its path. `horizon`: the time in
-/// seconds the filter must coast; with it, the six parameter formats carry the random walk
-/// `K_H` that overbounds the model up to it ([`bound`]); without, the model's `K`.
+/// seconds the filter must coast; the six parameter formats carry the smallest white noise and
+/// random walk `(N_H, K_H)` that overbound the model from 1 s up to it, or without it up to the
+/// model's longest octave ([`bound`]).
 ///
 /// # Errors
 ///
-/// A [`Fail`] for a model with a value that is not finite, a horizon that is not positive and
-/// finite, a topic with control characters, a filter rate PX4 cannot take, or a file that
-/// cannot be written.
+/// A [`Fail`] for a model with a value that is not finite, a horizon that is not finite or
+/// below [`bound::FROM_TAU`], a topic with control characters, a filter rate PX4 cannot take, a
+/// model that no white noise and random walk overbound, or a file that cannot be written.
 pub fn write(
     format: Format,
     model: &ImuModel,
@@ -291,8 +300,12 @@ pub fn write(
     dir: &Path,
 ) -> Result<PathBuf, Fail> {
     model.check()?;
-    if let Some(h) = horizon.filter(|h| !(h.is_finite() && *h > 0.0)) {
-        return Err(Fail(format!("horizon {h} s: must be positive and finite")));
+    if let Some(h) = horizon.filter(|h| !(h.is_finite() && *h >= bound::FROM_TAU)) {
+        return Err(Fail(format!(
+            "horizon {h} s: must be finite and at least {} s (the overbound runs from {} s)",
+            bound::FROM_TAU,
+            bound::FROM_TAU
+        )));
     }
     let text = match format {
         Format::Kalibr => files::kalibr(model, horizon)?,
@@ -331,7 +344,9 @@ fn state_space_json(model: &ImuModel) -> String {
                 "phi": a.state_space.phi,
                 "q": a.state_space.q,
                 "p0": a.state_space.p0,
+                "h": a.state_space.h,
                 "measurement_variance": a.state_space.measurement_variance,
+                "quantization": a.state_space.quantization,
                 "dt": a.state_space.dt,
                 "model_adev": adev,
             })
@@ -340,10 +355,12 @@ fn state_space_json(model: &ImuModel) -> String {
     let doc = json!({
         "written_by": files::TOOL,
         "units": "SI: a gyro in rad/s, an accelerometer in m/s^2; white_noise in unit/sqrt(Hz), \
-                  random_walk in unit/s/sqrt(Hz), q, p0 and measurement_variance in unit^2",
+                  random_walk in unit/s/sqrt(Hz), q, p0 and measurement_variance in unit^2, \
+                  quantization.value in unit s",
         "form": "discrete time at the filter's step dt: x_{k+1} = phi x_k + w_k, Cov(w_k) = q, \
-                 x_0 ~ (0, p0); the sensor is the sum of the states plus white noise of variance \
-                 measurement_variance (N^2/dt + 2 Q^2/dt^2) per sample",
+                 x_0 ~ (0, p0); the sensor averaged over a step is h x_k plus white noise of \
+                 variance measurement_variance (N^2/dt); h is 1 on every state but an \
+                 oscillator's (dx/dt), 0, and quantization (q_(k-1)/Dt), -1 (Dt is the step dt)",
         "rate_hz": model.rate_hz,
         "axes": axes,
     });

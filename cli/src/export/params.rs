@@ -52,8 +52,8 @@ fn autopilot(
     names: &Names,
 ) -> Result<(Vec<Value>, [Written; 2]), Fail> {
     let sensors = [
-        written(model, &GYRO, horizon),
-        written(model, &ACCEL, horizon),
+        written(model, &GYRO, horizon)?,
+        written(model, &ACCEL, horizon)?,
     ];
     let [g, a] = &sensors;
     let mut values = Vec::new();

@@ -12,7 +12,9 @@ use std::path::PathBuf;
 use imu_ar::ArModel;
 use imu_ar::batch::criteria::Criterion;
 use imu_ar::batch::{BatchConfig, burg};
-use imu_ar::noise::{Check, FitConfig, Ieee952, KalmanForm, NoiseError, NoiseModel, Octaves};
+use imu_ar::noise::{
+    Check, FitConfig, Ieee952, Interval, KalmanForm, NoiseError, NoiseModel, Octaves, Uncertainty,
+};
 use serde::Serialize;
 
 use crate::chart;
@@ -138,6 +140,99 @@ pub struct ArPart {
     pub scale: f64,
 }
 
+/// A value with its 95 % interval.
+#[derive(Clone, Copy, Serialize)]
+pub struct Bounds {
+    /// The value.
+    pub value: f64,
+    /// The interval's lower end.
+    pub low: f64,
+    /// The interval's upper end (infinite when the data do not bound it: `null` in JSON).
+    pub high: f64,
+}
+
+impl Bounds {
+    fn of(value: f64, i: Interval) -> Self {
+        Self {
+            value,
+            low: i.low,
+            high: i.high,
+        }
+    }
+
+    fn text(&self) -> String {
+        format!("[{}, {}]", json(&self.low), json(&self.high))
+    }
+}
+
+/// A Gauss-Markov term's intervals.
+#[derive(Serialize)]
+pub struct TermBounds {
+    /// `sigma`.
+    pub sigma: Bounds,
+    /// Correlation time (an oscillator's decay time), s.
+    pub correlation_time_s: Bounds,
+    /// An oscillator's frequency, Hz.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub frequency_hz: Option<Bounds>,
+}
+
+/// The 95 % intervals of the parameters (`NoiseModel::uncertainty`): from the sampling
+/// distribution of the octave Allan variances, the terms a model lacks from 0.
+#[derive(Serialize)]
+pub struct Intervals {
+    /// `N`.
+    pub white_noise: Bounds,
+    /// `Q`.
+    pub quantization: Bounds,
+    /// `K`.
+    pub random_walk: Bounds,
+    /// `R`.
+    pub rate_ramp: Bounds,
+    /// `B`.
+    pub bias_instability: Bounds,
+    /// The Gauss-Markov terms, in the order of `gauss_markov`.
+    pub gauss_markov: Vec<TermBounds>,
+}
+
+impl Intervals {
+    fn of<const P: usize>(
+        model: &NoiseModel<P, MAX_GM_STATES>,
+        u: &Uncertainty<MAX_GM_STATES, OCTAVES>,
+        b: f64,
+    ) -> Self {
+        let mut gauss_markov: Vec<TermBounds> = model
+            .gauss_markov()
+            .iter()
+            .zip(u.gauss_markov())
+            .map(|(t, i)| TermBounds {
+                sigma: Bounds::of(t.sigma, i.sigma),
+                correlation_time_s: Bounds::of(t.correlation_time, i.correlation_time),
+                frequency_hz: None,
+            })
+            .collect();
+        gauss_markov.extend(
+            model
+                .oscillators()
+                .iter()
+                .zip(u.oscillators())
+                .map(|(o, i)| TermBounds {
+                    sigma: Bounds::of(o.sigma, i.sigma),
+                    correlation_time_s: Bounds::of(o.decay_time, i.decay_time),
+                    frequency_hz: Some(Bounds::of(o.frequency, i.frequency)),
+                }),
+        );
+        Self {
+            white_noise: Bounds::of(model.white_noise(), u.white_noise),
+            quantization: Bounds::of(model.quantization(), u.quantization),
+            random_walk: Bounds::of(model.random_walk(), u.random_walk),
+            rate_ramp: Bounds::of(model.ramp(), u.ramp),
+            bias_instability: Bounds::of(b, u.bias_instability),
+            gauss_markov,
+        }
+    }
+}
+
 /// What the text output adds to the JSON object.
 #[derive(Default)]
 pub struct Details {
@@ -168,6 +263,11 @@ pub struct NoiseResult {
     pub bias_instability: BiasInstability,
     /// The Gauss-Markov terms: first order by correlation time, then the oscillators.
     pub gauss_markov: Vec<GmEntry>,
+    /// Whether a term the data call for was left out for want of states (`--gm-states`): the
+    /// budget, not the data, limited the model.
+    pub budget_limited: bool,
+    /// The 95 % intervals of the parameters, when the model has few enough for them.
+    pub intervals: Option<Intervals>,
     /// The AR part, or `None`.
     pub ar: Option<ArPart>,
     /// The filter's transition over one step: the Gauss-Markov states, the oscillators' state
@@ -337,8 +437,10 @@ impl Fitting {
         octaves: &'a Octaves<OCTAVES>,
         ar: Option<&ArModel<f64, P>>,
     ) -> Result<Fitted<'a>, Fail> {
-        let model = NoiseModel::<P, MAX_GM_STATES>::fit(octaves, ar, &self.config)?;
+        let fit = NoiseModel::<P, MAX_GM_STATES>::identify(octaves, ar, &self.config)?;
+        let model = fit.model;
         let check = model.check(octaves)?;
+        let uncertainty = model.uncertainty(octaves).ok();
         let span = self.n as f64 / self.rate;
         // The random walk's state starts with the variance it reaches over the record.
         let rw_p0 = model.random_walk() * model.random_walk() * span;
@@ -348,7 +450,11 @@ impl Fitting {
                 self.filter_rate
             ))
         })?;
-        let result = self.result(&model, ar, &model.ieee952(octaves), &form, &check);
+        let mut result = self.result(&model, ar, &model.ieee952(octaves), &form, &check);
+        result.budget_limited = fit.budget_limited;
+        result.intervals = uncertainty
+            .as_ref()
+            .map(|u| Intervals::of(&model, u, result.bias_instability.value));
         let default = self.caption(&model);
         let paint: Paint<'a> = Box::new(move |area, caption| {
             let caption = if caption.is_empty() {
@@ -362,10 +468,15 @@ impl Fitting {
         // instability is the data's IEEE 952 reading, not the model's.
         let axis = match self.export {
             true => {
+                let reach = octaves.avar().len();
                 let mut axis =
-                    AxisModel::from_noise(&model, 1.0, 1.0 / self.filter_rate, rw_p0, OCTAVES)?;
+                    AxisModel::from_noise(&model, 1.0, 1.0 / self.filter_rate, rw_p0, reach)?;
                 axis.bias_instability =
                     (result.bias_instability.value, result.bias_instability.tau_s);
+                if let Some(u) = &uncertainty {
+                    axis.white_noise_interval = Some((u.white_noise.low, u.white_noise.high));
+                    axis.random_walk_interval = Some((u.random_walk.low, u.random_walk.high));
+                }
                 Some(axis)
             }
             false => None,
@@ -436,6 +547,8 @@ impl Fitting {
                 tau_s: ieee.bias_instability.1,
             },
             gauss_markov,
+            budget_limited: false,
+            intervals: None,
             ar: ar_part,
             phi: space.phi,
             q: space.q,
@@ -533,6 +646,30 @@ impl Output for NoiseResult {
             }
             s += "\n";
         }
+        if self.budget_limited {
+            s += "budget_limited true: the data call for a term that --gm-states left no state \
+                  for; the random walk and the other terms carry it\n";
+        }
+        if let Some(i) = &self.intervals {
+            s += "95 % intervals (from the Allan variances' sampling distribution; a term the \
+                  model lacks from 0):\n";
+            s += &format!("  white_noise {}\n", i.white_noise.text());
+            s += &format!("  quantization {}\n", i.quantization.text());
+            s += &format!("  random_walk {}\n", i.random_walk.text());
+            s += &format!("  rate_ramp {}\n", i.rate_ramp.text());
+            s += &format!("  bias_instability {}\n", i.bias_instability.text());
+            for (k, t) in i.gauss_markov.iter().enumerate() {
+                s += &format!(
+                    "  gauss_markov[{k}] sigma {} correlation_time_s {}",
+                    t.sigma.text(),
+                    t.correlation_time_s.text()
+                );
+                if let Some(f) = &t.frequency_hz {
+                    s += &format!(" frequency_hz {}", f.text());
+                }
+                s += "\n";
+            }
+        }
         match &self.ar {
             Some(ar) => {
                 s += &format!(
@@ -558,7 +695,9 @@ impl Output for NoiseResult {
             }
         );
         s += &format!(
-            "phi {}\nq {}\np0 {}\nmeasurement_variance {} (N^2 / Dt + 2 Q^2 / Dt^2)\n",
+            "phi {}\nq {}\np0 {}\nmeasurement_variance {} (N^2 / Dt, white; the sample \
+             is h x plus it, h = 1 on each state but -1 on quantization (q_(k-1)/Dt) and 0 on \
+             an oscillator's (dx/dt))\n",
             json(&self.phi),
             json(&self.q),
             json(&self.p0),

@@ -22,17 +22,34 @@ fn normal(rng: &mut ChaCha8Rng) -> f64 {
     (-2.0 * a.ln()).sqrt() * (std::f64::consts::TAU * b).cos()
 }
 
+/// The noise of the six axes of a static IMU, SI: white noise `N`, random walk `K` and one
+/// Gauss-Markov term (`sigma`, correlation time `T` in s) per axis.
+struct Noise {
+    white: [f64; 6],
+    walk: [f64; 6],
+    gm_sigma: [f64; 6],
+    gm_t: f64,
+}
+
 /// `n` frames of a static IMU at `rate` Hz: white noise, a random walk and a Gauss-Markov term
 /// per axis (gyros in rad/s, accelerometers in m/s^2 about gravity on z), stamps in ns with a
 /// jitter of up to +-20 us.
 fn imu_frames(n: usize, rate: f64, seed: u64) -> Vec<Frame> {
+    let noise = Noise {
+        white: [1e-3, 1.2e-3, 0.8e-3, 2e-2, 2.5e-2, 3e-2],
+        walk: [2e-5, 1e-5, 3e-5, 4e-4, 2e-4, 5e-4],
+        gm_sigma: [3e-4, 2e-4, 4e-4, 5e-3, 4e-3, 6e-3],
+        gm_t: 5.0,
+    };
+    noise_frames_of(&noise, n, rate, seed)
+}
+
+/// `n` frames of a static IMU with `noise` at `rate` Hz, as [`imu_frames`].
+fn noise_frames_of(noise: &Noise, n: usize, rate: f64, seed: u64) -> Vec<Frame> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let dt = 1.0 / rate;
-    let white = [1e-3, 1.2e-3, 0.8e-3, 2e-2, 2.5e-2, 3e-2];
-    let walk = [2e-5, 1e-5, 3e-5, 4e-4, 2e-4, 5e-4];
     let mean = [0.01, -0.02, 0.005, 0.1, -0.2, 9.81];
-    let (gm_sigma, gm_t) = ([3e-4, 2e-4, 4e-4, 5e-3, 4e-3, 6e-3], 5.0);
-    let phi: f64 = (-dt / gm_t).exp();
+    let phi: f64 = (-dt / noise.gm_t).exp();
     let mut rw = [0.0; 6];
     let mut gm = [0.0; 6];
     (0..n)
@@ -40,9 +57,10 @@ fn imu_frames(n: usize, rate: f64, seed: u64) -> Vec<Frame> {
             let jitter = (rng.next_u32() % 40_001) as i64 - 20_000;
             let stamp_ns = 1_403_636_579_758_555_392 + (i as f64 * dt * 1e9) as i64 + jitter;
             let axes = std::array::from_fn(|k| {
-                rw[k] += walk[k] * dt.sqrt() * normal(&mut rng);
-                gm[k] = phi * gm[k] + gm_sigma[k] * (1.0 - phi * phi).sqrt() * normal(&mut rng);
-                mean[k] + white[k] / dt.sqrt() * normal(&mut rng) + rw[k] + gm[k]
+                rw[k] += noise.walk[k] * dt.sqrt() * normal(&mut rng);
+                gm[k] =
+                    phi * gm[k] + noise.gm_sigma[k] * (1.0 - phi * phi).sqrt() * normal(&mut rng);
+                mean[k] + noise.white[k] / dt.sqrt() * normal(&mut rng) + rw[k] + gm[k]
             });
             Frame { stamp_ns, axes }
         })
@@ -189,8 +207,44 @@ fn yaml_value(text: &str, key: &str) -> f64 {
     value.parse().unwrap()
 }
 
+/// The model's Allan variance of `axis` (of `characterise --json`) at its octaves with `tau`
+/// in `[1 s, upper]`: `(tau, AVAR)`.
+fn model_octaves(model: &serde_json::Value, axis: usize, upper: f64) -> Vec<(f64, f64)> {
+    model["axes"][axis]["model"]["allan"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| {
+            let (tau, adev) = (
+                r["tau_s"].as_f64().unwrap(),
+                r["model_adev"].as_f64().unwrap(),
+            );
+            (tau, adev * adev)
+        })
+        .filter(|(tau, _)| (1.0..=upper).contains(tau))
+        .collect()
+}
+
+/// The octaves of `rows` where `sqrt(n^2/tau + k^2 tau/3)` is below the model's deviation.
+fn uncovered(n: f64, k: f64, rows: &[(f64, f64)]) -> Vec<f64> {
+    rows.iter()
+        .filter(|(tau, v)| n * n / tau + k * k * tau / 3.0 < v * (1.0 - 1e-9))
+        .map(|(tau, _)| *tau)
+        .collect()
+}
+
+/// The Kalibr keys of the gyroscope and of the accelerometer: `(N key, K key, axes)`.
+const KALIBR_KEYS: [(&str, &str, std::ops::Range<usize>); 2] = [
+    ("gyroscope_noise_density", "gyroscope_random_walk", 0..3),
+    (
+        "accelerometer_noise_density",
+        "accelerometer_random_walk",
+        3..6,
+    ),
+];
+
 #[test]
-fn the_kalibr_file_carries_the_model_n_and_k_in_si() {
+fn the_kalibr_file_carries_the_models_overbound_in_si() {
     let dir = temp_dir("kalibr");
     let file = dir.join("data.csv");
     write_euroc(&file, &imu_frames(100_000, 200.0, 3));
@@ -201,19 +255,71 @@ fn the_kalibr_file_carries_the_model_n_and_k_in_si() {
         axes.map(|i| model["axes"][i]["model"][key].as_f64().unwrap_or(0.0))
             .fold(0.0, f64::max)
     };
-    for (key, axes, field) in [
-        ("gyroscope_noise_density", 0..3, "white_noise"),
-        ("gyroscope_random_walk", 0..3, "random_walk"),
-        ("accelerometer_noise_density", 3..6, "white_noise"),
-        ("accelerometer_random_walk", 3..6, "random_walk"),
-    ] {
-        let (got, want) = (yaml_value(&text, key), worst(axes, field));
+    for (n_key, k_key, axes) in KALIBR_KEYS {
+        let (n, k) = (yaml_value(&text, n_key), yaml_value(&text, k_key));
+        // At or above the worst axis's fitted values, never zero.
         assert!(
-            (got / want - 1.0).abs() < 1e-9,
-            "{key}: {got} against {want}"
+            n >= worst(axes.clone(), "white_noise") && n > 0.0,
+            "{n_key}: {n}"
         );
+        assert!(
+            k >= worst(axes.clone(), "random_walk") && k > 0.0,
+            "{k_key}: {k}"
+        );
+        // Without a horizon: the overbound reaches every octave the record resolves.
+        for i in axes {
+            let rows = model_octaves(&model, i, f64::INFINITY);
+            assert!(rows.len() >= 5, "axis {i}: {} octaves", rows.len());
+            let below = uncovered(n, k, &rows);
+            assert!(
+                below.is_empty(),
+                "axis {i}: ({n}, {k}) below the model at {below:?}"
+            );
+        }
     }
     assert!((yaml_value(&text, "update_rate") - 200.0).abs() < 0.2);
+}
+
+#[test]
+fn a_white_and_random_walk_record_exports_close_to_its_truth() {
+    // One hour at 100 Hz; the random walk crosses the white noise at sqrt(3) N / K = 43 s and
+    // rules the last 1.5 decades of the octaves the record resolves (to about 1300 s).
+    let (gyro, accel) = ((1e-3, 4e-5), (2e-2, 8e-4));
+    let noise = Noise {
+        white: [gyro.0, gyro.0, gyro.0, accel.0, accel.0, accel.0],
+        walk: [gyro.1, gyro.1, gyro.1, accel.1, accel.1, accel.1],
+        gm_sigma: [0.0; 6],
+        gm_t: 1.0,
+    };
+    let dir = temp_dir("white-rw");
+    let file = dir.join("data.csv");
+    write_euroc(&file, &noise_frames_of(&noise, 360_000, 100.0, 12));
+    let out = dir.join("out");
+    let horizon = 600.0;
+    let model = characterise(
+        &[path(&file)],
+        &out,
+        &["--format", "kalibr", "--horizon", "600"],
+    );
+    let text = std::fs::read_to_string(out.join("imu.yaml")).unwrap();
+    assert!(
+        text.contains("to H = 6.0000e2 s, the horizon asked for (log N_H/N"),
+        "{text}"
+    );
+    for ((n_key, k_key, axes), (n_true, k_true)) in KALIBR_KEYS.into_iter().zip([gyro, accel]) {
+        let (n, k) = (yaml_value(&text, n_key), yaml_value(&text, k_key));
+        assert!(n / n_true <= 1.2, "{n_key}: N_H / N = {}", n / n_true);
+        assert!(k / k_true <= 2.0, "{k_key}: K_H / K = {}", k / k_true);
+        for i in axes {
+            let rows = model_octaves(&model, i, horizon);
+            assert!(rows.len() >= 9, "axis {i}: {} octaves", rows.len());
+            let below = uncovered(n, k, &rows);
+            assert!(
+                below.is_empty(),
+                "axis {i}: ({n}, {k}) below the model at {below:?}"
+            );
+        }
+    }
 }
 
 /// `imu-ar ARGS` fails with status 2, one line containing `want`, and nothing on stdout.

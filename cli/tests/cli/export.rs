@@ -222,41 +222,121 @@ fn white_rw_round_trip(n: f64, k: f64, seed: u64) -> Vec<String> {
     agrees(&x, |m| c.avar(m as u32), kind)
 }
 
+/// The octaves `(tau, model AVAR)` of sensor `s`'s three axes with `tau` in `[1 s, upper]`.
+fn octaves_up_to(imu: &ImuModel, s: usize, upper: f64) -> Vec<(f64, f64)> {
+    imu.axes[3 * s..3 * s + 3]
+        .iter()
+        .flat_map(|a| {
+            a.model_avar
+                .iter()
+                .enumerate()
+                .map(|(j, v)| (a.dt * 2f64.powi(j as i32), *v))
+        })
+        .filter(|(tau, _)| (1.0..=upper).contains(tau))
+        .collect()
+}
+
+/// The model's longest octave, s.
+fn longest(imu: &ImuModel) -> f64 {
+    let a = &imu.axes[0];
+    a.dt * 2f64.powi(a.model_avar.len() as i32 - 1)
+}
+
+/// `sqrt(n^2/tau + k^2 tau/3)` at or above the Allan deviation of every row.
+fn covers(n: f64, k: f64, rows: &[(f64, f64)]) -> bool {
+    rows.iter()
+        .all(|(tau, v)| n * n / tau + k * k * tau / 3.0 >= *v)
+}
+
+/// The smallest `N' K'` with `N' >= n`, `K' >= k` whose curve covers `rows`, searched on a log
+/// grid (100 steps per decade of `N'` and of `K'`, four decades each).
+fn grid_minimum(n: f64, k: f64, rows: &[(f64, f64)]) -> f64 {
+    let mut best = f64::INFINITY;
+    for i in 0..400 {
+        let np = n * 10f64.powf(f64::from(i) / 100.0);
+        for j in 0..400 {
+            let kp = k * 10f64.powf(f64::from(j) / 100.0);
+            if np * kp < best && covers(np, kp, rows) {
+                best = np * kp;
+            }
+        }
+    }
+    best
+}
+
+/// The written `(nh, kh)` of sensor `s` is the smallest overbound of its model from 1 s to
+/// `upper` from its worst axis's `N` and `K`: at or above them, covering every octave, and no
+/// grid point does better.
+fn smallest_overbound(imu: &ImuModel, s: usize, upper: f64, (nh, kh): (f64, f64), at: &str) {
+    let worst =
+        |f: fn(&AxisModel) -> f64| imu.axes[3 * s..3 * s + 3].iter().map(f).fold(0.0, f64::max);
+    let (n, k) = (worst(|a| a.white_noise), worst(|a| a.random_walk));
+    assert!(nh >= n && kh >= k, "{at}: ({nh}, {kh}) below ({n}, {k})");
+    let rows = octaves_up_to(imu, s, upper);
+    assert!(rows.len() >= 3 * 9, "{at}: {} octaves", rows.len());
+    assert!(
+        covers(nh, kh, &rows),
+        "{at}: ({nh}, {kh}) does not overbound the model"
+    );
+    let searched = grid_minimum(n, k, &rows);
+    assert!(
+        nh * kh <= searched * (1.0 + 1e-9),
+        "{at}: N_H K_H {} > the grid's {searched}",
+        nh * kh
+    );
+    assert!(
+        searched <= nh * kh * 1.05,
+        "{at}: the grid's {searched} against {}",
+        nh * kh
+    );
+}
+
 #[test]
-fn kalibr_values_are_the_models_n_and_k() {
+fn kalibr_values_are_the_smallest_overbound_up_to_the_longest_octave() {
     let dir = temp_dir("kalibr");
     let path = write(Format::Kalibr, model(), None, &dir).unwrap_or_else(|e| panic!("{}", e.0));
     let text = std::fs::read_to_string(path).unwrap();
-    let [(gn, gk), (an, ak)] = continuous(Format::Kalibr, &text);
-    assert!(close(gn, worst(0, |a| a.white_noise), 1e-9));
-    assert!(close(gk, worst(0, |a| a.random_walk), 1e-9));
-    assert!(close(an, worst(1, |a| a.white_noise), 1e-9));
-    assert!(close(ak, worst(1, |a| a.random_walk), 1e-9));
+    let [gyro, accel] = continuous(Format::Kalibr, &text);
+    let h = longest(model());
+    smallest_overbound(model(), 0, h, gyro, "gyro");
+    smallest_overbound(model(), 1, h, accel, "accel");
+    // The Gauss-Markov terms raise the pair above the fitted one.
+    assert!(gyro.0 * gyro.1 > 1.01 * worst(0, |a| a.white_noise) * worst(0, |a| a.random_walk));
     assert!(text.contains("rostopic: \"/imu\\\"0\""), "{text}");
     assert!(text.contains("update_rate: 1.0e+02"), "{text}");
-    // The statement of how far white noise and random walk overbound the model.
-    assert!(text.contains("sqrt(N^2/tau + K^2 tau/3)"), "{text}");
-    assert!(text.contains("export with a horizon"), "{text}");
+    // The statement: the range, the objective, the fitted values beside the written ones.
+    for want in [
+        "the smallest overbound of the model's Allan deviation from tau = 1 s to H = ",
+        ", the model's longest octave (log N_H/N + log K_H/K minimal)",
+        "fitted N = ",
+        "fitted K = ",
+        "K_H/K = ",
+        "alone: N_H = ",
+        "sqrt(N_H^2/tau + K_H^2 tau/3) stays at or above the model's Allan deviation of every \
+         axis at every octave from 1 s to the last",
+    ] {
+        assert!(text.contains(want), "{want:?} not in {text}");
+    }
+    assert!(!text.contains("falls short"), "{text}");
 }
 
 #[test]
 fn every_format_round_trips_to_the_curve_it_claims_and_writes_the_worst_axis() {
     let dir = temp_dir("round-trip");
+    let kalibr = std::fs::read_to_string(
+        write(Format::Kalibr, model(), None, &dir).unwrap_or_else(|e| panic!("{}", e.0)),
+    )
+    .unwrap();
+    let pairs = continuous(Format::Kalibr, &kalibr);
     let mut failures = Vec::new();
     for (f, format) in SIX.into_iter().enumerate() {
         let path = write(format, model(), None, &dir).unwrap_or_else(|e| panic!("{}", e.0));
         let text = std::fs::read_to_string(path).unwrap();
         assert!(text.contains("worst (largest)"), "{format}: {text}");
         for (s, (n, k)) in continuous(format, &text).into_iter().enumerate() {
-            // The worst axis, in the target's convention and back.
-            assert!(
-                close(n, worst(s, |a| a.white_noise), 1e-9),
-                "{format} {s}: N {n}"
-            );
-            assert!(
-                close(k, worst(s, |a| a.random_walk), 1e-9),
-                "{format} {s}: K {k}"
-            );
+            // The same pair in every target's convention and back.
+            assert!(close(n, pairs[s].0, 1e-9), "{format} {s}: N {n}");
+            assert!(close(k, pairs[s].1, 1e-9), "{format} {s}: K {k}");
             for line in white_rw_round_trip(n, k, 100 + 2 * f as u64 + s as u64) {
                 failures.push(format!("{format} sensor {s}: {line}"));
             }
@@ -290,7 +370,7 @@ fn correlated(l: &[Vec<f64>], rng: &mut ChaCha8Rng, z: &mut StandardNormal) -> V
         .collect()
 }
 
-/// `n` samples of the sum of the states of `x_{k+1} = phi x_k + w_k`, `Cov(w) = q`, plus white
+/// `n` samples of `h x_k` for the states `x_{k+1} = phi x_k + w_k`, `Cov(w) = q`, plus white
 /// noise of the measurement variance; the states start from `p0`, the random walk at 0 (its
 /// turn-on variance does not show in the Allan deviation).
 fn state_space_record(axis: &serde_json::Value, n: usize, seed: u64) -> Vec<f64> {
@@ -301,6 +381,8 @@ fn state_space_record(axis: &serde_json::Value, n: usize, seed: u64) -> Vec<f64>
     if let Some(i) = states.iter().position(|s| s == "random_walk") {
         p0[i][i] = 0.0;
     }
+    let h: Vec<f64> = serde_json::from_value(axis["h"].clone()).unwrap();
+    assert_eq!(h.len(), states.len());
     let r = axis["measurement_variance"].as_f64().unwrap().sqrt();
     let (lq, lp) = (cholesky(&q), cholesky(&p0));
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
@@ -314,7 +396,7 @@ fn state_space_record(axis: &serde_json::Value, n: usize, seed: u64) -> Vec<f64>
                 .zip(&w)
                 .map(|(row, w)| row.iter().zip(&x).map(|(a, b)| a * b).sum::<f64>() + w)
                 .collect();
-            x.iter().sum::<f64>() + r * z.sample(&mut rng)
+            h.iter().zip(&x).map(|(a, b)| a * b).sum::<f64>() + r * z.sample(&mut rng)
         })
         .collect()
 }
@@ -354,45 +436,53 @@ fn the_state_space_round_trips_to_the_models_allan_deviation() {
 }
 
 #[test]
-fn a_horizon_writes_the_smallest_random_walk_that_overbounds_the_model() {
+fn a_horizon_writes_the_smallest_overbound_up_to_it() {
     let horizon = 600.0;
     let dir = temp_dir("horizon");
     for format in SIX {
         let path =
             write(format, model(), Some(horizon), &dir).unwrap_or_else(|e| panic!("{}", e.0));
         let text = std::fs::read_to_string(path).unwrap();
-        assert!(text.contains("K_H/K = "), "{format}: {text}");
-        for (s, (n, kh)) in continuous(format, &text).into_iter().enumerate() {
-            assert!(close(n, worst(s, |a| a.white_noise), 1e-9), "{format} {s}");
-            let k = worst(s, |a| a.random_walk);
-            assert!(kh >= k * (1.0 - 1e-12), "{format} {s}: K_H {kh} < K {k}");
-            // Every axis's model, every octave in [1 s, H]: (AVAR, tau).
-            let rows: Vec<(f64, f64)> = model().axes[3 * s..3 * s + 3]
-                .iter()
-                .flat_map(|a| {
-                    a.model_avar
-                        .iter()
-                        .enumerate()
-                        .map(|(j, v)| (*v, a.dt * 2f64.powi(j as i32)))
-                })
-                .filter(|(_, tau)| (1.0..=horizon).contains(tau))
-                .collect();
-            assert!(rows.len() >= 3 * 9, "{format}: {} octaves", rows.len());
-            let covers = |kh: f64| {
-                rows.iter()
-                    .all(|(v, tau)| n * n / tau + kh * kh * tau / 3.0 >= v * (1.0 - 1e-9))
-            };
-            assert!(
-                covers(kh),
-                "{format} {s}: K_H {kh} does not overbound the model"
-            );
-            // The smallest: 1 % lower breaks an octave (the Gauss-Markov terms raise it).
-            assert!(kh > 1.01 * k, "{format} {s}: K_H {kh}, K {k}");
-            assert!(
-                !covers(0.99 * kh),
-                "{format} {s}: K_H {kh} is not the smallest"
-            );
+        assert!(
+            text.contains("to H = 6.0000e2 s, the horizon asked for (log N_H/N"),
+            "{format}: {text}"
+        );
+        for (s, pair) in continuous(format, &text).into_iter().enumerate() {
+            smallest_overbound(model(), s, horizon, pair, &format!("{format} {s}"));
         }
+    }
+    // Below 1 s, where the overbound starts: refused.
+    assert!(write(Format::Kalibr, model(), Some(0.5), &dir).is_err());
+}
+
+#[test]
+fn a_model_without_random_walk_or_white_noise_writes_no_zero() {
+    let dir = temp_dir("no-zero");
+    let mut imu = model().clone();
+    for a in &mut imu.axes[3..] {
+        a.random_walk = 0.0;
+    }
+    for a in &mut imu.axes[..3] {
+        a.white_noise = 0.0;
+    }
+    for (format, horizon) in [(Format::Kalibr, None), (Format::ArduPilot, Some(600.0))] {
+        let text = std::fs::read_to_string(
+            write(format, &imu, horizon, &dir).unwrap_or_else(|e| panic!("{}", e.0)),
+        )
+        .unwrap();
+        for (s, (n, k)) in continuous(format, &text).into_iter().enumerate() {
+            assert!(n > 0.0 && k > 0.0, "{format} {s}: ({n}, {k})");
+            let rows = octaves_up_to(&imu, s, horizon.unwrap_or_else(|| longest(&imu)));
+            assert!(covers(n, k, &rows), "{format} {s}: ({n}, {k})");
+        }
+        assert!(
+            text.contains("The model has no random walk: K is taken as "),
+            "{format}: {text}"
+        );
+        assert!(
+            text.contains("The model has no white noise: N is taken as "),
+            "{format}: {text}"
+        );
     }
 }
 
@@ -407,9 +497,14 @@ fn the_filter_rate_sets_the_autopilots_step_and_bad_models_are_refused() {
     .unwrap();
     let m = values(&text);
     assert_eq!(m["EKF2_PREDICT_US"], "4000");
+    let kalibr = std::fs::read_to_string(
+        write(Format::Kalibr, &imu, None, &dir).unwrap_or_else(|e| panic!("{}", e.0)),
+    )
+    .unwrap();
+    let [(gn, _), (_, ak)] = continuous(Format::Kalibr, &kalibr);
     assert!(close(
         number(&m, "EKF2_GYR_NOISE"),
-        worst(0, |a| a.white_noise) / 0.004f64.sqrt(),
+        gn / 0.004f64.sqrt(),
         1e-12
     ));
     let text = std::fs::read_to_string(
@@ -418,7 +513,7 @@ fn the_filter_rate_sets_the_autopilots_step_and_bad_models_are_refused() {
     .unwrap();
     assert!(close(
         number(&values(&text), "EK3_ABIAS_P_NSE"),
-        worst(1, |a| a.random_walk) / 0.004f64.sqrt(),
+        ak / 0.004f64.sqrt(),
         1e-12
     ));
     imu.filter_rate_hz = Some(20.0);

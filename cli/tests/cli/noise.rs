@@ -62,7 +62,9 @@ fn both_real_records_are_explained_at_every_averaging_time() {
             let v = noise(&record.files, axis, "100", &[]);
             let (upto, longest) = (&v["explained_up_to_s"], longest_tau(&v));
             let order = v["ar"].get("order").map_or(0, |o| o.as_u64().unwrap());
-            let states = v["phi"].as_array().unwrap().len();
+            // The Gauss-Markov budget and the random walk; quantisation adds its two states.
+            let quantization = if v["quantization"].is_null() { 0 } else { 2 };
+            let states = v["phi"].as_array().unwrap().len() - quantization;
             let (n, at_1s) = (f(&v["white_noise"]), adev_at_1s(&v));
             println!(
                 "{} {axis} {order} {} {n:.4e} {at_1s:.4e} {upto} {longest}",
@@ -74,8 +76,9 @@ fn both_real_records_are_explained_at_every_averaging_time() {
                 "{} {axis}: {states} filter states",
                 record.name
             );
-            // N against the classic reading at 1 s, where white noise dominates there.
-            if white_share_at_1s(&v) >= 0.5 {
+            // N against the classic reading at 1 s, where white noise dominates there and the
+            // model explains the data up to there.
+            if white_share_at_1s(&v) >= 0.5 && f(upto) >= 1.0 {
                 assert!(
                     (n / at_1s - 1.0).abs() <= 0.1,
                     "{} {axis}: N {n} against ADEV(1 s) {at_1s}",
@@ -155,6 +158,8 @@ fn hands_a_simulated_composite_to_a_filter_at_its_rate() {
         "rate_ramp",
         "bias_instability",
         "gauss_markov",
+        "budget_limited",
+        "intervals",
         "ar",
         "phi",
         "q",
@@ -173,19 +178,35 @@ fn hands_a_simulated_composite_to_a_filter_at_its_rate() {
     );
     assert_eq!(f(&v["explained_up_to_s"]), longest_tau(&v));
 
-    // The filter's states: one per Gauss-Markov term, then the random walk; each block is the
-    // exact discretisation at the filter's step of 0.1 s.
+    // The filter's states: one per Gauss-Markov term, the random walk, then the quantisation
+    // pair `[q_k/Dt, q_(k-1)/Dt]` where the fit gives quantisation; each block is the exact
+    // discretisation at the filter's step of 0.1 s.
     let dt = 0.1;
     let gm = v["gauss_markov"].as_array().unwrap();
     let (phi, q, p0) = (&v["phi"], &v["q"], &v["p0"]);
     let n = gm.len() + 1;
-    assert_eq!(phi.as_array().unwrap().len(), n);
-    for i in 0..n {
-        for k in (0..n).filter(|k| *k != i) {
-            assert_eq!(f(&phi[i][k]), 0.0);
+    let pair = v["quantization"]
+        .as_f64()
+        .map(|quantization| (n, quantization));
+    let states = n + pair.map_or(0, |_| 2);
+    assert_eq!(phi.as_array().unwrap().len(), states);
+    for i in 0..states {
+        for k in (0..states).filter(|k| *k != i) {
+            // Within the pair, q_(k-1) takes q_k's value.
+            let within = pair.is_some_and(|(at, _)| i == at + 1 && k == at);
+            assert_eq!(f(&phi[i][k]), if within { 1.0 } else { 0.0 });
             assert_eq!(f(&q[i][k]), 0.0);
             assert_eq!(f(&p0[i][k]), 0.0);
         }
+    }
+    if let Some((at, quantization)) = pair {
+        let variance = (quantization / dt).powi(2);
+        assert_eq!(f(&phi[at][at]), 0.0);
+        assert_eq!(f(&phi[at + 1][at + 1]), 0.0);
+        assert!((f(&q[at][at]) / variance - 1.0).abs() < 1e-12);
+        assert_eq!(f(&q[at + 1][at + 1]), 0.0);
+        assert!((f(&p0[at][at]) / variance - 1.0).abs() < 1e-12);
+        assert!((f(&p0[at + 1][at + 1]) / variance - 1.0).abs() < 1e-12);
     }
     for (i, g) in gm.iter().enumerate() {
         let (s, t) = (f(&g["sigma"]), f(&g["correlation_time_s"]));

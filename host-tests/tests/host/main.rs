@@ -9,6 +9,7 @@ mod common;
 mod sim;
 
 mod batch;
+mod campaign;
 mod differential;
 mod estimator_hostile;
 mod fixed;
@@ -18,6 +19,7 @@ mod levinson;
 mod model;
 mod noise;
 mod noise_edges;
+mod noise_kalman;
 mod online_hostile;
 mod persist;
 mod prior;
