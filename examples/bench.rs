@@ -251,7 +251,8 @@ mod firmware {
 
         /// One fit of the composite noise model from a 20-octave Allan stream (2^21 samples of
         /// white noise, a Gauss-Markov drift and a random walk), without and with an AR(8)
-        /// part: instructions, and the stack it used (painted before, scanned after).
+        /// part, as a curve fit and identified (with the intervals of its parameters):
+        /// instructions, and the stack it used (painted before, scanned after).
         fn noise_fit(&mut self) {
             let mut stream = AllanStream::<20>::new();
             let (mut seed, mut drift, mut walk) = (777u32, 0.0f32, 0.0f32);
@@ -272,13 +273,26 @@ mod firmware {
                 common::exit(false)
             };
             let config = FitConfig::new(3);
-            for (name, ar) in [("none", None), ("ar8", Some(&ar))] {
+            let identified = config.with_identification(true);
+            let runs = [
+                ("none", None, config, false),
+                ("ar8", Some(&ar), config, false),
+                ("none_identified", None, identified, true),
+                ("ar8_identified", Some(&ar), identified, true),
+            ];
+            for (name, ar, config, intervals) in runs {
                 let mut fitted = None;
                 // The fit's frames start below this one; 1 KiB leaves room for the painter's.
                 let top = stack_pointer() - 1024;
                 paint_stack(top);
+                // Identified, the fit and the 95 % intervals of its parameters.
                 let n = ticks(&mut self.syst, || {
-                    fitted = Some(NoiseModel::<8, 3>::fit(black_box(&octaves), ar, &config));
+                    let fit = NoiseModel::<8, 3>::fit(black_box(&octaves), ar, &config);
+                    if intervals {
+                        let u = fit.as_ref().ok().map(|m| m.uncertainty(&octaves));
+                        black_box(u.map(|u| u.map(|u| u.random_walk.high)));
+                    }
+                    fitted = Some(fit);
                 }) * self.per_tick;
                 // The fit's stack: what it used below `top`, and the 1 KiB above it.
                 let stack = stack_used(top) + 1024;

@@ -87,7 +87,9 @@ text = open(sys.argv[1]).read()
 print("| noise-model fit, 20 octaves, budget 3 | instructions | stack (bytes) | Gauss-Markov terms |")
 print("|---|---|---|---|")
 for ar, insns, stack, terms in re.findall(r"noise fit octaves=20 gm=3 ar=(\w+) insns/fit=(\d+) stack=(\d+) terms=(\d+)", text):
-    label = "with an AR(8) part" if ar == "ar8" else "without an AR part"
+    label = "with an AR(8) part" if ar.startswith("ar8") else "without an AR part"
+    if ar.endswith("_identified"):
+        label += ", identified, with the 95 % intervals"
     print(f"| {label} | {int(insns):,} | {int(stack):,} | {terms} |")
 m = re.search(r"allan_stream_l20 bytes=(\d+) noise_model_p8_g3 bytes=(\d+) octaves_l20 bytes=(\d+)", text)
 print()

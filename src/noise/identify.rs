@@ -10,6 +10,9 @@ use super::{NoiseError, indexed};
 /// Golden-section steps of a refinement: the bracket shrinks to `0.618^14`, 0.1 % of it.
 const GOLDEN_STEPS: usize = 14;
 
+/// Forward and backward rounds at most.
+const ROUNDS: usize = 4;
+
 /// Reweighting passes of a set before it is judged.
 const JUDGING_PASSES: usize = 2;
 
@@ -153,85 +156,93 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
             .fold(Set::new(), |set, c| set.with(*c));
         self.reweight::<MAX>(None);
         let mut limited = false;
-        // Forward: each step adds a column or ends; a column may come back after a later one
-        // took its place, so the steps are bounded by the columns' count twice.
-        for _ in 0..columns.len().saturating_mul(2) {
-            self.reweight_by(&set)?;
-            let (current, _) = self.criterion(&set)?;
-            let mut within: Option<(f64, Column)> = None;
-            let mut beyond: Option<f64> = None;
-            let candidates = columns
-                .iter()
-                .filter(|c| optional(**c) && !set.contains(**c));
-            for &c in candidates {
-                let (ic, _) = self.criterion(&set.with(c))?;
-                if states(set.columns()).saturating_add(states(&[c])) <= budget {
-                    if within.is_none_or(|b| ic < b.0) {
-                        within = Some((ic, c));
+        // Whether the random walk took a Gauss-Markov term's place (it then carries that
+        // term's power, and stays).
+        let mut from_term = false;
+        // Forward, then backward, until neither changes the set: a term dropped backward
+        // frees a state for one that the budget kept out.
+        for _ in 0..ROUNDS {
+            let before = set;
+            limited = false;
+            // Forward: each step adds a column or ends; a column may come back after a later one
+            // took its place, so the steps are bounded by the columns' count twice.
+            for _ in 0..columns.len().saturating_mul(2) {
+                self.reweight_by(&set)?;
+                let (current, _) = self.criterion(&set)?;
+                let mut within: Option<(f64, Column)> = None;
+                let mut beyond: Option<f64> = None;
+                let candidates = columns
+                    .iter()
+                    .filter(|c| optional(**c) && !set.contains(**c));
+                for &c in candidates {
+                    let (ic, _) = self.criterion(&set.with(c))?;
+                    if states(set.columns()).saturating_add(states(&[c])) <= budget {
+                        if within.is_none_or(|b| ic < b.0) {
+                            within = Some((ic, c));
+                        }
+                    } else if beyond.is_none_or(|b| ic < b) {
+                        beyond = Some(ic);
                     }
-                } else if beyond.is_none_or(|b| ic < b) {
-                    beyond = Some(ic);
                 }
-            }
-            match within {
-                Some((ic, c)) if ic < current => {
-                    let grown = set.with(c);
-                    let grown = self.refine_term(grown, grown.len.saturating_sub(1), spacing)?;
-                    let (_, x) = self.criterion(&grown)?;
-                    set = Self::compact(&grown, &x);
-                }
-                _ => {
-                    limited = beyond.is_some_and(|ic| ic < current);
-                    break;
-                }
-            }
-        }
-        // Backward: drop a term, or take a Gauss-Markov term as the random walk it is over the
-        // record, while that lowers the criterion. Each step shortens the set.
-        for _ in 0..columns.len() {
-            self.reweight_by(&set)?;
-            let (current, _) = self.criterion(&set)?;
-            let mut best: Option<(f64, Set)> = None;
-            for (i, c) in indexed(set.columns().iter()).filter(|(_, c)| optional(**c)) {
-                let without = set.without(i);
-                let walk = matches!(c, Column::GaussMarkov(_))
-                    && !set.contains(Column::RandomWalk)
-                    && columns.contains(&Column::RandomWalk);
-                let alternatives = [
-                    Some(without),
-                    walk.then(|| without.with(Column::RandomWalk)),
-                ];
-                for alternative in alternatives.into_iter().flatten() {
-                    let (ic, _) = self.criterion(&alternative)?;
-                    if best.as_ref().is_none_or(|b| ic < b.0) {
-                        best = Some((ic, alternative));
+                match within {
+                    Some((ic, c)) if ic < current => {
+                        let grown = set.with(c);
+                        let grown =
+                            self.refine_term(grown, grown.len.saturating_sub(1), spacing)?;
+                        let (_, x) = self.criterion(&grown)?;
+                        set = Self::compact(&grown, &x);
+                    }
+                    _ => {
+                        limited = beyond.is_some_and(|ic| ic < current);
+                        break;
                     }
                 }
             }
-            match best {
-                Some((ic, smaller)) if ic < current => set = smaller,
-                _ => break,
+            // Backward: drop a term, or take a Gauss-Markov term as the random walk it is over the
+            // record, while that lowers the criterion. Each step shortens the set.
+            for _ in 0..columns.len() {
+                self.reweight_by(&set)?;
+                let (current, _) = self.criterion(&set)?;
+                let mut best: Option<(f64, Set)> = None;
+                for (i, c) in indexed(set.columns().iter()).filter(|(_, c)| optional(**c)) {
+                    let without = set.without(i);
+                    let walk = matches!(c, Column::GaussMarkov(_))
+                        && !set.contains(Column::RandomWalk)
+                        && columns.contains(&Column::RandomWalk);
+                    let alternatives = [
+                        Some(without),
+                        walk.then(|| without.with(Column::RandomWalk)),
+                    ];
+                    for alternative in alternatives.into_iter().flatten() {
+                        let (ic, _) = self.criterion(&alternative)?;
+                        if best.as_ref().is_none_or(|b| ic < b.0) {
+                            best = Some((ic, alternative));
+                        }
+                    }
+                }
+                match best {
+                    Some((ic, smaller)) if ic < current => set = smaller,
+                    _ => break,
+                }
+            }
+            // A Gauss-Markov term whose correlation time the record cannot bound (its 95 % upper
+            // end beyond the longest tau) is the random walk it looks like there.
+            if columns.contains(&Column::RandomWalk) {
+                let taken;
+                (set, taken) = self.walks(set)?;
+                from_term |= taken;
+            }
+            if set.columns() == before.columns() {
+                break;
             }
         }
         for i in 0..set.len {
             set = self.refine_term(set, i, spacing)?;
         }
-        // A Gauss-Markov term whose correlation time the record cannot bound (its 95 % upper
-        // end beyond the longest tau) is the random walk it looks like there.
         if columns.contains(&Column::RandomWalk) {
-            for _ in 0..set.len {
-                match self.unbounded_term(&set)? {
-                    Some(i) => {
-                        let walk = set.without(i);
-                        set = if walk.contains(Column::RandomWalk) {
-                            walk
-                        } else {
-                            walk.with(Column::RandomWalk)
-                        };
-                    }
-                    None => break,
-                }
-            }
+            let taken;
+            (set, taken) = self.walks(set)?;
+            from_term |= taken;
         }
         let (x, _) = self.nnls(set.columns())?;
         let set = Self::compact(&set, &x);
@@ -251,7 +262,7 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
             .gauss_markov()
             .iter()
             .any(|t| t.correlation_time > reach / 4.0);
-        let candidate = walk.filter(|_| model.random_walk() > 0.0 && !long);
+        let candidate = walk.filter(|_| model.random_walk() > 0.0 && !long && !from_term);
         if let Some(i) = candidate
             && !model.walk_significant(self)?
         {
@@ -266,8 +277,31 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
         Ok((model, limited))
     }
 
+    /// `set` with every Gauss-Markov term that [`Self::unbounded_term`] finds taken as the
+    /// random walk, and whether one was.
+    fn walks(&mut self, mut set: Set) -> Result<(Set, bool), NoiseError> {
+        let mut taken = false;
+        for _ in 0..set.len {
+            match self.unbounded_term(&set)? {
+                Some(i) => {
+                    let walk = set.without(i);
+                    let walk = if walk.contains(Column::RandomWalk) {
+                        walk
+                    } else {
+                        walk.with(Column::RandomWalk)
+                    };
+                    taken = true;
+                    set = walk;
+                }
+                None => break,
+            }
+        }
+        Ok((set, taken))
+    }
+
     /// The column of the Gauss-Markov term of `set` whose correlation time's 95 % upper end
-    /// lies furthest beyond the longest `tau`, if one does.
+    /// lies furthest beyond the longest `tau` (or that sits at the longest correlation time
+    /// the record tells, [`RECORD_OCTAVES`]), if one does.
     fn unbounded_term(&mut self, set: &Set) -> Result<Option<usize>, NoiseError> {
         let (x, _) = self.nnls(set.columns())?;
         let model = self.model_of(set.columns(), &x)?;
@@ -279,7 +313,10 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
         let mut worst: Option<(f64, f64)> = None;
         for (t, s) in model.gauss_markov().iter().zip(&spread) {
             let high = t.correlation_time * libm::exp(Z95 * s);
-            let beyond = high.partial_cmp(&longest) != Some(core::cmp::Ordering::Less);
+            // Pressed against the longest correlation time the record tells (the refinement's
+            // bound), a term would be longer still: a random walk there too.
+            let pressed = t.correlation_time >= 0.97 * longest / RECORD_OCTAVES;
+            let beyond = pressed || high.partial_cmp(&longest) != Some(core::cmp::Ordering::Less);
             if beyond && worst.is_none_or(|w| high > w.0) {
                 worst = Some((high, t.correlation_time));
             }

@@ -77,6 +77,11 @@ pub struct ModelArgs {
     /// Fit a rate ramp too (in a static record, usually a temperature drift).
     #[arg(long)]
     ramp: bool,
+    /// Identify the terms instead of fitting the curve: each added only when it lowers an
+    /// information criterion, correlation times refined off the grid, a term the record cannot
+    /// tell from a random walk taken as one (`NoiseModel::identify`).
+    #[arg(long)]
+    identify: bool,
     /// The filter's rate in Hz for `phi`, `q` and `p0` (and for the PX4 and ArduPilot files)
     /// [default: the model's rate].
     #[arg(long, allow_negative_numbers = true)]
@@ -101,7 +106,8 @@ impl ModelArgs {
         }
         Ok(FitConfig::new(self.gm_states)
             .with_oscillators(self.oscillators)
-            .with_ramp(self.ramp))
+            .with_ramp(self.ramp)
+            .with_identification(self.identify))
     }
 }
 

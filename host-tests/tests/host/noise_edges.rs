@@ -69,16 +69,22 @@ fn a_model_far_above_the_data_fails_however_wide_the_tolerance() {
 #[test]
 fn the_fit_scales_with_the_data_across_the_range_of_f64() {
     let dt = 0.01;
+    // A random walk that the curve shows over its last octaves (at 1e-8 it would show in the
+    // last alone, and an identified fit leaves it out).
     let base = curve(20, |m| {
         1e-4 * component::white(dt, m)
-            + 1e-8 * component::random_walk(dt, m)
+            + 1e-7 * component::random_walk(dt, m)
             + 1e-2 * component::gauss_markov(dt, 2.0, m)
     });
     let fit = |scale: f64| {
         let avar: Vec<f64> = base.iter().map(|v| v * scale).collect();
         let octaves = Octaves::<20>::new(dt, &avar, Estimator::Overlapping { n: 1 << 21 }).unwrap();
         let model = NoiseModel::<1, 3>::fit(&octaves, None, &FitConfig::new(3)).unwrap();
-        assert!(model.check(&octaves).unwrap().holds(), "scale {scale:e}");
+        // The whole curve at 95 %: the random walk shows in the last octave alone.
+        assert!(
+            model.check_whole(&octaves).unwrap().holds(),
+            "scale {scale:e}"
+        );
         (
             model.white_noise(),
             model.random_walk(),
@@ -148,6 +154,16 @@ fn exact_white_and_walk_curves_always_fit() {
         let model = NoiseModel::<1, 3>::fit(&octaves, None, &FitConfig::new(3))
             .unwrap_or_else(|e| panic!("trial {trial}: N^2 {n2:e} K^2 {k2:e}: {e}"));
         assert!(model.check(&octaves).unwrap().holds(), "trial {trial}");
+        // Identified, judged as the identification judges it: the whole curve at 95 % (a
+        // random walk seen in the last octave alone, one degree of freedom, is not identified).
+        let config = FitConfig::new(3).with_identification(true);
+        let model = NoiseModel::<1, 3>::fit(&octaves, None, &config)
+            .unwrap_or_else(|e| panic!("trial {trial}: N^2 {n2:e} K^2 {k2:e}: {e}"));
+        let check = model.check_whole(&octaves).unwrap();
+        assert!(
+            check.holds(),
+            "trial {trial} identified: N^2 {n2:e} K^2 {k2:e}"
+        );
     }
 }
 
