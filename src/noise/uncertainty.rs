@@ -13,6 +13,9 @@ pub const MAX_PARAMETERS: usize = 32;
 /// The normal quantile of a two-sided 95 % interval.
 pub(super) const Z95: f64 = 1.959_963_984_540_054;
 
+/// Doublings, and then bisections, of the search for an absent term's room.
+const ROOM_STEPS: usize = 40;
+
 /// Relative step of the numerical derivatives in `ln T` and `ln f`.
 const STEP: f64 = 1e-4;
 
@@ -159,8 +162,10 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
     ///   the interval of a chi^2 estimate with `2 (v / s)^2` degrees of freedom, or
     ///   `[0, v + 1.96 s]` where `v < 1.96 s` (the data do not exclude 0); `N`, `Q`, `K`, `R`
     ///   and `sigma` are the square roots;
-    /// - a term the model does not have (no random walk, say) gets `[0, 1.96 s]`, `s` from the
-    ///   information with that term added at 0: the largest value the data leave room for;
+    /// - a coefficient the model does not have (no random walk, say) gets `[0, high]`, `high`
+    ///   the largest value with which the model still passes the Allan check as one test of
+    ///   the whole curve, and at least `1.96 s`, `s` from the information with that term added
+    ///   at 0: the room the record leaves for it;
     /// - correlation times, frequencies and decay times are log-normal;
     /// - `B` is read from the data, with the degrees of freedom of its octave.
     ///
@@ -243,7 +248,7 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
             let s = libm::sqrt(cov.variance(p));
             Ok(root(Interval {
                 low: 0.0,
-                high: Z95 * s,
+                high: self.room(octaves, column, Z95 * s)?,
             }))
         };
         let quantization = coefficient(self.quantization, Column::Quantization)?;
@@ -338,6 +343,53 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
         let cov = self.covariance(problem, own.get(..len).unwrap_or(&[]))?;
         let k2 = self.random_walk * self.random_walk;
         Ok(k2 > libm::sqrt(cov.variance(Parameter::Variance(Column::RandomWalk))))
+    }
+
+    /// The largest variance of the absent coefficient `column` (quantisation, random walk or
+    /// ramp) with which the model still passes the Allan check as one test of the whole curve
+    /// ([`NoiseModel::check_whole`]), at least `start`: the room the record leaves for it. The
+    /// information at zero alone understates it where the model is far below the data's noise
+    /// at the octaves the term would raise. Doubling, then bisection on the logarithm.
+    fn room<const L: usize>(
+        &self,
+        octaves: &Octaves<L>,
+        column: Column,
+        start: f64,
+    ) -> Result<f64, NoiseError> {
+        let passes = |v: f64| -> Result<bool, NoiseError> {
+            let mut with = *self;
+            let root = libm::sqrt(v);
+            match column {
+                Column::Quantization => with.quantization = root,
+                Column::RandomWalk => with.random_walk = root,
+                Column::Ramp => with.ramp = root,
+                _ => return Ok(false),
+            }
+            Ok(with.check_whole(octaves)?.holds())
+        };
+        if !(start.is_finite() && start > 0.0 && passes(start)?) {
+            return Ok(start);
+        }
+        let (mut lo, mut hi) = (start, start);
+        for _ in 0..ROOM_STEPS {
+            hi *= 2.0;
+            if !hi.is_finite() || !passes(hi)? {
+                break;
+            }
+            lo = hi;
+        }
+        if lo == hi {
+            return Ok(lo);
+        }
+        for _ in 0..ROOM_STEPS {
+            let mid = libm::sqrt(lo * hi);
+            if passes(mid)? {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        Ok(lo)
     }
 
     /// The model's own parameters (see [`NoiseModel::uncertainty`]).
@@ -608,6 +660,14 @@ fn bias_instability<const P: usize, const G: usize, const L: usize>(
     let b = |q: f64| libm::sqrt(*a / q) / 0.664;
     Interval {
         low: b(chi2_over_nu(nu, Z95)),
-        high: b(chi2_over_nu(nu, -Z95).max(f64::MIN_POSITIVE)),
+        high: b(chi2_lower_over_nu(nu)),
     }
+}
+
+/// `chi^2_nu / nu` at its 2.5 % quantile: Wilson-Hilferty, and below a few degrees of freedom,
+/// where that reaches 0, the lower tail `P(chi^2 < x) ~ (x/2)^(nu/2) / Gamma(nu/2 + 1)`.
+fn chi2_lower_over_nu(nu: f64) -> f64 {
+    let tail = 2.0 * libm::pow(0.025 * libm::tgamma(nu / 2.0 + 1.0), 2.0 / nu) / nu;
+    let q = chi2_over_nu(nu, -Z95).max(tail);
+    if q > 0.0 { q } else { f64::MIN_POSITIVE }
 }

@@ -327,3 +327,48 @@ fn an_extreme_range_across_octaves_gives_no_silent_zero_model() {
         }
     }
 }
+
+#[test]
+fn k_intervals_cover_the_truth_where_the_record_shows_little_of_it() {
+    // White noise and a random walk that rises over the last few octaves only: the identified
+    // fit often leaves K out, and then its interval must still reach the truth (the room the
+    // record leaves, not the information at zero alone).
+    let truth = imu_ar_host::composite::Composite {
+        dt: 0.01,
+        white: 0.01,
+        quantization: 0.0,
+        gm: Vec::new(),
+        random_walk: 1e-4,
+    };
+    let config = FitConfig::new(3).with_identification(true);
+    let (mut covered, mut absent, runs) = (0, 0, 40);
+    for seed in 0..runs {
+        let x = truth.simulate(1 << 18, 5000 + seed);
+        let octaves = Octaves::<24>::overlapping(&x, truth.dt).unwrap();
+        let model = NoiseModel::<1, 3>::fit(&octaves, None, &config).unwrap();
+        let u = model.uncertainty(&octaves).unwrap();
+        covered += usize::from(u.random_walk.contains(truth.random_walk));
+        absent += usize::from(model.random_walk() == 0.0);
+    }
+    println!("K interval covers {covered} of {runs}; K absent on {absent}");
+    assert!(covered * 100 >= 85 * runs as usize, "{covered} of {runs}");
+}
+
+#[test]
+fn the_bias_instability_interval_is_finite_with_one_degree_of_freedom() {
+    // A stream of 16 samples: its last octave has one difference.
+    let mut stream = imu_ar::allan::AllanStream::<8>::new();
+    for i in 0..16u32 {
+        stream.push(f64::from(i % 3) - 1.0 + 0.1 * f64::from(i % 5));
+    }
+    let octaves = Octaves::<8>::from_stream(&stream, 0.01).unwrap();
+    let model = NoiseModel::<1, 1>::fit(&octaves, None, &FitConfig::new(1)).unwrap();
+    let u = model.uncertainty(&octaves).unwrap();
+    let b = model.ieee952(&octaves).bias_instability.0;
+    let i = u.bias_instability;
+    // chi^2 with one degree of freedom: its 2.5 % quantile is 9.8e-4, so at most about 32 B.
+    assert!(
+        i.low <= b && b <= i.high && i.high < 50.0 * b,
+        "{i:?} B {b}"
+    );
+}
