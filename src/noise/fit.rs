@@ -113,7 +113,9 @@ pub const OSCILLATOR_MIN_HZ: f64 = 0.1;
 /// with `T` longer, that fall would rest on the last three octaves alone, whose overlapping
 /// estimates hold about 1, 2 and 4 degrees of freedom where a random walk dominates (Riley's
 /// formula): a bend there is as likely the noise of the estimate. Over the record, such a term
-/// is a random walk (`K^2 = 2 sigma^2 / T`, its form for `tau << T`).
+/// is a random walk (`K^2 = 2 sigma^2 / T`, its form for `tau << T`). The refinement stops at
+/// this bound, and a term it leaves within 3 % of it (pressed against it) is taken as the
+/// random walk too.
 pub const RECORD_OCTAVES: f64 = 16.0;
 
 /// A column of the fit: a component of unit parameter.

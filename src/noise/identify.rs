@@ -248,7 +248,16 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
         let set = Self::compact(&set, &x);
         let (x, _) = self.nnls(set.columns())?;
         let start = self.model_of(set.columns(), &x)?;
-        let (model, _) = self.refine(set.columns(), Some(&start))?;
+        let (refined, _) = self.refine(set.columns(), Some(&start))?;
+        // The refinement reweights by its own model, which can talk a term down to zero where
+        // the data need it: then the identified set's own fit stands.
+        let model = if !refined.check_whole(self.octaves)?.holds()
+            && start.check_whole(self.octaves)?.holds()
+        {
+            start
+        } else {
+            refined
+        };
         // A random walk less than one standard deviation above zero, without which the model
         // still passes the Allan check at every octave, is not identified.
         self.reweight(Some(&model));
