@@ -144,6 +144,8 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
     /// Identifies the model among `columns`, with at most `budget` Gauss-Markov states;
     /// `spacing` is the grid's, in octaves. Returns the model and whether the budget limited
     /// it (see [`super::NoiseModel::identify`]).
+    // Its own frame: the curve fit that shares `fit_unit` does not carry its locals.
+    #[inline(never)]
     pub(super) fn identify(
         &mut self,
         columns: &[Column],

@@ -18,7 +18,8 @@
 //! Everything here runs in `f64`, on the host and on the device alike, allocation-free: the fit
 //! is not per-sample work. On the emulated Cortex-M4F one fit from a 20-octave
 //! [`AllanStream`](crate::allan::AllanStream) with a budget of three Gauss-Markov states takes
-//! about 70 million instructions (82 million with an AR(8) part) and 34 KiB of stack
+//! about 70 million instructions (82 million with an AR(8) part) and 34 KiB of stack; the
+//! identified fit with the intervals of its parameters about 620 million and 122 KiB
 //! (`cargo qemu bench`, [Performance](crate::guide::performance)).
 
 use core::fmt;

@@ -460,6 +460,8 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
 
     /// The covariance of `parameters` at the model: `2 (J~^T J~)^-1` with `J~` the weighted,
     /// whitened Jacobian, its columns scaled to unit norm for the solve.
+    // One frame, reused by every call (inlined, each call's matrices would stack up).
+    #[inline(never)]
     fn covariance<const L: usize>(
         &self,
         problem: &Problem<'_, P, L>,
@@ -557,6 +559,7 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
 /// below `1e-12` (of a unit diagonal) is taken as 1e-12, so that an undetermined parameter gets a
 /// huge variance instead of a failure.
 #[allow(clippy::needless_range_loop)] // triangular loops over a fixed-size matrix read best by index
+#[inline(never)]
 fn cholesky_inverse(
     a: &[[f64; MAX_PARAMETERS]; MAX_PARAMETERS],
     k: usize,
