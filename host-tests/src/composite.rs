@@ -72,3 +72,38 @@ impl Composite {
         v
     }
 }
+
+/// `n` samples of a damped oscillator (a second-order Gauss-Markov process) of standard
+/// deviation `sigma`, natural frequency `frequency` (Hz) and damping ratio `damping`, sampled
+/// every `dt`: the continuous poles `-zeta w +- i w sqrt(1 - zeta^2)` mapped to `z = exp(s dt)`,
+/// driven by white noise, started after a run-in of ten decay times.
+pub fn oscillator(
+    sigma: f64,
+    frequency: f64,
+    damping: f64,
+    dt: f64,
+    n: usize,
+    seed: u64,
+) -> Vec<f64> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut z = StandardNormal::new();
+    let w = 2.0 * std::f64::consts::PI * frequency;
+    let r = (-damping * w * dt).exp();
+    let theta = w * (1.0 - damping * damping).sqrt() * dt;
+    let (a1, a2) = (2.0 * r * theta.cos(), -r * r);
+    // The stationary variance of x_k = a1 x_(k-1) + a2 x_(k-2) + e_k per unit innovation
+    // variance.
+    let gain = (1.0 - a2) / ((1.0 + a2) * ((1.0 - a2).powi(2) - a1 * a1));
+    let e = sigma / gain.sqrt();
+    let run_in = (10.0 / (damping * w * dt)) as usize;
+    let (mut x1, mut x2) = (0.0, 0.0);
+    let mut out = Vec::with_capacity(n);
+    for k in 0..run_in + n {
+        let x = a1 * x1 + a2 * x2 + e * z.sample(&mut rng);
+        (x2, x1) = (x1, x);
+        if k >= run_in {
+            out.push(x);
+        }
+    }
+    out
+}

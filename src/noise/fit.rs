@@ -3,7 +3,7 @@
 use crate::model::ArModel;
 
 use super::columns::{compact, edit, head, head_mut, merge, sort_by_correlation_time, states};
-use super::model::{GmTerm, NoiseModel, Oscillator};
+use super::model::{Check, GmTerm, NoiseModel, Oscillator};
 use super::{NoiseError, NoiseType, Octaves, component, indexed, nnls};
 
 /// How to fit a [`NoiseModel`].
@@ -230,6 +230,9 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
     ///    `tau` (`N^2 = 2 sigma^2 T`).
     /// 5. Last, every correlation time is refined again and the weights refined as in
     ///    [`NoiseModel::fit`].
+    /// 6. Where the identified model fails the whole-curve check ([`NoiseModel::check_whole`])
+    ///    and the curve fit fails it at fewer octaves, the curve fit stands
+    ///    ([`Identified::curve_fit`]).
     ///
     /// # Errors
     ///
@@ -272,7 +275,26 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
             ),
             None => None,
         };
-        let (model, budget_limited) = Self::fit_unit(&scaled, ar.as_ref(), config)?;
+        let (mut model, budget_limited) = Self::fit_unit(&scaled, ar.as_ref(), config)?;
+        // Identified terms that fail the whole-curve check at octaves where the curve fit
+        // passes it: the data hold more than the criterion found terms for, and the curve fit
+        // stands.
+        let mut curve_fit = !config.identify;
+        let failing = |c: &Check<L>| {
+            c.rows()
+                .iter()
+                .fold(0usize, |n, r| n.saturating_add(usize::from(!r.agrees)))
+        };
+        if config.identify {
+            let failed = failing(&model.check_whole(&scaled)?);
+            if failed > 0 {
+                let (curve, _) =
+                    Self::fit_unit(&scaled, ar.as_ref(), &config.with_identification(false))?;
+                if failing(&curve.check_whole(&scaled)?) < failed {
+                    (model, curve_fit) = (curve, true);
+                }
+            }
+        }
         // A model of no noise at all for data with some: the weights spanned more than f64
         // can hold.
         let mut curve = [0.0; L];
@@ -283,6 +305,7 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
         Ok(Identified {
             model: model.scaled(exponent)?,
             budget_limited,
+            curve_fit,
         })
     }
 
@@ -670,4 +693,9 @@ pub struct Identified<const P: usize, const G: usize> {
     /// not the data, limited the model (its random walk, say, then also carries what a
     /// Gauss-Markov term would have taken).
     pub budget_limited: bool,
+    /// Whether the model is the curve fit's, which fills the budget: asked for (identification
+    /// off), or because the identified terms failed the whole-curve check
+    /// ([`NoiseModel::check_whole`]) at more octaves than the curve fit. Its parameters then
+    /// describe the curve, and may not be the sensor's.
+    pub curve_fit: bool,
 }

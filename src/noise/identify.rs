@@ -9,6 +9,11 @@ use super::{NoiseError, indexed};
 
 /// Golden-section steps of a refinement: the bracket shrinks to `0.618^14`, 0.1 % of it.
 const GOLDEN_STEPS: usize = 14;
+/// The most alternations of an oscillator's frequency and decay searches.
+const OSCILLATOR_ROUNDS: usize = 12;
+
+/// A Gauss-Markov term with a correlation time of at most this many samples is white noise.
+const WHITE_SAMPLES: f64 = 3.0;
 
 /// Forward and backward rounds at most.
 const ROUNDS: usize = 4;
@@ -246,20 +251,22 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
             (set, taken) = self.walks(set)?;
             from_term |= taken;
         }
-        let (x, _) = self.nnls(set.columns())?;
-        let set = Self::compact(&set, &x);
-        let (x, _) = self.nnls(set.columns())?;
-        let start = self.model_of(set.columns(), &x)?;
-        let (refined, _) = self.refine(set.columns(), Some(&start))?;
-        // The refinement reweights by its own model, which can talk a term down to zero where
-        // the data need it: then the identified set's own fit stands.
-        let model = if !refined.check_whole(self.octaves)?.holds()
-            && start.check_whole(self.octaves)?.holds()
-        {
-            start
-        } else {
-            refined
-        };
+        let (mut set, mut model) = self.settle(set)?;
+        // A Gauss-Markov term that forgets within a few samples is white noise at every octave
+        // but the first few: it takes no state where the model without it passes the check.
+        let dt = self.octaves.dt();
+        for _ in 0..set.len {
+            let short = set
+                .columns()
+                .iter()
+                .position(|c| matches!(c, Column::GaussMarkov(t) if *t <= WHITE_SAMPLES * dt));
+            let Some(i) = short else { break };
+            let (smaller, without) = self.settle(set.without(i))?;
+            if !without.check_whole(self.octaves)?.holds() {
+                break;
+            }
+            (set, model) = (smaller, without);
+        }
         // A random walk less than one standard deviation above zero, without which the model
         // still passes the Allan check at every octave, is not identified.
         self.reweight(Some(&model));
@@ -277,15 +284,32 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
         if let Some(i) = candidate
             && !model.walk_significant(self)?
         {
-            let smaller = set.without(i);
-            let (x, _) = self.nnls(smaller.columns())?;
-            let start = self.model_of(smaller.columns(), &x)?;
-            let (without, _) = self.refine(smaller.columns(), Some(&start))?;
+            let (_, without) = self.settle(set.without(i))?;
             if without.check_whole(self.octaves)?.holds() {
                 return Ok((without, limited));
             }
         }
         Ok((model, limited))
+    }
+
+    /// The fit of `set` (its zero terms left out, the set returned without them), refined by
+    /// its own weights; where that reweighting talks a term the data need down to zero, so
+    /// that the refined fit fails the whole-curve check that the set's own fit passes, the
+    /// set's own fit.
+    fn settle(&mut self, set: Set) -> Result<(Set, Full<P>), NoiseError> {
+        let (x, _) = self.nnls(set.columns())?;
+        let set = Self::compact(&set, &x);
+        let (x, _) = self.nnls(set.columns())?;
+        let start = self.model_of(set.columns(), &x)?;
+        let (refined, _) = self.refine(set.columns(), Some(&start))?;
+        let model = if !refined.check_whole(self.octaves)?.holds()
+            && start.check_whole(self.octaves)?.holds()
+        {
+            start
+        } else {
+            refined
+        };
+        Ok((set, model))
     }
 
     /// `set` with every Gauss-Markov term that [`Self::unbounded_term`] finds taken as the
@@ -301,6 +325,15 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
                     } else {
                         walk.with(Column::RandomWalk)
                     };
+                    // Unless the record contradicts the walk: the term explains every octave
+                    // and the walk does not (a rise that levels off, as a long term's does).
+                    let (_, term) = self.settle(set)?;
+                    let (_, walked) = self.settle(walk)?;
+                    if term.check_whole(self.octaves)?.holds()
+                        && !walked.check_whole(self.octaves)?.holds()
+                    {
+                        break;
+                    }
                     taken = true;
                     set = walk;
                 }
@@ -362,19 +395,27 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
                 Ok(set.replaced(i, Column::GaussMarkov(libm::exp(u))))
             }
             Some(Column::Oscillator(mut f, mut t)) => {
+                // Frequency and decay trade along a narrow valley of the misfit (a longer decay
+                // narrows the line as a lower frequency moves it): the two searches alternate
+                // until neither moves.
                 let half = core::f64::consts::LN_2 / 2.0;
-                for _ in 0..2 {
+                for _ in 0..OSCILLATOR_ROUNDS {
                     let lo = (ln(f) - half).max(ln(OSCILLATOR_MIN_HZ));
                     let hi = (ln(f) + half).min(ln(0.25 / dt));
                     let u = self.golden(ln(f), lo, hi, |u| {
                         set.replaced(i, Column::Oscillator(libm::exp(u), t))
                     })?;
+                    let moved_f = libm::fabs(u - ln(f));
                     f = libm::exp(u);
                     let (lo, hi) = (ln(MIN_CYCLES / f), ln(MAX_CYCLES / f));
-                    let u = self.golden(ln(t), lo, hi, |u| {
-                        set.replaced(i, Column::Oscillator(f, libm::exp(u)))
+                    let v = self.golden(ln(t), lo, hi, |v| {
+                        set.replaced(i, Column::Oscillator(f, libm::exp(v)))
                     })?;
-                    t = libm::exp(u);
+                    let moved_t = libm::fabs(v - ln(t));
+                    t = libm::exp(v);
+                    if moved_f < 1e-4 && moved_t < 1e-3 {
+                        break;
+                    }
                 }
                 Ok(set.replaced(i, Column::Oscillator(f, t)))
             }

@@ -77,11 +77,12 @@ pub struct ModelArgs {
     /// Fit a rate ramp too (in a static record, usually a temperature drift).
     #[arg(long)]
     ramp: bool,
-    /// Identify the terms instead of fitting the curve: each added only when it lowers an
-    /// information criterion, correlation times refined off the grid, a term the record cannot
-    /// tell from a random walk taken as one (`NoiseModel::identify`).
+    /// Fit the curve with every state the budget allows instead of identifying the terms (the
+    /// identification adds each term only when it lowers an information criterion, refines
+    /// correlation times off the grid and takes a term the record cannot tell from a random
+    /// walk as one: `NoiseModel::identify`).
     #[arg(long)]
-    identify: bool,
+    curve_fit: bool,
     /// The filter's rate in Hz for `phi`, `q` and `p0` (and for the PX4 and ArduPilot files)
     /// [default: the model's rate].
     #[arg(long, allow_negative_numbers = true)]
@@ -107,7 +108,7 @@ impl ModelArgs {
         Ok(FitConfig::new(self.gm_states)
             .with_oscillators(self.oscillators)
             .with_ramp(self.ramp)
-            .with_identification(self.identify))
+            .with_identification(!self.curve_fit))
     }
 }
 
@@ -272,6 +273,10 @@ pub struct NoiseResult {
     /// Whether a term the data call for was left out for want of states (`--gm-states`): the
     /// budget, not the data, limited the model.
     pub budget_limited: bool,
+    /// Whether the model is the curve fit that fills the budget (`--curve-fit`, or where the
+    /// identified terms fail the whole-curve check and the curve fit passes it): its
+    /// parameters describe the curve, and may not be the sensor's.
+    pub curve_fit: bool,
     /// The 95 % intervals of the parameters, when the model has few enough for them.
     pub intervals: Option<Intervals>,
     /// The AR part, or `None`.
@@ -287,6 +292,9 @@ pub struct NoiseResult {
     pub allan: Vec<AllanRow>,
     /// The largest `tau` (s) up to which every row agrees.
     pub explained_up_to_s: Option<f64>,
+    /// The normal deviate of each row's test, so that the check is one 95 % test of the whole
+    /// curve (`NoiseModel::check_whole`).
+    pub check_z: f64,
     /// What the timestamps show, when the rate came from them.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub timing: Option<TimingSummary>,
@@ -445,7 +453,7 @@ impl Fitting {
     ) -> Result<Fitted<'a>, Fail> {
         let fit = NoiseModel::<P, MAX_GM_STATES>::identify(octaves, ar, &self.config)?;
         let model = fit.model;
-        let check = model.check(octaves)?;
+        let check = model.check_whole(octaves)?;
         let uncertainty = model.uncertainty(octaves).ok();
         let span = self.n as f64 / self.rate;
         // The random walk's state starts with the variance it reaches over the record.
@@ -458,6 +466,7 @@ impl Fitting {
         })?;
         let mut result = self.result(&model, ar, &model.ieee952(octaves), &form, &check);
         result.budget_limited = fit.budget_limited;
+        result.curve_fit = fit.curve_fit;
         result.intervals = uncertainty
             .as_ref()
             .map(|u| Intervals::of(&model, u, result.bias_instability.value));
@@ -554,6 +563,7 @@ impl Fitting {
             },
             gauss_markov,
             budget_limited: false,
+            curve_fit: false,
             intervals: None,
             ar: ar_part,
             phi: space.phi,
@@ -572,6 +582,7 @@ impl Fitting {
                 })
                 .collect(),
             explained_up_to_s: check.explained_up_to(),
+            check_z: check.z(),
             timing: None,
             details: Details {
                 unit: self.units.name.clone(),
@@ -656,6 +667,11 @@ impl Output for NoiseResult {
             s += "budget_limited true: the data call for a term that --gm-states left no state \
                   for; the random walk and the other terms carry it\n";
         }
+        if self.curve_fit {
+            s += "curve_fit true: every state of the budget spent on the curve (--curve-fit, or \
+                  the identified terms failed the whole-curve check); the parameters describe \
+                  the curve, and may not be the sensor's\n";
+        }
         if let Some(i) = &self.intervals {
             s += "95 % intervals (from the Allan variances' sampling distribution; a term the \
                   model lacks from 0):\n";
@@ -708,6 +724,11 @@ impl Output for NoiseResult {
             json(&self.q),
             json(&self.p0),
             json(&d.measurement_variance)
+        );
+        s += &format!(
+            "Allan check: one 95 % test of the whole curve, each octave at z = {:.2} standard \
+             errors\n",
+            self.check_z
         );
         s += &allan_text(&self.allan);
         s += &format!("explained_up_to_s {}\n", json(&self.explained_up_to_s));

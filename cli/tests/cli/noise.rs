@@ -142,7 +142,7 @@ fn composite_record(name: &str) -> (Composite, PathBuf) {
 fn identifies_a_simulated_composite_with_intervals_around_the_truth() {
     let (truth, path) = composite_record("noise-identify.csv");
     let files = [path];
-    let v = noise(&files, "x", "100", &["--ar-order", "0", "--identify"]);
+    let v = noise(&files, "x", "100", &["--ar-order", "0"]);
     let within = |b: &Value, want: f64| f(&b["low"]) <= want && want <= f(&b["high"]);
     let i = &v["intervals"];
     assert!(
@@ -158,6 +158,7 @@ fn identifies_a_simulated_composite_with_intervals_around_the_truth() {
     let t = &i["gauss_markov"][0]["correlation_time_s"];
     assert!(within(t, truth.gm[0].1), "{t}");
     assert_eq!(v["budget_limited"], Value::Bool(false));
+    assert_eq!(v["curve_fit"], Value::Bool(false));
     // Each octave is checked at two standard errors, a 95 % test of its own: the true model
     // failed one somewhere on a quarter of the records of the identification campaign.
     let failing = v["allan"]
@@ -190,6 +191,7 @@ fn hands_a_simulated_composite_to_a_filter_at_its_rate() {
         "bias_instability",
         "gauss_markov",
         "budget_limited",
+        "curve_fit",
         "intervals",
         "ar",
         "phi",
@@ -197,6 +199,7 @@ fn hands_a_simulated_composite_to_a_filter_at_its_rate() {
         "p0",
         "allan",
         "explained_up_to_s",
+        "check_z",
     ];
     documented.sort_unstable();
     assert_eq!(keys, documented);
