@@ -55,6 +55,38 @@ mod firmware {
         start.wrapping_sub(end) & RELOAD
     }
 
+    /// SysTick wraps counted by its exception while [`long_ticks`] has it enabled.
+    static WRAPS: core::sync::atomic::AtomicU32 = core::sync::atomic::AtomicU32::new(0);
+
+    #[cortex_m_rt::exception]
+    fn SysTick() {
+        use core::sync::atomic::Ordering::Relaxed;
+        // The one writer besides `long_ticks`'s reset (single core, no nesting with itself).
+        WRAPS.store(WRAPS.load(Relaxed).wrapping_add(1), Relaxed);
+    }
+
+    /// SysTick ticks spent in `f`, however many: each wrap of the 24-bit counter is counted by
+    /// its exception (a few instructions per 671 million).
+    fn long_ticks(syst: &mut SYST, f: impl FnOnce()) -> u64 {
+        use core::sync::atomic::Ordering::Relaxed;
+        syst.clear_current();
+        WRAPS.store(0, Relaxed);
+        syst.enable_interrupt();
+        let start = SYST::get_current();
+        f();
+        let end = SYST::get_current();
+        syst.disable_interrupt();
+        let wraps = u64::from(WRAPS.load(Relaxed));
+        // From `start` down to 0 (a cleared counter, 0, reloads first: a whole period), then
+        // `wraps - 1` whole periods, then from RELOAD down to `end`.
+        let period = u64::from(RELOAD) + 1;
+        let start = match start {
+            0 => period,
+            s => u64::from(s),
+        };
+        (wraps * period + start).saturating_sub(u64::from(end))
+    }
+
     /// Instructions per SysTick tick, from `subs; bne` loops of known length.
     fn calibrate(syst: &mut SYST) -> u32 {
         let spin = |n: u32| {
@@ -286,14 +318,14 @@ mod firmware {
                 let top = stack_pointer() - 1024;
                 paint_stack(top);
                 // Identified, the fit and the 95 % intervals of its parameters.
-                let n = ticks(&mut self.syst, || {
+                let n = long_ticks(&mut self.syst, || {
                     let fit = NoiseModel::<8, 3>::fit(black_box(&octaves), ar, &config);
                     if intervals {
                         let u = fit.as_ref().ok().map(|m| m.uncertainty(&octaves));
                         black_box(u.map(|u| u.map(|u| u.random_walk.high)));
                     }
                     fitted = Some(fit);
-                }) * self.per_tick;
+                }) * u64::from(self.per_tick);
                 // The fit's stack: what it used below `top`, and the 1 KiB above it.
                 let stack = stack_used(top) + 1024;
                 let Some(Ok(model)) = fitted else {
@@ -301,7 +333,7 @@ mod firmware {
                     common::exit(false)
                 };
                 defmt::info!(
-                    "noise fit octaves=20 gm=3 ar={=str} insns/fit={=u32} stack={=usize} terms={=usize}",
+                    "noise fit octaves=20 gm=3 ar={=str} insns/fit={=u64} stack={=usize} terms={=usize}",
                     name,
                     n,
                     stack,
