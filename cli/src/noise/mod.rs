@@ -471,13 +471,17 @@ impl Fitting {
             .as_ref()
             .map(|u| Intervals::of(&model, u, result.bias_instability.value));
         let default = self.caption(&model);
+        // The 95 % band of the model's Allan deviation, from its parameters' intervals.
+        let band: Vec<(f64, f64)> = uncertainty.as_ref().map_or(Vec::new(), |u| {
+            u.adev_band().iter().map(|i| (i.low, i.high)).collect()
+        });
         let paint: Paint<'a> = Box::new(move |area, caption| {
             let caption = if caption.is_empty() {
                 &default
             } else {
                 caption
             };
-            plot::decomposition(area, &model, octaves, &check, caption)
+            plot::decomposition(area, &model, octaves, &check, &band, caption)
         });
         // In SI units already (`export` is asked for with the record in SI); the bias
         // instability is the data's IEEE 952 reading, not the model's.

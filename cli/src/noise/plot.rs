@@ -96,13 +96,15 @@ pub(crate) fn png(
     root.present().map_err(|e| e.to_string())
 }
 
-/// The data's Allan deviation with one standard error either side, the model's, and each
-/// component's, on log-log axes, on `root`; octaves where the check fails are crossed.
+/// The data's Allan deviation with one standard error either side, the model's with its 95 % band
+/// (when `band` holds one interval per octave), and each component's, on log-log axes, on `root`;
+/// octaves where the check fails are crossed.
 pub(crate) fn decomposition<const P: usize, const G: usize, const L: usize>(
     root: &Area,
     model: &NoiseModel<P, G>,
     octaves: &Octaves<L>,
     check: &Check<L>,
+    band: &[(f64, f64)],
     caption: &str,
 ) -> Result<(), String> {
     let draw_err = |e: DrawingAreaErrorKind<_>| e.to_string();
@@ -146,6 +148,26 @@ pub(crate) fn decomposition<const P: usize, const G: usize, const L: usize>(
             .map_err(draw_err)?
             .label(label.as_str())
             .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], colour.stroke_width(1)));
+    }
+    // The model's 95 % band (its parameters' intervals), under the model's line.
+    if band.len() == rows.len() && band.iter().all(|(lo, hi)| lo.is_finite() && hi.is_finite()) {
+        let shade = RED.mix(0.15);
+        let outline: Vec<(f64, f64)> = tau
+            .iter()
+            .zip(band)
+            .map(|(t, (lo, _))| (*t, lo.max(floor)))
+            .chain(
+                tau.iter()
+                    .zip(band)
+                    .rev()
+                    .map(|(t, (_, hi))| (*t, hi.max(floor))),
+            )
+            .collect();
+        chart
+            .draw_series(std::iter::once(Polygon::new(outline, shade.filled())))
+            .map_err(draw_err)?
+            .label("model, 95 % band")
+            .legend(move |(x, y)| Rectangle::new([(x, y - 4), (x + 20, y + 4)], shade.filled()));
     }
     let model_curve = rows.iter().map(|r| (r.tau, r.model_adev));
     chart
