@@ -1,12 +1,13 @@
 //! Bit-exact parity of host and target: the f32 and the fixed-point lattice on a seeded input
-//! sequence (documented in `examples/common/parity.rs`), hashed to one checksum each.
+//! sequence, and the identified noise model with its intervals on a seeded Allan stream
+//! (documented in `examples/common/parity.rs`), hashed to one checksum each.
 //!
 //! ```text
 //! cargo qemu parity
 //! cargo run -p imu-ar-cli --bin imu-ar -- parity
 //! ```
 //!
-//! Both print `parity f32 <hex> fixed <hex>`; `.ci/run` fails when the two lines differ.
+//! Both print `parity f32 <hex> fixed <hex> noise <hex>`; `.ci/run` fails when the two lines differ.
 #![cfg_attr(target_os = "none", no_std, no_main)]
 
 #[cfg(target_os = "none")]
@@ -20,13 +21,18 @@ mod parity;
 #[cfg(target_os = "none")]
 #[cortex_m_rt::entry]
 fn main() -> ! {
-    match parity::checksums() {
-        Some((f, q)) => {
-            defmt::info!("parity f32 {=u64:016x} fixed {=u64:016x}", f, q);
+    match parity::checksums().zip(parity::noise_checksum()) {
+        Some(((f, q), n)) => {
+            defmt::info!(
+                "parity f32 {=u64:016x} fixed {=u64:016x} noise {=u64:016x}",
+                f,
+                q,
+                n
+            );
             common::exit(true)
         }
         None => {
-            defmt::error!("parity: a configuration was refused");
+            defmt::error!("parity: a configuration or the noise fit was refused");
             common::exit(false)
         }
     }

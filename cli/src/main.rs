@@ -73,7 +73,8 @@ enum Command {
     Order(order::Args),
     /// Overlapping Allan deviation at m = 1, 2, 4, ...
     Adev(adev::Args),
-    /// Checksums of the f32 and fixed-point lattices on the seeded parity sequence, to compare
+    /// Checksums of the f32 and fixed-point lattices on the seeded parity sequence and of the
+    /// identified noise model on a seeded Allan stream, to compare
     /// with `cargo qemu parity` (bit-identical results on host and target).
     Parity,
     /// Simulate an AR process; CSV `t_s,x` on stdout.

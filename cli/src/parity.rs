@@ -1,5 +1,5 @@
 //! `imu-ar parity`: the checksums of the f32 and fixed-point lattices on the seeded parity
-//! sequence, to compare with `cargo qemu parity` (bit-identical results on host and target).
+//! sequence and of the identified noise model on the seeded Allan stream, to compare with `cargo qemu parity` (bit-identical results on host and target).
 
 use serde::Serialize;
 
@@ -17,17 +17,23 @@ pub struct Checksums {
     pub f32: u64,
     /// Of the fixed-point lattice.
     pub fixed: u64,
+    /// Of the identified noise model and its intervals.
+    pub noise: u64,
 }
 
 impl Output for Checksums {
     /// The line the firmware prints.
     fn text(&self) -> String {
-        format!("parity f32 {:016x} fixed {:016x}\n", self.f32, self.fixed)
+        format!(
+            "parity f32 {:016x} fixed {:016x} noise {:016x}\n",
+            self.f32, self.fixed, self.noise
+        )
     }
 }
 
 /// Runs the parity sequence through both lattices.
 pub fn run() -> Result<Checksums, Fail> {
     let (f32, fixed) = shared::checksums().ok_or_else(|| Fail("parity run refused".into()))?;
-    Ok(Checksums { f32, fixed })
+    let noise = shared::noise_checksum().ok_or_else(|| Fail("parity noise fit failed".into()))?;
+    Ok(Checksums { f32, fixed, noise })
 }

@@ -82,8 +82,9 @@ pub struct GmState {
 
 /// The two filter states `[x, dx/dt]` of an oscillator at the filter's step `Dt`: the
 /// continuous-time process `x'' + 2 x' / T + (w^2 + 1/T^2) x = noise` (`w = 2 pi f`) with the
-/// oscillator's poles and variance, sampled exactly: `Phi = exp(A Dt)` and, for a stationary
-/// process, `Qd = P0 - Phi P0 Phi^T` with `P0 = diag(sigma^2, (w^2 + 1/T^2) sigma^2)`.
+/// oscillator's poles and variance, sampled exactly: `Phi = exp(A Dt)`, `P0 = diag(sigma^2,
+/// (w^2 + 1/T^2) sigma^2)` and `Qd = P0 - Phi P0 Phi^T`, computed as the integral it equals
+/// so that it keeps its precision at any filter rate.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct OscillatorState {
@@ -115,20 +116,106 @@ impl OscillatorState {
         ];
         let s2 = o.sigma * o.sigma;
         let p = [s2, wn2 * s2];
-        let mut q = [[0.0; 2]; 2];
-        for (i, row) in indexed(q.iter_mut()) {
-            for (k, v) in indexed(row.iter_mut()) {
-                let fpf: f64 = (0..2).map(|l| phi[i][l] * p[l] * phi[k][l]).sum();
-                *v = if i == k { p[i] } else { 0.0 } - fpf;
-            }
-        }
+        // The noise drives dx/dt with density 4 alpha wn^2 sigma^2, which keeps P0 stationary.
+        let qc = 4.0 * alpha * wn2 * s2;
+        let [i11, i12, i22] = response_integrals(alpha, w, dt);
+        let q12 = qc * i12;
         Self {
             phi,
-            q,
+            q: [[qc * i11, q12], [q12, qc * i22]],
             p0: [[p[0], 0.0], [0.0, p[1]]],
         }
     }
 }
+
+/// `int_0^dt exp(-2 alpha s) g_i(s) g_j(s) ds` for the oscillator's impulse response into its
+/// two states, `g_1 = sin(w s) / w`, `g_2 = cos(w s) - alpha sin(w s) / w` (the second column
+/// of `exp(A s)` without its `exp(-alpha s)`): `[I_11, I_12, I_22]`, so that
+/// `Qd = q_c I`. `P0 - Phi P0 Phi^T` gives the same in exact arithmetic but cancels where the
+/// step is short against the period and the decay (a relative error of `eps / (alpha dt)`);
+/// here every entry is computed to a few `eps` of its own size.
+///
+/// Up to [`QUADRATURE_SPAN`] radians of `|alpha + i w| dt` (`dt` at most 40 decay times):
+/// composite Gauss-Legendre, 16 nodes
+/// on each piece of at most a quarter radian (the integrands are entire, and the rule exact to
+/// degree 31). Beyond: the integrals in closed form, `sin^2`, `cos^2` and `sin cos` written with
+/// `K = int_0^dt exp((-2 alpha + 2 i w) s) ds`, and `exp(z dt) - 1` evaluated without
+/// cancellation (`expm1`, and `cos - 1 = -2 sin^2(/2)`).
+fn response_integrals(alpha: f64, w: f64, dt: f64) -> [f64; 3] {
+    // Past 40 decay times the integrands are below exp(-80) of their start: not integrated.
+    let span = if alpha > 0.0 {
+        dt.min(40.0 / alpha)
+    } else {
+        dt
+    };
+    let reach = libm::hypot(alpha, w) * span;
+    // With w <= alpha the reach is at most 40 sqrt(2): the closed form below has w > 0.
+    if reach <= QUADRATURE_SPAN {
+        let pieces = libm::ceil(reach / 0.25).max(1.0);
+        let h = span / pieces;
+        let mut sum = [0.0; 3];
+        let mut a = 0.0;
+        // `pieces` is at most QUADRATURE_SPAN / 0.25 + 1.
+        for _ in 0..pieces as u32 {
+            for (x, wt) in GAUSS_16 {
+                for sign in [-1.0, 1.0] {
+                    let s = a + 0.5 * h * (1.0 + sign * x);
+                    let (sin, cos) = (libm::sin(w * s), libm::cos(w * s));
+                    let decay = libm::exp(-2.0 * alpha * s);
+                    let g1 = if w > 0.0 { sin / w } else { s };
+                    let g2 = cos - alpha * g1;
+                    let c = 0.5 * h * wt * decay;
+                    sum[0] += c * g1 * g1;
+                    sum[1] += c * g1 * g2;
+                    sum[2] += c * g2 * g2;
+                }
+            }
+            a += h;
+        }
+        return sum;
+    }
+    let (beta, gamma) = (2.0 * alpha, 2.0 * w);
+    // J0 = int exp(-beta s) ds; K = (exp(z dt) - 1) / z, z = -beta + i gamma.
+    let j0 = if beta > 0.0 {
+        -libm::expm1(-beta * dt) / beta
+    } else {
+        dt
+    };
+    let em = libm::expm1(-beta * dt);
+    let half = libm::sin(0.5 * gamma * dt);
+    let (re_num, im_num) = (
+        em * libm::cos(gamma * dt) - 2.0 * half * half,
+        (1.0 + em) * libm::sin(gamma * dt),
+    );
+    // Divided by z = -beta + i gamma.
+    let norm = beta * beta + gamma * gamma;
+    let (re_k, im_k) = (
+        (-re_num * beta + im_num * gamma) / norm,
+        (-im_num * beta - re_num * gamma) / norm,
+    );
+    let (ss, cc, sc) = (0.5 * (j0 - re_k), 0.5 * (j0 + re_k), 0.5 * im_k);
+    let w2 = w * w;
+    [
+        ss / w2,
+        sc / w - alpha * ss / w2,
+        cc - 2.0 * alpha * sc / w + alpha * alpha * ss / w2,
+    ]
+}
+
+/// The reach `|alpha + i w| dt` up to which [`response_integrals`] integrates numerically.
+const QUADRATURE_SPAN: f64 = 64.0;
+
+/// The positive nodes of the 16-point Gauss-Legendre rule on [-1, 1], with their weights.
+const GAUSS_16: [(f64, f64); 8] = [
+    (0.095_012_509_837_637_44, 0.189_450_610_455_068_64),
+    (0.281_603_550_779_258_9, 0.182_603_415_044_923_64),
+    (0.458_016_777_657_227_37, 0.169_156_519_395_002_65),
+    (0.617_876_244_402_643_8, 0.149_595_988_816_576_7),
+    (0.755_404_408_355_003, 0.124_628_971_255_534_07),
+    (0.865_631_202_387_831_8, 0.095_158_511_682_492_6),
+    (0.944_575_023_073_232_6, 0.062_253_523_938_647_456),
+    (0.989_400_934_991_649_9, 0.027_152_459_411_754_176),
+];
 
 /// The two filter states `[q_k / Dt, q_(k-1) / Dt]` of quantisation `Q` at the filter's step
 /// `Dt`: the quantisation error `q_k ~ N(0, Q^2)` of the integrated sensor (angle or velocity)
@@ -616,4 +703,76 @@ pub(super) fn family_z(rows: usize) -> f64 {
         }
     }
     (lo + hi) / 2.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `[I_11, I_12, I_22]` of [`response_integrals`] by composite Simpson on 400,000 panels
+    /// with compensated sums: slow, and independent of the rule under test.
+    fn simpson(alpha: f64, w: f64, dt: f64) -> [f64; 3] {
+        const PANELS: usize = 400_000;
+        let h = dt / PANELS as f64;
+        let mut sum = [(0.0f64, 0.0f64); 3];
+        for i in 0..=PANELS {
+            let s = i as f64 * h;
+            let weight = if i == 0 || i == PANELS {
+                1.0
+            } else if i % 2 == 1 {
+                4.0
+            } else {
+                2.0
+            };
+            let decay = (-2.0 * alpha * s).exp();
+            let g1 = (w * s).sin() / w;
+            let g2 = (w * s).cos() - alpha * g1;
+            for (acc, v) in sum.iter_mut().zip([g1 * g1, g1 * g2, g2 * g2]) {
+                // Kahan: acc.0 the sum, acc.1 its lost low part.
+                let y = weight * decay * v - acc.1;
+                let t = acc.0 + y;
+                acc.1 = (t - acc.0) - y;
+                acc.0 = t;
+            }
+        }
+        sum.map(|(v, _)| v * h / 3.0)
+    }
+
+    #[test]
+    fn the_oscillator_noise_keeps_its_precision_at_every_filter_rate() {
+        // (frequency Hz, decay s): a 0.6 Hz line with damping 0.05, a fast damped one, a
+        // slow one that barely decays.
+        for (f, decay) in [(0.6, 5.3), (12.0, 0.8), (0.1, 1000.0)] {
+            let o = Oscillator {
+                sigma: 0.3,
+                frequency: f,
+                decay_time: decay,
+            };
+            let (alpha, w) = (1.0 / decay, 2.0 * core::f64::consts::PI * f);
+            for rate in [0.05, 1.0, 10.0, 100.0, 1e3, 1e4, 1e5, 1e6] {
+                let dt = 1.0 / rate;
+                let got = response_integrals(alpha, w, dt);
+                let want = simpson(alpha, w, dt);
+                let scale = (want[0] * want[2]).sqrt();
+                for (k, (g, r)) in got.iter().zip(want).enumerate() {
+                    let size = if k == 1 { scale } else { r };
+                    assert!(
+                        (g - r).abs() <= 1e-12 * size,
+                        "f {f} decay {decay} rate {rate}: I[{k}] {g:e}, reference {r:e}"
+                    );
+                }
+                // Stationary: Phi P0 Phi^T + Qd = P0, and Qd positive definite.
+                let s = OscillatorState::new(&o, dt);
+                assert!(s.q[0][0] > 0.0 && s.q[0][0] * s.q[1][1] > s.q[0][1] * s.q[0][1]);
+                for i in 0..2 {
+                    for k in 0..2 {
+                        let fpf: f64 = (0..2).map(|l| s.phi[i][l] * s.p0[l][l] * s.phi[k][l]).sum();
+                        let p = s.p0[i][k];
+                        let size = (s.p0[i][i] * s.p0[k][k]).sqrt();
+                        assert!((fpf + s.q[i][k] - p).abs() <= 1e-12 * size, "rate {rate}");
+                    }
+                }
+            }
+        }
+    }
 }

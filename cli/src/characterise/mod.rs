@@ -41,6 +41,9 @@ pub struct Args {
     /// The sensor_msgs/Imu topic of a bag or an MCAP file.
     #[arg(long)]
     topic: Option<String>,
+    /// The header frame_id of the IMU to read, when the topic carries more than one.
+    #[arg(long)]
+    frame_id: Option<String>,
     /// The six CSV columns: gyro x, y, z, then accelerometer x, y, z (names, names without
     /// their unit bracket, or 0-based indices) [default: w_RS_S_x .. a_RS_S_z (EuRoC), or
     /// gx .. az].
@@ -76,6 +79,14 @@ pub struct Args {
     /// 1 s to it [default: the model's random walk, and the files say how far it overbounds].
     #[arg(long, allow_negative_numbers = true)]
     horizon: Option<f64>,
+    /// ArduPilot's main loop rate (SCHED_LOOP_RATE), Hz: it sets EKF3's step, 12.5 ms at the
+    /// default 400 Hz (EKF3 sums the loop's IMU samples to about 12 ms).
+    #[arg(long, allow_negative_numbers = true)]
+    loop_rate: Option<f64>,
+    /// The vehicle ID (MAV_SYS_ID) of the PX4 parameter file: QGroundControl loads it only
+    /// into that vehicle [default: 1].
+    #[arg(long)]
+    sysid: Option<u8>,
     /// Print one JSON object instead of the table.
     #[arg(long)]
     pub json: bool,
@@ -107,6 +118,8 @@ pub struct SkippedCounts {
     pub non_finite: u64,
     /// Samples whose timestamp went backwards (with --drop-backward).
     pub backward: u64,
+    /// Messages of the topic's other IMUs (those --frame-id did not choose).
+    pub other_frame_id: u64,
 }
 
 /// One axis.
@@ -141,15 +154,33 @@ pub fn run(args: &Args) -> Result<Characterisation, Fail> {
         )));
     }
     let columns = columns(args)?;
+    // Created now, so that a folder that cannot be made fails before the record is read;
+    // removed again (while still empty) when the run fails.
+    let created = !args.out.exists();
     std::fs::create_dir_all(&args.out)
         .map_err(|e| Fail(format!("--out {}: cannot create: {e}", args.out.display())))?;
+    let result = characterise(args, &config, given, &formats, &columns);
+    if result.is_err() && created {
+        let _ = std::fs::remove_dir(&args.out);
+    }
+    result
+}
 
+/// [`run`] once its arguments are checked and `--out` exists.
+fn characterise(
+    args: &Args,
+    config: &imu_ar::noise::FitConfig,
+    given: [Option<Unit>; 2],
+    formats: &[Format],
+    columns: &[String],
+) -> Result<Characterisation, Fail> {
     let mut axes: Vec<AxisStream<OCTAVES>> = (0..6).map(|_| AxisStream::new()).collect();
     let progress = Progress::new();
     crate::input::csv::quiet_progress();
     let request = Request {
-        columns: &columns,
+        columns,
         topic: args.topic.as_deref(),
+        frame_id: args.frame_id.as_deref(),
         time_column: args.time_column.as_deref(),
         want_time: args.rate.is_none(),
         drop_backward: args.drop_backward,
@@ -172,6 +203,7 @@ pub fn run(args: &Args) -> Result<Characterisation, Fail> {
             axis_unit(
                 i,
                 read.units.get(i).copied().flatten(),
+                read.unknown.get(i).and_then(Option::as_deref),
                 given[i / 3],
                 &columns[i],
             )
@@ -183,7 +215,7 @@ pub fn run(args: &Args) -> Result<Characterisation, Fail> {
             n: n as usize,
             rate,
             filter_rate: args.model.filter_rate.unwrap_or(rate),
-            config,
+            config: *config,
             units: Units::of(u.si().name),
             export: true,
         })
@@ -224,30 +256,40 @@ pub fn run(args: &Args) -> Result<Characterisation, Fail> {
         rate_hz: rate,
         topic: args.topic.clone(),
         filter_rate_hz: args.model.filter_rate,
+        loop_rate_hz: args.loop_rate,
+        sysid: args.sysid,
     };
-    let mut files = write_all(&formats, &imu, args.horizon, &args.out)?;
-    for (name, range, what) in [
-        ("gyro.png", 0..3, "gyro"),
-        ("accel.png", 3..6, "accelerometer"),
-    ] {
-        let path = args.out.join(name);
-        let panels: Vec<(&crate::noise::Paint, String)> = range
-            .map(|i| {
-                (
-                    &paints[i],
-                    format!(
-                        "{what} {} ({}), {}",
-                        AXES[i],
-                        escaped(&columns[i]),
-                        units[i].si().name
-                    ),
-                )
-            })
-            .collect();
-        plot::png(&path, (1800, 600), &panels)
-            .map_err(|e| Fail(format!("{}: cannot draw: {e}", path.display())))?;
-        files.push(path.display().to_string());
-    }
+    let draw = |dir: &Path| -> Result<Vec<PathBuf>, Fail> {
+        let mut drawn = Vec::new();
+        for (name, range, what) in [
+            ("gyro.png", 0..3, "gyro"),
+            ("accel.png", 3..6, "accelerometer"),
+        ] {
+            let path = dir.join(name);
+            let panels: Vec<(&crate::noise::Paint, String)> = range
+                .map(|i| {
+                    (
+                        &paints[i],
+                        format!(
+                            "{what} {} ({}), {}",
+                            AXES[i],
+                            escaped(&columns[i]),
+                            units[i].si().name
+                        ),
+                    )
+                })
+                .collect();
+            plot::png(&path, (1800, 600), &panels).map_err(|e| {
+                Fail(format!(
+                    "{}: cannot draw: {e}",
+                    args.out.join(name).display()
+                ))
+            })?;
+            drawn.push(path);
+        }
+        Ok(drawn)
+    };
+    let files = write_all(formats, &imu, args.horizon, &args.out, &draw)?;
 
     Ok(Characterisation {
         rate_hz: rate,
@@ -256,6 +298,7 @@ pub fn run(args: &Args) -> Result<Characterisation, Fail> {
             undecodable: read.skipped.undecodable,
             non_finite: read.skipped.non_finite,
             backward,
+            other_frame_id: read.skipped.other_frame_id,
         },
         timing,
         axes: results,
@@ -263,40 +306,51 @@ pub fn run(args: &Args) -> Result<Characterisation, Fail> {
     })
 }
 
-/// Writes every file of `formats`, or none: each into a fresh folder in `out` first, moved into
-/// `out` once all are written.
+/// Writes every file of `formats` and the plots `draw` makes, or none: each into a fresh
+/// folder in `out` first, moved into `out` once all are written (and moved back out when a
+/// move fails midway).
 fn write_all(
     formats: &[Format],
     imu: &ImuModel,
     horizon: Option<f64>,
     out: &Path,
+    draw: &dyn Fn(&Path) -> Result<Vec<PathBuf>, Fail>,
 ) -> Result<Vec<String>, Fail> {
     let staging = out.join(format!(".imu-ar-{}", std::process::id()));
     let cannot = |e: std::io::Error| Fail(format!("{}: {e}", out.display()));
     std::fs::create_dir_all(&staging).map_err(cannot)?;
-    let written: Result<Vec<PathBuf>, Fail> = formats
+    let written = formats
         .iter()
         .map(|f| write(*f, imu, horizon, &staging))
-        .collect();
+        .collect::<Result<Vec<PathBuf>, Fail>>()
+        .and_then(|mut paths| {
+            paths.extend(draw(&staging)?);
+            Ok(paths)
+        });
     let moved = written.and_then(|paths| {
-        if let Some(to) = paths
-            .iter()
-            .map(|p| out.join(p.file_name().unwrap_or_default()))
-            .find(|to| to.is_dir())
-        {
+        let target = |p: &PathBuf| out.join(p.file_name().unwrap_or_default());
+        if let Some(to) = paths.iter().map(target).find(|to| to.is_dir()) {
             return Err(Fail(format!(
-                "{}: is a directory; no parameter file was written",
+                "{}: is a directory; no file was written",
                 to.display()
             )));
         }
-        paths
+        // A move that fails undoes the ones before it.
+        let mut done: Vec<(PathBuf, PathBuf)> = Vec::new();
+        for p in &paths {
+            let to = target(p);
+            if let Err(e) = std::fs::rename(p, &to) {
+                for (from, to) in done.iter().rev() {
+                    let _ = std::fs::rename(to, from);
+                }
+                return Err(cannot(e));
+            }
+            done.push((p.clone(), to));
+        }
+        Ok(done
             .iter()
-            .map(|p| {
-                let to = out.join(p.file_name().unwrap_or_default());
-                std::fs::rename(p, &to).map_err(cannot)?;
-                Ok(to.display().to_string())
-            })
-            .collect()
+            .map(|(_, to)| to.display().to_string())
+            .collect())
     });
     let _ = std::fs::remove_dir_all(&staging);
     moved
@@ -385,10 +439,11 @@ fn parse_unit(name: &str) -> Result<Unit, Fail> {
 }
 
 /// The unit of axis `i`: its header's (or the message's), else the flag's, checked to measure
-/// what the axis measures.
+/// what the axis measures. `bracket` is a header bracket that names no unit known here.
 fn axis_unit(
     i: usize,
     read: Option<Unit>,
+    bracket: Option<&str>,
     given: Option<Unit>,
     column: &str,
 ) -> Result<Unit, Fail> {
@@ -414,11 +469,16 @@ fn axis_unit(
             g.name, AXES[i]
         )));
     }
-    let unit = read.or(given).ok_or_else(|| {
-        Fail(format!(
+    let unit = read.or(given).ok_or_else(|| match bracket {
+        Some(b) => Fail(format!(
+            "column '{}': its unit [{}] is not one known here (rad/s, deg/s, deg/h for a gyro;              m/s^2, g, mg for an accelerometer; G and mG are read as gauss); give {flag}",
+            escaped(column),
+            escaped(b)
+        )),
+        None => Fail(format!(
             "column '{}': its unit is unknown (no unit bracket in the header); give {flag}",
             escaped(column)
-        ))
+        )),
     })?;
     if unit.quantity != want {
         return Err(Fail(format!(
@@ -466,12 +526,14 @@ impl Progress {
 impl Output for Characterisation {
     fn text(&self) -> String {
         let mut s = format!(
-            "{} samples per axis at {} Hz; skipped: {} undecodable, {} not finite, {} backward\n",
+            "{} samples per axis at {} Hz; skipped: {} undecodable, {} not finite, {} backward, \
+             {} of other frame_ids\n",
             self.n,
             json(&self.rate_hz),
             self.skipped.undecodable,
             self.skipped.non_finite,
-            self.skipped.backward
+            self.skipped.backward,
+            self.skipped.other_frame_id
         );
         if let Some(t) = &self.timing {
             s += &t.text();

@@ -574,15 +574,25 @@ pub fn vins(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
 /// continuous `N`, `IMU.GyroWalk`/`IMU.AccWalk` the continuous `K`, discretised with
 /// `IMU.Frequency`.
 pub fn orbslam3(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
-    let ([g, a], lines) = opened(
+    // Its configuration reader without `File.version: "1.0"` takes IMU.Frequency as an
+    // integer only (Tracking.cc: `node.isInt()`); the rounded rate discretises the densities.
+    let frequency = model.rate_hz.round().max(1.0);
+    let ([g, a], mut lines) = opened(
         model,
         horizon,
         "ORB-SLAM3 IMU parameters",
         &[
             "ORB-SLAM3 takes continuous-time densities and discretises them with IMU.Frequency",
             "(UZ-SLAMLab/ORB_SLAM3 Tracking.cc: Ng*sqrt(f), Ngw/sqrt(f); ImuTypes.cc preintegration).",
+            "IMU.Frequency is an integer: ORB-SLAM3 reads it as one.",
         ],
     )?;
+    if frequency != model.rate_hz {
+        lines.push(format!(
+            "The record's rate {} Hz is written rounded to {frequency:.0} Hz.",
+            num(model.rate_hz)
+        ));
+    }
     Ok(format!("%YAML:1.0\n\n{}\n", comments(&lines))
         + &format!(
             "IMU.NoiseGyro: {}  # rad/s/sqrt(Hz), continuous\nIMU.NoiseAcc: {}  # \
@@ -592,6 +602,6 @@ pub fn orbslam3(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> 
             num(a.n),
             num(g.k),
             num(a.k),
-            num(model.rate_hz)
+            frequency as u64
         ))
 }

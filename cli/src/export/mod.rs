@@ -144,10 +144,14 @@ pub struct ImuModel {
     pub rate_hz: f64,
     /// The IMU's ROS topic (Kalibr, OpenVINS) [default: `/imu0`].
     pub topic: Option<String>,
-    /// The prediction rate of PX4 EKF2 or ArduPilot EKF3, Hz, with which they use their noise
-    /// parameters [default: EKF2's 100 Hz (`EKF2_PREDICT_US` 10000), EKF3's 83.3 Hz
-    /// (`EKF_TARGET_DT` 12 ms)].
+    /// The rate of the state-space filter and of PX4 EKF2's prediction, Hz, with which EKF2
+    /// uses its noise parameters [default: EKF2's 100 Hz (`EKF2_PREDICT_US` 10000)].
     pub filter_rate_hz: Option<f64>,
+    /// ArduPilot's main loop rate (`SCHED_LOOP_RATE`), Hz, which sets EKF3's step
+    /// ([`params::ekf3_step`]) [default: 400, 12.5 ms].
+    pub loop_rate_hz: Option<f64>,
+    /// The vehicle ID of PX4's parameter file (`MAV_SYS_ID`) [default: 1].
+    pub sysid: Option<u8>,
 }
 
 /// The names of the six axes.

@@ -12,7 +12,23 @@ use crate::error::Fail;
 pub const PX4_PREDICT_US: f64 = 10_000.0;
 
 /// ArduPilot EKF3's `EKF_TARGET_DT`, s.
-pub const ARDUPILOT_DT: f64 = 0.012;
+pub const ARDUPILOT_TARGET_DT: f64 = 0.012;
+
+/// ArduPilot's default main loop rate (`SCHED_LOOP_RATE` of a copter), Hz.
+pub const ARDUPILOT_LOOP_HZ: f64 = 400.0;
+
+/// PX4's default vehicle ID (`MAV_SYS_ID`).
+pub const PX4_SYSID: u8 = 1;
+
+/// EKF3's prediction step at a main loop of `loop_hz`: it sums IMU samples (one per loop,
+/// `dtIMUavg = 1 / loop_hz`) until `n dtIMUavg >= EKF_TARGET_DT - dtIMUavg / 2`
+/// (`AP_NavEKF3_core.cpp`, `readIMUData`), so `dt` is the smallest such `n` times the loop
+/// period: 12.5 ms at 400 Hz, 12 ms at 500 Hz, 20 ms at 50 Hz.
+pub fn ekf3_step(loop_hz: f64) -> f64 {
+    let period = 1.0 / loop_hz;
+    let n = (ARDUPILOT_TARGET_DT / period - 0.5 - 1e-9).ceil().max(1.0);
+    n * period
+}
 
 /// The discrete value `x / sqrt(dt)` of a continuous density `x` for a filter that adds
 /// `(dt * value)^2` per step (so that the variance grows by `x^2 dt`).
@@ -35,12 +51,13 @@ const PX4_NAMES: Names = [
     ("EKF2_ACC_B_NOISE", (0.0, 0.01)),
 ];
 
-/// ArduPilot's, from the `@Range` of `libraries/AP_NavEKF3/AP_NavEKF3.cpp`.
+/// ArduPilot's, from the `@Range` of `libraries/AP_NavEKF3/AP_NavEKF3.cpp` (master:
+/// `EK3_ABIAS_P_NSE` to 0.02).
 const ARDUPILOT_NAMES: Names = [
     ("EK3_GYRO_P_NSE", (1e-4, 0.1)),
     ("EK3_ACC_P_NSE", (0.01, 1.0)),
     ("EK3_GBIAS_P_NSE", (1e-5, 1e-3)),
-    ("EK3_ABIAS_P_NSE", (1e-5, 5e-3)),
+    ("EK3_ABIAS_P_NSE", (1e-5, 0.02)),
 ];
 
 /// The values `N / sqrt(dt)`, `K / sqrt(dt)` of `names` for a filter stepping `dt`, and the
@@ -99,7 +116,7 @@ fn range_notes(values: &[Value]) -> Vec<String> {
 /// # Errors
 ///
 /// A [`Fail`] for a filter rate outside `EKF2_PREDICT_US`'s range (1000 to 20000 us: 50 to
-/// 1000 Hz), or a value that is not finite.
+/// 1000 Hz), a vehicle id of 0, or a value that is not finite.
 pub fn px4(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
     let predict_us = match model.filter_rate_hz {
         Some(f) => (1e6 / f).round(),
@@ -114,8 +131,14 @@ pub fn px4(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
     }
     let dt = predict_us * 1e-6;
     let (values, sensors) = autopilot(model, horizon, dt, &PX4_NAMES)?;
+    let sysid = model.sysid.unwrap_or(PX4_SYSID);
+    if sysid == 0 {
+        return Err(Fail(
+            "PX4: vehicle id 0 is not a MAV_SYS_ID (1 to 255)".into(),
+        ));
+    }
     let mut lines = vec![
-        "Onboard parameters for Vehicle 1".to_string(),
+        format!("Onboard parameters for Vehicle {sysid}"),
         String::new(),
     ];
     lines.extend(document(
@@ -129,6 +152,15 @@ pub fn px4(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
                 "step dt = EKF2_PREDICT_US = {predict_us} us: value = N / sqrt(dt), K / sqrt(dt)."
             ),
             "(EKF2 steps an integer number of IMU samples: set EKF2_PREDICT_US to a multiple.)",
+            &format!(
+                "Vehicle-Id {sysid} (MAV_SYS_ID{}): QGroundControl loads the file only into the",
+                if model.sysid.is_some() {
+                    ""
+                } else {
+                    ", the default"
+                }
+            ),
+            "vehicle of that id (imu-ar characterise --sysid sets it).",
         ],
         &[&sensors[0], &sensors[1]],
     ));
@@ -136,9 +168,9 @@ pub fn px4(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
     lines.push(String::new());
     lines.push("Vehicle-Id\tComponent-Id\tName\tValue\tType".into());
     let mut text = comments(&lines);
-    text += &format!("1\t1\tEKF2_PREDICT_US\t{predict_us}\t6\n");
+    text += &format!("{sysid}\t1\tEKF2_PREDICT_US\t{predict_us}\t6\n");
     for (name, v, _) in values {
-        text += &format!("1\t1\t{name}\t{}\t9\n", num(v));
+        text += &format!("{sysid}\t1\t{name}\t{}\t9\n", num(v));
     }
     Ok(text)
 }
@@ -149,8 +181,9 @@ pub fn px4(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
 ///
 /// Convention (ArduPilot/ardupilot, `libraries/AP_NavEKF3/AP_NavEKF3_core.cpp`,
 /// `NavEKF3_core::CovariancePrediction`, at 363e7e9eec9bdd54953b1bcc3e6bb71895c3c139): `dt`
-/// is the EKF's step (the IMU samples it averages, about `EKF_TARGET_DT` = 12 ms in
-/// `AP_NavEKF3_core.h`); per step, `daxVar = sq(dt*_gyrNoise)` (`EK3_GYRO_P_NSE`) and
+/// is the EKF's step, set by its target `EKF_TARGET_DT` = 12 ms and the main loop rate
+/// ([`ekf3_step`]; [`super::ImuModel::loop_rate_hz`], default 400 Hz: 12.5 ms), not by a
+/// filter rate of the user's; per step, `daxVar = sq(dt*_gyrNoise)` (`EK3_GYRO_P_NSE`) and
 /// `dvxVar = sq(dt*_accNoise)` (`EK3_ACC_P_NSE`); the delta-angle bias state (the rate bias
 /// times `dt`) gets `sq(sq(dt) * _gyroBiasProcessNoise)` (`EK3_GBIAS_P_NSE`), the
 /// delta-velocity bias `sq(sq(dt) * _accelBiasProcessNoise)` (`EK3_ABIAS_P_NSE`): the rate
@@ -159,9 +192,15 @@ pub fn px4(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
 ///
 /// # Errors
 ///
-/// A [`Fail`] for a value that is not finite.
+/// A [`Fail`] for a loop rate outside 50 to 2000 Hz, or a value that is not finite.
 pub fn ardupilot(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
-    let dt = model.filter_rate_hz.map_or(ARDUPILOT_DT, |f| 1.0 / f);
+    let loop_hz = model.loop_rate_hz.unwrap_or(ARDUPILOT_LOOP_HZ);
+    if !(50.0..=2000.0).contains(&loop_hz) {
+        return Err(Fail(format!(
+            "ArduPilot: loop rate {loop_hz} Hz is outside SCHED_LOOP_RATE's 50 to 2000 Hz"
+        )));
+    }
+    let dt = ekf3_step(loop_hz);
     let (values, sensors) = autopilot(model, horizon, dt, &ARDUPILOT_NAMES)?;
     let mut lines = document(
         model,
@@ -171,18 +210,30 @@ pub fn ardupilot(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail>
             "EK3_GBIAS_P_NSE)^2 to the delta-angle bias variance every step dt (ArduPilot",
             "AP_NavEKF3_core.cpp, CovariancePrediction); the accelerometer alike. Discrete at the",
             &format!(
-                "EKF's step dt = {} s ({} Hz{}): value = N / sqrt(dt), K / sqrt(dt).",
-                short(dt),
-                short(1.0 / dt),
-                if model.filter_rate_hz.is_some() {
+                "EKF's step dt = {} s: value = N / sqrt(dt), K / sqrt(dt). EKF3 sums IMU samples",
+                short(dt)
+            ),
+            &format!(
+                "until their time reaches EKF_TARGET_DT (12 ms) less half a sample: {} samples of a",
+                (dt * loop_hz).round()
+            ),
+            &format!(
+                "{} Hz main loop (SCHED_LOOP_RATE{}; imu-ar characterise --loop-rate sets it).",
+                short(loop_hz),
+                if model.loop_rate_hz.is_some() {
                     ""
                 } else {
-                    ", EKF_TARGET_DT"
+                    ", a copter's default"
                 }
             ),
         ],
         &[&sensors[0], &sensors[1]],
     );
+    if let Some(f) = model.filter_rate_hz {
+        lines.push(format!(
+            "note: --filter-rate {f} Hz is not EKF3's step, which its loop rate sets."
+        ));
+    }
     lines.extend(range_notes(&values));
     let mut text = comments(&lines);
     for (name, v, _) in values {

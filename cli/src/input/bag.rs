@@ -4,7 +4,8 @@
 //!
 //! The bag is memory-mapped by [`rosbag::RosBag`] and read one chunk at a time (a compressed
 //! chunk is decompressed into one buffer, dropped before the next): memory is bounded by the
-//! largest chunk, whatever the length of the bag. The connections come from the index section
+//! largest chunk, whatever the length of the bag (unless its chunks are out of time order:
+//! then the topic's messages are held to be sorted). The connections come from the index section
 //! at the end of the bag, so the topic and its type are checked before any message is read.
 //!
 //! A message is decoded by hand from its ROS 1 serialization
@@ -20,9 +21,10 @@ use std::path::Path;
 
 use rosbag::{ChunkRecord, IndexRecord, MessageRecord, RosBag};
 
+use crate::error::escaped;
 use crate::input::csv::DataError;
 use crate::input::frame::{
-    Frame, IMU_F64S, Skipped, Tally, absent_topic, data_error, imu_axes, stamp_ns, u32_at,
+    Frame, IMU_F64S, Select, Skipped, Tally, absent_topic, data_error, imu_axes, stamp_ns, u32_at,
 };
 
 /// The message type of the IMU connections.
@@ -37,8 +39,10 @@ const IMU_MD5: [u8; 16] = [
 const MAGIC: &[u8] = b"#ROSBAG V2.0\n";
 
 /// Calls `each` with every finite `sensor_msgs/Imu` message on `topic` of the ROS 1 bag `path`,
-/// in file order (chunk after chunk, each chunk's messages as stored: the order they were
-/// recorded in), and returns what was skipped.
+/// in the order of their receive times, and returns what was skipped. A bag whose chunks
+/// follow each other in time (the index's chunk records say so) is streamed in file order;
+/// one written out of time order is read whole and its messages on the topic sorted (56
+/// bytes each held).
 ///
 /// Messages that cannot be decoded, and those with a NaN or an infinite axis, are counted and
 /// not delivered. An error (after the frames already delivered, when the damage is found
@@ -46,6 +50,19 @@ const MAGIC: &[u8] = b"#ROSBAG V2.0\n";
 /// connection on `topic`, has one of another type (or another definition of `sensor_msgs/Imu`),
 /// or has no finite message on it.
 pub fn read(path: &Path, topic: &str, each: &mut dyn FnMut(Frame)) -> Result<Skipped, DataError> {
+    read_selected(path, &Select::topic(topic), each)
+}
+
+/// [`read`] of the messages `select` asks for: on its topic, from the IMU of its header
+/// frame_id (the others counted as skipped). An error too when the topic carries more than one
+/// IMU (frame_ids) and `select` names none, or when two connections send one frame_id at
+/// interleaved times.
+pub fn read_selected(
+    path: &Path,
+    select: &Select,
+    each: &mut dyn FnMut(Frame),
+) -> Result<Skipped, DataError> {
+    let topic = select.topic;
     let fail = |problem: String| data_error(path, problem);
     let corrupt = |what: String| fail(format!("truncated or corrupt bag: {what}"));
     check_header(path)?;
@@ -53,13 +70,19 @@ pub fn read(path: &Path, topic: &str, each: &mut dyn FnMut(Frame)) -> Result<Ski
 
     // The connections, from the index section.
     let mut ids = Vec::new();
+    let mut callers: Vec<(u32, String)> = Vec::new();
     let mut imu_topics = Vec::new();
     let mut all_topics = Vec::new();
+    // Each chunk's position, and the receive times of its first and last message.
+    let mut chunks: Vec<(u64, u64, u64)> = Vec::new();
     for record in bag.index_records() {
-        let IndexRecord::Connection(c) =
-            record.map_err(|e| corrupt(format!("{} (in the index)", text(&e))))?
-        else {
-            continue;
+        let c = match record.map_err(|e| corrupt(format!("{} (in the index)", text(&e))))? {
+            IndexRecord::Connection(c) => c,
+            IndexRecord::ChunkInfo(info) => {
+                chunks.push((info.chunk_pos, info.start_time, info.end_time));
+                continue;
+            }
+            _ => continue,
         };
         let name = c.storage_topic.to_string();
         if c.storage_topic == topic {
@@ -77,6 +100,7 @@ pub fn read(path: &Path, topic: &str, each: &mut dyn FnMut(Frame)) -> Result<Ski
                 )));
             }
             ids.push(c.id);
+            callers.push((c.id, c.caller_id.to_string()));
         }
         if c.tp == IMU_TYPE && !imu_topics.contains(&name) {
             imu_topics.push(name.clone());
@@ -94,7 +118,7 @@ pub fn read(path: &Path, topic: &str, each: &mut dyn FnMut(Frame)) -> Result<Ski
         )));
     }
 
-    let mut tally = Tally::new(each);
+    let mut tally = Tally::new(select, each);
     let mut messages = 0u64;
     let midway = |e: &rosbag::Error, messages: u64| {
         corrupt(format!(
@@ -102,6 +126,14 @@ pub fn read(path: &Path, topic: &str, each: &mut dyn FnMut(Frame)) -> Result<Ski
             text(e)
         ))
     };
+    // Chunks that follow each other in receive time (as a recorder writes them) are streamed
+    // chunk by chunk. A bag written out of time order (merged, or filtered by a script) is
+    // read whole, its messages on the topic sorted by receive time, the order `rosbag play`
+    // plays them in.
+    chunks.sort_unstable();
+    let in_order = chunks.windows(2).all(|w| w[0].2 <= w[1].1);
+    let mut sorted: Vec<Held> = Vec::new();
+    let mut frame_ids: Vec<Vec<u8>> = Vec::new();
     for record in bag.chunk_records() {
         let ChunkRecord::Chunk(chunk) = record.map_err(|e| midway(&e, messages))? else {
             continue;
@@ -111,13 +143,41 @@ pub fn read(path: &Path, topic: &str, each: &mut dyn FnMut(Frame)) -> Result<Ski
                 continue;
             };
             messages += 1;
-            if ids.contains(&m.conn_id) {
-                tally.offer(decode(m.data));
+            if !ids.contains(&m.conn_id) {
+                continue;
             }
+            if in_order {
+                tally.offer(m.conn_id, decode(m.data));
+                continue;
+            }
+            let frame = decode(m.data).map(|(f, id)| {
+                let k = frame_ids.iter().position(|i| i == id).unwrap_or_else(|| {
+                    frame_ids.push(id.to_vec());
+                    frame_ids.len() - 1
+                });
+                (f, u16::try_from(k).unwrap_or(u16::MAX))
+            });
+            sorted.push((m.time, m.conn_id, frame));
         }
     }
-    tally.finish(path, topic)
+    sorted.sort_by_key(|&(time, _, _)| time);
+    for (_, conn, frame) in sorted {
+        let id = |k: u16| frame_ids.get(usize::from(k)).map_or(&[][..], Vec::as_slice);
+        tally.offer(conn, frame.map(|(f, k)| (f, id(k))));
+    }
+    let names = |id: u32| {
+        let caller = callers.iter().find(|(c, _)| *c == id).map(|(_, n)| n);
+        match caller {
+            Some(n) if !n.is_empty() => format!("connection {id}, callerid '{}'", escaped(n)),
+            _ => format!("connection {id}"),
+        }
+    };
+    tally.finish(path, topic, &names)
 }
+
+/// A message held to be sorted: its receive time, connection, and frame with the index of its
+/// frame_id (`None` when it did not decode).
+type Held = (u64, u32, Option<(Frame, u16)>);
 
 /// The rosbag crate's error text without its `rosbag::Error: ` prefix.
 fn text(e: &rosbag::Error) -> String {
@@ -198,9 +258,9 @@ fn not_a_bag(head: &[u8]) -> String {
     }
 }
 
-/// The frame of one serialized `sensor_msgs/Imu`: `None` when its length is not that of the
-/// message (the header's frame_id length included).
-fn decode(b: &[u8]) -> Option<Frame> {
+/// The frame of one serialized `sensor_msgs/Imu` and its header's frame_id: `None` when its
+/// length is not that of the message (the header's frame_id length included).
+fn decode(b: &[u8]) -> Option<(Frame, &[u8])> {
     let secs = u32_at(b, 4, false)?;
     let nsecs = u32_at(b, 8, false)?;
     let frame_id = usize::try_from(u32_at(b, 12, false)?).ok()?;
@@ -208,8 +268,9 @@ fn decode(b: &[u8]) -> Option<Frame> {
     if b.len() != at.checked_add(IMU_F64S * 8)? {
         return None;
     }
-    Some(Frame {
+    let frame = Frame {
         stamp_ns: stamp_ns(i64::from(secs), nsecs),
         axes: imu_axes(b, at, false)?,
-    })
+    };
+    Some((frame, b.get(16..at)?))
 }

@@ -5,8 +5,8 @@ use std::fmt;
 use std::fs::File;
 use std::io::{BufReader, IsTerminal, Read, Write};
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Mutex, OnceLock};
 
 use crate::error::escaped;
 
@@ -64,7 +64,8 @@ pub const STDIN: &str = "-";
 /// streamed row by row; on a terminal, progress goes to stderr every 100,000 rows.
 ///
 /// The file [`STDIN`] (`-`) is standard input, read to its end first (so that an error can
-/// name its line); wherever it is named again it gives the same bytes.
+/// name its line); wherever it is named again it gives the same bytes. A named pipe or a
+/// process substitution is read once the same way ([`read_once`]).
 ///
 /// Every cell must be a finite number: a missing column, an empty or non-numeric cell, NaN or
 /// infinity is an error naming the file and line, and so is a file without data rows.
@@ -135,8 +136,8 @@ pub fn read_rows(
         each(cells)
     };
     for path in files {
-        if path.as_os_str() == STDIN {
-            let bytes = stdin().map_err(|e| error(path, None, format!("cannot read: {e}")))?;
+        if let Some(bytes) = read_once(path) {
+            let bytes = bytes.map_err(|e| error(path, None, format!("cannot read: {e}")))?;
             let header = comment_header(bytes).map_err(|e| error(path, None, e))?;
             let locate = |byte| line_at(bytes, byte);
             read_source(path, (bytes, header), select, &mut counted, &locate)?;
@@ -341,18 +342,39 @@ pub fn finite(column: &str) -> impl Fn(&str) -> Result<f64, String> + '_ {
 }
 
 /// All of standard input, read once.
-fn stdin() -> Result<&'static [u8], &'static str> {
-    static BYTES: OnceLock<Result<Vec<u8>, String>> = OnceLock::new();
-    BYTES
-        .get_or_init(|| {
-            let mut bytes = Vec::new();
-            match std::io::stdin().lock().read_to_end(&mut bytes) {
-                Ok(_) => Ok(bytes),
-                Err(e) => Err(e.to_string()),
-            }
-        })
-        .as_deref()
-        .map_err(String::as_str)
+/// The bytes of standard input, or of a file that can be read only once (a named pipe, a
+/// process substitution such as `<(cat f.csv)`, a character device): read to its end the
+/// first time it is asked for, and the same bytes every time after. `None` for a regular file
+/// (and a folder), which is read where it lies.
+pub fn read_once(path: &Path) -> Option<Result<&'static [u8], String>> {
+    type Cache = Mutex<Vec<(PathBuf, Result<&'static [u8], String>)>>;
+    static READ: OnceLock<Cache> = OnceLock::new();
+    let is_stdin = path.as_os_str() == STDIN;
+    if !is_stdin {
+        match std::fs::metadata(path) {
+            Ok(m) if m.is_file() || m.is_dir() => return None,
+            Ok(_) => {}
+            // Cannot even be looked at: opening it gives the error.
+            Err(_) => return None,
+        }
+    }
+    let mut cache = READ
+        .get_or_init(Mutex::default)
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    if let Some((_, bytes)) = cache.iter().find(|(p, _)| p == path) {
+        return Some(bytes.clone());
+    }
+    let mut bytes = Vec::new();
+    let read = if is_stdin {
+        std::io::stdin().lock().read_to_end(&mut bytes)
+    } else {
+        File::open(path).and_then(|mut f| f.read_to_end(&mut bytes))
+    };
+    // Leaked: read once per process, and kept to its end like the file it stands for.
+    let got = read.map(|_| &*Vec::leak(bytes)).map_err(|e| e.to_string());
+    cache.push((path.to_path_buf(), got.clone()));
+    Some(got)
 }
 
 /// Passes the cells that `select` picks of each row of one CSV source (named `path` in errors,

@@ -6,6 +6,7 @@ use std::fs::File;
 use std::io::Read;
 use std::path::Path;
 
+use crate::error::escaped;
 use crate::input::csv::DataError;
 
 /// One IMU message: the header stamp in nanoseconds since the epoch, and the six axes in the
@@ -25,6 +26,8 @@ pub struct Skipped {
     pub undecodable: u64,
     /// Messages with a NaN or infinite value in one of the six axes.
     pub non_finite: u64,
+    /// Messages of another IMU on the topic than the one `--frame-id` chose.
+    pub other_frame_id: u64,
 }
 
 /// The `N` bytes at `at`, if `bytes` holds them.
@@ -86,43 +89,196 @@ pub(crate) fn stamp_ns(sec: i64, nanosec: u32) -> i64 {
     sec * 1_000_000_000 + i64::from(nanosec)
 }
 
-/// Delivers the finite frames of one read to its consumer and counts the others.
-pub(crate) struct Tally<'a> {
-    each: &'a mut dyn FnMut(Frame),
-    delivered: u64,
-    skipped: Skipped,
+/// Which messages of a file to read: those on `topic`, from the publisher whose header
+/// frame_id is `frame_id` (when `None`, the topic must carry one IMU).
+#[derive(Clone, Copy, Debug)]
+pub struct Select<'a> {
+    /// The topic.
+    pub topic: &'a str,
+    /// The frame_id of the IMU to read, when the topic carries several.
+    pub frame_id: Option<&'a str>,
 }
 
+impl<'a> Select<'a> {
+    /// The messages on `topic`, which must carry one IMU.
+    pub fn topic(topic: &'a str) -> Self {
+        Select {
+            topic,
+            frame_id: None,
+        }
+    }
+}
+
+/// A publisher seen on the topic: a bag's connection or an MCAP file's channel.
+struct Source {
+    /// The reader's ID of it.
+    id: u32,
+    /// Its frame_ids (indices into [`Tally::frame_ids`]), in the order first seen.
+    frames: Vec<usize>,
+    /// Its first and last stamp among delivered frames.
+    span: Option<(i64, i64)>,
+}
+
+/// Delivers the finite frames of one read to its consumer and counts the others; keeps
+/// apart the IMUs that share the topic (by their header frame_id and their publisher).
+pub(crate) struct Tally<'a> {
+    each: &'a mut dyn FnMut(Frame),
+    frame_id: Option<&'a str>,
+    delivered: u64,
+    skipped: Skipped,
+    /// Each frame_id seen, with its messages.
+    frame_ids: Vec<(Vec<u8>, u64)>,
+    sources: Vec<Source>,
+}
+
+/// The most frame_ids told apart on one topic; more are one error.
+const MAX_FRAME_IDS: usize = 16;
+
 impl<'a> Tally<'a> {
-    /// A tally delivering to `each`.
-    pub(crate) fn new(each: &'a mut dyn FnMut(Frame)) -> Self {
+    /// A tally delivering the frames `select` asks for to `each`.
+    pub(crate) fn new(select: &Select<'a>, each: &'a mut dyn FnMut(Frame)) -> Self {
         Tally {
             each,
+            frame_id: select.frame_id,
             delivered: 0,
             skipped: Skipped::default(),
+            frame_ids: Vec::new(),
+            sources: Vec::new(),
         }
     }
 
-    /// One message on the topic: delivered when decoded (`Some`) and finite, counted otherwise.
-    pub(crate) fn offer(&mut self, frame: Option<Frame>) {
-        match frame {
-            None => self.skipped.undecodable += 1,
-            Some(f) if f.axes.iter().all(|v| v.is_finite()) => {
-                self.delivered += 1;
-                (self.each)(f);
+    /// One message on the topic from publisher `source`: its frame and header frame_id when
+    /// decoded. Delivered when decoded, finite and of the chosen frame_id; counted otherwise.
+    pub(crate) fn offer(&mut self, source: u32, decoded: Option<(Frame, &[u8])>) {
+        let Some((frame, frame_id)) = decoded else {
+            self.skipped.undecodable += 1;
+            return;
+        };
+        let k = match self.frame_ids.iter().position(|(f, _)| f == frame_id) {
+            Some(k) => k,
+            None if self.frame_ids.len() < MAX_FRAME_IDS => {
+                self.frame_ids.push((frame_id.to_vec(), 0));
+                self.frame_ids.len() - 1
             }
-            Some(_) => self.skipped.non_finite += 1,
+            None => MAX_FRAME_IDS,
+        };
+        if let Some((_, n)) = self.frame_ids.get_mut(k) {
+            *n += 1;
         }
+        if let Some(want) = self.frame_id
+            && want.as_bytes() != frame_id
+        {
+            self.skipped.other_frame_id += 1;
+            return;
+        }
+        if !frame.axes.iter().all(|v| v.is_finite()) {
+            self.skipped.non_finite += 1;
+            return;
+        }
+        let at = match self.sources.iter().position(|s| s.id == source) {
+            Some(at) => at,
+            None => {
+                self.sources.push(Source {
+                    id: source,
+                    frames: Vec::new(),
+                    span: None,
+                });
+                self.sources.len() - 1
+            }
+        };
+        if let Some(s) = self.sources.get_mut(at) {
+            if !s.frames.contains(&k) {
+                s.frames.push(k);
+            }
+            let t = frame.stamp_ns;
+            s.span = Some(s.span.map_or((t, t), |(a, b)| (a.min(t), b.max(t))));
+        }
+        self.delivered += 1;
+        (self.each)(frame);
     }
 
-    /// What was skipped; an error when no frame was delivered.
-    pub(crate) fn finish(self, file: &Path, topic: &str) -> Result<Skipped, DataError> {
+    /// The frame_ids seen, with their messages, for a message.
+    fn listed(&self) -> String {
+        let mut text: Vec<String> = self
+            .frame_ids
+            .iter()
+            .map(|(f, n)| format!("'{}' ({n} messages)", escaped(&String::from_utf8_lossy(f))))
+            .collect();
+        if self.frame_ids.len() >= MAX_FRAME_IDS {
+            text.push("and more".into());
+        }
+        text.join(", ")
+    }
+
+    /// What was skipped; an error when no frame was delivered, when the topic carries more
+    /// than one IMU and none was chosen, or when two publishers of one frame_id overlap in
+    /// time. `names` gives a publisher's name by its ID.
+    pub(crate) fn finish(
+        self,
+        file: &Path,
+        topic: &str,
+        names: &dyn Fn(u32) -> String,
+    ) -> Result<Skipped, DataError> {
+        if self.frame_id.is_none() && self.frame_ids.len() > 1 {
+            return Err(data_error(
+                file,
+                format!(
+                    "{} IMUs publish on '{topic}', told apart by their header frame_id: {}; \
+                     read one with --frame-id",
+                    if self.frame_ids.len() >= MAX_FRAME_IDS {
+                        "more than 16".to_string()
+                    } else {
+                        self.frame_ids.len().to_string()
+                    },
+                    self.listed()
+                ),
+            ));
+        }
+        if let Some(want) = self.frame_id
+            && !self.frame_ids.iter().any(|(f, _)| f == want.as_bytes())
+        {
+            return Err(data_error(
+                file,
+                format!(
+                    "--frame-id {}: no message on '{topic}' has it (frame_ids: {})",
+                    escaped(want),
+                    if self.frame_ids.is_empty() {
+                        "none".into()
+                    } else {
+                        self.listed()
+                    }
+                ),
+            ));
+        }
+        // Publishers of the chosen frame_id whose stamps interleave: two IMUs that cannot be
+        // told apart (a publisher that restarted follows the one before, and is read).
+        for (i, a) in self.sources.iter().enumerate() {
+            for b in self.sources.iter().skip(i + 1) {
+                let shared = a.frames.iter().any(|f| b.frames.contains(f));
+                if let (true, Some((a0, a1)), Some((b0, b1))) = (shared, a.span, b.span)
+                    && a0 <= b1
+                    && b0 <= a1
+                {
+                    return Err(data_error(
+                        file,
+                        format!(
+                            "two publishers on '{topic}' ({} and {}) send the same header \
+                             frame_id at interleaved times: two IMUs that the record cannot \
+                             tell apart",
+                            names(a.id),
+                            names(b.id)
+                        ),
+                    ));
+                }
+            }
+        }
         if self.delivered > 0 {
             return Ok(self.skipped);
         }
         let Skipped {
             undecodable,
             non_finite,
+            ..
         } = self.skipped;
         let problem = if non_finite == 0 {
             format!("no decodable messages on '{topic}' ({undecodable} undecodable)")

@@ -29,7 +29,7 @@ use ::mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
 
 use crate::input::csv::DataError;
 use crate::input::frame::{
-    Frame, Skipped, Tally, absent_topic, bytes_at, data_error, imu_axes, stamp_ns, u32_at,
+    Frame, Select, Skipped, Tally, absent_topic, bytes_at, data_error, imu_axes, stamp_ns, u32_at,
 };
 
 /// The schema name of the IMU channels.
@@ -57,6 +57,19 @@ const MIN_RECORD_LIMIT: u64 = 64 * 1024 * 1024;
 /// `topic`, has one with another schema, another schema encoding than ros2msg or ros2idl, or
 /// another message encoding than cdr, or has no finite message on it.
 pub fn read(path: &Path, topic: &str, each: &mut dyn FnMut(Frame)) -> Result<Skipped, DataError> {
+    read_selected(path, &Select::topic(topic), each)
+}
+
+/// [`read`] of the messages `select` asks for: on its topic, from the IMU of its header
+/// frame_id (the others counted as skipped). An error too when the topic carries more than one
+/// IMU (frame_ids) and `select` names none, or when two channels send one frame_id at
+/// interleaved times.
+pub fn read_selected(
+    path: &Path,
+    select: &Select,
+    each: &mut dyn FnMut(Frame),
+) -> Result<Skipped, DataError> {
+    let topic = select.topic;
     let fail = |problem: String| data_error(path, problem);
     let (mut file, len, head) = open_head(path, ::mcap::MAGIC.len() as u64)?;
     if head.as_slice() != ::mcap::MAGIC {
@@ -76,7 +89,7 @@ pub fn read(path: &Path, topic: &str, each: &mut dyn FnMut(Frame)) -> Result<Ski
     );
 
     let mut channels = Channels::default();
-    let mut tally = Tally::new(each);
+    let mut tally = Tally::new(select, each);
     let mut messages = 0u64;
     let corrupt = |what: &dyn std::fmt::Display, messages: u64| {
         fail(format!(
@@ -109,7 +122,7 @@ pub fn read(path: &Path, topic: &str, each: &mut dyn FnMut(Frame)) -> Result<Ski
                         .map(u16::from_le_bytes)
                         .ok_or_else(|| corrupt(&"a message record of 0 or 1 bytes", messages))?;
                     if channels.wanted.contains(&channel) {
-                        tally.offer(data.get(22..).and_then(decode));
+                        tally.offer(u32::from(channel), data.get(22..).and_then(decode));
                     }
                 }
                 _ => {}
@@ -124,7 +137,7 @@ pub fn read(path: &Path, topic: &str, each: &mut dyn FnMut(Frame)) -> Result<Ski
             &channels.all_topics,
         )));
     }
-    tally.finish(path, topic)
+    tally.finish(path, topic, &|id| format!("channel {id}"))
 }
 
 /// The schemas and channels read so far.
@@ -213,9 +226,10 @@ fn not_mcap(head: &[u8]) -> String {
     }
 }
 
-/// The frame of one CDR-serialized `sensor_msgs/msg/Imu`: `None` when the encapsulation is not
-/// CDR_LE or CDR_BE, or the message is too short.
-fn decode(b: &[u8]) -> Option<Frame> {
+/// The frame of one CDR-serialized `sensor_msgs/msg/Imu` and its header's frame_id (without
+/// its NUL): `None` when the encapsulation is not CDR_LE or CDR_BE, or the message is too
+/// short.
+pub(crate) fn decode(b: &[u8]) -> Option<(Frame, &[u8])> {
     let big = match b.get(..2)? {
         [0, 1] => false,
         [0, 0] => true,
@@ -228,8 +242,10 @@ fn decode(b: &[u8]) -> Option<Frame> {
     let frame_id = usize::try_from(u32_at(body, 8, big)?).ok()?;
     let end = 12usize.checked_add(frame_id)?;
     let at = end.checked_add(7)? & !7;
-    Some(Frame {
+    let frame = Frame {
         stamp_ns: stamp_ns(i64::from(sec), nanosec),
         axes: imu_axes(body, at, big)?,
-    })
+    };
+    let id = body.get(12..end)?;
+    Some((frame, id.strip_suffix(&[0]).unwrap_or(id)))
 }

@@ -7,6 +7,7 @@ pub mod bag;
 pub mod csv;
 pub mod frame;
 pub mod mcap;
+pub mod rosbag2;
 pub mod source;
 pub mod timing;
 pub mod units;
@@ -36,6 +37,9 @@ pub struct Input {
     /// The sensor_msgs/Imu topic of a ROS 1 bag or an MCAP file.
     #[arg(long)]
     pub topic: Option<String>,
+    /// The header frame_id of the IMU to read, when the topic carries more than one.
+    #[arg(long)]
+    pub frame_id: Option<String>,
     /// The CSV column of the timestamps, when --rate is not given [default: the column named
     /// timestamp, time, t or t_UNIT; its unit from its bracket or suffix (s, ms, us, ns), else
     /// from its magnitude].
@@ -82,6 +86,7 @@ impl Input {
         let request = Request {
             columns: &columns,
             topic: self.topic.as_deref(),
+            frame_id: self.frame_id.as_deref(),
             time_column: self.time_column.as_deref(),
             want_time,
             drop_backward: self.drop_backward,
@@ -122,8 +127,12 @@ impl Series {
     }
 }
 
+/// The highest rate taken from timestamps without `--rate` to confirm it, Hz.
+pub const MAX_STAMPED_RATE: f64 = 10_000.0;
+
 /// The sample rate: `given` (`--rate`) when there is one (an error when the timestamps give
-/// one more than 1 % away), else the timestamps'.
+/// one more than 1 % away), else the timestamps' (an error above [`MAX_STAMPED_RATE`]: such
+/// a rate is more often a time unit mistaken).
 pub fn resolve_rate(given: Option<f64>, timing: Option<&TimingSummary>) -> Result<f64, Fail> {
     match (given, timing) {
         (Some(r), Some(t)) => {
@@ -137,6 +146,16 @@ pub fn resolve_rate(given: Option<f64>, timing: Option<&TimingSummary>) -> Resul
             Ok(r)
         }
         (Some(r), None) => check_rate(r),
+        (None, Some(t)) if t.rate_hz > MAX_STAMPED_RATE => Err(Fail(format!(
+            "the timestamps ({}) give {} Hz: an IMU above {} kHz is rare, and stamps in a unit \
+             1000 times finer than the column says (microseconds under [ns], milliseconds \
+             under [us]) give a rate 1000 times too high; check the time column's unit, or \
+             give --rate {} to confirm the rate",
+            t.unit,
+            t.rate_hz,
+            MAX_STAMPED_RATE / 1e3,
+            t.rate_hz
+        ))),
         (None, Some(t)) => Ok(t.rate_hz),
         (None, None) => Err(Fail(
             "--rate is required: the record has no time column (name one with \

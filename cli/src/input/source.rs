@@ -1,15 +1,16 @@
-//! One reader over every kind of recording: CSV files, ROS 1 bags and MCAP files, streamed
-//! row by row (message by message) with their timestamps checked on the way.
+//! One reader over every kind of recording: CSV files, ROS 1 bags, MCAP files and rosbag2
+//! folders or databases, streamed row by row (message by message) with their timestamps
+//! checked on the way. Each input is opened once for its data (a pipe is read once).
 
 use std::cell::Cell;
 use std::io::Read as _;
 use std::path::{Path, PathBuf};
 
 use super::csv::{self, DataError, position, split_unit};
-use super::frame::{Frame, Skipped};
+use super::frame::{Frame, Select, Skipped};
 use super::timing::{Step, TimeUnit, Timing};
 use super::units::Unit;
-use super::{bag, mcap};
+use super::{bag, mcap, rosbag2};
 use crate::error::{Fail, escaped, with_file};
 
 /// The kinds of recording.
@@ -17,26 +18,88 @@ use crate::error::{Fail, escaped, with_file};
 pub enum Kind {
     /// CSV with a header row.
     Csv,
-    /// A ROS 1 bag (format 2.0).
+    /// A ROS 1 bag (`#ROSBAG V`; format 2.0 is read).
     Bag,
     /// An MCAP file (ROS 2).
     Mcap,
+    /// A rosbag2 folder (`metadata.yaml` and its storage files).
+    Rosbag2,
+    /// An SQLite database: a rosbag2 `.db3` storage file.
+    Db3,
+    /// A file none of the readers takes, with what it is.
+    Other(&'static str),
 }
 
 impl Kind {
-    /// The kind of `path`, by its first bytes (standard input and short files are CSV).
+    /// The kind of `path`: a folder holding `metadata.yaml` is a rosbag2 folder; a file is
+    /// known by its first bytes (standard input, a pipe and a short text file are CSV).
     pub fn of(path: &Path) -> Kind {
-        if path.as_os_str() == csv::STDIN {
-            return Kind::Csv;
+        if path.is_dir() {
+            return if path.join(rosbag2::METADATA).is_file() {
+                Kind::Rosbag2
+            } else {
+                Kind::Other("a folder without metadata.yaml (not a rosbag2 folder)")
+            };
         }
-        let mut head = [0u8; 13];
-        let n = std::fs::File::open(path)
-            .and_then(|mut f| f.read(&mut head))
-            .unwrap_or(0);
-        match &head[..n] {
-            h if h.starts_with(b"#ROSBAG V2.0") => Kind::Bag,
-            h if h.starts_with(b"\x89MCAP0\r\n") => Kind::Mcap,
-            _ => Kind::Csv,
+        let mut head = [0u8; 16];
+        let head: &[u8] = match csv::read_once(path) {
+            Some(Ok(bytes)) => &bytes[..bytes.len().min(16)],
+            Some(Err(_)) => return Kind::Csv,
+            None => {
+                let n = std::fs::File::open(path)
+                    .and_then(|mut f| f.read(&mut head))
+                    .unwrap_or(0);
+                &head[..n]
+            }
+        };
+        Kind::of_head(head, path)
+    }
+
+    /// The kind of a file that starts with `head` (at most 16 bytes) and is named `path`.
+    fn of_head(head: &[u8], path: &Path) -> Kind {
+        let extension = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        match head {
+            h if h.starts_with(b"#ROSBAG V") => Kind::Bag,
+            h if h.starts_with(b"\x89MCAP") => Kind::Mcap,
+            // A cut MCAP file: its magic's first bytes.
+            h if !h.is_empty() && b"\x89MCAP".starts_with(h) => Kind::Mcap,
+            h if h.starts_with(rosbag2::SQLITE_MAGIC) => Kind::Db3,
+            [0x28, 0xb5, 0x2f, 0xfd, ..] => Kind::Other(
+                "a zstd-compressed file (a rosbag2 folder compressed file by file: \
+                 `ros2 bag decompress` writes one that can be read)",
+            ),
+            [0x04, 0x22, 0x4d, 0x18, ..] => Kind::Other("an lz4-compressed file"),
+            [0x1f, 0x8b, ..] => Kind::Other("a gzip-compressed file"),
+            [b'B', b'Z', b'h', ..] => Kind::Other("a bzip2-compressed file"),
+            [] => match extension.as_deref() {
+                Some("bag") => Kind::Other("an empty file, not a ROS 1 bag"),
+                Some("mcap") => Kind::Other("an empty file, not an MCAP file"),
+                Some("db3") => Kind::Other("an empty file, not a rosbag2 database"),
+                _ => Kind::Csv,
+            },
+            _ => match extension.as_deref() {
+                Some("bag") => Kind::Other("not a ROS 1 bag (it does not start with '#ROSBAG V')"),
+                Some("mcap") => {
+                    Kind::Other("not an MCAP file (it does not start with the MCAP magic)")
+                }
+                Some("db3") => Kind::Other("not a rosbag2 database (not an SQLite file)"),
+                _ => Kind::Csv,
+            },
+        }
+    }
+
+    /// What the kind is called in messages.
+    fn name(self) -> &'static str {
+        match self {
+            Kind::Csv => "a CSV file",
+            Kind::Bag => "a ROS 1 bag",
+            Kind::Mcap => "an MCAP file",
+            Kind::Rosbag2 => "a rosbag2 folder",
+            Kind::Db3 => "a rosbag2 database",
+            Kind::Other(what) => what,
         }
     }
 }
@@ -66,6 +129,8 @@ pub struct Request<'a> {
     pub columns: &'a [String],
     /// The `sensor_msgs/Imu` topic of a bag or an MCAP file.
     pub topic: Option<&'a str>,
+    /// The header frame_id of the IMU to read, when the topic carries several.
+    pub frame_id: Option<&'a str>,
     /// The CSV time column, when the user named one.
     pub time_column: Option<&'a str>,
     /// Whether the timestamps are wanted (they are read and checked only then, or when
@@ -95,14 +160,46 @@ pub fn stream(
     each: &mut dyn FnMut(&[f64]),
 ) -> Result<Read, Fail> {
     let kind = Kind::of(&files[0]);
-    if let Some(other) = files.iter().find(|f| Kind::of(f) != kind) {
+    if let Kind::Other(what) = kind {
+        return Err(with_file(
+            &files[..1],
+            format!("{what}: not a recording read here"),
+        ));
+    }
+    for file in files.iter().skip(1) {
+        let other = Kind::of(file);
+        if other != kind {
+            return Err(with_file(
+                files,
+                format!(
+                    "{} is {} and {} is {}: one record is one kind of file",
+                    files[0].display(),
+                    kind.name(),
+                    file.display(),
+                    other.name()
+                ),
+            ));
+        }
+    }
+    if kind != Kind::Csv
+        && let Some(piped) = files.iter().find(|f| csv::read_once(f).is_some())
+    {
         return Err(with_file(
             files,
             format!(
-                "{} is a {:?} file and {} is not: one record is one kind of file",
-                files[0].display(),
-                kind,
-                other.display()
+                "{} is {} read from a pipe: it is read from a file (or folder) on disk",
+                piped.display(),
+                kind.name()
+            ),
+        ));
+    }
+    if let (Kind::Csv, Some(f)) = (kind, request.frame_id) {
+        return Err(with_file(
+            files,
+            format!(
+                "--frame-id {}: the file is CSV; --frame-id picks an IMU of a bag's or an MCAP \
+                 file's topic",
+                escaped(f)
             ),
         ));
     }
@@ -111,7 +208,8 @@ pub fn stream(
         (Kind::Csv, Some(t)) => Err(with_file(
             files,
             format!(
-                "--topic {}: the file is CSV; --topic is for ROS 1 bags and MCAP files",
+                "--topic {}: the file is CSV (its first bytes are text); --topic is for ROS 1 \
+                 bags, MCAP files and rosbag2 folders or databases",
                 escaped(t)
             ),
         )),
@@ -128,12 +226,14 @@ fn messages(
     each: &mut dyn FnMut(&[f64]),
 ) -> Result<Read, Fail> {
     let read = match kind {
-        Kind::Mcap => mcap::read,
-        _ => bag::read,
+        Kind::Mcap => mcap::read_selected,
+        Kind::Rosbag2 => rosbag2::read_folder,
+        Kind::Db3 => rosbag2::read_db3,
+        _ => bag::read_selected,
     };
     let Some(topic) = topic else {
         // The reader's error for no topic lists the file's IMU topics.
-        let listed = read(&files[0], "", &mut |_| {}).err();
+        let listed = read(&files[0], &Select::topic(""), &mut |_| {}).err();
         let topics = listed.map_or(String::new(), |e| {
             e.problem
                 .split_once('(')
@@ -141,7 +241,7 @@ fn messages(
         });
         return Err(with_file(
             files,
-            format!("a {kind:?} file needs --topic{topics}"),
+            format!("{} needs --topic{topics}", kind.name()),
         ));
     };
     let picks = request
@@ -164,11 +264,20 @@ fn messages(
     let mut skipped = Skipped::default();
     let mut backward: Option<(u64, i64, i64)> = None;
     let mut count = 0u64;
+    // Messages stamped 0: a driver that does not stamp. With --rate they are read in file
+    // order, and the stamps give no rate.
+    let mut unstamped = 0u64;
     let mut values = vec![0.0; picks.len()];
+    let select = Select {
+        topic,
+        frame_id: request.frame_id,
+    };
     for file in files {
-        let s = read(file, topic, &mut |frame: Frame| {
+        let s = read(file, &select, &mut |frame: Frame| {
             count += 1;
-            if let Step::Backward { last } = timing.push(frame.stamp_ns) {
+            if frame.stamp_ns == 0 {
+                unstamped += 1;
+            } else if let Step::Backward { last } = timing.push(frame.stamp_ns) {
                 timing.drop_one();
                 backward.get_or_insert((count, frame.stamp_ns, last));
                 return;
@@ -181,19 +290,43 @@ fn messages(
         .map_err(|e| Fail(e.to_string()))?;
         skipped.undecodable += s.undecodable;
         skipped.non_finite += s.non_finite;
+        skipped.other_frame_id += s.other_frame_id;
+    }
+    if unstamped > 0 {
+        if request.want_time {
+            return Err(with_file(
+                files,
+                format!(
+                    "the header stamps of {unstamped} of {count} messages on '{}' are zero (a \
+                     driver that does not stamp its messages): give --rate to read them in \
+                     file order",
+                    escaped(topic)
+                ),
+            ));
+        }
+        return Ok(Read {
+            unknown: vec![None; picks.len()],
+            units: picks.iter().map(|&i| si_unit(i)).collect(),
+            timing: None,
+            skipped,
+        });
     }
     if let Some((at, stamp, last)) = backward
         && !request.drop_backward
     {
         return Err(with_file(files, backward_text(&timing, at, stamp, last)));
     }
-    let si = |i: usize| Unit::parse(if i < 3 { "rad/s" } else { "m/s^2" });
     Ok(Read {
         unknown: vec![None; picks.len()],
-        units: picks.iter().map(|&i| si(i)).collect(),
+        units: picks.iter().map(|&i| si_unit(i)).collect(),
         timing: Some((timing, TimeUnit::Nanoseconds)),
         skipped,
     })
+}
+
+/// The unit of a message's axis `i` (of [`AXES`]).
+fn si_unit(i: usize) -> Option<Unit> {
+    Unit::parse(if i < 3 { "rad/s" } else { "m/s^2" })
 }
 
 /// The refusal of stamps that go backwards.

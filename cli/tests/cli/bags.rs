@@ -10,7 +10,7 @@ use crate::ros;
 use std::collections::BTreeMap;
 use std::time::Instant;
 
-use imu_ar_cli::input::frame::{Frame, Skipped};
+use imu_ar_cli::input::frame::{Frame, Select, Skipped};
 use imu_ar_cli::input::{bag, mcap as mcap_reader};
 use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
@@ -102,9 +102,25 @@ fn big_endian_cdr_and_every_frame_id_alignment() {
     }
     w.finish().unwrap();
     drop(w);
-    let (got, result) = collect(mcap_reader::read, &path, "/imu");
-    assert_eq!(result, Ok(Skipped::default()));
-    assert_bits(&got, &want, "hand-made CDR");
+    // Each frame_id length is one IMU of the topic: read one at a time.
+    for id_len in 0..10 {
+        let id = "f".repeat(id_len);
+        let select = Select {
+            topic: "/imu",
+            frame_id: Some(&id),
+        };
+        let mut got = Vec::new();
+        let result = mcap_reader::read_selected(&path, &select, &mut |f| got.push(f));
+        assert_eq!(
+            result,
+            Ok(Skipped {
+                other_frame_id: 18,
+                ..Skipped::default()
+            })
+        );
+        let mine: Vec<Frame> = want.iter().skip(id_len).step_by(10).copied().collect();
+        assert_bits(&got, &mine, "hand-made CDR");
+    }
 }
 
 #[test]
@@ -286,6 +302,7 @@ fn non_finite_and_undecodable_messages_are_counted() {
         let skipped = Skipped {
             undecodable: 0,
             non_finite: 3,
+            other_frame_id: 0,
         };
         assert_eq!(result, Ok(skipped), "{format}");
         let finite: Vec<Frame> = want
@@ -307,7 +324,8 @@ fn non_finite_and_undecodable_messages_are_counted() {
             result,
             Ok(Skipped {
                 undecodable: 1,
-                non_finite: 3
+                non_finite: 3,
+                other_frame_id: 0,
             }),
             "{format}"
         );

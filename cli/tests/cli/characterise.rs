@@ -13,7 +13,7 @@ use common::{assert_one_line_failure, imu_ar, json, stderr};
 use imu_ar_cli::input::frame::Frame;
 use rand_chacha::ChaCha8Rng;
 use rand_core::{RngCore, SeedableRng};
-use ros::{edited_bag, fixture, fixture_bytes, noise_frames, temp_dir};
+use ros::{edited_bag, fixture, fixture_bytes, fixture_dir, noise_frames, temp_dir};
 
 /// A standard normal deviate (Box-Muller).
 fn normal(rng: &mut ChaCha8Rng) -> f64 {
@@ -156,7 +156,7 @@ fn assert_close(a: &serde_json::Value, b: &serde_json::Value, rel: f64, at: &str
 }
 
 #[test]
-fn a_bag_and_an_mcap_file_give_the_model_of_the_csv() {
+fn every_recording_kind_gives_the_model_of_the_csv() {
     let dir = temp_dir("same-model");
     let frames = noise_frames();
     let csv = dir.join("frames.csv");
@@ -166,11 +166,25 @@ fn a_bag_and_an_mcap_file_give_the_model_of_the_csv() {
     // The same frames, written by Python's rosbags (tests/fixtures/write_ros.py).
     let bag = fixture("noise-bz2.bag");
     let mcap = fixture("noise-zstd.mcap");
+    // ROS 2: rosbag2 folders of both storages, and a bare SQLite storage file.
+    let folder_mcap = fixture_dir("rosbag2-mcap");
+    let folder_sqlite = fixture_dir("rosbag2-sqlite3");
+    let db3 = fixture("noise.db3");
     // The CSV has no unit brackets: the bag's SI units are given.
     let units = ["--gyro-unit", "rad/s", "--accel-unit", "m/s^2"];
     let from_csv = characterise(&[path(&csv)], &dir.join("csv"), &units);
-    for (file, name) in [(&bag, "bag"), (&mcap, "mcap")] {
-        let got = characterise(&[path(file), "--topic", "/imu0"], &dir.join(name), &[]);
+    for (file, name) in [
+        (&bag, "bag"),
+        (&mcap, "mcap"),
+        (&folder_mcap, "rosbag2 mcap"),
+        (&folder_sqlite, "rosbag2 sqlite3"),
+        (&db3, "db3"),
+    ] {
+        let got = characterise(
+            &[path(file), "--topic", "/imu0"],
+            &dir.join(name.replace(' ', "-")),
+            &[],
+        );
         assert_close(&got["axes"], &from_csv["axes"], 1e-12, name);
         assert_eq!(got["n"], 1_200);
         // One axis through `noise`, as the CSV's column.

@@ -54,6 +54,8 @@ fn model() -> &'static ImuModel {
             rate_hz: RATE,
             topic: Some("/imu\"0".into()),
             filter_rate_hz: None,
+            loop_rate_hz: None,
+            sysid: None,
         }
     })
 }
@@ -113,7 +115,8 @@ fn continuous(format: Format, text: &str) -> [(f64, f64); 2] {
             ),
         ],
         Format::OrbSlam3 => {
-            assert_eq!(n("IMU.Frequency"), RATE);
+            // An integer: ORB-SLAM3's reader (without File.version) refuses 1.0e+02.
+            assert_eq!(m["IMU.Frequency"], format!("{RATE:.0}"));
             [
                 (n("IMU.NoiseGyro"), n("IMU.GyroWalk")),
                 (n("IMU.NoiseAcc"), n("IMU.AccWalk")),
@@ -134,8 +137,9 @@ fn continuous(format: Format, text: &str) -> [(f64, f64); 2] {
                 back(n("EKF2_ACC_NOISE"), n("EKF2_ACC_B_NOISE")),
             ]
         }
+        // EKF3's step at the default 400 Hz loop: 5 samples of 2.5 ms.
         Format::ArduPilot => {
-            let dt: f64 = 0.012;
+            let dt: f64 = 0.0125;
             let back = |w: f64, b: f64| (w * dt.sqrt(), b * dt.sqrt());
             [
                 back(n("EK3_GYRO_P_NSE"), n("EK3_GBIAS_P_NSE")),
@@ -507,15 +511,48 @@ fn the_filter_rate_sets_the_autopilots_step_and_bad_models_are_refused() {
         gn / 0.004f64.sqrt(),
         1e-12
     ));
+    // EKF3's step is not the filter rate: its loop rate sets it (EKF_TARGET_DT 12 ms less
+    // half a loop, in whole loops), 12.5 ms at the default 400 Hz.
+    for (loop_rate, dt) in [(None, 0.0125f64), (Some(500.0), 0.012), (Some(50.0), 0.02)] {
+        imu.loop_rate_hz = loop_rate;
+        let text = std::fs::read_to_string(
+            write(Format::ArduPilot, &imu, None, &dir).unwrap_or_else(|e| panic!("{}", e.0)),
+        )
+        .unwrap();
+        assert!(
+            close(
+                number(&values(&text), "EK3_ABIAS_P_NSE"),
+                ak / dt.sqrt(),
+                1e-12
+            ),
+            "{loop_rate:?}: {text}"
+        );
+        assert!(
+            text.contains("--filter-rate 250 Hz is not EKF3's step"),
+            "{text}"
+        );
+    }
+    imu.loop_rate_hz = Some(10.0);
+    assert!(write(Format::ArduPilot, &imu, None, &dir).is_err());
+    imu.loop_rate_hz = None;
+    // PX4's file names its vehicle: 1 unless asked, never 0.
+    imu.sysid = Some(7);
     let text = std::fs::read_to_string(
-        write(Format::ArduPilot, &imu, None, &dir).unwrap_or_else(|e| panic!("{}", e.0)),
+        write(Format::Px4, &imu, None, &dir).unwrap_or_else(|e| panic!("{}", e.0)),
     )
     .unwrap();
-    assert!(close(
-        number(&values(&text), "EK3_ABIAS_P_NSE"),
-        ak / 0.004f64.sqrt(),
-        1e-12
-    ));
+    let rows: Vec<&str> = text.lines().filter(|l| !l.starts_with('#')).collect();
+    assert!(
+        rows.len() == 5 && rows.iter().all(|l| l.starts_with("7\t1\t")),
+        "{text}"
+    );
+    assert!(
+        text.contains("# Onboard parameters for Vehicle 7"),
+        "{text}"
+    );
+    imu.sysid = Some(0);
+    assert!(write(Format::Px4, &imu, None, &dir).is_err());
+    imu.sysid = None;
     imu.filter_rate_hz = Some(20.0);
     assert!(write(Format::Px4, &imu, None, &dir).is_err());
     // Nothing that is not finite is written.

@@ -17,6 +17,7 @@ mod hostile;
 mod misuse;
 mod noise;
 mod outputs;
+mod recordings;
 mod report;
 mod report_prior;
 mod streams;

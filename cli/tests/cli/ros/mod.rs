@@ -24,6 +24,15 @@ pub fn fixture(name: &str) -> PathBuf {
     path
 }
 
+/// The committed fixture folder `name` (a rosbag2 folder).
+pub fn fixture_dir(name: &str) -> PathBuf {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures/ros")
+        .join(name);
+    assert!(path.is_dir(), "no fixture folder {}", path.display());
+    path
+}
+
 /// The bytes of the committed fixture `name`.
 pub fn fixture_bytes(name: &str) -> Vec<u8> {
     std::fs::read(fixture(name)).unwrap()

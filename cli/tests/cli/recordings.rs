@@ -1,0 +1,459 @@
+//! Recordings as users have them: two IMUs on one topic, drivers that do not stamp, chunks
+//! stored out of order, ROS 2 folders and databases, files that are none of these, pipes,
+//! units the tool does not know, and time units mistaken by 1000. The fixtures are
+//! cli/tests/fixtures/ros/ (write_ros.py, `publisher_fixtures`).
+
+use crate::common;
+use crate::ros;
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use common::{assert_one_line_failure, imu_ar, json, stderr};
+use imu_ar_cli::input::frame::{Frame, Select};
+use imu_ar_cli::input::{bag, mcap, rosbag2};
+use ros::{assert_bits, fixture, noise, temp_dir};
+
+fn path(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// The readers by extension, with a chosen frame_id.
+fn read(file: &Path, frame_id: Option<&str>) -> (Vec<Frame>, Result<u64, String>) {
+    let select = Select {
+        topic: "/imu0",
+        frame_id,
+    };
+    let mut got = Vec::new();
+    let each = &mut |f| got.push(f);
+    let result = match file.extension().and_then(|e| e.to_str()) {
+        Some("bag") => bag::read_selected(file, &select, each),
+        Some("mcap") => mcap::read_selected(file, &select, each),
+        Some("db3") => rosbag2::read_db3(file, &select, each),
+        _ => rosbag2::read_folder(file, &select, each),
+    };
+    (got, result.map(|s| s.other_frame_id).map_err(|e| e.problem))
+}
+
+/// A CSV `t_ns,gx,..,az` of `frames`.
+fn csv_of(dir: &Path, name: &str, frames: &[Frame]) -> PathBuf {
+    let mut s = "t_ns,gx,gy,gz,ax,ay,az\n".to_string();
+    for f in frames {
+        write!(s, "{}", f.stamp_ns).unwrap();
+        for v in f.axes {
+            write!(s, ",{v:?}").unwrap();
+        }
+        s.push('\n');
+    }
+    let file = dir.join(name);
+    std::fs::write(&file, s).unwrap();
+    file
+}
+
+#[test]
+fn two_imus_on_one_topic_are_refused_by_name_and_either_can_be_read() {
+    let a = noise(400, 2);
+    let b: Vec<Frame> = noise(400, 3)
+        .into_iter()
+        .map(|f| Frame {
+            stamp_ns: f.stamp_ns + 5_000_000,
+            ..f
+        })
+        .collect();
+    for name in ["two-imus.bag", "two-imus.mcap", "two-imus.db3"] {
+        let file = fixture(name);
+        let (_, result) = read(&file, None);
+        let e = result.expect_err(name);
+        assert!(
+            e.contains("2 IMUs publish on '/imu0'")
+                && e.contains("'imu_a' (400 messages)")
+                && e.contains("'imu_b' (400 messages)")
+                && e.contains("--frame-id"),
+            "{name}: {e}"
+        );
+        for (id, want) in [("imu_a", &a), ("imu_b", &b)] {
+            let (got, result) = read(&file, Some(id));
+            assert_eq!(
+                result,
+                Ok(400),
+                "{name} {id}: the other IMU's messages are counted"
+            );
+            assert_bits(&got, want, name);
+        }
+        let (_, result) = read(&file, Some("imu_c"));
+        let e = result.expect_err(name);
+        assert!(
+            e.contains("--frame-id imu_c: no message on '/imu0' has it"),
+            "{e}"
+        );
+        // The tool: refused with exit 2 (not a 200 Hz IMU of half the noise), then read.
+        let out = imu_ar(&["noise", path(&file), "--topic", "/imu0", "--column", "gz"]);
+        assert_one_line_failure(&out);
+        assert!(stderr(&out).contains("imu_a"), "{}", stderr(&out));
+        let dir = temp_dir(&format!("two-imus-{name}"));
+        let csv = csv_of(&dir, "a.csv", &a);
+        let one = json(&imu_ar(&[
+            "noise",
+            path(&file),
+            "--topic",
+            "/imu0",
+            "--frame-id",
+            "imu_a",
+            "--column",
+            "gz",
+            "--json",
+        ]));
+        let from_csv = json(&imu_ar(&[
+            "noise",
+            path(&csv),
+            "--column",
+            "gz",
+            "--unit",
+            "rad/s",
+            "--json",
+        ]));
+        assert_eq!(one["white_noise"], from_csv["white_noise"], "{name}");
+        assert_eq!(one["rate_hz"], from_csv["rate_hz"], "{name}");
+    }
+}
+
+#[test]
+fn publishers_of_one_frame_id_are_one_imu_only_one_after_the_other() {
+    // Interleaved: two sensors that cannot be told apart.
+    let (_, result) = read(&fixture("same-frame.bag"), None);
+    let e = result.expect_err("interleaved publishers");
+    assert!(
+        e.contains("two publishers on '/imu0'")
+            && e.contains("callerid '/imu_driver'")
+            && e.contains("callerid '/imu_driver_2'"),
+        "{e}"
+    );
+    // A driver that restarted: its second connection follows the first, and is read.
+    let (got, result) = read(&fixture("restart.bag"), None);
+    assert_eq!(result, Ok(0));
+    assert_bits(&got, &noise(400, 2), "restart.bag");
+}
+
+#[test]
+fn unstamped_messages_need_the_rate_and_are_then_read_in_file_order() {
+    let dir = temp_dir("unstamped");
+    let frames = noise(400, 2);
+    let csv = csv_of(&dir, "frames.csv", &frames);
+    let from_csv = json(&imu_ar(&[
+        "noise",
+        path(&csv),
+        "--column",
+        "gx",
+        "--unit",
+        "rad/s",
+        "--rate",
+        "100",
+        "--json",
+    ]));
+    for name in ["unstamped.bag", "unstamped.mcap", "unstamped.db3"] {
+        let file = fixture(name);
+        let out = imu_ar(&["noise", path(&file), "--topic", "/imu0", "--column", "gx"]);
+        assert_one_line_failure(&out);
+        assert!(
+            stderr(&out).contains("the header stamps of 400 of 400 messages on '/imu0' are zero")
+                && stderr(&out).contains("give --rate"),
+            "{name}: {}",
+            stderr(&out)
+        );
+        let got = json(&imu_ar(&[
+            "noise",
+            path(&file),
+            "--topic",
+            "/imu0",
+            "--column",
+            "gx",
+            "--rate",
+            "100",
+            "--json",
+        ]));
+        assert_eq!(got["white_noise"], from_csv["white_noise"], "{name}");
+        assert_eq!(got["allan"], from_csv["allan"], "{name}");
+    }
+}
+
+#[test]
+fn chunks_stored_out_of_time_order_are_read_in_time_order() {
+    // The second half of the record written first, in chunks of 8 KiB.
+    let bytes = std::fs::read(fixture("out-of-order.bag")).unwrap();
+    let (got, result) = read(&fixture("out-of-order.bag"), None);
+    assert_eq!(result, Ok(0));
+    assert_bits(&got, &noise(400, 2), "out-of-order.bag");
+    assert!(bytes.len() > 4 * 8 * 1024, "several chunks");
+    // The tool reads it with no --drop-backward and no sample lost.
+    let one = json(&imu_ar(&[
+        "noise",
+        path(&fixture("out-of-order.bag")),
+        "--topic",
+        "/imu0",
+        "--column",
+        "gx",
+        "--json",
+    ]));
+    assert_eq!(one["n"], 400);
+}
+
+#[test]
+fn files_that_are_no_recording_are_named_for_what_they_are() {
+    let dir = temp_dir("kinds");
+    let mcap_bytes = std::fs::read(fixture("one.mcap")).unwrap();
+    let cases: [(&str, Vec<u8>, &str); 7] = [
+        ("empty.bag", Vec::new(), "an empty file, not a ROS 1 bag"),
+        (
+            "old.bag",
+            b"#ROSBAG V1.3\n\0\0\0\0".to_vec(),
+            "a ROS bag of format 1.3: only format 2.0 is read",
+        ),
+        (
+            "cut.mcap",
+            mcap_bytes[..5].to_vec(),
+            "truncated or corrupt MCAP file",
+        ),
+        (
+            "bag.mcap.zstd",
+            vec![0x28, 0xb5, 0x2f, 0xfd, 0, 0, 0, 0],
+            "a zstd-compressed file",
+        ),
+        (
+            "text.db3",
+            b"hello,world\n1,2\n".to_vec(),
+            "not a rosbag2 database",
+        ),
+        ("notes.bag", b"gx,gy\n1,2\n".to_vec(), "not a ROS 1 bag"),
+        (
+            "plain.db3",
+            b"SQLite format 3\0 but nothing after".to_vec(),
+            "not a readable rosbag2 database",
+        ),
+    ];
+    for (name, bytes, want) in cases {
+        let file = dir.join(name);
+        std::fs::write(&file, bytes).unwrap();
+        let out = imu_ar(&["noise", path(&file), "--topic", "/imu0", "--column", "gx"]);
+        assert_one_line_failure(&out);
+        assert!(stderr(&out).contains(want), "{name}: {}", stderr(&out));
+        assert!(!stderr(&out).contains("the file is CSV"), "{name}");
+    }
+    // A folder without metadata.yaml, and a rosbag2 folder whose metadata names a missing file.
+    let bare = dir.join("folder");
+    std::fs::create_dir_all(&bare).unwrap();
+    let out = imu_ar(&["noise", path(&bare), "--topic", "/imu0", "--column", "gx"]);
+    assert!(
+        stderr(&out).contains("a folder without metadata.yaml"),
+        "{}",
+        stderr(&out)
+    );
+    let broken = dir.join("broken");
+    std::fs::create_dir_all(&broken).unwrap();
+    std::fs::write(
+        broken.join("metadata.yaml"),
+        "rosbag2_bagfile_information:\n  storage_identifier: sqlite3\n  relative_file_paths:\n  - broken_0.db3\n",
+    )
+    .unwrap();
+    let out = imu_ar(&["noise", path(&broken), "--topic", "/imu0", "--column", "gx"]);
+    assert_one_line_failure(&out);
+    assert!(
+        stderr(&out).contains("storage file 'broken_0.db3' is missing from the folder"),
+        "{}",
+        stderr(&out)
+    );
+    std::fs::write(
+        broken.join("metadata.yaml"),
+        "rosbag2_bagfile_information:\n  storage_identifier: sqlite3\n  relative_file_paths:\n  - ../x.db3\n",
+    )
+    .unwrap();
+    let out = imu_ar(&["noise", path(&broken), "--topic", "/imu0", "--column", "gx"]);
+    assert!(
+        stderr(&out).contains("is not inside the folder"),
+        "{}",
+        stderr(&out)
+    );
+    // A topic of a bare database that is not there lists the IMU topics.
+    let out = imu_ar(&[
+        "noise",
+        path(&fixture("noise.db3")),
+        "--topic",
+        "/imu9",
+        "--column",
+        "gx",
+    ]);
+    assert!(
+        stderr(&out)
+            .contains("no sensor_msgs/msg/Imu messages on topic '/imu9' (IMU topics: /imu0)"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+#[test]
+fn a_named_pipe_is_read_once() {
+    let dir = temp_dir("pipe");
+    let frames = noise(1200, 2);
+    let csv = csv_of(&dir, "frames.csv", &frames);
+    let fifo = dir.join("p");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    if !made.is_ok_and(|s| s.success()) {
+        eprintln!("no mkfifo here: the pipe is not tested");
+        return;
+    }
+    let from_file = json(&imu_ar(&["noise", path(&csv), "--column", "gy", "--json"]));
+    // The writer opens the pipe once and writes the file once, as `cat f > p &` does.
+    let (source, target) = (csv.clone(), fifo.clone());
+    let writer = std::thread::spawn(move || {
+        let bytes = std::fs::read(source).unwrap();
+        std::fs::write(target, bytes).unwrap();
+    });
+    let mut child = common::command()
+        .args(["noise", path(&fifo), "--column", "gy", "--json"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let started = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if started.elapsed() > std::time::Duration::from_secs(60) {
+            child.kill().unwrap();
+            panic!("the tool hangs on a named pipe");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let out = child.wait_with_output().unwrap();
+    writer.join().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let got: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(got["white_noise"], from_file["white_noise"]);
+    assert_eq!(got["n"], from_file["n"]);
+}
+
+#[test]
+fn a_rate_above_10_khz_from_stamps_needs_the_rate_to_confirm_it() {
+    let dir = temp_dir("us-as-ns");
+    // 400 Hz stamps written in microseconds under a [ns] header: 400 kHz read as is.
+    let frames = noise(1200, 2);
+    let mut s = "t [ns],gx\n".to_string();
+    for (i, f) in frames.iter().enumerate() {
+        writeln!(s, "{},{:?}", 1_000_000 + i as u64 * 2_500, f.axes[0]).unwrap();
+    }
+    let file = dir.join("us.csv");
+    std::fs::write(&file, s).unwrap();
+    let out = imu_ar(&["noise", path(&file), "--column", "gx"]);
+    assert_one_line_failure(&out);
+    let e = stderr(&out);
+    assert!(
+        e.contains("give 400000 Hz")
+            && e.contains("microseconds under [ns]")
+            && e.contains("--rate 400000"),
+        "{e}"
+    );
+    // Confirmed, it is read at that rate; and 10 kHz is still taken from the stamps.
+    let got = json(&imu_ar(&[
+        "noise",
+        path(&file),
+        "--column",
+        "gx",
+        "--rate",
+        "400000",
+        "--json",
+    ]));
+    assert_eq!(got["rate_hz"], 400_000.0);
+    let mut s = "t [ns],gx\n".to_string();
+    for (i, f) in frames.iter().enumerate() {
+        writeln!(s, "{},{:?}", 1_000_000 + i as u64 * 100_000, f.axes[0]).unwrap();
+    }
+    std::fs::write(&file, s).unwrap();
+    let got = json(&imu_ar(&["noise", path(&file), "--column", "gx", "--json"]));
+    assert_eq!(got["rate_hz"], 10_000.0);
+}
+
+#[test]
+fn an_unknown_unit_bracket_is_named_with_the_known_ones() {
+    let dir = temp_dir("unit-g");
+    let frames = noise(1200, 2);
+    let mut s = "t [s],gx [rad/s],gy [rad/s],gz [rad/s],ax [G],ay [G],az [G]\n".to_string();
+    for (i, f) in frames.iter().enumerate() {
+        write!(s, "{}", i as f64 * 0.01).unwrap();
+        for v in f.axes {
+            write!(s, ",{v:?}").unwrap();
+        }
+        s.push('\n');
+    }
+    let file = dir.join("g.csv");
+    std::fs::write(&file, s).unwrap();
+    let out = imu_ar(&[
+        "characterise",
+        path(&file),
+        "--columns",
+        "gx,gy,gz,ax,ay,az",
+        "--out",
+        path(&dir.join("out")),
+    ]);
+    assert_one_line_failure(&out);
+    let e = stderr(&out);
+    assert!(
+        e.contains("its unit [G] is not one known here")
+            && e.contains("m/s^2, g, mg")
+            && e.contains("--accel-unit"),
+        "{e}"
+    );
+    // A failed run leaves no --out folder behind.
+    assert!(!dir.join("out").exists());
+}
+
+#[test]
+fn a_plot_that_cannot_be_written_leaves_no_parameter_file() {
+    let dir = temp_dir("all-or-nothing");
+    let frames = noise(1200, 2);
+    let csv = csv_of(&dir, "frames.csv", &frames);
+    let out_dir = dir.join("out");
+    std::fs::create_dir_all(out_dir.join("gyro.png")).unwrap();
+    let out = imu_ar(&[
+        "characterise",
+        path(&csv),
+        "--gyro-unit",
+        "rad/s",
+        "--accel-unit",
+        "m/s^2",
+        "--out",
+        path(&out_dir),
+    ]);
+    assert_one_line_failure(&out);
+    assert!(
+        stderr(&out).contains("gyro.png: is a directory"),
+        "{}",
+        stderr(&out)
+    );
+    let left: Vec<_> = std::fs::read_dir(&out_dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left, vec![std::ffi::OsString::from("gyro.png")], "{left:?}");
+}
+
+#[test]
+fn rosbag2_metadata_is_read_in_its_block_and_flow_forms() {
+    let meta = rosbag2::Metadata::parse(
+        "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: sqlite3\n  \
+         relative_file_paths:\n    - 'run_0.db3'\n    - run_1.db3\n  duration:\n    \
+         nanoseconds: 1\n  files:\n  - path: run_0.db3\n  compression_format: \"\"\n  \
+         compression_mode: \"\"\n",
+    )
+    .unwrap();
+    assert_eq!(meta.storage, "sqlite3");
+    assert_eq!(meta.files, ["run_0.db3", "run_1.db3"]);
+    let meta = rosbag2::Metadata::parse(
+        "storage_identifier: mcap\nrelative_file_paths: [a.mcap, \"b.mcap\"]\ncompression_mode: FILE\n",
+    )
+    .unwrap();
+    assert_eq!(meta.files, ["a.mcap", "b.mcap"]);
+    assert_eq!(meta.compression_mode, "FILE");
+    assert!(rosbag2::Metadata::parse("relative_file_paths: []\n").is_err());
+    assert!(rosbag2::Metadata::parse("storage_identifier: mcap\n").is_err());
+}
