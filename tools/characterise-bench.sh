@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # The cost of `imu-ar characterise` on a long recording: a generated static IMU, six axes at
-# 400 Hz for 4 hours (5.76 M messages), as a EuRoC CSV and as a ROS 1 bag (written by the
-# Python package rosbags), each characterised by the release build; wall time and peak
-# memory (maximum resident set) from GNU time, as the table perf-characterise of
-# docs/recordings.md.
+# 400 Hz for 4 hours (5.76 M messages), as a EuRoC CSV, a ROS 1 bag and a rosbag2 SQLite
+# database (written by the Python package rosbags), each characterised by the release build;
+# wall time and peak memory (maximum resident set) from GNU time, as the table
+# perf-characterise of docs/recordings.md.
 #
 #   tools/characterise-bench.sh [DIR]      (DIR: where the recordings go, default /tmp)
 set -euo pipefail
@@ -48,11 +48,17 @@ if [ ! -f "$dir/imu.bag" ]; then
     python3 cli/tests/fixtures/write_ros.py one "$dir/imu.bag" ros1 /imu0 lz4 "$dir/plain.csv"
     rm "$dir/plain.csv"
 fi
+if [ ! -f "$dir/imu.db3" ]; then
+    sed '1s/.*/t_ns,gx,gy,gz,ax,ay,az/' "$dir/imu.csv" > "$dir/plain.csv"
+    python3 cli/tests/fixtures/write_ros.py one "$dir/imu.db3" sqlite3 /imu0 none "$dir/plain.csv"
+    rm "$dir/plain.csv"
+fi
 cargo build --release -p imu-ar-cli --quiet
 {
     echo "| input | size | wall (s) | peak resident (MB) |"
     echo "|---|---|---|---|"
-    for input in "EuRoC CSV=imu.csv" "ROS 1 bag, lz4 chunks=imu.bag --topic /imu0"; do
+    for input in "EuRoC CSV=imu.csv" "ROS 1 bag, lz4 chunks=imu.bag --topic /imu0" \
+        "ROS 2 database (.db3)=imu.db3 --topic /imu0"; do
         label=${input%%=*}
         # shellcheck disable=SC2086
         set -- ${input#*=}

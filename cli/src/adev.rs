@@ -60,7 +60,7 @@ pub fn run(args: &Args) -> Result<AdevResult, Fail> {
         let e = format!("{} sample(s), at least 2 needed", x.len());
         return Err(args.input.fail(e));
     }
-    let rate = series.rate(args.rate)?;
+    let rate = series.rate(args.rate, &args.input)?;
     check_span("--rate", rate, x.len())?;
     let (mut tau, mut avar) = (Vec::new(), Vec::new());
     let mut m = 1usize;

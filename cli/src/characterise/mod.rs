@@ -83,9 +83,9 @@ pub struct Args {
     /// default 400 Hz (EKF3 sums the loop's IMU samples to about 12 ms).
     #[arg(long, allow_negative_numbers = true)]
     loop_rate: Option<f64>,
-    /// The vehicle ID (MAV_SYS_ID) of the PX4 parameter file: QGroundControl loads it only
-    /// into that vehicle [default: 1].
-    #[arg(long)]
+    /// The vehicle ID (MAV_SYS_ID, 1 to 255) of the PX4 parameter file: QGroundControl loads
+    /// it only into that vehicle [default: 1].
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..))]
     sysid: Option<u8>,
     /// Print one JSON object instead of the table.
     #[arg(long)]
@@ -155,13 +155,20 @@ pub fn run(args: &Args) -> Result<Characterisation, Fail> {
     }
     let columns = columns(args)?;
     // Created now, so that a folder that cannot be made fails before the record is read;
-    // removed again (while still empty) when the run fails.
-    let created = !args.out.exists();
+    // removed again with the parents it needed (while still empty) when the run fails.
+    let created: Vec<&Path> = args
+        .out
+        .ancestors()
+        .take_while(|p| !p.as_os_str().is_empty() && !p.exists())
+        .collect();
     std::fs::create_dir_all(&args.out)
         .map_err(|e| Fail(format!("--out {}: cannot create: {e}", args.out.display())))?;
     let result = characterise(args, &config, given, &formats, &columns);
-    if result.is_err() && created {
-        let _ = std::fs::remove_dir(&args.out);
+    if result.is_err() {
+        // Deepest first; a folder something else has filled since stays.
+        for dir in created {
+            let _ = std::fs::remove_dir(dir);
+        }
     }
     result
 }
@@ -196,7 +203,7 @@ fn characterise(
     let backward = read.timing.as_ref().map_or(0, |(t, _)| t.dropped());
     let timing =
         summary(read.timing, args.rate.is_none()).map_err(|e| with_file(&args.files, e))?;
-    let rate = resolve_rate(args.rate, timing.as_ref())?;
+    let rate = resolve_rate(args.rate, timing.as_ref()).map_err(|e| with_file(&args.files, e.0))?;
     check_span("--rate", rate, n as usize)?;
     let units: Vec<Unit> = (0..6)
         .map(|i| {
@@ -208,7 +215,8 @@ fn characterise(
                 &columns[i],
             )
         })
-        .collect::<Result<_, _>>()?;
+        .collect::<Result<_, _>>()
+        .map_err(|e| with_file(&args.files, e.0))?;
     let fits: Vec<Fitting> = units
         .iter()
         .map(|u| Fitting {
@@ -471,7 +479,8 @@ fn axis_unit(
     }
     let unit = read.or(given).ok_or_else(|| match bracket {
         Some(b) => Fail(format!(
-            "column '{}': its unit [{}] is not one known here (rad/s, deg/s, deg/h for a gyro;              m/s^2, g, mg for an accelerometer; G and mG are read as gauss); give {flag}",
+            "column '{}': its unit [{}] is not one known here (rad/s, deg/s, deg/h for a gyro; \
+             m/s^2, g, mg for an accelerometer; G and mG are read as gauss); give {flag}",
             escaped(column),
             escaped(b)
         )),

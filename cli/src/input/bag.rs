@@ -75,11 +75,15 @@ pub fn read_selected(
     let mut all_topics = Vec::new();
     // Each chunk's position, and the receive times of its first and last message.
     let mut chunks: Vec<(u64, u64, u64)> = Vec::new();
+    // Each chunk's position and its messages per connection, as the index counts them.
+    let mut counted: Vec<(u64, Vec<(u32, u32)>)> = Vec::new();
     for record in bag.index_records() {
         let c = match record.map_err(|e| corrupt(format!("{} (in the index)", text(&e))))? {
             IndexRecord::Connection(c) => c,
             IndexRecord::ChunkInfo(info) => {
                 chunks.push((info.chunk_pos, info.start_time, info.end_time));
+                let per_connection = info.entries().map(|e| (e.conn_id, e.count)).collect();
+                counted.push((info.chunk_pos, per_connection));
                 continue;
             }
             _ => continue,
@@ -132,6 +136,16 @@ pub fn read_selected(
     // plays them in.
     chunks.sort_unstable();
     let in_order = chunks.windows(2).all(|w| w[0].2 <= w[1].1);
+    // The topic's messages the index counts (each chunk once), to find a chunk that holds
+    // fewer than it should (a compressed chunk whose declared size was damaged reads empty).
+    counted.sort_unstable_by_key(|&(pos, _)| pos);
+    counted.dedup_by_key(|&mut (pos, _)| pos);
+    let expected: u64 = counted
+        .iter()
+        .flat_map(|(_, entries)| entries)
+        .filter(|(conn, _)| ids.contains(conn))
+        .fold(0u64, |a, &(_, n)| a.saturating_add(u64::from(n)));
+    let mut found = 0u64;
     let mut sorted: Vec<Held> = Vec::new();
     let mut frame_ids: Vec<Vec<u8>> = Vec::new();
     for record in bag.chunk_records() {
@@ -146,6 +160,7 @@ pub fn read_selected(
             if !ids.contains(&m.conn_id) {
                 continue;
             }
+            found += 1;
             if in_order {
                 tally.offer(m.conn_id, decode(m.data));
                 continue;
@@ -159,6 +174,12 @@ pub fn read_selected(
             });
             sorted.push((m.time, m.conn_id, frame));
         }
+    }
+    if found < expected {
+        return Err(corrupt(format!(
+            "the index counts {expected} messages on '{topic}' and the chunks hold {found}: a \
+             chunk is damaged"
+        )));
     }
     sorted.sort_by_key(|&(time, _, _)| time);
     for (_, conn, frame) in sorted {

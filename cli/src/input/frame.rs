@@ -126,8 +126,8 @@ pub(crate) struct Tally<'a> {
     frame_id: Option<&'a str>,
     delivered: u64,
     skipped: Skipped,
-    /// Each frame_id seen, with its messages.
-    frame_ids: Vec<(Vec<u8>, u64)>,
+    /// Each frame_id seen, with its messages and whether it is the one chosen.
+    frame_ids: Vec<(Vec<u8>, u64, bool)>,
     sources: Vec<Source>,
 }
 
@@ -154,20 +154,26 @@ impl<'a> Tally<'a> {
             self.skipped.undecodable += 1;
             return;
         };
-        let k = match self.frame_ids.iter().position(|(f, _)| f == frame_id) {
+        let k = match self.frame_ids.iter().position(|(f, _, _)| f == frame_id) {
             Some(k) => k,
             None if self.frame_ids.len() < MAX_FRAME_IDS => {
-                self.frame_ids.push((frame_id.to_vec(), 0));
+                // Chosen as written, or as shown (a frame_id that is not UTF-8).
+                let chosen = self
+                    .frame_id
+                    .is_none_or(|w| w.as_bytes() == frame_id || shown(frame_id) == w);
+                self.frame_ids.push((frame_id.to_vec(), 0, chosen));
                 self.frame_ids.len() - 1
             }
             None => MAX_FRAME_IDS,
         };
-        if let Some((_, n)) = self.frame_ids.get_mut(k) {
-            *n += 1;
-        }
-        if let Some(want) = self.frame_id
-            && want.as_bytes() != frame_id
-        {
+        let chosen = match self.frame_ids.get_mut(k) {
+            Some((_, n, chosen)) => {
+                *n += 1;
+                *chosen
+            }
+            None => self.frame_id.is_none(),
+        };
+        if !chosen {
             self.skipped.other_frame_id += 1;
             return;
         }
@@ -202,7 +208,7 @@ impl<'a> Tally<'a> {
         let mut text: Vec<String> = self
             .frame_ids
             .iter()
-            .map(|(f, n)| format!("'{}' ({n} messages)", escaped(&String::from_utf8_lossy(f))))
+            .map(|(f, n, _)| format!("'{}' ({n} messages)", shown(f)))
             .collect();
         if self.frame_ids.len() >= MAX_FRAME_IDS {
             text.push("and more".into());
@@ -235,7 +241,7 @@ impl<'a> Tally<'a> {
             ));
         }
         if let Some(want) = self.frame_id
-            && !self.frame_ids.iter().any(|(f, _)| f == want.as_bytes())
+            && !self.frame_ids.iter().any(|(_, _, chosen)| *chosen)
         {
             return Err(data_error(
                 file,
@@ -289,6 +295,15 @@ impl<'a> Tally<'a> {
             )
         };
         Err(data_error(file, problem))
+    }
+}
+
+/// A frame_id as messages show it (and `--frame-id` may name it): its text with control
+/// characters escaped, or, when it is not UTF-8, its bytes with every non-ASCII one as `\xNN`.
+fn shown(frame_id: &[u8]) -> String {
+    match std::str::from_utf8(frame_id) {
+        Ok(text) => escaped(text),
+        Err(_) => frame_id.escape_ascii().to_string(),
     }
 }
 

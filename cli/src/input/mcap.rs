@@ -89,6 +89,10 @@ pub fn read_selected(
     );
 
     let mut channels = Channels::default();
+    // The messages per channel that the summary's statistics count, and those found: a
+    // compressed chunk whose declared size was damaged reads empty.
+    let mut counted = None;
+    let mut found = 0u64;
     let mut tally = Tally::new(select, each);
     let mut messages = 0u64;
     let corrupt = |what: &dyn std::fmt::Display, messages: u64| {
@@ -115,6 +119,11 @@ pub fn read_selected(
                         ::mcap::parse_record(opcode, data).map_err(|e| corrupt(&e, messages))?;
                     channels.add(record, topic).map_err(fail)?;
                 }
+                op::STATISTICS => {
+                    if let Ok(Record::Statistics(stats)) = ::mcap::parse_record(opcode, data) {
+                        counted = Some(stats.channel_message_counts);
+                    }
+                }
                 op::MESSAGE => {
                     messages += 1;
                     // channel_id (u16), sequence (u32), log_time, publish_time (u64), data.
@@ -122,6 +131,7 @@ pub fn read_selected(
                         .map(u16::from_le_bytes)
                         .ok_or_else(|| corrupt(&"a message record of 0 or 1 bytes", messages))?;
                     if channels.wanted.contains(&channel) {
+                        found += 1;
                         tally.offer(u32::from(channel), data.get(22..).and_then(decode));
                     }
                 }
@@ -136,6 +146,19 @@ pub fn read_selected(
             &channels.imu_topics,
             &channels.all_topics,
         )));
+    }
+    if let Some(counts) = counted {
+        let expected: u64 = channels
+            .wanted
+            .iter()
+            .filter_map(|c| counts.get(c))
+            .fold(0u64, |a, &n| a.saturating_add(n));
+        if found < expected {
+            return Err(fail(format!(
+                "truncated or corrupt MCAP file: its statistics count {expected} messages on \
+                 '{topic}' and its chunks hold {found}: a chunk is damaged"
+            )));
+        }
     }
     tally.finish(path, topic, &|id| format!("channel {id}"))
 }

@@ -121,9 +121,9 @@ impl Input {
 
 impl Series {
     /// The sample rate: `--rate` when given (an error when the timestamps give one more than
-    /// 1 % away), else the timestamps'.
-    pub fn rate(&self, given: Option<f64>) -> Result<f64, Fail> {
-        resolve_rate(given, self.timing.as_ref())
+    /// 1 % away), else the timestamps'. Errors name `input`'s files.
+    pub fn rate(&self, given: Option<f64>, input: &Input) -> Result<f64, Fail> {
+        resolve_rate(given, self.timing.as_ref()).map_err(|e| input.fail(e.0))
     }
 }
 
@@ -146,6 +146,13 @@ pub fn resolve_rate(given: Option<f64>, timing: Option<&TimingSummary>) -> Resul
             Ok(r)
         }
         (Some(r), None) => check_rate(r),
+        (None, Some(t)) if t.rate_hz > MAX_STAMPED_RATE && t.header_stamps => Err(Fail(format!(
+            "the messages' header stamps give {} Hz: an IMU above {} kHz is rare; give --rate {} \
+             to confirm the rate",
+            t.rate_hz,
+            MAX_STAMPED_RATE / 1e3,
+            t.rate_hz
+        ))),
         (None, Some(t)) if t.rate_hz > MAX_STAMPED_RATE => Err(Fail(format!(
             "the timestamps ({}) give {} Hz: an IMU above {} kHz is rare, and stamps in a unit \
              1000 times finer than the column says (microseconds under [ns], milliseconds \

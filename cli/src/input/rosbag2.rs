@@ -149,9 +149,17 @@ pub fn storage_files(dir: &Path) -> Result<(Vec<PathBuf>, bool), DataError> {
             )));
         }
         let file = dir.join(rel);
-        if !file.is_file() {
+        let problem = match std::fs::metadata(&file) {
+            Ok(m) if m.is_file() => None,
+            Ok(_) => Some("is not a regular file"),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                Some("is missing from the folder")
+            }
+            Err(_) => Some("cannot be read"),
+        };
+        if let Some(p) = problem {
             return Err(fail(format!(
-                "storage file '{}' is missing from the folder",
+                "storage file '{}' {p}",
                 crate::error::escaped(f)
             )));
         }
@@ -263,6 +271,23 @@ pub fn read_db3(
     }
     // One topic row per publisher's QoS profile: all of them, told apart by their frame_id.
     let list: Vec<String> = ids.iter().map(i64::to_string).collect();
+    let untimed: i64 = db
+        .query_row(
+            &format!(
+                "SELECT COUNT(*) FROM messages WHERE topic_id IN ({}) AND \
+                 typeof(timestamp) != 'integer'",
+                list.join(",")
+            ),
+            [],
+            |r| r.get(0),
+        )
+        .map_err(sql)?;
+    if untimed > 0 {
+        return Err(fail(format!(
+            "{untimed} messages on '{topic}' have a receive timestamp that is not an integer \
+             (nanoseconds): not a rosbag2 database as ROS 2 writes it"
+        )));
+    }
     let mut messages = db
         .prepare(&format!(
             "SELECT topic_id, data FROM messages WHERE topic_id IN ({}) ORDER BY timestamp, id",

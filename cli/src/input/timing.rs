@@ -16,6 +16,8 @@ pub enum TimeUnit {
     Microseconds,
     /// Nanoseconds.
     Nanoseconds,
+    /// The header stamps of a bag's or an MCAP file's messages, in nanoseconds.
+    HeaderStamps,
 }
 
 impl TimeUnit {
@@ -66,7 +68,7 @@ impl TimeUnit {
             Self::Seconds => "s",
             Self::Milliseconds => "ms",
             Self::Microseconds => "us",
-            Self::Nanoseconds => "ns",
+            Self::Nanoseconds | Self::HeaderStamps => "ns",
         }
     }
 
@@ -77,7 +79,7 @@ impl TimeUnit {
             Self::Seconds => 1_000_000_000,
             Self::Milliseconds => 1_000_000,
             Self::Microseconds => 1_000,
-            Self::Nanoseconds => 1,
+            Self::Nanoseconds | Self::HeaderStamps => 1,
         };
         if let Ok(v) = cell.parse::<i64>() {
             return v
@@ -226,6 +228,7 @@ impl Timing {
         let mean = sum / regular.max(1) as f64;
         let summary = TimingSummary {
             unit: unit.name(),
+            header_stamps: unit == TimeUnit::HeaderStamps,
             rate_hz: 1e9 / mean,
             median_interval_s: median * 1e-9,
             jitter_rms: (sq / regular.max(1) as f64).sqrt(),
@@ -245,12 +248,19 @@ impl Timing {
             ));
         }
         if !(0.01..=1e6).contains(&summary.rate_hz) {
-            return Err(format!(
-                "the timestamps, read as {}, give {:.6e} Hz, not an IMU's rate: state the time \
-                 column's unit in its header ([s], [ms], [us], [ns]), or give --rate",
-                unit.name(),
-                summary.rate_hz
-            ));
+            return Err(if unit == TimeUnit::HeaderStamps {
+                format!(
+                    "the messages' header stamps give {:.6e} Hz, not an IMU's rate: give --rate",
+                    summary.rate_hz
+                )
+            } else {
+                format!(
+                    "the timestamps, read as {}, give {:.6e} Hz, not an IMU's rate: state the \
+                     time column's unit in its header ([s], [ms], [us], [ns]), or give --rate",
+                    unit.name(),
+                    summary.rate_hz
+                )
+            });
         }
         Ok(summary)
     }
@@ -300,6 +310,9 @@ struct Classes {
 pub struct TimingSummary {
     /// The unit of the time column (`ns` for a bag's header stamps).
     pub unit: &'static str,
+    /// Whether they are the header stamps of a bag's or an MCAP file's messages.
+    #[serde(skip)]
+    pub header_stamps: bool,
     /// The rate, the reciprocal of the mean regular interval, Hz.
     pub rate_hz: f64,
     /// The median interval, s.

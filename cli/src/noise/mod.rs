@@ -317,7 +317,7 @@ pub fn run(args: &Args) -> Result<NoiseResult, Fail> {
         plot::check_path(path)?;
     }
     let series = args.input.series(args.rate.is_none())?;
-    let rate = series.rate(args.rate)?;
+    let rate = series.rate(args.rate, &args.input)?;
     let x = decimated(&args.input.files, &series.x, args.decimate)?;
     check_span("--rate", rate, x.len())?;
     let rate = rate / args.decimate as f64;

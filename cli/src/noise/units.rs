@@ -45,33 +45,46 @@ impl Units {
         format!("{}/sqrt(Hz)", self.name)
     }
 
-    /// `N` as angle random walk in deg/sqrt(h) (a gyro), or velocity random walk in
-    /// m/s/sqrt(h) (an accelerometer): ` = ...`, or nothing.
+    /// `N` as angle random walk in deg/sqrt(h) (a gyro; in rad/sqrt(h) first for a gyro in
+    /// rad/s), or velocity random walk in m/s/sqrt(h) (an accelerometer): ` = ...`, or nothing.
     pub fn arw(&self, n: f64) -> String {
         match self.kind {
-            Kind::Gyro(angle, f) => format!(" = {} {angle}/sqrt(h)", short(60.0 * n * f)),
+            Kind::Gyro(angle, f) => Self::angles(angle, 60.0 * n * f, "/sqrt(h)"),
             Kind::Accelerometer(to_si) => format!(" = {} m/s/sqrt(h)", short(60.0 * n * to_si)),
             Kind::Other => String::new(),
         }
     }
 
-    /// `K` of a gyro in deg/h/sqrt(h) (`216000 K`), or nothing.
+    /// `K` of a gyro in deg/h/sqrt(h) (`216000 K`; in rad/h/sqrt(h) first for a gyro in
+    /// rad/s), of an accelerometer in m/s/h/sqrt(h): ` = ...`, or nothing.
     pub fn rrw(&self, k: f64) -> String {
         match self.kind {
-            Kind::Gyro(angle, f) => {
-                format!(" = {} {angle}/h/sqrt(h)", short(3600.0 * 60.0 * k * f))
+            Kind::Gyro(angle, f) => Self::angles(angle, 3600.0 * 60.0 * k * f, "/h/sqrt(h)"),
+            Kind::Accelerometer(to_si) => {
+                format!(" = {} m/s/h/sqrt(h)", short(3600.0 * 60.0 * k * to_si))
             }
-            _ => String::new(),
+            Kind::Other => String::new(),
         }
     }
 
-    /// `B` of a gyro in deg/h, of an accelerometer in micro-g: ` = ...`, or nothing.
+    /// `B` of a gyro in deg/h (in rad/h first for a gyro in rad/s), of an accelerometer in
+    /// micro-g: ` = ...`, or nothing.
     pub fn bias(&self, b: f64) -> String {
         match self.kind {
-            Kind::Gyro(angle, f) => format!(" = {} {angle}/h", short(3600.0 * b * f)),
+            Kind::Gyro(angle, f) => Self::angles(angle, 3600.0 * b * f, "/h"),
             Kind::Accelerometer(to_si) => format!(" = {} ug", short(1e6 * b * to_si / G)),
             Kind::Other => String::new(),
         }
+    }
+
+    /// ` = v angle<per>`, and ` = v deg<per>` after it when `angle` is rad (datasheets print
+    /// degrees).
+    fn angles(angle: &str, v: f64, per: &str) -> String {
+        let mut s = format!(" = {} {angle}{per}", short(v));
+        if angle == "rad" {
+            s += &format!(" = {} deg{per}", short(v.to_degrees()));
+        }
+        s
     }
 }
 
@@ -100,5 +113,14 @@ mod tests {
         assert_eq!(Units::of("counts").arw(1.0), "");
         // 3600 deg/h = 1 deg/s.
         assert_eq!(Units::of("deg/h").bias(3600.0 * 1e-3), " = 3.6 deg/h");
+        // A gyro in rad/s: radians, then the degrees datasheets print.
+        let rad = Units::of("rad/s");
+        assert_eq!(rad.arw(1e-3), " = 0.06 rad/sqrt(h) = 3.4377 deg/sqrt(h)");
+        assert_eq!(
+            rad.rrw(1e-5),
+            " = 2.16 rad/h/sqrt(h) = 123.76 deg/h/sqrt(h)"
+        );
+        // An accelerometer's K: 1 m/s^2/sqrt(s) = 216000 m/s/h/sqrt(h).
+        assert_eq!(Units::of("m/s^2").rrw(1e-5), " = 2.16 m/s/h/sqrt(h)");
     }
 }

@@ -238,6 +238,22 @@ fn files_that_are_no_recording_are_named_for_what_they_are() {
         assert!(stderr(&out).contains(want), "{name}: {}", stderr(&out));
         assert!(!stderr(&out).contains("the file is CSV"), "{name}");
     }
+    // A file that is not there is not there (not an empty bag).
+    let missing = dir.join("missing.bag");
+    let out = imu_ar(&[
+        "noise",
+        path(&missing),
+        "--topic",
+        "/imu0",
+        "--column",
+        "gx",
+    ]);
+    assert_one_line_failure(&out);
+    assert!(
+        stderr(&out).contains("missing.bag: cannot open: "),
+        "{}",
+        stderr(&out)
+    );
     // A folder without metadata.yaml, and a rosbag2 folder whose metadata names a missing file.
     let bare = dir.join("folder");
     std::fs::create_dir_all(&bare).unwrap();
@@ -403,8 +419,24 @@ fn an_unknown_unit_bracket_is_named_with_the_known_ones() {
             && e.contains("--accel-unit"),
         "{e}"
     );
-    // A failed run leaves no --out folder behind.
+    // A failed run leaves no --out folder behind, nor the parents it made; and the file is
+    // named.
     assert!(!dir.join("out").exists());
+    assert!(
+        e.starts_with(&format!("imu-ar: {}: column 'ax'", file.display())),
+        "{e}"
+    );
+    let nested = dir.join("nest/a/b");
+    let out = imu_ar(&[
+        "characterise",
+        path(&file),
+        "--columns",
+        "gx,gy,gz,ax,ay,az",
+        "--out",
+        path(&nested),
+    ]);
+    assert_one_line_failure(&out);
+    assert!(!dir.join("nest").exists());
 }
 
 #[test]
@@ -456,4 +488,208 @@ fn rosbag2_metadata_is_read_in_its_block_and_flow_forms() {
     assert_eq!(meta.compression_mode, "FILE");
     assert!(rosbag2::Metadata::parse("relative_file_paths: []\n").is_err());
     assert!(rosbag2::Metadata::parse("storage_identifier: mcap\n").is_err());
+}
+
+/// `imu-ar noise FILE --topic /imu0 --column gx EXTRA..`.
+fn noise_of(file: &Path, extra: &[&str]) -> std::process::Output {
+    let mut args = vec!["noise", path(file), "--topic", "/imu0", "--column", "gx"];
+    args.extend_from_slice(extra);
+    imu_ar(&args)
+}
+
+#[test]
+fn more_than_one_percent_of_skipped_messages_is_refused() {
+    let dir = temp_dir("skipped-share");
+    let base = std::fs::read(fixture("noise.bag")).unwrap();
+    let ids = ros::frame_ids(&base);
+    // A frame_id given another length: the message no longer decodes. Every 50th message of
+    // 1200 (24, 2 %) is refused; every 400th (3, 0.25 %) is read, the holes shown as gaps.
+    for (every, refused) in [(50, true), (400, false)] {
+        let mut bytes = base.clone();
+        for &id in ids.iter().step_by(every) {
+            bytes[id - 4..id].copy_from_slice(&1000u32.to_le_bytes());
+        }
+        let file = dir.join(format!("every-{every}.bag"));
+        std::fs::write(&file, bytes).unwrap();
+        let out = noise_of(&file, &[]);
+        if refused {
+            assert_one_line_failure(&out);
+            assert!(
+                stderr(&out)
+                    .contains("24 of the 1200 messages on '/imu0' were skipped (24 undecodable")
+                    && stderr(&out).contains("more than 1 %"),
+                "{}",
+                stderr(&out)
+            );
+        } else {
+            assert!(out.status.success(), "{}", stderr(&out));
+            assert_eq!(json(&noise_of(&file, &["--json"]))["n"], 1197);
+        }
+    }
+}
+
+#[test]
+fn a_chunk_that_reads_short_is_a_damaged_file() {
+    let dir = temp_dir("short-chunk");
+    // ROS 1, bz2: the first chunk's header says its data decompress to 0 bytes.
+    let mut bytes = std::fs::read(fixture("noise-bz2.bag")).unwrap();
+    let at = ros::find_all(&bytes, b"size=")[0] + 5;
+    bytes[at..at + 4].copy_from_slice(&0u32.to_le_bytes());
+    let bag = dir.join("zero.bag");
+    std::fs::write(&bag, bytes).unwrap();
+    let out = noise_of(&bag, &[]);
+    assert_one_line_failure(&out);
+    assert!(
+        stderr(&out).contains("a chunk is damaged"),
+        "{}",
+        stderr(&out)
+    );
+    // MCAP, zstd: the same in a chunk record (opcode 0x06: start and end times, then the
+    // uncompressed size and CRC, zeroed so that no CRC check tells).
+    let mut bytes = std::fs::read(fixture("noise-zstd.mcap")).unwrap();
+    let mut at = 8;
+    while bytes[at] != 0x06 {
+        let len = u64::from_le_bytes(bytes[at + 1..at + 9].try_into().unwrap()) as usize;
+        at += 9 + len;
+    }
+    let body = at + 9;
+    bytes[body + 16..body + 28].fill(0);
+    let mcap = dir.join("zero.mcap");
+    std::fs::write(&mcap, bytes).unwrap();
+    let out = noise_of(&mcap, &[]);
+    assert_one_line_failure(&out);
+    assert!(
+        stderr(&out).contains("a chunk is damaged"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+#[test]
+fn refusals_name_the_file_and_what_it_is() {
+    let dir = temp_dir("messages");
+    // The rate's refusals name the file; for a bag they speak of its header stamps.
+    let bag = fixture("noise.bag");
+    let out = noise_of(&bag, &["--rate", "103"]);
+    assert!(
+        stderr(&out).starts_with(&format!("imu-ar: {}: --rate 103", bag.display())),
+        "{}",
+        stderr(&out)
+    );
+    let mut bytes = std::fs::read(&bag).unwrap();
+    for (i, &id) in ros::frame_ids(&bytes.clone()).iter().enumerate() {
+        ros::set_stamp(
+            &mut bytes,
+            id,
+            1_600_000_000_000_000_000 + i as i64 * 50_000,
+        );
+    }
+    let fast = dir.join("fast.bag");
+    std::fs::write(&fast, bytes).unwrap();
+    let out = noise_of(&fast, &[]);
+    assert_one_line_failure(&out);
+    assert!(
+        stderr(&out).starts_with(&format!(
+            "imu-ar: {}: the messages' header stamps give 20000 Hz",
+            fast.display()
+        )) && !stderr(&out).contains("time column"),
+        "{}",
+        stderr(&out)
+    );
+    // A damaged bag without --topic says it is damaged.
+    let cut = dir.join("cut.bag");
+    let whole = std::fs::read(&bag).unwrap();
+    std::fs::write(&cut, &whole[..whole.len() - 100]).unwrap();
+    let out = imu_ar(&["noise", path(&cut), "--column", "gx"]);
+    assert_one_line_failure(&out);
+    assert!(
+        stderr(&out).contains("truncated or corrupt bag"),
+        "{}",
+        stderr(&out)
+    );
+    // Empty, binary and compressed files under --topic.
+    let cases: [(&str, &[u8], &str); 4] = [
+        ("empty.bin", b"", "the file is empty"),
+        ("x.h5", b"\x89HDF\r\n\x1a\n\0\0\0\0", "an HDF5 file"),
+        ("blob", b"\x01\x02\x03\x04abc", "a binary file"),
+        ("a.csv.xz", b"\xfd7zXZ\0\0\x04", "an xz-compressed file"),
+    ];
+    for (name, bytes, want) in cases {
+        let file = dir.join(name);
+        std::fs::write(&file, bytes).unwrap();
+        let out = noise_of(&file, &[]);
+        assert_one_line_failure(&out);
+        assert!(stderr(&out).contains(want), "{name}: {}", stderr(&out));
+    }
+    // A storage file that is a folder is not a missing one.
+    let folder = dir.join("rb2");
+    std::fs::create_dir_all(folder.join("bag_0.db3")).unwrap();
+    std::fs::write(
+        folder.join("metadata.yaml"),
+        "storage_identifier: sqlite3\nrelative_file_paths:\n- bag_0.db3\n",
+    )
+    .unwrap();
+    let out = noise_of(&folder, &[]);
+    assert!(
+        stderr(&out).contains("'bag_0.db3' is not a regular file"),
+        "{}",
+        stderr(&out)
+    );
+    // PX4's vehicle id is 1 to 255 in one message.
+    let out = imu_ar(&[
+        "characterise",
+        path(&bag),
+        "--topic",
+        "/imu0",
+        "--sysid",
+        "0",
+        "--out",
+        path(&dir.join("o")),
+    ]);
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("1..=255"), "{}", stderr(&out));
+}
+
+#[test]
+fn a_frame_id_that_is_not_utf8_is_shown_escaped_and_can_be_chosen() {
+    let dir = temp_dir("non-utf8");
+    let mut bytes = std::fs::read(fixture("noise.bag")).unwrap();
+    let ids = ros::frame_ids(&bytes);
+    // Every other message from frame_id "\xffmu_link".
+    for &id in ids.iter().step_by(2) {
+        bytes[id] = 0xff;
+    }
+    let file = dir.join("bytes.bag");
+    std::fs::write(&file, bytes).unwrap();
+    let out = noise_of(&file, &[]);
+    assert_one_line_failure(&out);
+    assert!(
+        stderr(&out).contains("'\\xffmu_link' (600 messages)")
+            && stderr(&out).contains("'imu_link' (600 messages)"),
+        "{}",
+        stderr(&out)
+    );
+    let (got, result) = read(&file, Some("\\xffmu_link"));
+    assert_eq!(result, Ok(600));
+    let want: Vec<Frame> = ros::noise_frames().into_iter().step_by(2).collect();
+    assert_bits(&got, &want, "\\xffmu_link");
+}
+
+#[test]
+fn a_database_with_a_timestamp_that_is_not_an_integer_is_refused() {
+    let dir = temp_dir("db3-types");
+    let file = dir.join("text.db3");
+    std::fs::copy(fixture("noise.db3"), &file).unwrap();
+    let db = rusqlite::Connection::open(&file).unwrap();
+    db.execute("UPDATE messages SET timestamp = 'abc' WHERE id = 5", [])
+        .unwrap();
+    drop(db);
+    let out = noise_of(&file, &[]);
+    assert_one_line_failure(&out);
+    assert!(
+        stderr(&out)
+            .contains("1 messages on '/imu0' have a receive timestamp that is not an integer"),
+        "{}",
+        stderr(&out)
+    );
 }
