@@ -181,7 +181,7 @@ fn characterise(
     formats: &[Format],
     columns: &[String],
 ) -> Result<Characterisation, Fail> {
-    let mut axes: Vec<AxisStream<OCTAVES>> = (0..6).map(|_| AxisStream::new()).collect();
+    let axes: Vec<AxisStream<OCTAVES>> = (0..6).map(|_| AxisStream::new()).collect();
     let progress = Progress::new();
     crate::input::csv::quiet_progress();
     let request = Request {
@@ -192,12 +192,44 @@ fn characterise(
         want_time: args.rate.is_none(),
         drop_backward: args.drop_backward,
     };
-    let read = source::stream(&args.files, &request, &mut |v| {
-        for (axis, x) in axes.iter_mut().zip(v) {
-            axis.push(*x);
+    // The rows go in batches to a second thread, which keeps the six axes' statistics while
+    // this one reads and parses: the two halves of the work overlap.
+    let (send, receive) = std::sync::mpsc::sync_channel::<Vec<[f64; 6]>>(4);
+    let worker = |mut axes: Vec<AxisStream<OCTAVES>>| {
+        for batch in receive {
+            for row in &batch {
+                for (axis, x) in axes.iter_mut().zip(row) {
+                    axis.push(*x);
+                }
+            }
         }
-        progress.tick(axes[0].samples());
-    })?;
+        axes
+    };
+    let (read, kept) = std::thread::scope(|scope| {
+        let kept = scope.spawn(move || worker(axes));
+        let mut batch = Vec::with_capacity(BATCH);
+        let mut rows = 0u64;
+        let read = source::stream(&args.files, &request, &mut |v| {
+            let mut row = [0.0; 6];
+            for (r, x) in row.iter_mut().zip(v) {
+                *r = *x;
+            }
+            batch.push(row);
+            if batch.len() == BATCH {
+                // A closed channel means the worker is gone; its join says why.
+                let _ = send.send(std::mem::replace(&mut batch, Vec::with_capacity(BATCH)));
+            }
+            rows += 1;
+            progress.tick(rows);
+        });
+        if !batch.is_empty() {
+            let _ = send.send(batch);
+        }
+        drop(send);
+        (read, kept.join())
+    });
+    let axes = kept.map_err(|_| Fail("the statistics thread stopped".into()))?;
+    let read = read?;
     progress.finish();
     let n = axes[0].samples();
     let backward = read.timing.as_ref().map_or(0, |(t, _)| t.dropped());
@@ -435,6 +467,9 @@ fn columns(args: &Args) -> Result<Vec<String>, Fail> {
         "no EuRoC (w_RS_S_x .. a_RS_S_z) or gx .. az columns: name the six with --columns",
     ))
 }
+
+/// Rows handed to the statistics thread at a time.
+const BATCH: usize = 4096;
 
 /// A `--gyro-unit` or `--accel-unit`.
 fn parse_unit(name: &str) -> Result<Unit, Fail> {

@@ -387,9 +387,10 @@ fn read_source(
     each: &mut dyn FnMut(&[&str]) -> Result<(), String>,
     locate: &dyn Fn(u64) -> Option<u64>,
 ) -> Result<(), DataError> {
+    // Cells are trimmed here, the selected ones only (the reader's own trimming allocates a
+    // record per row).
     let mut reader = ::csv::ReaderBuilder::new()
         .comment(Some(b'#'))
-        .trim(::csv::Trim::All)
         .flexible(true)
         .has_headers(comment_header.is_none())
         .from_reader(source);
@@ -399,7 +400,7 @@ fn read_source(
             .headers()
             .map_err(|e| error(path, None, format!("cannot read the header: {e}")))?
             .iter()
-            .map(str::to_string)
+            .map(|h| h.trim().to_string())
             .collect(),
     };
     if header.is_empty() {
@@ -436,10 +437,18 @@ fn read_source(
                 ),
             ));
         }
-        let mut cells: Vec<&str> = Vec::with_capacity(indices.len());
-        for &i in &indices {
+        // Up to 16 selected cells on the stack, more in a vector.
+        let mut small = [""; 16];
+        let mut large = Vec::new();
+        let cells: &mut [&str] = if indices.len() <= small.len() {
+            &mut small[..indices.len()]
+        } else {
+            large.resize(indices.len(), "");
+            &mut large
+        };
+        for (cell, &i) in cells.iter_mut().zip(&indices) {
             match record.get(i) {
-                Some(cell) => cells.push(cell),
+                Some(c) => *cell = c.trim(),
                 None => {
                     let name = header.get(i).map_or(String::new(), |h| escaped(h));
                     return Err(error(
@@ -450,7 +459,7 @@ fn read_source(
                 }
             }
         }
-        each(&cells).map_err(|problem| error(path, line(), problem))?;
+        each(cells).map_err(|problem| error(path, line(), problem))?;
         rows += 1;
     }
     if rows == 0 {

@@ -81,27 +81,32 @@ pub fn read_selected(
         return Err(fail(not_mcap(&head)));
     }
     let limit = usize::try_from(len.max(MIN_RECORD_LIMIT)).unwrap_or(usize::MAX);
+    // Chunks are handed over whole and opened here: the reader trusts the lengths of the
+    // records inside an uncompressed chunk.
     let mut reader = LinearReader::new_with_options(
         LinearReaderOptions::default()
             .with_skip_start_magic(true)
-            .with_prevalidate_chunk_crcs(true)
+            .with_emit_chunks(true)
             .with_record_length_limit(limit),
     );
-
-    let mut channels = Channels::default();
-    // The messages per channel that the summary's statistics count, and those found: a
-    // compressed chunk whose declared size was damaged reads empty.
-    let mut counted = None;
-    let mut found = 0u64;
-    let mut tally = Tally::new(select, each);
-    let mut messages = 0u64;
+    let mut state = State {
+        channels: Channels::default(),
+        counted: None,
+        found: 0,
+        messages: 0,
+        tally: Tally::new(select, each),
+    };
     let corrupt = |what: &dyn std::fmt::Display, messages: u64| {
         fail(format!(
             "truncated or corrupt MCAP file: {what} (after {messages} messages)"
         ))
     };
+    let refused = |r: Refusal, messages: u64| match r {
+        Refusal::Corrupt(e) => corrupt(&e, messages),
+        Refusal::Channel(e) => fail(e),
+    };
     while let Some(event) = reader.next_event() {
-        match event.map_err(|e| corrupt(&e, messages))? {
+        match event.map_err(|e| corrupt(&e, state.messages))? {
             LinearReadEvent::ReadRequest(need) => {
                 let buf = reader.insert(need.max(READ_SIZE));
                 let n = loop {
@@ -113,32 +118,42 @@ pub fn read_selected(
                 };
                 reader.notify_read(n);
             }
-            LinearReadEvent::Record { opcode, data } => match opcode {
-                op::SCHEMA | op::CHANNEL => {
-                    let record =
-                        ::mcap::parse_record(opcode, data).map_err(|e| corrupt(&e, messages))?;
-                    channels.add(record, topic).map_err(fail)?;
+            LinearReadEvent::Record {
+                opcode: op::CHUNK,
+                data,
+            } => {
+                let records = match ::mcap::parse_record(op::CHUNK, data) {
+                    Ok(Record::Chunk { header, data }) => chunk_records(&header, data, limit),
+                    Ok(_) => Err("a chunk record that is not one".into()),
+                    Err(e) => Err(e.to_string()),
                 }
-                op::STATISTICS => {
-                    if let Ok(Record::Statistics(stats)) = ::mcap::parse_record(opcode, data) {
-                        counted = Some(stats.channel_message_counts);
-                    }
+                .map_err(|e| corrupt(&e, state.messages))?;
+                let mut rest: &[u8] = &records;
+                while !rest.is_empty() {
+                    let (opcode, body, after) = split_record(rest)
+                        .ok_or_else(|| corrupt(&"a record overruns its chunk", state.messages))?;
+                    let messages = state.messages;
+                    state
+                        .record(opcode, body, topic)
+                        .map_err(|r| refused(r, messages))?;
+                    rest = after;
                 }
-                op::MESSAGE => {
-                    messages += 1;
-                    // channel_id (u16), sequence (u32), log_time, publish_time (u64), data.
-                    let channel = bytes_at::<2>(data, 0)
-                        .map(u16::from_le_bytes)
-                        .ok_or_else(|| corrupt(&"a message record of 0 or 1 bytes", messages))?;
-                    if channels.wanted.contains(&channel) {
-                        found += 1;
-                        tally.offer(u32::from(channel), data.get(22..).and_then(decode));
-                    }
-                }
-                _ => {}
-            },
+            }
+            LinearReadEvent::Record { opcode, data } => {
+                let messages = state.messages;
+                state
+                    .record(opcode, data, topic)
+                    .map_err(|r| refused(r, messages))?;
+            }
         }
     }
+    let State {
+        channels,
+        counted,
+        found,
+        tally,
+        ..
+    } = state;
     if channels.wanted.is_empty() {
         return Err(fail(absent_topic(
             IMU_SCHEMA,
@@ -161,6 +176,128 @@ pub fn read_selected(
         }
     }
     tally.finish(path, topic, &|id| format!("channel {id}"))
+}
+
+/// What a read has found so far.
+struct State<'a> {
+    channels: Channels,
+    /// The messages per channel that the summary's statistics count: a chunk that holds
+    /// fewer is damaged.
+    counted: Option<std::collections::BTreeMap<u16, u64>>,
+    /// Messages found on the topic's channels.
+    found: u64,
+    /// Messages found on every channel.
+    messages: u64,
+    tally: Tally<'a>,
+}
+
+/// Why a record was not taken: the file is damaged, or a channel on the topic cannot be read.
+enum Refusal {
+    Corrupt(String),
+    Channel(String),
+}
+
+impl State<'_> {
+    /// One record of the data section or of a chunk.
+    fn record(&mut self, opcode: u8, data: &[u8], topic: &str) -> Result<(), Refusal> {
+        match opcode {
+            op::SCHEMA | op::CHANNEL => {
+                let record = ::mcap::parse_record(opcode, data)
+                    .map_err(|e| Refusal::Corrupt(e.to_string()))?;
+                self.channels.add(record, topic).map_err(Refusal::Channel)
+            }
+            op::STATISTICS => {
+                if let Ok(Record::Statistics(stats)) = ::mcap::parse_record(opcode, data) {
+                    self.counted = Some(stats.channel_message_counts);
+                }
+                Ok(())
+            }
+            op::MESSAGE => {
+                self.messages += 1;
+                // channel_id (u16), sequence (u32), log_time, publish_time (u64), data.
+                let channel = bytes_at::<2>(data, 0)
+                    .map(u16::from_le_bytes)
+                    .ok_or_else(|| Refusal::Corrupt("a message record of 0 or 1 bytes".into()))?;
+                if self.channels.wanted.contains(&channel) {
+                    self.found += 1;
+                    self.tally
+                        .offer(u32::from(channel), data.get(22..).and_then(decode));
+                }
+                Ok(())
+            }
+            _ => Ok(()),
+        }
+    }
+}
+
+/// The first record of `bytes` (opcode u8, length u64, body): its opcode, body and what
+/// follows it; `None` when it overruns `bytes`.
+fn split_record(bytes: &[u8]) -> Option<(u8, &[u8], &[u8])> {
+    let opcode = *bytes.first()?;
+    let len = usize::try_from(u64::from_le_bytes(bytes_at::<8>(bytes, 1)?)).ok()?;
+    let end = 9usize.checked_add(len)?;
+    Some((opcode, bytes.get(9..end)?, bytes.get(end..)?))
+}
+
+/// The records of a chunk: its data decompressed (none, zstd or lz4), of exactly the size it
+/// declares (at most `limit`), with the CRC it declares (0: none).
+fn chunk_records<'a>(
+    header: &::mcap::records::ChunkHeader,
+    data: std::borrow::Cow<'a, [u8]>,
+    limit: usize,
+) -> Result<std::borrow::Cow<'a, [u8]>, String> {
+    use std::borrow::Cow;
+    let size = usize::try_from(header.uncompressed_size)
+        .ok()
+        .filter(|&s| s <= limit)
+        .ok_or_else(|| {
+            format!(
+                "a chunk declares {} bytes, more than the file could hold",
+                header.uncompressed_size
+            )
+        })?;
+    let cap = u64::try_from(size).unwrap_or(u64::MAX).saturating_add(1);
+    let inflate = |reader: &mut dyn Read| -> Result<Vec<u8>, String> {
+        let mut out = Vec::new();
+        reader
+            .take(cap)
+            .read_to_end(&mut out)
+            .map_err(|e| format!("a chunk does not decompress: {e}"))?;
+        Ok(out)
+    };
+    let records: Cow<'a, [u8]> = match header.compression.as_str() {
+        "" => data,
+        "zstd" => {
+            let mut d = zstd::stream::read::Decoder::new(&data[..])
+                .map_err(|e| format!("a chunk does not decompress: {e}"))?;
+            Cow::Owned(inflate(&mut d)?)
+        }
+        "lz4" => {
+            let mut d = lz4::Decoder::new(&data[..])
+                .map_err(|e| format!("a chunk does not decompress: {e}"))?;
+            Cow::Owned(inflate(&mut d)?)
+        }
+        other => {
+            return Err(format!(
+                "chunk compression '{}' is not read (zstd, lz4 or none)",
+                crate::error::escaped(other)
+            ));
+        }
+    };
+    if records.len() != size {
+        return Err(format!(
+            "a chunk is damaged: it declares {size} bytes and holds {}",
+            if records.len() > size {
+                "more".to_string()
+            } else {
+                records.len().to_string()
+            }
+        ));
+    }
+    if header.uncompressed_crc != 0 && crc32fast::hash(&records) != header.uncompressed_crc {
+        return Err("a chunk's CRC does not match its data".into());
+    }
+    Ok(records)
 }
 
 /// The schemas and channels read so far.

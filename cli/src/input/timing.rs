@@ -1,7 +1,8 @@
 //! A record's timestamps: their unit, and the rate, jitter, gaps and backward steps they show,
 //! gathered in one streaming pass with bounded memory.
 
-use std::collections::BTreeMap;
+use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
 
 use serde::Serialize;
 
@@ -123,7 +124,7 @@ pub struct Timing {
     accepted: u64,
     dropped: u64,
     /// Interval / quantum -> count.
-    intervals: BTreeMap<i64, u64>,
+    intervals: HashMap<i64, u64, BuildHasherDefault<Mix>>,
     quantum: i64,
     spoiled: bool,
 }
@@ -175,7 +176,7 @@ impl Timing {
     }
 
     fn coarsen(&mut self) {
-        let mut coarse = BTreeMap::new();
+        let mut coarse = HashMap::default();
         for (k, n) in std::mem::take(&mut self.intervals) {
             *coarse.entry(k / 10).or_insert(0) += n;
         }
@@ -189,14 +190,18 @@ impl Timing {
         if self.spoiled {
             return Err("the timestamps go backwards".into());
         }
-        let intervals: u64 = self.intervals.values().sum();
+        // In the order of the intervals: the median, and sums that do not depend on the
+        // table's order.
+        let mut sorted: Vec<(i64, u64)> = self.intervals.iter().map(|(&k, &n)| (k, n)).collect();
+        sorted.sort_unstable();
+        let intervals: u64 = sorted.iter().map(|&(_, n)| n).sum();
         if intervals == 0 {
             return Err("fewer than two timestamps: no rate".into());
         }
         // The median interval, ns (the middle of its quantum).
         let mut seen = 0;
         let mut median = 0.0;
-        for (k, n) in &self.intervals {
+        for (k, n) in &sorted {
             seen += n;
             if 2 * seen >= intervals {
                 median =
@@ -207,9 +212,9 @@ impl Timing {
         // Intervals are judged against the median; where that leaves under 90 % regular (stamps
         // rounded to a coarse clock: 5 and 6 ms at 180 Hz), against the mean interval.
         let span = self.last.saturating_sub(self.first.unwrap_or(self.last)) as f64;
-        let mut classes = self.classes(median);
+        let mut classes = self.classes(&sorted, median);
         if (classes.regular as f64) < 0.9 * intervals as f64 {
-            let by_mean = self.classes(span / intervals as f64);
+            let by_mean = self.classes(&sorted, span / intervals as f64);
             if by_mean.regular > classes.regular {
                 classes = by_mean;
             }
@@ -268,12 +273,12 @@ impl Timing {
 
 impl Timing {
     /// The intervals against `reference` (ns): within 25 % of it regular, else short or gaps.
-    fn classes(&self, reference: f64) -> Classes {
+    fn classes(&self, sorted: &[(i64, u64)], reference: f64) -> Classes {
         let mut c = Classes {
             reference,
             ..Classes::default()
         };
-        for (k, n) in &self.intervals {
+        for (k, n) in sorted {
             let v = (*k as f64 + if self.quantum > 1 { 0.5 } else { 0.0 }) * self.quantum as f64;
             let r = v / reference;
             if r < 0.75 {
@@ -289,6 +294,27 @@ impl Timing {
             }
         }
         c
+    }
+}
+
+/// The hash of the interval table: one multiply (the keys are integers, not chosen by an
+/// adversary who could gain from collisions: at worst a slow table).
+#[derive(Default)]
+struct Mix(u64);
+
+impl Hasher for Mix {
+    fn finish(&self) -> u64 {
+        self.0 ^ (self.0 >> 29)
+    }
+
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0 ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    }
+
+    fn write_i64(&mut self, v: i64) {
+        self.0 = (self.0 ^ v as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15);
     }
 }
 

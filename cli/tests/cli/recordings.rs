@@ -693,3 +693,19 @@ fn a_database_with_a_timestamp_that_is_not_an_integer_is_refused() {
         stderr(&out)
     );
 }
+
+#[test]
+fn an_mcap_record_that_overruns_its_chunk_is_a_damaged_file() {
+    // Found by the `ros_read` fuzz target: an uncompressed chunk whose last record claims more
+    // bytes than the chunk holds (the mcap crate's reader overflowed its count on it).
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/fuzz/chunk-overrun.mcap");
+    for topic in ["/imu0", "/imu"] {
+        let select = Select::topic(topic);
+        let result = mcap::read_selected(&file, &select, &mut |_| {});
+        let e = result.expect_err("a damaged file");
+        assert!(
+            e.problem.starts_with("truncated or corrupt MCAP file"),
+            "{e}"
+        );
+    }
+}
