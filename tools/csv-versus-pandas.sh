@@ -1,0 +1,73 @@
+#!/usr/bin/env bash
+# `imu-ar characterise` beside what a notebook does first: a generated 1-hour, 400 Hz six-axis
+# EuRoC CSV (1.44 M rows), characterised by the release build (Allan deviation, composite
+# model, plots, seven parameter files), against pandas reading the same file and allantools
+# computing the overlapping Allan deviation of its six columns at octave averaging times.
+# Wall times of each, run one after the other on an otherwise idle machine, best of three;
+# the table perf-versus-pandas of docs/recordings.md.
+#
+#   pip install pandas allantools
+#   tools/csv-versus-pandas.sh [DIR]      (DIR: where the recording goes, default /tmp)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+dir=${1:-/tmp}/imu-ar-versus
+mkdir -p "$dir"
+n=$((3600 * 400))
+if [ ! -f "$dir/imu.csv" ]; then
+    python3 - "$dir" "$n" <<'PY'
+import sys
+import numpy as np
+out, n = sys.argv[1], int(sys.argv[2])
+rng = np.random.default_rng(11)
+dt = 1 / 400
+t = 1_700_000_000_000_000_000 + np.arange(n, dtype=np.int64) * 2_500_000 \
+    + rng.integers(-20_000, 20_001, n)
+white = np.array([1e-3, 1.2e-3, 0.8e-3, 2e-2, 2.5e-2, 3e-2]) / np.sqrt(dt)
+walk = np.array([2e-5, 1e-5, 3e-5, 4e-4, 2e-4, 5e-4]) * np.sqrt(dt)
+mean = np.array([0.01, -0.02, 0.005, 0.1, -0.2, 9.81])
+x = mean + white * rng.standard_normal((n, 6)) + np.cumsum(walk * rng.standard_normal((n, 6)), 0)
+with open(f"{out}/imu.csv", "w") as f:
+    f.write("#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],"
+            "a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]\n")
+    step = 200_000
+    for i in range(0, n, step):
+        block = np.column_stack([t[i:i + step].astype(object), x[i:i + step]])
+        f.write("\n".join(",".join([str(r[0])] + [repr(float(v)) for v in r[1:]]) for r in block))
+        f.write("\n")
+PY
+fi
+cargo build --release -p imu-ar-cli --quiet
+best() {
+    local best=
+    for _ in 1 2 3; do
+        local start end
+        start=$(date +%s.%N)
+        "$@" > /dev/null
+        end=$(date +%s.%N)
+        best=$(python3 -c "a, b = $end - $start, '${best}'; print(a if not b else min(a, float(b)))")
+    done
+    echo "$best"
+}
+tool=$(best target/release/imu-ar characterise "$dir/imu.csv" --out "$dir/out")
+cat > "$dir/notebook.py" <<'PY'
+import sys
+import allantools
+import numpy as np
+import pandas as pd
+frame = pd.read_csv(sys.argv[1])
+rate = 400.0
+taus = 2.0 ** np.arange(0, 21) / rate
+for column in frame.columns[1:]:
+    allantools.oadev(frame[column].to_numpy(), rate=rate, data_type="freq", taus=taus)
+PY
+notebook=$(best python3 "$dir/notebook.py" "$dir/imu.csv")
+bytes=$(stat -c %s "$dir/imu.csv")
+{
+    echo "| the 1-hour, 400 Hz six-axis EuRoC CSV ($(((bytes + 500000) / 1000000)) MB) | wall (s) |"
+    echo "|---|---|"
+    printf '| pandas read_csv + allantools oadev of the six columns (octaves) | %.2f |\n' "$notebook"
+    printf '| imu-ar characterise (Allan deviation, models, plots, seven files) | %.2f |\n' "$tool"
+    python3 -c "print(f'| ratio | {$tool / $notebook:.2f} |')"
+} > "$dir/table.md"
+cat "$dir/table.md"
+python3 tools/readme.py replace perf-versus-pandas "$dir/table.md"
