@@ -11,6 +11,12 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 dir=${1:-/tmp}/imu-ar-versus
+
+# replace SECTION FILE: put FILE's contents between the section's markers, in whichever of
+# README.md and docs/*.md holds them.
+replace() {
+    python3 tools/readme.py replace "$1" "$2"
+}
 mkdir -p "$dir"
 n=$((3600 * 400))
 if [ ! -f "$dir/imu.csv" ]; then
@@ -70,4 +76,4 @@ bytes=$(stat -c %s "$dir/imu.csv")
     python3 -c "print(f'| ratio | {$tool / $notebook:.2f} |')"
 } > "$dir/table.md"
 cat "$dir/table.md"
-python3 tools/readme.py replace perf-versus-pandas "$dir/table.md"
+replace perf-versus-pandas "$dir/table.md"
