@@ -40,9 +40,9 @@ const MAGIC: &[u8] = b"#ROSBAG V2.0\n";
 
 /// Calls `each` with every finite `sensor_msgs/Imu` message on `topic` of the ROS 1 bag `path`,
 /// in the order of their receive times, and returns what was skipped. A bag whose chunks
-/// follow each other in time (the index's chunk records say so) is streamed in file order;
-/// one written out of time order is read whole and its messages on the topic sorted (56
-/// bytes each held).
+/// follow each other in time (the index's chunk records say so) is streamed chunk by chunk,
+/// each chunk's messages sorted; one written out of time order is read whole and its
+/// messages on the topic sorted (56 bytes each held).
 ///
 /// Messages that cannot be decoded, and those with a NaN or an infinite axis, are counted and
 /// not delivered. An error (after the frames already delivered, when the damage is found
@@ -161,10 +161,6 @@ pub fn read_selected(
                 continue;
             }
             found += 1;
-            if in_order {
-                tally.offer(m.conn_id, decode(m.data));
-                continue;
-            }
             let frame = decode(m.data).map(|(f, id)| {
                 let k = frame_ids.iter().position(|i| i == id).unwrap_or_else(|| {
                     frame_ids.push(id.to_vec());
@@ -174,6 +170,12 @@ pub fn read_selected(
             });
             sorted.push((m.time, m.conn_id, frame));
         }
+        if in_order {
+            // The chunk's messages in receive-time order (as stored, unless the bag was
+            // edited), delivered before the next chunk is read.
+            deliver(&mut sorted, &frame_ids, &mut tally);
+            frame_ids.clear();
+        }
     }
     if found < expected {
         return Err(corrupt(format!(
@@ -181,11 +183,7 @@ pub fn read_selected(
              chunk is damaged"
         )));
     }
-    sorted.sort_by_key(|&(time, _, _)| time);
-    for (_, conn, frame) in sorted {
-        let id = |k: u16| frame_ids.get(usize::from(k)).map_or(&[][..], Vec::as_slice);
-        tally.offer(conn, frame.map(|(f, k)| (f, id(k))));
-    }
+    deliver(&mut sorted, &frame_ids, &mut tally);
     let names = |id: u32| {
         let caller = callers.iter().find(|(c, _)| *c == id).map(|(_, n)| n);
         match caller {
@@ -194,6 +192,16 @@ pub fn read_selected(
         }
     };
     tally.finish(path, topic, &names)
+}
+
+/// The `held` messages to `tally` in the order of their receive times (stable), `held` left
+/// empty; `frame_ids` names their frame_ids by index.
+fn deliver(held: &mut Vec<Held>, frame_ids: &[Vec<u8>], tally: &mut Tally) {
+    held.sort_by_key(|&(time, _, _)| time);
+    for (_, conn, frame) in held.drain(..) {
+        let id = |k: u16| frame_ids.get(usize::from(k)).map_or(&[][..], Vec::as_slice);
+        tally.offer(conn, frame.map(|(f, k)| (f, id(k))));
+    }
 }
 
 /// A message held to be sorted: its receive time, connection, and frame with the index of its

@@ -709,3 +709,27 @@ fn an_mcap_record_that_overruns_its_chunk_is_a_damaged_file() {
         );
     }
 }
+
+#[test]
+fn messages_stored_out_of_order_inside_a_chunk_are_read_in_time_order() {
+    let dir = temp_dir("swapped");
+    let mut bytes = std::fs::read(fixture("noise.bag")).unwrap();
+    let ids = ros::frame_ids(&bytes);
+    // Two neighbouring message records of one chunk (equal strides: no chunk boundary
+    // between them), swapped whole: header (with its receive time) and data.
+    let i = (40..ids.len() - 2)
+        .find(|&i| ids[i + 1] - ids[i] == ids[i + 2] - ids[i + 1])
+        .unwrap();
+    let stride = ids[i + 1] - ids[i];
+    let data_len = u32::from_le_bytes(bytes[ids[i] - 20..ids[i] - 16].try_into().unwrap());
+    let next = ids[i] - 16 + data_len as usize;
+    let start = next - stride;
+    let first = bytes[start..next].to_vec();
+    bytes.copy_within(next..next + stride, start);
+    bytes[start + stride..start + 2 * stride].copy_from_slice(&first);
+    let file = dir.join("swapped.bag");
+    std::fs::write(&file, bytes).unwrap();
+    let (got, result) = read(&file, None);
+    assert_eq!(result, Ok(0));
+    assert_bits(&got, &ros::noise_frames(), "swapped.bag");
+}
