@@ -66,7 +66,14 @@ pub fn run(args: &Args) -> Result<AdevResult, Fail> {
     let mut m = 1usize;
     while x.len() / 2 >= m {
         tau.push(m as f64 / rate);
-        avar.push(overlapping_avar(x, m)?);
+        let v = overlapping_avar(x, m)?;
+        if !v.is_finite() {
+            return Err(args.input.fail(format!(
+                "the Allan variance at m = {m} overflows: the samples' differences are too large \
+                 for f64 (scale the data, --unit)"
+            )));
+        }
+        avar.push(v);
         m *= 2;
     }
     Ok(AdevResult {

@@ -240,8 +240,22 @@ impl<'a> Tally<'a> {
                 ),
             ));
         }
+        let chosen = self.frame_ids.iter().filter(|(_, _, c)| *c).count();
         if let Some(want) = self.frame_id
-            && !self.frame_ids.iter().any(|(_, _, chosen)| *chosen)
+            && chosen > 1
+        {
+            return Err(data_error(
+                file,
+                format!(
+                    "--frame-id {}: names more than one IMU on '{topic}' (as written and as \
+                     shown: {})",
+                    escaped(want),
+                    self.listed()
+                ),
+            ));
+        }
+        if let Some(want) = self.frame_id
+            && chosen == 0
         {
             return Err(data_error(
                 file,
@@ -298,11 +312,12 @@ impl<'a> Tally<'a> {
     }
 }
 
-/// A frame_id as messages show it (and `--frame-id` may name it): its text with control
-/// characters escaped, or, when it is not UTF-8, its bytes with every non-ASCII one as `\xNN`.
+/// A frame_id as messages show it (and `--frame-id` may name it): its text with backslashes
+/// and control characters escaped, or, when it is not UTF-8, its bytes with every non-ASCII
+/// one as `\xNN` (and a backslash as `\\`).
 fn shown(frame_id: &[u8]) -> String {
     match std::str::from_utf8(frame_id) {
-        Ok(text) => escaped(text),
+        Ok(text) => escaped(&text.replace('\\', "\\\\")),
         Err(_) => frame_id.escape_ascii().to_string(),
     }
 }
@@ -341,4 +356,50 @@ pub(crate) fn absent_topic(imu_type: &str, topic: &str, imu: &[String], all: &[S
         "no topics".to_string()
     };
     format!("no {imu_type} messages on topic '{topic}' ({what})")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A frame stamped `t`.
+    fn frame(t: i64) -> Frame {
+        Frame {
+            stamp_ns: t,
+            axes: [0.5; 6],
+        }
+    }
+
+    #[test]
+    fn a_frame_id_named_as_written_and_as_shown_by_two_imus_is_refused() {
+        // The text `ab\xffc` (seven characters) and the bytes `ab`, 0xff, `c`: both read
+        // `ab\xffc`; shown, the text's backslash is doubled.
+        let text: &[u8] = b"ab\\xffc";
+        let bytes: &[u8] = b"ab\xffc";
+        let file = Path::new("two.bag");
+        for (want, result) in [("ab\\xffc", None), ("ab\\\\xffc", Some(10))] {
+            let mut got = 0;
+            let mut each = |_: Frame| got += 1;
+            let select = Select {
+                topic: "/imu",
+                frame_id: Some(want),
+            };
+            let mut tally = Tally::new(&select, &mut each);
+            for t in 0..10 {
+                tally.offer(1, Some((frame(2 * t), text)));
+                tally.offer(2, Some((frame(2 * t + 1), bytes)));
+            }
+            let finished = tally.finish(file, "/imu", &|id| format!("connection {id}"));
+            match result {
+                None => {
+                    let e = finished.expect_err(want).problem;
+                    assert!(e.contains("names more than one IMU"), "{e}");
+                }
+                Some(other) => {
+                    assert_eq!(finished.map(|s| s.other_frame_id), Ok(other));
+                    assert_eq!(got, 10);
+                }
+            }
+        }
+    }
 }

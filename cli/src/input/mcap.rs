@@ -168,10 +168,15 @@ pub fn read_selected(
             .iter()
             .filter_map(|c| counts.get(c))
             .fold(0u64, |a, &n| a.saturating_add(n));
-        if found < expected {
+        if found != expected {
             return Err(fail(format!(
                 "truncated or corrupt MCAP file: its statistics count {expected} messages on \
-                 '{topic}' and its chunks hold {found}: a chunk is damaged"
+                 '{topic}' and its chunks hold {found}: {}",
+                if found < expected {
+                    "a chunk is damaged"
+                } else {
+                    "the summary is damaged"
+                }
             )));
         }
     }
@@ -204,8 +209,34 @@ impl State<'_> {
             op::SCHEMA | op::CHANNEL => {
                 let record = ::mcap::parse_record(opcode, data)
                     .map_err(|e| Refusal::Corrupt(e.to_string()))?;
+                // The summary repeats schemas and channels: the same again is no news, a
+                // different definition of an ID is a damaged file.
+                let redefined = match &record {
+                    Record::Schema { header, .. } => self
+                        .channels
+                        .schemas
+                        .get(&header.id)
+                        .is_some_and(|(n, e)| *n != header.name || *e != header.encoding)
+                        .then(|| format!("schema {} is defined twice, differently", header.id)),
+                    Record::Channel(c) => self
+                        .channels
+                        .known
+                        .get(&c.id)
+                        .is_some_and(|(t, s)| *t != c.topic || *s != c.schema_id)
+                        .then(|| format!("channel {} is defined twice, differently", c.id)),
+                    _ => None,
+                };
+                if let Some(e) = redefined {
+                    return Err(Refusal::Corrupt(e));
+                }
+                if let Record::Channel(c) = &record {
+                    self.channels
+                        .known
+                        .insert(c.id, (c.topic.clone(), c.schema_id));
+                }
                 self.channels.add(record, topic).map_err(Refusal::Channel)
             }
+            op::CHUNK => Err(Refusal::Corrupt("a chunk inside a chunk".into())),
             op::STATISTICS => {
                 if let Ok(Record::Statistics(stats)) = ::mcap::parse_record(opcode, data) {
                     self.counted = Some(stats.channel_message_counts);
@@ -217,7 +248,15 @@ impl State<'_> {
                 // channel_id (u16), sequence (u32), log_time, publish_time (u64), data.
                 let channel = bytes_at::<2>(data, 0)
                     .map(u16::from_le_bytes)
-                    .ok_or_else(|| Refusal::Corrupt("a message record of 0 or 1 bytes".into()))?;
+                    .filter(|_| data.len() >= 22)
+                    .ok_or_else(|| {
+                        Refusal::Corrupt("a message record shorter than its header".into())
+                    })?;
+                if !self.channels.known.contains_key(&channel) {
+                    return Err(Refusal::Corrupt(format!(
+                        "a message on channel {channel}, which the file does not define before it"
+                    )));
+                }
                 if self.channels.wanted.contains(&channel) {
                     self.found += 1;
                     self.tally
@@ -311,6 +350,8 @@ struct Channels {
     imu_topics: Vec<String>,
     /// All topics, in the order first seen.
     all_topics: Vec<String>,
+    /// Channel ID to topic and schema ID, of every channel.
+    known: HashMap<u16, (String, u16)>,
 }
 
 impl Channels {

@@ -511,8 +511,8 @@ fn csv_stream(
             && let Step::Backward { last } = timing.push(t)
         {
             if !strict && !request.drop_backward {
-                // The rate is given: the sample stays, the stamps give no rate.
-                timing.spoil();
+                // The rate is given: the sample stays, its stamp is left out of the stamps'
+                // statistics, which still check the rate given.
                 return row_values(&mut values, cells, request, &mut *each);
             }
             timing.drop_one();
