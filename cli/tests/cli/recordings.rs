@@ -783,3 +783,113 @@ fn allan_deviations_that_overflow_are_refused() {
     assert_one_line_failure(&out);
     assert!(stderr(&out).contains("overflows"), "{}", stderr(&out));
 }
+
+/// An MCAP record: opcode, length, body.
+fn record(out: &mut Vec<u8>, opcode: u8, body: &[u8]) {
+    out.push(opcode);
+    out.extend((body.len() as u64).to_le_bytes());
+    out.extend(body);
+}
+
+/// An MCAP string: length, bytes.
+fn string(out: &mut Vec<u8>, s: &str) {
+    out.extend((s.len() as u32).to_le_bytes());
+    out.extend(s.as_bytes());
+}
+
+/// A CDR `sensor_msgs/msg/Imu` of `frame`, frame_id `imu_link`.
+fn cdr(frame: &Frame) -> Vec<u8> {
+    let mut b = vec![0, 1, 0, 0];
+    b.extend((frame.stamp_ns.div_euclid(1_000_000_000) as i32).to_le_bytes());
+    b.extend((frame.stamp_ns.rem_euclid(1_000_000_000) as u32).to_le_bytes());
+    b.extend(9u32.to_le_bytes());
+    b.extend(b"imu_link\0");
+    while (b.len() - 4) % 8 != 0 {
+        b.push(0);
+    }
+    let mut values = [0.0; 37];
+    values[13..16].copy_from_slice(&frame.axes[..3]);
+    values[25..28].copy_from_slice(&frame.axes[3..]);
+    values.iter().for_each(|v| b.extend(v.to_le_bytes()));
+    b
+}
+
+/// An unchunked MCAP file: the IMU schema, `channels` (id, topic), and one message per frame
+/// on `channel_of(i)`.
+fn hand_mcap(
+    channels: &[(u16, &str)],
+    frames: &[Frame],
+    channel_of: impl Fn(usize) -> u16,
+) -> Vec<u8> {
+    let mut out = b"\x89MCAP0\r\n".to_vec();
+    let mut body = Vec::new();
+    string(&mut body, "ros2");
+    string(&mut body, "hand");
+    record(&mut out, 0x01, &body);
+    let mut schema = 1u16.to_le_bytes().to_vec();
+    string(&mut schema, "sensor_msgs/msg/Imu");
+    string(&mut schema, "ros2msg");
+    schema.extend(0u32.to_le_bytes());
+    record(&mut out, 0x03, &schema);
+    for &(id, topic) in channels {
+        let mut c = id.to_le_bytes().to_vec();
+        c.extend(1u16.to_le_bytes());
+        string(&mut c, topic);
+        string(&mut c, "cdr");
+        c.extend(0u32.to_le_bytes());
+        record(&mut out, 0x04, &c);
+    }
+    for (i, f) in frames.iter().enumerate() {
+        let mut m = channel_of(i).to_le_bytes().to_vec();
+        m.extend((i as u32).to_le_bytes());
+        m.extend((f.stamp_ns as u64).to_le_bytes());
+        m.extend((f.stamp_ns as u64).to_le_bytes());
+        m.extend(cdr(f));
+        record(&mut out, 0x05, &m);
+    }
+    record(&mut out, 0x0f, &0u32.to_le_bytes());
+    let mut footer = 0u64.to_le_bytes().to_vec();
+    footer.extend(0u64.to_le_bytes());
+    footer.extend(0u32.to_le_bytes());
+    record(&mut out, 0x02, &footer);
+    out.extend(b"\x89MCAP0\r\n");
+    out
+}
+
+#[test]
+fn an_mcap_file_whose_structure_is_damaged_is_refused() {
+    let dir = temp_dir("mcap-structure");
+    let frames = noise(200, 2);
+    let cases: [(&str, Vec<u8>, Option<&str>); 3] = [
+        (
+            "good.mcap",
+            hand_mcap(&[(1, "/imu0")], &frames, |_| 1),
+            None,
+        ),
+        (
+            "undefined.mcap",
+            hand_mcap(&[(1, "/imu0")], &frames, |i| if i % 4 == 3 { 7 } else { 1 }),
+            Some("a message on channel 7, which the file does not define"),
+        ),
+        (
+            "redefined.mcap",
+            hand_mcap(&[(1, "/imu0"), (1, "/imuX")], &frames, |_| 1),
+            Some("channel 1 is defined twice, differently"),
+        ),
+    ];
+    for (name, bytes, refused) in cases {
+        let file = dir.join(name);
+        std::fs::write(&file, bytes).unwrap();
+        let (got, result) = read(&file, None);
+        match refused {
+            None => {
+                assert_eq!(result, Ok(0), "{name}");
+                assert_bits(&got, &frames, name);
+            }
+            Some(want) => {
+                let e = result.expect_err(name);
+                assert!(e.contains(want), "{name}: {e}");
+            }
+        }
+    }
+}
