@@ -1,39 +1,10 @@
 //! The tool's errors: one line on stderr, and status 2.
 
 use std::ffi::OsString;
-use std::fmt::Display;
-use std::path::PathBuf;
 
 use clap::error::ErrorKind;
 
-/// A one-line error for stderr; the tool exits with status 2.
-pub struct Fail(pub String);
-
-impl<E: Display> From<E> for Fail {
-    fn from(e: E) -> Self {
-        Fail(e.to_string())
-    }
-}
-
-/// `e` after the names of the record's files, joined by `+` (`a.csv+b.csv: e`).
-pub fn with_file(files: &[PathBuf], e: impl Display) -> Fail {
-    let names: Vec<String> = files.iter().map(|f| f.display().to_string()).collect();
-    Fail(format!("{}: {e}", names.join("+")))
-}
-
-/// `text` with every control character escaped (`\n`, `\r`, `\t`, `\u{..}`), so that echoed
-/// input keeps an error message on one line.
-pub fn escaped(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    for c in text.chars() {
-        if c.is_control() {
-            out.extend(c.escape_default());
-        } else {
-            out.push(c);
-        }
-    }
-    out
-}
+pub use imu_ar_recordings::error::{Fail, escaped, with_file};
 
 /// A command-line error of `command`, parsed from `args`, as one line: clap's message and
 /// details (the missing arguments, a tip) without the usage and the pointer to `--help`;

@@ -196,11 +196,12 @@ fn characterise(
     // this one reads and parses: the two halves of the work overlap.
     let (send, receive) = std::sync::mpsc::sync_channel::<Vec<[f64; 6]>>(4);
     let worker = |mut axes: Vec<AxisStream<OCTAVES>>| {
+        let mut column = Vec::with_capacity(BATCH);
         for batch in receive {
-            for row in &batch {
-                for (axis, x) in axes.iter_mut().zip(row) {
-                    axis.push(*x);
-                }
+            for (i, axis) in axes.iter_mut().enumerate() {
+                column.clear();
+                column.extend(batch.iter().map(|row| row[i]));
+                axis.extend(&column);
             }
         }
         axes

@@ -3,14 +3,7 @@
 //! averaged in blocks (`--decimate`); and the checks of the settings the commands share. An
 //! error names the flag, or the files.
 
-pub mod bag;
-pub mod csv;
-pub mod frame;
-pub mod mcap;
-pub mod rosbag2;
-pub mod source;
-pub mod timing;
-pub mod units;
+pub use imu_ar_recordings::{bag, csv, frame, mcap, rosbag2, source, timing, units};
 
 use std::path::PathBuf;
 

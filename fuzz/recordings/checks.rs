@@ -1,0 +1,78 @@
+//! What the fuzz targets of the readers check, one function per target: the targets
+//! (`fuzz_targets/*.rs`) call these on libFuzzer's inputs, and the readers' tests
+//! (`recordings/tests/fuzz_corpora.rs`) replay every kept corpus file through them on the stable
+//! toolchain, so the test command checks the corpora without a sanitised build.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use imu_ar_recordings::csv::{DataError, parse_column};
+use imu_ar_recordings::frame::{Frame, Select, Skipped};
+use imu_ar_recordings::rosbag2::Metadata;
+use imu_ar_recordings::{bag, mcap, rosbag2};
+
+/// The CSV reader on arbitrary bytes: a column of finite numbers, or an error naming the source
+/// and, for a bad row, its line; never a panic.
+pub fn csv_column(data: &[u8]) {
+    let label = Path::new("fuzz.csv");
+    match parse_column(label, data, "x") {
+        Ok(x) => assert!(!x.is_empty() && x.iter().all(|v| v.is_finite())),
+        Err(e) => assert!(e.to_string().starts_with("fuzz.csv")),
+    }
+}
+
+/// A scratch file of its own for each call (the tests replay on several threads).
+fn scratch(extension: &str) -> PathBuf {
+    static CALLS: AtomicU64 = AtomicU64::new(0);
+    let call = CALLS.fetch_add(1, Ordering::Relaxed);
+    let name = format!("imu-ar-fuzz-{}-{call}.{extension}", std::process::id());
+    std::env::temp_dir().join(name)
+}
+
+/// The ROS readers (ROS 1 bag, MCAP, rosbag2 SQLite database) on arbitrary bytes: the first
+/// byte picks the reader, the rest is the file, read with and without a frame_id. Every
+/// delivered frame is finite, a success delivered at least one, an error names the file, and
+/// nothing panics.
+pub fn ros_read(data: &[u8]) {
+    let Some((&which, bytes)) = data.split_first() else {
+        return;
+    };
+    type Read = fn(&Path, &Select, &mut dyn FnMut(Frame)) -> Result<Skipped, DataError>;
+    let (extension, read): (&str, Read) = match which % 3 {
+        0 => ("bag", bag::read_selected),
+        1 => ("mcap", mcap::read_selected),
+        _ => ("db3", rosbag2::read_db3),
+    };
+    let path = scratch(extension);
+    std::fs::write(&path, bytes).expect("a scratch file in the temporary folder");
+    for select in [
+        Select::topic("/imu0"),
+        Select::topic("/imu"),
+        Select {
+            topic: "/imu0",
+            frame_id: Some("imu_a"),
+        },
+    ] {
+        let mut frames = 0u64;
+        let result = read(&path, &select, &mut |f: Frame| {
+            assert!(f.axes.iter().all(|v| v.is_finite()));
+            frames += 1;
+        });
+        match result {
+            Ok(_) => assert!(frames > 0),
+            Err(e) => assert_eq!(e.file, path),
+        }
+    }
+    let _ = std::fs::remove_file(&path);
+}
+
+/// The rosbag2 `metadata.yaml` reader on arbitrary text: a storage and a list of files, or an
+/// error; never a panic.
+pub fn rosbag2_metadata(data: &[u8]) {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    if let Ok(meta) = Metadata::parse(text) {
+        assert!(!meta.storage.is_empty());
+    }
+}

@@ -1,0 +1,452 @@
+//! Streaming `sensor_msgs/msg/Imu` messages out of a ROS 2 MCAP file
+//! (<https://mcap.dev/spec>, ROS 2 profile <https://mcap.dev/spec/registry>), uncompressed,
+//! zstd or lz4 chunks, through the sans-I/O reader of the [`mcap`] crate.
+//!
+//! The file is read front to back in pieces of 256 KiB and one chunk is decompressed at a
+//! time (its CRC, when it has one, checked before any of its messages is delivered): memory is
+//! bounded by the largest chunk, whatever the length of the file. Messages are delivered in
+//! file order (chunk after chunk, each chunk's messages as stored), not re-sorted by log time.
+//! A channel is checked when its record is read, which is before any of its messages.
+//!
+//! A message is decoded by hand from its CDR serialization (OMG CDR, XCDR version 1: OMG DDS-XTypes
+//! 1.3 section 7.4.3, <https://www.omg.org/spec/DDS-XTypes/1.3>, as the ROS 2 middleware writes
+//! it, <https://design.ros2.org/articles/generated_interfaces_cpp.html> and
+//! <https://github.com/eProsima/Fast-CDR>): a 4-byte encapsulation header (CDR_LE `00 01` or
+//! CDR_BE `00 00`, then two option bytes), then `sensor_msgs/msg/Imu`
+//! (<https://docs.ros2.org/latest/api/sensor_msgs/msg/Imu.html>): builtin_interfaces/Time
+//! (int32 sec, uint32 nanosec), string frame_id (uint32 length counting its NUL, then the bytes),
+//! then 37 float64 (orientation, its covariance, angular_velocity, its covariance,
+//! linear_acceleration, its covariance), the first aligned to 8 bytes counted from the end of
+//! the encapsulation header.
+
+use crate::frame::open_head;
+use std::collections::HashMap;
+use std::io::{ErrorKind, Read};
+use std::path::Path;
+
+use ::mcap::records::{Record, op};
+use ::mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
+
+use crate::csv::DataError;
+use crate::frame::{
+    Frame, Select, Skipped, Tally, absent_topic, bytes_at, data_error, imu_axes, stamp_ns, u32_at,
+};
+
+/// The schema name of the IMU channels.
+pub const IMU_SCHEMA: &str = "sensor_msgs/msg/Imu";
+
+/// The one message encoding read.
+const CDR: &str = "cdr";
+
+/// The schema encodings of ROS 2 message definitions.
+const SCHEMA_ENCODINGS: [&str; 2] = ["ros2msg", "ros2idl"];
+
+/// How much of the file is asked for at a time, at least.
+const READ_SIZE: usize = 256 * 1024;
+
+/// The longest record (or decompressed chunk) read when the file is shorter: longer ones are
+/// corrupt lengths, not allocated.
+const MIN_RECORD_LIMIT: u64 = 64 * 1024 * 1024;
+
+/// Calls `each` with every finite `sensor_msgs/msg/Imu` message on `topic` of the MCAP file
+/// `path`, in file order, and returns what was skipped.
+///
+/// Messages that cannot be decoded, and those with a NaN or an infinite axis, are counted and
+/// not delivered. An error (after the frames already delivered, when the damage is found
+/// midway) when the file is not an MCAP file, is truncated or corrupt, has no channel on
+/// `topic`, has one with another schema, another schema encoding than ros2msg or ros2idl, or
+/// another message encoding than cdr, or has no finite message on it.
+pub fn read(path: &Path, topic: &str, each: &mut dyn FnMut(Frame)) -> Result<Skipped, DataError> {
+    read_selected(path, &Select::topic(topic), each)
+}
+
+/// [`read`] of the messages `select` asks for: on its topic, from the IMU of its header
+/// frame_id (the others counted as skipped). An error too when the topic carries more than one
+/// IMU (frame_ids) and `select` names none, or when two channels send one frame_id at
+/// interleaved times.
+pub fn read_selected(
+    path: &Path,
+    select: &Select,
+    each: &mut dyn FnMut(Frame),
+) -> Result<Skipped, DataError> {
+    let topic = select.topic;
+    let fail = |problem: String| data_error(path, problem);
+    let (mut file, len, head) = open_head(path, ::mcap::MAGIC.len() as u64)?;
+    if head.as_slice() != ::mcap::MAGIC {
+        if ::mcap::MAGIC.starts_with(&head) {
+            return Err(fail(format!(
+                "truncated or corrupt MCAP file: {len} bytes, shorter than the magic"
+            )));
+        }
+        return Err(fail(not_mcap(&head)));
+    }
+    let limit = usize::try_from(len.max(MIN_RECORD_LIMIT)).unwrap_or(usize::MAX);
+    // Chunks are handed over whole and opened here: the reader trusts the lengths of the
+    // records inside an uncompressed chunk.
+    let mut reader = LinearReader::new_with_options(
+        LinearReaderOptions::default()
+            .with_skip_start_magic(true)
+            .with_emit_chunks(true)
+            .with_record_length_limit(limit),
+    );
+    let mut state = State {
+        channels: Channels::default(),
+        counted: None,
+        found: 0,
+        messages: 0,
+        tally: Tally::new(select, each),
+    };
+    let corrupt = |what: &dyn std::fmt::Display, messages: u64| {
+        fail(format!(
+            "truncated or corrupt MCAP file: {what} (after {messages} messages)"
+        ))
+    };
+    let refused = |r: Refusal, messages: u64| match r {
+        Refusal::Corrupt(e) => corrupt(&e, messages),
+        Refusal::Channel(e) => fail(e),
+    };
+    while let Some(event) = reader.next_event() {
+        match event.map_err(|e| corrupt(&e, state.messages))? {
+            LinearReadEvent::ReadRequest(need) => {
+                let buf = reader.insert(need.max(READ_SIZE));
+                let n = loop {
+                    match file.read(buf) {
+                        Ok(n) => break n,
+                        Err(e) if e.kind() == ErrorKind::Interrupted => continue,
+                        Err(e) => return Err(fail(format!("cannot read: {e}"))),
+                    }
+                };
+                reader.notify_read(n);
+            }
+            LinearReadEvent::Record {
+                opcode: op::CHUNK,
+                data,
+            } => {
+                let records = match ::mcap::parse_record(op::CHUNK, data) {
+                    Ok(Record::Chunk { header, data }) => chunk_records(&header, data, limit),
+                    Ok(_) => Err("a chunk record that is not one".into()),
+                    Err(e) => Err(e.to_string()),
+                }
+                .map_err(|e| corrupt(&e, state.messages))?;
+                let mut rest: &[u8] = &records;
+                while !rest.is_empty() {
+                    let (opcode, body, after) = split_record(rest)
+                        .ok_or_else(|| corrupt(&"a record overruns its chunk", state.messages))?;
+                    let messages = state.messages;
+                    state
+                        .record(opcode, body, topic)
+                        .map_err(|r| refused(r, messages))?;
+                    rest = after;
+                }
+            }
+            LinearReadEvent::Record { opcode, data } => {
+                let messages = state.messages;
+                state
+                    .record(opcode, data, topic)
+                    .map_err(|r| refused(r, messages))?;
+            }
+        }
+    }
+    let State {
+        channels,
+        counted,
+        found,
+        tally,
+        ..
+    } = state;
+    if channels.wanted.is_empty() {
+        return Err(fail(absent_topic(
+            IMU_SCHEMA,
+            topic,
+            &channels.imu_topics,
+            &channels.all_topics,
+        )));
+    }
+    if let Some(counts) = counted {
+        let expected: u64 = channels
+            .wanted
+            .iter()
+            .filter_map(|c| counts.get(c))
+            .fold(0u64, |a, &n| a.saturating_add(n));
+        if found != expected {
+            return Err(fail(format!(
+                "truncated or corrupt MCAP file: its statistics count {expected} messages on \
+                 '{topic}' and its chunks hold {found}: {}",
+                if found < expected {
+                    "a chunk is damaged"
+                } else {
+                    "the summary is damaged"
+                }
+            )));
+        }
+    }
+    tally.finish(path, topic, &|id| format!("channel {id}"))
+}
+
+/// What a read has found so far.
+struct State<'a> {
+    channels: Channels,
+    /// The messages per channel that the summary's statistics count: a chunk that holds
+    /// fewer is damaged.
+    counted: Option<std::collections::BTreeMap<u16, u64>>,
+    /// Messages found on the topic's channels.
+    found: u64,
+    /// Messages found on every channel.
+    messages: u64,
+    tally: Tally<'a>,
+}
+
+/// Why a record was not taken: the file is damaged, or a channel on the topic cannot be read.
+enum Refusal {
+    Corrupt(String),
+    Channel(String),
+}
+
+impl State<'_> {
+    /// One record of the data section or of a chunk.
+    fn record(&mut self, opcode: u8, data: &[u8], topic: &str) -> Result<(), Refusal> {
+        match opcode {
+            op::SCHEMA | op::CHANNEL => {
+                let record = ::mcap::parse_record(opcode, data)
+                    .map_err(|e| Refusal::Corrupt(e.to_string()))?;
+                // The summary repeats schemas and channels: the same again is no news, a
+                // different definition of an ID is a damaged file.
+                let redefined = match &record {
+                    Record::Schema { header, .. } => self
+                        .channels
+                        .schemas
+                        .get(&header.id)
+                        .is_some_and(|(n, e)| *n != header.name || *e != header.encoding)
+                        .then(|| format!("schema {} is defined twice, differently", header.id)),
+                    Record::Channel(c) => self
+                        .channels
+                        .known
+                        .get(&c.id)
+                        .is_some_and(|(t, s)| *t != c.topic || *s != c.schema_id)
+                        .then(|| format!("channel {} is defined twice, differently", c.id)),
+                    _ => None,
+                };
+                if let Some(e) = redefined {
+                    return Err(Refusal::Corrupt(e));
+                }
+                if let Record::Channel(c) = &record {
+                    self.channels
+                        .known
+                        .insert(c.id, (c.topic.clone(), c.schema_id));
+                }
+                self.channels.add(record, topic).map_err(Refusal::Channel)
+            }
+            op::CHUNK => Err(Refusal::Corrupt("a chunk inside a chunk".into())),
+            op::STATISTICS => {
+                if let Ok(Record::Statistics(stats)) = ::mcap::parse_record(opcode, data) {
+                    self.counted = Some(stats.channel_message_counts);
+                }
+                Ok(())
+            }
+            op::MESSAGE => {
+                self.messages += 1;
+                // channel_id (u16), sequence (u32), log_time, publish_time (u64), data.
+                let channel = bytes_at::<2>(data, 0)
+                    .map(u16::from_le_bytes)
+                    .filter(|_| data.len() >= 22)
+                    .ok_or_else(|| {
+                        Refusal::Corrupt("a message record shorter than its header".into())
+                    })?;
+                if !self.channels.known.contains_key(&channel) {
+                    return Err(Refusal::Corrupt(format!(
+                        "a message on channel {channel}, which the file does not define before it"
+                    )));
+                }
+                if self.channels.wanted.contains(&channel) {
+                    self.found += 1;
+                    self.tally
+                        .offer(u32::from(channel), data.get(22..).and_then(decode));
+                }
+                Ok(())
+            }
+            _ => Ok(()),
+        }
+    }
+}
+
+/// The first record of `bytes` (opcode u8, length u64, body): its opcode, body and what
+/// follows it; `None` when it overruns `bytes`.
+fn split_record(bytes: &[u8]) -> Option<(u8, &[u8], &[u8])> {
+    let opcode = *bytes.first()?;
+    let len = usize::try_from(u64::from_le_bytes(bytes_at::<8>(bytes, 1)?)).ok()?;
+    let end = 9usize.checked_add(len)?;
+    Some((opcode, bytes.get(9..end)?, bytes.get(end..)?))
+}
+
+/// The records of a chunk: its data decompressed (none, zstd or lz4), of exactly the size it
+/// declares (at most `limit`), with the CRC it declares (0: none).
+fn chunk_records<'a>(
+    header: &::mcap::records::ChunkHeader,
+    data: std::borrow::Cow<'a, [u8]>,
+    limit: usize,
+) -> Result<std::borrow::Cow<'a, [u8]>, String> {
+    use std::borrow::Cow;
+    let size = usize::try_from(header.uncompressed_size)
+        .ok()
+        .filter(|&s| s <= limit)
+        .ok_or_else(|| {
+            format!(
+                "a chunk declares {} bytes, more than the file could hold",
+                header.uncompressed_size
+            )
+        })?;
+    let cap = u64::try_from(size).unwrap_or(u64::MAX).saturating_add(1);
+    let inflate = |reader: &mut dyn Read| -> Result<Vec<u8>, String> {
+        let mut out = Vec::new();
+        reader
+            .take(cap)
+            .read_to_end(&mut out)
+            .map_err(|e| format!("a chunk does not decompress: {e}"))?;
+        Ok(out)
+    };
+    let records: Cow<'a, [u8]> = match header.compression.as_str() {
+        "" => data,
+        "zstd" => {
+            let mut d = zstd::stream::read::Decoder::new(&data[..])
+                .map_err(|e| format!("a chunk does not decompress: {e}"))?;
+            Cow::Owned(inflate(&mut d)?)
+        }
+        "lz4" => {
+            let mut d = lz4::Decoder::new(&data[..])
+                .map_err(|e| format!("a chunk does not decompress: {e}"))?;
+            Cow::Owned(inflate(&mut d)?)
+        }
+        other => {
+            return Err(format!(
+                "chunk compression '{}' is not read (zstd, lz4 or none)",
+                crate::error::escaped(other)
+            ));
+        }
+    };
+    if records.len() != size {
+        return Err(format!(
+            "a chunk is damaged: it declares {size} bytes and holds {}",
+            if records.len() > size {
+                "more".to_string()
+            } else {
+                records.len().to_string()
+            }
+        ));
+    }
+    if header.uncompressed_crc != 0 && crc32fast::hash(&records) != header.uncompressed_crc {
+        return Err("a chunk's CRC does not match its data".into());
+    }
+    Ok(records)
+}
+
+/// The schemas and channels read so far.
+#[derive(Default)]
+struct Channels {
+    /// Schema ID to name and encoding.
+    schemas: HashMap<u16, (String, String)>,
+    /// The IDs of the channels on the topic.
+    wanted: Vec<u16>,
+    /// The topics of the IMU channels, in the order first seen.
+    imu_topics: Vec<String>,
+    /// All topics, in the order first seen.
+    all_topics: Vec<String>,
+    /// Channel ID to topic and schema ID, of every channel.
+    known: HashMap<u16, (String, u16)>,
+}
+
+impl Channels {
+    /// Takes in a schema or channel record; an error when it is a channel on `topic` that
+    /// cannot be read.
+    fn add(&mut self, record: Record<'_>, topic: &str) -> Result<(), String> {
+        match record {
+            Record::Schema { header, .. } => {
+                self.schemas
+                    .insert(header.id, (header.name, header.encoding));
+            }
+            Record::Channel(c) => {
+                let schema = self.schemas.get(&c.schema_id);
+                let name = schema.map_or("", |s| s.0.as_str());
+                if c.topic == topic {
+                    check_channel(topic, c.schema_id, schema, &c.message_encoding)?;
+                    if !self.wanted.contains(&c.id) {
+                        self.wanted.push(c.id);
+                    }
+                }
+                if name == IMU_SCHEMA && !self.imu_topics.contains(&c.topic) {
+                    self.imu_topics.push(c.topic.clone());
+                }
+                if !self.all_topics.contains(&c.topic) {
+                    self.all_topics.push(c.topic);
+                }
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+}
+
+/// A channel on `topic` (its schema, and its message encoding) that this reader can decode.
+fn check_channel(
+    topic: &str,
+    schema_id: u16,
+    schema: Option<&(String, String)>,
+    message_encoding: &str,
+) -> Result<(), String> {
+    let Some((name, encoding)) = schema else {
+        return Err(if schema_id == 0 {
+            format!("topic '{topic}' has no schema, not {IMU_SCHEMA}")
+        } else {
+            format!("topic '{topic}' names schema {schema_id}, which the file does not define")
+        });
+    };
+    if name != IMU_SCHEMA {
+        return Err(format!("topic '{topic}' has type {name}, not {IMU_SCHEMA}"));
+    }
+    if !SCHEMA_ENCODINGS.contains(&encoding.as_str()) {
+        return Err(format!(
+            "unknown schema encoding '{encoding}' on topic '{topic}' (supported: {})",
+            SCHEMA_ENCODINGS.join(", ")
+        ));
+    }
+    if message_encoding != CDR {
+        return Err(format!(
+            "unknown encoding '{message_encoding}' on topic '{topic}' (supported: {CDR})"
+        ));
+    }
+    Ok(())
+}
+
+/// Why a file that does not start with the MCAP magic is not read.
+fn not_mcap(head: &[u8]) -> String {
+    if head.starts_with(b"#ROSBAG") {
+        "not an MCAP file: a ROS 1 bag (read it as a bag)".to_string()
+    } else if head.starts_with(b"SQLite format 3") {
+        "not an MCAP file: an SQLite database (a rosbag2 .db3 file?)".to_string()
+    } else {
+        "not an MCAP file (it does not start with the MCAP magic)".to_string()
+    }
+}
+
+/// The frame of one CDR-serialized `sensor_msgs/msg/Imu` and its header's frame_id (without
+/// its NUL): `None` when the encapsulation is not CDR_LE or CDR_BE, or the message is too
+/// short.
+pub(crate) fn decode(b: &[u8]) -> Option<(Frame, &[u8])> {
+    let big = match b.get(..2)? {
+        [0, 1] => false,
+        [0, 0] => true,
+        _ => return None,
+    };
+    // Offsets past the encapsulation header, where CDR alignment counts from.
+    let body = b.get(4..)?;
+    let sec = u32_at(body, 0, big)? as i32;
+    let nanosec = u32_at(body, 4, big)?;
+    let frame_id = usize::try_from(u32_at(body, 8, big)?).ok()?;
+    let end = 12usize.checked_add(frame_id)?;
+    let at = end.checked_add(7)? & !7;
+    let frame = Frame {
+        stamp_ns: stamp_ns(i64::from(sec), nanosec),
+        axes: imu_axes(body, at, big)?,
+    };
+    let id = body.get(12..end)?;
+    Some((frame, id.strip_suffix(&[0]).unwrap_or(id)))
+}

@@ -1,0 +1,308 @@
+//! ROS 2 recordings: a rosbag2 folder (what `ros2 bag record` writes: `metadata.yaml` and its
+//! storage files, <https://github.com/ros2/rosbag2>), and a bare SQLite storage file (`.db3`).
+//!
+//! A folder is read through its `metadata.yaml`: `storage_identifier` (`mcap` or `sqlite3`)
+//! and `relative_file_paths`, the storage files in recording order, each read in turn by the
+//! MCAP reader ([`super::mcap`]) or by [`read_db3`]. A folder compressed file by file
+//! (`compression_mode: FILE`) is refused with what to run (`ros2 bag decompress`).
+//!
+//! A `.db3` file is the rosbag2 SQLite storage (`rosbag2_storage_default_plugins`, the default
+//! of ROS 2 before Iron): a table `topics` (`id`, `name`, `type`, `serialization_format`) and a
+//! table `messages` (`topic_id`, `timestamp`, `data`), each message's `data` the CDR
+//! serialization of the message, decoded as in an MCAP file. Messages are read in the order of
+//! their receive `timestamp` (then of their row), which is the order `ros2 bag play` plays.
+
+use std::path::{Path, PathBuf};
+
+use rusqlite::{Connection, OpenFlags};
+
+use crate::csv::DataError;
+use crate::frame::{Frame, Select, Skipped, Tally, absent_topic, data_error};
+use crate::mcap::{self, IMU_SCHEMA};
+
+/// The name of a rosbag2 folder's metadata file.
+pub const METADATA: &str = "metadata.yaml";
+
+/// What a rosbag2 folder's `metadata.yaml` says of its storage.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Metadata {
+    /// `storage_identifier`: `mcap` or `sqlite3`.
+    pub storage: String,
+    /// `relative_file_paths`: the storage files, in order.
+    pub files: Vec<String>,
+    /// `compression_mode` (`FILE`, `MESSAGE` or empty).
+    pub compression_mode: String,
+    /// `compression_format` (`zstd` or empty).
+    pub compression_format: String,
+}
+
+impl Metadata {
+    /// Parses the keys read here out of a `metadata.yaml` (block style, as rosbag2 writes it:
+    /// `key: value` lines and `- item` lists; values plain or quoted).
+    pub fn parse(text: &str) -> Result<Self, String> {
+        let mut meta = Metadata {
+            storage: String::new(),
+            files: Vec::new(),
+            compression_mode: String::new(),
+            compression_format: String::new(),
+        };
+        let mut in_files = false;
+        let mut seen_files = false;
+        for line in text.lines() {
+            let trimmed = line.trim();
+            if trimmed.is_empty() || trimmed.starts_with('#') {
+                continue;
+            }
+            if in_files && let Some(item) = trimmed.strip_prefix("- ") {
+                meta.files.push(unquoted(item).to_string());
+                continue;
+            }
+            in_files = false;
+            let Some((key, value)) = trimmed.split_once(':') else {
+                continue;
+            };
+            let value = unquoted(value.trim());
+            match key.trim() {
+                "storage_identifier" => meta.storage = value.to_string(),
+                "compression_mode" => meta.compression_mode = value.to_string(),
+                "compression_format" => meta.compression_format = value.to_string(),
+                "relative_file_paths" => {
+                    seen_files = true;
+                    if let Some(list) = value.strip_prefix('[').and_then(|v| v.strip_suffix(']')) {
+                        meta.files.extend(
+                            list.split(',')
+                                .map(|f| unquoted(f.trim()).to_string())
+                                .filter(|f| !f.is_empty()),
+                        );
+                    } else {
+                        in_files = value.is_empty();
+                    }
+                }
+                _ => {}
+            }
+        }
+        if meta.storage.is_empty() {
+            return Err("it has no storage_identifier".into());
+        }
+        if !seen_files {
+            return Err("it has no relative_file_paths".into());
+        }
+        Ok(meta)
+    }
+}
+
+/// `v` without the quotes around it, if it has them.
+fn unquoted(v: &str) -> &str {
+    for q in ['\'', '"'] {
+        if let Some(inner) = v.strip_prefix(q).and_then(|v| v.strip_suffix(q)) {
+            return inner;
+        }
+    }
+    v
+}
+
+/// The storage files of the rosbag2 folder `dir`, in order, and whether they are MCAP
+/// (else SQLite). An error when the metadata cannot be read, names a storage this tool does
+/// not read, is compressed file by file, or names a file that is not in the folder.
+pub fn storage_files(dir: &Path) -> Result<(Vec<PathBuf>, bool), DataError> {
+    let path = dir.join(METADATA);
+    let fail = |p: String| data_error(&path, p);
+    let text = std::fs::read_to_string(&path).map_err(|e| fail(format!("cannot read: {e}")))?;
+    let meta = Metadata::parse(&text).map_err(|e| fail(format!("not rosbag2 metadata: {e}")))?;
+    let mcap = match meta.storage.as_str() {
+        "mcap" => true,
+        "sqlite3" => false,
+        other => {
+            return Err(fail(format!(
+                "storage '{}': the storages read are mcap and sqlite3",
+                crate::error::escaped(other)
+            )));
+        }
+    };
+    if meta.compression_mode.eq_ignore_ascii_case("file") {
+        return Err(fail(format!(
+            "the bag's files are compressed whole ({}); `ros2 bag decompress` writes a folder \
+             that can be read",
+            if meta.compression_format.is_empty() {
+                "compression_mode FILE"
+            } else {
+                meta.compression_format.as_str()
+            }
+        )));
+    }
+    if meta.files.is_empty() {
+        return Err(fail(
+            "it names no storage file (relative_file_paths is empty)".into(),
+        ));
+    }
+    let mut files = Vec::with_capacity(meta.files.len());
+    for f in &meta.files {
+        let rel = Path::new(f);
+        if rel.is_absolute()
+            || rel
+                .components()
+                .any(|c| c == std::path::Component::ParentDir)
+        {
+            return Err(fail(format!(
+                "storage file '{}' is not inside the folder",
+                crate::error::escaped(f)
+            )));
+        }
+        let file = dir.join(rel);
+        let problem = match std::fs::metadata(&file) {
+            Ok(m) if m.is_file() => None,
+            Ok(_) => Some("is not a regular file"),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                Some("is missing from the folder")
+            }
+            Err(_) => Some("cannot be read"),
+        };
+        if let Some(p) = problem {
+            return Err(fail(format!(
+                "storage file '{}' {p}",
+                crate::error::escaped(f)
+            )));
+        }
+        files.push(file);
+    }
+    Ok((files, mcap))
+}
+
+/// Calls `each` with every finite `sensor_msgs/msg/Imu` message on `select`'s topic (and
+/// frame_id) of the rosbag2 folder `dir`, file after file, and returns what was skipped.
+/// Errors as [`super::mcap::read_selected`] and [`read_db3`], and [`storage_files`]'.
+pub fn read_folder(
+    dir: &Path,
+    select: &Select,
+    each: &mut dyn FnMut(Frame),
+) -> Result<Skipped, DataError> {
+    let (files, is_mcap) = storage_files(dir)?;
+    let mut skipped = Skipped::default();
+    let mut found = false;
+    let mut last_err = None;
+    for file in &files {
+        let read = if is_mcap {
+            mcap::read_selected(file, select, each)
+        } else {
+            read_db3(file, select, each)
+        };
+        match read {
+            Ok(s) => {
+                found = true;
+                skipped.undecodable += s.undecodable;
+                skipped.non_finite += s.non_finite;
+                skipped.other_frame_id += s.other_frame_id;
+            }
+            // A split bag's file may hold none of the topic's messages; the others must.
+            Err(e) if files.len() > 1 && e.problem.starts_with("no ") => last_err = Some(e),
+            Err(e) => return Err(e),
+        }
+    }
+    match (found, last_err) {
+        (false, Some(e)) => Err(e),
+        _ => Ok(skipped),
+    }
+}
+
+/// The first bytes of an SQLite 3 database.
+pub const SQLITE_MAGIC: &[u8] = b"SQLite format 3\0";
+
+/// Calls `each` with every finite `sensor_msgs/msg/Imu` message on `select`'s topic (and
+/// frame_id) of the rosbag2 SQLite file `path`, in the order of their receive timestamps, and
+/// returns what was skipped. Errors as [`super::mcap::read_selected`]'s: not a rosbag2
+/// database, no such topic, another type or serialization, no finite message.
+pub fn read_db3(
+    path: &Path,
+    select: &Select,
+    each: &mut dyn FnMut(Frame),
+) -> Result<Skipped, DataError> {
+    let topic = select.topic;
+    let fail = |p: String| data_error(path, p);
+    let sql = |e: rusqlite::Error| fail(format!("not a readable rosbag2 database: {e}"));
+    let db = Connection::open_with_flags(
+        path,
+        OpenFlags::SQLITE_OPEN_READ_ONLY | OpenFlags::SQLITE_OPEN_NO_MUTEX,
+    )
+    .map_err(sql)?;
+    let mut topics = db
+        .prepare("SELECT id, name, type, serialization_format FROM topics")
+        .map_err(sql)?;
+    let rows = topics
+        .query_map([], |r| {
+            Ok((
+                r.get::<_, i64>(0)?,
+                r.get::<_, String>(1)?,
+                r.get::<_, String>(2)?,
+                r.get::<_, String>(3)?,
+            ))
+        })
+        .map_err(sql)?;
+    let (mut ids, mut imu_topics, mut all_topics) = (Vec::new(), Vec::new(), Vec::new());
+    for row in rows {
+        let (id, name, ty, format) = row.map_err(sql)?;
+        if name == topic {
+            if ty != IMU_SCHEMA {
+                return Err(fail(format!(
+                    "topic '{topic}' has type {ty}, not {IMU_SCHEMA}"
+                )));
+            }
+            if format != "cdr" {
+                return Err(fail(format!(
+                    "unknown encoding '{}' on topic '{topic}' (supported: cdr)",
+                    crate::error::escaped(&format)
+                )));
+            }
+            ids.push(id);
+        }
+        if ty == IMU_SCHEMA && !imu_topics.contains(&name) {
+            imu_topics.push(name.clone());
+        }
+        if !all_topics.contains(&name) {
+            all_topics.push(name);
+        }
+    }
+    if ids.is_empty() {
+        return Err(fail(absent_topic(
+            IMU_SCHEMA,
+            topic,
+            &imu_topics,
+            &all_topics,
+        )));
+    }
+    // One topic row per publisher's QoS profile: all of them, told apart by their frame_id.
+    let list: Vec<String> = ids.iter().map(i64::to_string).collect();
+    let untimed: i64 = db
+        .query_row(
+            &format!(
+                "SELECT COUNT(*) FROM messages WHERE topic_id IN ({}) AND \
+                 typeof(timestamp) != 'integer'",
+                list.join(",")
+            ),
+            [],
+            |r| r.get(0),
+        )
+        .map_err(sql)?;
+    if untimed > 0 {
+        return Err(fail(format!(
+            "{untimed} messages on '{topic}' have a receive timestamp that is not an integer \
+             (nanoseconds): not a rosbag2 database as ROS 2 writes it"
+        )));
+    }
+    let mut messages = db
+        .prepare(&format!(
+            "SELECT topic_id, data FROM messages WHERE topic_id IN ({}) ORDER BY timestamp, id",
+            list.join(",")
+        ))
+        .map_err(sql)?;
+    let mut rows = messages.query([]).map_err(sql)?;
+    let mut tally = Tally::new(select, each);
+    while let Some(row) = rows.next().map_err(sql)? {
+        let source = row.get::<_, i64>(0).map_err(sql)?;
+        let data = row.get_ref(1).map_err(sql)?;
+        tally.offer(
+            u32::try_from(source).unwrap_or(u32::MAX),
+            data.as_blob().ok().and_then(mcap::decode),
+        );
+    }
+    tally.finish(path, topic, &|id| format!("topic row {id}"))
+}

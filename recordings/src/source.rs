@@ -1,0 +1,543 @@
+//! One reader over every kind of recording: CSV files, ROS 1 bags, MCAP files and rosbag2
+//! folders or databases, streamed row by row (message by message) with their timestamps
+//! checked on the way. Each input is opened once for its data (a pipe is read once).
+
+use std::cell::Cell;
+use std::io::Read as _;
+use std::path::{Path, PathBuf};
+
+use crate::csv::{self, DataError, position, split_unit};
+use crate::error::{Fail, escaped, with_file};
+use crate::frame::{Frame, Select, Skipped};
+use crate::timing::{Step, TimeUnit, Timing};
+use crate::units::Unit;
+use crate::{bag, mcap, rosbag2};
+
+/// The kinds of recording.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// CSV with a header row.
+    Csv,
+    /// A ROS 1 bag (`#ROSBAG V`; format 2.0 is read).
+    Bag,
+    /// An MCAP file (ROS 2).
+    Mcap,
+    /// A rosbag2 folder (`metadata.yaml` and its storage files).
+    Rosbag2,
+    /// An SQLite database: a rosbag2 `.db3` storage file.
+    Db3,
+    /// A file none of the readers takes, with what it is.
+    Other(&'static str),
+    /// A file that cannot be opened.
+    Unreadable,
+}
+
+impl Kind {
+    /// The kind of `path`: a folder holding `metadata.yaml` is a rosbag2 folder; a file is
+    /// known by its first bytes (standard input, a pipe and a short text file are CSV).
+    pub fn of(path: &Path) -> Kind {
+        if path.is_dir() {
+            return if path.join(rosbag2::METADATA).is_file() {
+                Kind::Rosbag2
+            } else {
+                Kind::Other("a folder without metadata.yaml (not a rosbag2 folder)")
+            };
+        }
+        let mut head = [0u8; 16];
+        let head: &[u8] = match csv::read_once(path) {
+            Some(Ok(bytes)) => &bytes[..bytes.len().min(16)],
+            Some(Err(_)) => return Kind::Csv,
+            None => match std::fs::File::open(path).and_then(|mut f| f.read(&mut head)) {
+                Ok(n) => &head[..n],
+                Err(_) => return Kind::Unreadable,
+            },
+        };
+        Kind::of_head(head, path)
+    }
+
+    /// The kind of a file that starts with `head` (at most 16 bytes) and is named `path`.
+    fn of_head(head: &[u8], path: &Path) -> Kind {
+        let extension = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        match head {
+            h if h.starts_with(b"#ROSBAG V") => Kind::Bag,
+            h if h.starts_with(b"\x89MCAP") => Kind::Mcap,
+            // A cut MCAP file: its magic's first bytes.
+            h if !h.is_empty() && b"\x89MCAP".starts_with(h) => Kind::Mcap,
+            h if h.starts_with(rosbag2::SQLITE_MAGIC) => Kind::Db3,
+            [0x28, 0xb5, 0x2f, 0xfd, ..] => Kind::Other(
+                "a zstd-compressed file (a rosbag2 folder compressed file by file: \
+                 `ros2 bag decompress` writes one that can be read)",
+            ),
+            [0x04, 0x22, 0x4d, 0x18, ..] => Kind::Other("an lz4-compressed file"),
+            [0x1f, 0x8b, ..] => Kind::Other("a gzip-compressed file"),
+            [b'B', b'Z', b'h', ..] => Kind::Other("a bzip2-compressed file"),
+            [0xfd, b'7', b'z', b'X', b'Z', 0, ..] => Kind::Other("an xz-compressed file"),
+            [b'P', b'K', 3, 4, ..] => Kind::Other("a zip archive"),
+            [0x89, b'H', b'D', b'F', ..] => Kind::Other("an HDF5 file"),
+            [] => match extension.as_deref() {
+                Some("bag") => Kind::Other("an empty file, not a ROS 1 bag"),
+                Some("mcap") => Kind::Other("an empty file, not an MCAP file"),
+                Some("db3") => Kind::Other("an empty file, not a rosbag2 database"),
+                _ => Kind::Csv,
+            },
+            // Text has no NUL and few control bytes: a file that starts otherwise is binary.
+            h if h
+                .iter()
+                .any(|&b| b == 0 || (b < 0x09) || (0x0e..0x1b).contains(&b)) =>
+            {
+                Kind::Other("a binary file of no kind read here (not text, not a known magic)")
+            }
+            _ => match extension.as_deref() {
+                Some("bag") => Kind::Other("not a ROS 1 bag (it does not start with '#ROSBAG V')"),
+                Some("mcap") => {
+                    Kind::Other("not an MCAP file (it does not start with the MCAP magic)")
+                }
+                Some("db3") => Kind::Other("not a rosbag2 database (not an SQLite file)"),
+                _ => Kind::Csv,
+            },
+        }
+    }
+
+    /// What the kind is called in messages.
+    fn name(self) -> &'static str {
+        match self {
+            Kind::Csv => "a CSV file",
+            Kind::Bag => "a ROS 1 bag",
+            Kind::Mcap => "an MCAP file",
+            Kind::Rosbag2 => "a rosbag2 folder",
+            Kind::Db3 => "a rosbag2 database",
+            Kind::Other(what) => what,
+            Kind::Unreadable => "a file that cannot be read",
+        }
+    }
+}
+
+/// The six axes of a `sensor_msgs/Imu` message, as `--column` names them.
+pub const AXES: [&str; 6] = ["gx", "gy", "gz", "ax", "ay", "az"];
+
+/// The index in [`AXES`] of a column name: `gx` or `angular_velocity.x` .. `az` or
+/// `linear_acceleration.z`.
+pub fn axis(name: &str) -> Option<usize> {
+    const LONG: [&str; 6] = [
+        "angular_velocity.x",
+        "angular_velocity.y",
+        "angular_velocity.z",
+        "linear_acceleration.x",
+        "linear_acceleration.y",
+        "linear_acceleration.z",
+    ];
+    AXES.iter()
+        .position(|a| *a == name)
+        .or_else(|| LONG.iter().position(|a| *a == name))
+}
+
+/// What to read.
+pub struct Request<'a> {
+    /// The columns (CSV names or indices; for a bag or an MCAP file, names of [`axis`]).
+    pub columns: &'a [String],
+    /// The `sensor_msgs/Imu` topic of a bag or an MCAP file.
+    pub topic: Option<&'a str>,
+    /// The header frame_id of the IMU to read, when the topic carries several.
+    pub frame_id: Option<&'a str>,
+    /// The CSV time column, when the user named one.
+    pub time_column: Option<&'a str>,
+    /// Whether the timestamps are wanted (they are read and checked only then, or when
+    /// `time_column` names one; a bag's and an MCAP file's always are).
+    pub want_time: bool,
+    /// Drop (and count) samples whose stamp is not after the last one, instead of refusing them.
+    pub drop_backward: bool,
+}
+
+/// What a read gave besides the samples.
+pub struct Read {
+    /// The unit of each column, where its header bracket (or the message's SI units) says it.
+    pub units: Vec<Option<Unit>>,
+    /// A header bracket that names no unit known here, per column.
+    pub unknown: Vec<Option<String>>,
+    /// The timestamps, when read: their statistics and unit.
+    pub timing: Option<(Timing, TimeUnit)>,
+    /// Messages skipped (undecodable or not finite), counted.
+    pub skipped: Skipped,
+}
+
+/// Reads `request` from `files` (one kind, joined in order), passing the values of each row
+/// (message) whose stamp moves forward to `each`, in the order of `request.columns`.
+pub fn stream(
+    files: &[PathBuf],
+    request: &Request,
+    each: &mut dyn FnMut(&[f64]),
+) -> Result<Read, Fail> {
+    // Each file's kind, found once (each is opened for it).
+    let kinds: Vec<Kind> = files.iter().map(|f| Kind::of(f)).collect();
+    let kind = kinds[0];
+    if let Kind::Other(what) = kind {
+        return Err(with_file(
+            &files[..1],
+            format!("{what}: not a recording read here"),
+        ));
+    }
+    if let Some((file, _)) = files
+        .iter()
+        .zip(&kinds)
+        .find(|(_, k)| **k == Kind::Unreadable)
+    {
+        let problem = match std::fs::File::open(file) {
+            Err(e) => format!("cannot open: {e}"),
+            Ok(mut f) => match f.read(&mut [0u8; 1]) {
+                Err(e) => format!("cannot read: {e}"),
+                Ok(_) => "cannot read: it changed while being read".into(),
+            },
+        };
+        return Err(with_file(std::slice::from_ref(file), problem));
+    }
+    for (file, &other) in files.iter().zip(&kinds).skip(1) {
+        if other != kind {
+            return Err(with_file(
+                files,
+                format!(
+                    "{} is {} and {} is {}: one record is one kind of file",
+                    files[0].display(),
+                    kind.name(),
+                    file.display(),
+                    other.name()
+                ),
+            ));
+        }
+    }
+    if kind != Kind::Csv
+        && let Some(piped) = files.iter().find(|f| csv::read_once(f).is_some())
+    {
+        return Err(with_file(
+            files,
+            format!(
+                "{} is {} read from a pipe: it is read from a file (or folder) on disk",
+                piped.display(),
+                kind.name()
+            ),
+        ));
+    }
+    if let (Kind::Csv, Some(f)) = (kind, request.frame_id) {
+        return Err(with_file(
+            files,
+            format!(
+                "--frame-id {}: the file is CSV; --frame-id picks an IMU of a bag's or an MCAP \
+                 file's topic",
+                escaped(f)
+            ),
+        ));
+    }
+    match (kind, request.topic) {
+        (Kind::Csv, None) => csv_stream(files, request, each),
+        (Kind::Csv, Some(t)) => Err(with_file(
+            files,
+            format!(
+                "--topic {}: the file is {}; --topic is for ROS 1 bags, MCAP files and rosbag2 \
+                 folders or databases",
+                escaped(t),
+                if std::fs::metadata(&files[0]).is_ok_and(|m| m.is_file() && m.len() == 0) {
+                    "empty"
+                } else {
+                    "CSV (its first bytes are text)"
+                }
+            ),
+        )),
+        (kind, topic) => messages(files, kind, topic, request, each),
+    }
+}
+
+/// A bag's or an MCAP file's messages.
+fn messages(
+    files: &[PathBuf],
+    kind: Kind,
+    topic: Option<&str>,
+    request: &Request,
+    each: &mut dyn FnMut(&[f64]),
+) -> Result<Read, Fail> {
+    let read = match kind {
+        Kind::Mcap => mcap::read_selected,
+        Kind::Rosbag2 => rosbag2::read_folder,
+        Kind::Db3 => rosbag2::read_db3,
+        _ => bag::read_selected,
+    };
+    let Some(topic) = topic else {
+        // The reader's error for no topic lists the file's IMU topics.
+        // (A damaged file gives its own error, before any topic is looked for.)
+        let topics = match read(&files[0], &Select::topic(""), &mut |_| {}) {
+            Err(e) if e.problem.starts_with("no ") && e.problem.contains(" messages on topic ") => {
+                e.problem
+                    .split_once(" (")
+                    .map_or(String::new(), |(_, t)| format!(" ({t}"))
+            }
+            Err(e) => return Err(Fail(e.to_string())),
+            Ok(_) => String::new(),
+        };
+        return Err(with_file(
+            files,
+            format!("{} needs --topic{topics}", kind.name()),
+        ));
+    };
+    let picks = request
+        .columns
+        .iter()
+        .map(|c| {
+            axis(c).ok_or_else(|| {
+                with_file(
+                    files,
+                    format!(
+                        "--column {}: a sensor_msgs/Imu message has gx, gy, gz (angular_velocity, \
+                         rad/s) and ax, ay, az (linear_acceleration, m/s^2)",
+                        escaped(c)
+                    ),
+                )
+            })
+        })
+        .collect::<Result<Vec<usize>, Fail>>()?;
+    let mut timing = Timing::new();
+    let mut skipped = Skipped::default();
+    let mut backward: Option<(u64, i64, i64)> = None;
+    let mut count = 0u64;
+    // Messages stamped 0: a driver that does not stamp. With --rate they are read in file
+    // order, and the stamps give no rate.
+    let mut unstamped = 0u64;
+    let mut values = vec![0.0; picks.len()];
+    let select = Select {
+        topic,
+        frame_id: request.frame_id,
+    };
+    for file in files {
+        let s = read(file, &select, &mut |frame: Frame| {
+            count += 1;
+            if frame.stamp_ns == 0 {
+                unstamped += 1;
+            } else if let Step::Backward { last } = timing.push(frame.stamp_ns) {
+                timing.drop_one();
+                backward.get_or_insert((count, frame.stamp_ns, last));
+                return;
+            }
+            for (v, &i) in values.iter_mut().zip(&picks) {
+                *v = frame.axes[i];
+            }
+            each(&values);
+        })
+        .map_err(|e| Fail(e.to_string()))?;
+        skipped.undecodable += s.undecodable;
+        skipped.non_finite += s.non_finite;
+        skipped.other_frame_id += s.other_frame_id;
+    }
+    // Skipped messages leave holes the stamps show only as gaps; uniform ones (every other
+    // message) would pass for a lower rate. More than 1 % of the record is refused.
+    let lost = skipped.undecodable.saturating_add(skipped.non_finite);
+    let total = count.saturating_add(lost);
+    if lost.saturating_mul(100) > total {
+        return Err(with_file(
+            files,
+            format!(
+                "{lost} of the {total} messages on '{}' were skipped ({} undecodable, {} with \
+                 a NaN or infinite axis): more than 1 % of the record is missing",
+                escaped(topic),
+                skipped.undecodable,
+                skipped.non_finite
+            ),
+        ));
+    }
+    if unstamped > 0 {
+        if request.want_time {
+            return Err(with_file(
+                files,
+                format!(
+                    "the header stamps of {unstamped} of {count} messages on '{}' are zero (a \
+                     driver that does not stamp its messages): give --rate to read them in \
+                     file order",
+                    escaped(topic)
+                ),
+            ));
+        }
+        return Ok(Read {
+            unknown: vec![None; picks.len()],
+            units: picks.iter().map(|&i| si_unit(i)).collect(),
+            timing: None,
+            skipped,
+        });
+    }
+    if let Some((at, stamp, last)) = backward
+        && !request.drop_backward
+    {
+        return Err(with_file(files, backward_text(&timing, at, stamp, last)));
+    }
+    Ok(Read {
+        unknown: vec![None; picks.len()],
+        units: picks.iter().map(|&i| si_unit(i)).collect(),
+        timing: Some((timing, TimeUnit::HeaderStamps)),
+        skipped,
+    })
+}
+
+/// The unit of a message's axis `i` (of [`AXES`]).
+fn si_unit(i: usize) -> Option<Unit> {
+    Unit::parse(if i < 3 { "rad/s" } else { "m/s^2" })
+}
+
+/// The refusal of stamps that go backwards.
+fn backward_text(timing: &Timing, at: u64, stamp: i64, last: i64) -> String {
+    format!(
+        "{} timestamps are not after the one before (the first: message {at}, {stamp} ns after \
+         {last} ns); --drop-backward drops such samples and counts them",
+        timing.dropped()
+    )
+}
+
+/// Parses `cells` (named by `request.columns`) into `values` and passes them on.
+fn row_values(
+    values: &mut [f64],
+    cells: &[&str],
+    request: &Request,
+    each: &mut dyn FnMut(&[f64]),
+) -> Result<(), String> {
+    for ((v, cell), name) in values.iter_mut().zip(cells).zip(request.columns) {
+        *v = csv::finite(name)(cell)?;
+    }
+    each(values);
+    Ok(())
+}
+
+/// The names a time column goes by.
+fn is_time(name: &str) -> bool {
+    let bare = split_unit(name).0.to_ascii_lowercase();
+    let bare = bare.trim_start_matches('#');
+    matches!(
+        bare,
+        "t" | "time" | "timestamp" | "stamp" | "sec" | "seconds"
+    ) || ["t_", "time_", "timestamp_", "stamp_"].iter().any(|p| {
+        bare.strip_prefix(p)
+            .is_some_and(|u| matches!(TimeUnit::of(u, Some(u)), Ok(Some(_))))
+    })
+}
+
+/// CSV files.
+fn csv_stream(
+    files: &[PathBuf],
+    request: &Request,
+    each: &mut dyn FnMut(&[f64]),
+) -> Result<Read, Fail> {
+    let mut units: Option<Vec<Option<Unit>>> = None;
+    let mut unknown: Vec<Option<String>> = Vec::new();
+    // The time column's index and unit (when the column does not say: by its first value).
+    let time: Cell<Option<(usize, Option<TimeUnit>)>> = Cell::new(None);
+    let strict = request.want_time;
+    let mut timing = Timing::new();
+    let mut values = vec![0.0; request.columns.len()];
+    let mut select = |header: &[String]| -> Result<Vec<usize>, String> {
+        let mut picks = request
+            .columns
+            .iter()
+            .map(|c| position(header, c))
+            .collect::<Result<Vec<usize>, String>>()?;
+        if let Some(k) = (1..picks.len()).find(|&k| picks[..k].contains(&picks[k])) {
+            return Err(format!(
+                "column '{}' is named twice",
+                escaped(&header[picks[k]])
+            ));
+        }
+        let here: Vec<Option<Unit>> = picks
+            .iter()
+            .map(|&i| split_unit(&header[i]).1.and_then(Unit::parse))
+            .collect();
+        if let Some(first) = &units
+            && *first != here
+        {
+            return Err(
+                "the columns' unit brackets differ from the first file's: one record is in \
+                 one unit"
+                    .into(),
+            );
+        }
+        units.get_or_insert(here);
+        unknown = picks
+            .iter()
+            .map(|&i| {
+                let bracket = split_unit(&header[i]).1?;
+                Unit::parse(bracket).is_none().then(|| bracket.to_string())
+            })
+            .collect();
+        let t = match request.time_column {
+            Some(name) => Some(position(header, name)?),
+            None => (0..header.len()).find(|&i| is_time(&header[i])),
+        };
+        let t = match t.map(|i| (i, split_unit(&header[i]))) {
+            Some((i, (name, bracket))) => match TimeUnit::of(name, bracket) {
+                Ok(unit) => Some((i, unit)),
+                Err(e) if strict => return Err(e),
+                Err(_) => None,
+            },
+            None => None,
+        };
+        time.set(t);
+        if let Some((i, _)) = t {
+            picks.push(i);
+        }
+        Ok(picks)
+    };
+    let mut row = |cells: &[&str]| -> Result<(), String> {
+        let (cells, stamp) = match time.get() {
+            Some((i, unit)) => {
+                let (last, cells) = cells.split_last().ok_or("no cells")?;
+                let unit = match unit.or_else(|| TimeUnit::by_magnitude(last.parse().ok()?)) {
+                    Some(u) => u,
+                    None if strict => {
+                        return Err(format!(
+                            "the time column does not say its unit ([s], [ms], [us] or [ns] \
+                             in its header, or a suffix such as _ns) and its first value '{}' \
+                             is no epoch time; name the unit, or give --rate",
+                            csv::shown(last)
+                        ));
+                    }
+                    None => {
+                        // The rate is given: stamps of unknown unit are not read.
+                        time.set(None);
+                        return row_values(&mut values, cells, request, &mut *each);
+                    }
+                };
+                time.set(Some((i, Some(unit))));
+                match unit.nanoseconds(last) {
+                    Ok(t) => (cells, Some(t)),
+                    Err(e) if strict => return Err(e),
+                    Err(_) => {
+                        timing.spoil();
+                        return row_values(&mut values, cells, request, &mut *each);
+                    }
+                }
+            }
+            None => (cells, None),
+        };
+        if let Some(t) = stamp
+            && let Step::Backward { last } = timing.push(t)
+        {
+            if !strict && !request.drop_backward {
+                // The rate is given: the sample stays, its stamp is left out of the stamps'
+                // statistics, which still check the rate given.
+                return row_values(&mut values, cells, request, &mut *each);
+            }
+            timing.drop_one();
+            if !request.drop_backward {
+                return Err(format!(
+                    "timestamp {t} ns is not after the one before ({last} ns); \
+                     --drop-backward drops such samples and counts them"
+                ));
+            }
+            return Ok(());
+        }
+        row_values(&mut values, cells, request, &mut *each)
+    };
+    csv::read_rows(files, &mut select, &mut row).map_err(|e: DataError| Fail(e.to_string()))?;
+    Ok(Read {
+        unknown,
+        units: units.unwrap_or_default(),
+        timing: time
+            .get()
+            .map(|(_, u)| (timing, u.unwrap_or(TimeUnit::Seconds))),
+        skipped: Skipped::default(),
+    })
+}
