@@ -3,7 +3,7 @@
 
 use std::fmt;
 use std::fs::File;
-use std::io::{BufReader, IsTerminal, Read, Seek, SeekFrom, Write};
+use std::io::{BufRead, BufReader, IsTerminal, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Mutex, OnceLock};
@@ -103,7 +103,7 @@ pub fn parse_column(label: &Path, bytes: &[u8], column: &str) -> Result<Vec<f64>
     let parse = finite(column);
     let mut out = Vec::new();
     let locate = |byte| line_at(bytes, byte);
-    let header = comment_header(bytes).map_err(|e| error(label, None, e))?;
+    let header = comment_header(Source::Held(bytes)).map_err(|e| error(label, None, e))?;
     read_source(
         label,
         (Source::Held(bytes), header),
@@ -138,7 +138,7 @@ pub fn read_rows(
     for path in files {
         if let Some(bytes) = read_once(path) {
             let bytes = bytes.map_err(|e| error(path, None, format!("cannot read: {e}")))?;
-            let header = comment_header(bytes).map_err(|e| error(path, None, e))?;
+            let header = comment_header(Source::Held(bytes)).map_err(|e| error(path, None, e))?;
             let locate = |byte| line_at(bytes, byte);
             read_source(
                 path,
@@ -149,8 +149,9 @@ pub fn read_rows(
             )?;
             continue;
         }
-        let open = || File::open(path).map_err(|e| error(path, None, format!("cannot open: {e}")));
-        let header = comment_header(BufReader::new(open()?)).map_err(|e| error(path, None, e))?;
+        // Opened first, for the error of a file that cannot be.
+        File::open(path).map_err(|e| error(path, None, format!("cannot open: {e}")))?;
+        let header = comment_header(Source::File(path)).map_err(|e| error(path, None, e))?;
         let locate = |byte| line_at(File::open(path).ok()?, byte);
         read_source(
             path,
@@ -242,31 +243,60 @@ fn all_numbers(record: &::csv::StringRecord) -> bool {
 /// The header of a file whose header is a comment: when the first record that is not a
 /// comment holds only numbers and a comment line comes before it, that comment line without
 /// its `#`. `None` when the file has an ordinary header row (or no comment before its data).
-fn comment_header(source: impl Read) -> Result<Option<Vec<String>>, String> {
-    let mut reader = ::csv::ReaderBuilder::new()
-        .comment(None)
-        .has_headers(false)
-        .flexible(true)
-        .from_reader(source);
-    let mut last_comment = None;
-    let mut record = ::csv::StringRecord::new();
-    loop {
+///
+/// Read line by line as the row reader reads them: a comment is a line whose first byte is `#`
+/// (after a UTF-8 byte order mark on the first line), running to the next `\n`, and whatever
+/// it holds (a quote too) stays in it; empty lines are skipped.
+fn comment_header(source: Source) -> Result<Option<Vec<String>>, String> {
+    let cannot = |e: &dyn fmt::Display| format!("cannot read the header: {e}");
+    // One line's first record, as the CSV reader reads it.
+    let record_of = |line: &[u8]| -> Result<Option<::csv::StringRecord>, String> {
+        let mut reader = ::csv::ReaderBuilder::new()
+            .comment(None)
+            .has_headers(false)
+            .flexible(true)
+            .from_reader(line);
+        let mut record = ::csv::StringRecord::new();
         match reader.read_record(&mut record) {
-            Ok(true) => {}
-            Ok(false) => return Ok(None),
-            Err(e) => return Err(format!("cannot read the header: {e}")),
+            Ok(true) => Ok(Some(record)),
+            Ok(false) => Ok(None),
+            Err(e) => Err(cannot(&e)),
         }
-        let first = record.get(0).unwrap_or("");
-        if let Some(rest) = first.strip_prefix('#') {
-            let mut names = vec![rest.trim().to_string()];
-            names.extend(record.iter().skip(1).map(|c| c.trim().to_string()));
-            last_comment = Some(names);
+    };
+    let mut lines = BufReader::new(source.open_at(0).map_err(|e| cannot(&e))?);
+    let mut last_comment = None;
+    let mut line = Vec::new();
+    let mut first = true;
+    loop {
+        line.clear();
+        if lines.read_until(b'\n', &mut line).map_err(|e| cannot(&e))? == 0 {
+            return Ok(None);
+        }
+        let mut text = &line[..];
+        if std::mem::take(&mut first) {
+            text = text.strip_prefix(BOM).unwrap_or(text);
+        }
+        if let Some(rest) = text.strip_prefix(b"#") {
+            if let Some(record) = record_of(rest)? {
+                last_comment = Some(record.iter().map(|c| c.trim().to_string()).collect());
+            }
             continue;
         }
-        let numeric = all_numbers(&record);
-        return Ok(if numeric { last_comment } else { None });
+        // The first record: from this line on (a quoted cell may run over lines).
+        let Some(record) = record_of(text)? else {
+            // An empty line (or one of carriage returns only).
+            continue;
+        };
+        return Ok(if all_numbers(&record) {
+            last_comment
+        } else {
+            None
+        });
     }
 }
+
+/// The UTF-8 byte order mark some editors put first in a text file.
+const BOM: &[u8] = b"\xef\xbb\xbf";
 
 /// The 1-based line of the record that starts at `byte` of `source` (or at the first line
 /// after it that is neither empty nor a comment): a record's own line, however many empty or
@@ -543,6 +573,8 @@ impl Rows<'_> {
         let mut offset = base;
         let mut end = false;
         let mut bounds = Vec::with_capacity(self.header.len() + 1);
+        // A byte order mark first in the file is no part of its first line.
+        let mut bom = base == 0;
         while !(end && held == 0) {
             if !end {
                 if held == buf.len() {
@@ -557,6 +589,15 @@ impl Rows<'_> {
                 }
             }
             let mut at = 0;
+            if bom {
+                if held < BOM.len() && !end {
+                    continue;
+                }
+                bom = false;
+                if buf[..held].starts_with(BOM) {
+                    at = BOM.len();
+                }
+            }
             loop {
                 // The lines before the first quote, carriage return or invalid UTF-8, all at
                 // once: one scan of each kind over many lines.
@@ -587,19 +628,17 @@ impl Rows<'_> {
                 at += clean;
                 // Then one line as it comes.
                 let rest = &buf[at..held];
-                let (line, next, ended) = match memchr::memchr(b'\n', rest) {
-                    Some(n) => (&rest[..n], at + n + 1, true),
-                    None if end && !rest.is_empty() => (rest, held, false),
+                let (line, next) = match memchr::memchr(b'\n', rest) {
+                    Some(n) => (&rest[..n], at + n + 1),
+                    None if end && !rest.is_empty() => (rest, held),
                     None => break,
                 };
-                let comment = line.first() == Some(&b'#');
-                if comment && ended {
+                if line.first() == Some(&b'#') {
                     at = next;
                     continue;
                 }
                 let line = line.strip_suffix(b"\r").unwrap_or(line);
-                // (A comment that no line end closes is the CSV reader's to read.)
-                let plain = !comment && memchr::memchr2(b'"', b'\r', line).is_none();
+                let plain = memchr::memchr2(b'"', b'\r', line).is_none();
                 match std::str::from_utf8(line) {
                     Ok(text) if plain => {
                         if !text.is_empty() {
@@ -607,7 +646,11 @@ impl Rows<'_> {
                         }
                     }
                     _ => {
-                        let tail = std::io::Cursor::new(&buf[at..held]).chain(source);
+                        // A line end after the last line: a comment there is one without it
+                        // too (the CSV reader would take it for a record).
+                        let tail = std::io::Cursor::new(&buf[at..held])
+                            .chain(source)
+                            .chain(&b"\n"[..]);
                         return self.read_quoted(tail, offset + at as u64);
                     }
                 }
@@ -726,7 +769,8 @@ mod tests {
     use super::*;
 
     /// The selected cells of every record, or the error's line and message: the CSV reader
-    /// alone, record by record, as every row was read before plain lines were split apart.
+    /// alone, record by record, as every row was read before plain lines were split apart
+    /// (with a line end after the last line, so that a comment there is one).
     fn by_the_csv_reader(
         bytes: &[u8],
         column: usize,
@@ -735,7 +779,7 @@ mod tests {
         let mut reader = ::csv::ReaderBuilder::new()
             .comment(Some(b'#'))
             .flexible(true)
-            .from_reader(bytes);
+            .from_reader(bytes.chain(&b"\n"[..]));
         let header = match reader.headers() {
             Ok(h) => h.len(),
             Err(e) => return fail(None, format!("cannot read the header: {e}")),
@@ -807,13 +851,7 @@ mod tests {
             .ok()
             .and_then(|n| n.parse().ok())
             .unwrap_or(20_000);
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut next = crate::xorshift(0x9e37_79b9_7f4a_7c15);
         let mut agreed = [0u64; 2];
         for case in 0..cases {
             let mut text = b"a,b,c\n".to_vec();
@@ -861,5 +899,33 @@ mod tests {
         }
         // Both outcomes were tried, many times.
         assert!(agreed.iter().all(|&n| n > cases / 20), "{agreed:?}");
+    }
+
+    /// A header row whose first cell is a quoted `"#..."` is a header row, not a comment (the
+    /// CSV reader's comments start with the byte `#`); a `#` line before numbers is the header.
+    #[test]
+    fn only_a_line_that_starts_with_a_hash_is_a_comment_header() {
+        let label = Path::new("t.csv");
+        let quoted = parse_column(label, b"\"#t [ns]\",x\n1,2\n3,4\n", "x");
+        assert_eq!(quoted, Ok(vec![2.0, 4.0]));
+        let time = parse_column(label, b"\"#t [ns]\",x\n1,2\n3,4\n", "#t");
+        assert_eq!(time, Ok(vec![1.0, 3.0]));
+        let comment = parse_column(label, b"# written by a logger\n#t [ns],x\n1,2\n3,4\n", "x");
+        assert_eq!(comment, Ok(vec![2.0, 4.0]));
+    }
+
+    /// A EuRoC comment header after a byte order mark, after a comment holding a quote, and a
+    /// comment as the last line without a line end: read as the header, and ignored.
+    #[test]
+    fn comments_hold_whatever_they_hold() {
+        let label = Path::new("t.csv");
+        let bom = parse_column(label, b"\xef\xbb\xbf#t [ns],x\n1,2\n3,4\n", "x");
+        assert_eq!(bom, Ok(vec![2.0, 4.0]));
+        let quote = b"# by x,\"hello world\n#t [ns],x\n1,2\n3,4\n";
+        assert_eq!(parse_column(label, quote, "x"), Ok(vec![2.0, 4.0]));
+        let last = parse_column(label, b"t,x\n1,2\n3,4\n# end of log", "x");
+        assert_eq!(last, Ok(vec![2.0, 4.0]));
+        let last_quoted = parse_column(label, b"t,x\n1,\"2\"\n3,4\n# end, \"of log", "x");
+        assert_eq!(last_quoted, Ok(vec![2.0, 4.0]));
     }
 }

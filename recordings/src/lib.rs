@@ -18,3 +18,14 @@ pub mod rosbag2;
 pub mod source;
 pub mod timing;
 pub mod units;
+
+/// A fixed generator for the unit tests' random inputs (xorshift64).
+#[cfg(test)]
+pub(crate) fn xorshift(mut state: u64) -> impl FnMut() -> u64 {
+    move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        state
+    }
+}

@@ -246,6 +246,7 @@ fn characterise(
                 read.unknown.get(i).and_then(Option::as_deref),
                 given[i / 3],
                 &columns[i],
+                args.topic.is_some(),
             )
         })
         .collect::<Result<_, _>>()
@@ -483,13 +484,15 @@ fn parse_unit(name: &str) -> Result<Unit, Fail> {
 }
 
 /// The unit of axis `i`: its header's (or the message's), else the flag's, checked to measure
-/// what the axis measures. `bracket` is a header bracket that names no unit known here.
+/// what the axis measures. `bracket` is a header bracket that names no unit known here;
+/// `messages`: the axes are a ROS message's, not CSV columns.
 fn axis_unit(
     i: usize,
     read: Option<Unit>,
     bracket: Option<&str>,
     given: Option<Unit>,
     column: &str,
+    messages: bool,
 ) -> Result<Unit, Fail> {
     let (want, flag) = match i {
         0..3 => (Quantity::AngularRate, "--gyro-unit"),
@@ -498,12 +501,22 @@ fn axis_unit(
     if let (Some(r), Some(g)) = (read, given)
         && r != g
     {
-        return Err(Fail(format!(
-            "{flag} {}: the header of column '{}' says {}",
-            g.name,
-            escaped(column),
-            r.name
-        )));
+        return Err(Fail(if messages {
+            format!(
+                "{flag} {}: a sensor_msgs/Imu message gives {} in {} (SI units, REP 103); \
+                 {flag} is for CSV columns without a unit",
+                g.name,
+                escaped(column),
+                r.name
+            )
+        } else {
+            format!(
+                "{flag} {}: the header of column '{}' says {}",
+                g.name,
+                escaped(column),
+                r.name
+            )
+        }));
     }
     if let Some(g) = given
         && g.quantity != want

@@ -132,7 +132,13 @@ pub fn resolve_rate(given: Option<f64>, timing: Option<&TimingSummary>) -> Resul
             let r = check_rate(r)?;
             if (r / t.rate_hz - 1.0).abs() > 0.01 {
                 return Err(Fail(format!(
-                    "--rate {r}: the timestamps give {} Hz",
+                    "--rate {}: {} give {} Hz",
+                    number(r),
+                    if t.header_stamps {
+                        "the messages' header stamps"
+                    } else {
+                        "the timestamps"
+                    },
                     t.rate_hz
                 )));
             }
@@ -280,10 +286,23 @@ pub fn check_decimate(m: usize) -> Result<(), Fail> {
 pub fn check_rate(rate: f64) -> Result<f64, Fail> {
     if !(rate.is_finite() && rate > 0.0) {
         return Err(Fail(format!(
-            "--rate {rate}: must be a positive number of Hz"
+            "--rate {}: must be a positive number of Hz",
+            number(rate)
         )));
     }
     Ok(rate)
+}
+
+/// A number given on the command line, as an error shows it: as written for most, in
+/// exponent form where that is shorter (`1e-300`, not three hundred digits).
+pub fn number(v: f64) -> String {
+    let plain = v.to_string();
+    let exponent = format!("{v:e}");
+    if exponent.len() < plain.len() {
+        exponent
+    } else {
+        plain
+    }
 }
 
 /// A `--lambda` in (0, 1].
@@ -353,7 +372,8 @@ pub fn check_span(flag: &str, rate: f64, samples: usize) -> Result<(), Fail> {
     let span = samples.max(1) as f64 / rate;
     if !(span.is_finite() && (1.0 / rate).is_finite()) {
         return Err(Fail(format!(
-            "{flag} {rate}: too small, the time of {samples} samples overflows f64"
+            "{flag} {}: too small, the time of {samples} samples overflows f64",
+            number(rate)
         )));
     }
     Ok(())

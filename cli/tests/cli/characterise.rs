@@ -358,6 +358,48 @@ fn bad_recordings_exit_2_with_one_line() {
         "IMU topics: /imu0",
     );
     refused(&["noise", b, "--column", "gx"], "/imu0");
+    // A message's units are SI: a unit flag that says otherwise is refused in the words of a
+    // message, not of a CSV header; a --rate the header stamps disagree with names them.
+    refused(
+        &[
+            "characterise",
+            b,
+            "--topic",
+            "/imu0",
+            "--gyro-unit",
+            "deg/s",
+            "--out",
+            o,
+        ],
+        "--gyro-unit deg/s: a sensor_msgs/Imu message gives gx in rad/s (SI units, REP 103)",
+    );
+    refused(
+        &[
+            "characterise",
+            b,
+            "--topic",
+            "/imu0",
+            "--rate",
+            "200",
+            "--out",
+            o,
+        ],
+        "--rate 200: the messages' header stamps give 100",
+    );
+    // A number too small to write out is shown in exponent form.
+    refused(
+        &[
+            "characterise",
+            b,
+            "--topic",
+            "/imu0",
+            "--rate",
+            "1e-300",
+            "--out",
+            o,
+        ],
+        "--rate 1e-300: ",
+    );
     // A truncated bag.
     let bytes = fixture_bytes("noise.bag");
     let cut = dir.join("cut.bag");

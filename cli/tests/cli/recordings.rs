@@ -735,39 +735,46 @@ fn messages_stored_out_of_order_inside_a_chunk_are_read_in_time_order() {
 }
 
 #[test]
-fn a_backward_stamp_does_not_switch_off_the_check_of_a_given_rate() {
+fn a_bad_stamp_does_not_switch_off_the_check_of_a_given_rate() {
     let dir = temp_dir("backward-rate");
-    // 1000 rows at 100 Hz; row 10 stamped as row 8.
+    // 1000 rows at 100 Hz; row 10 stamped as row 8, not a number, or empty.
     let frames = noise(1000, 2);
-    let mut s = "t_ns,gx\n".to_string();
-    for (i, f) in frames.iter().enumerate() {
-        let stamp = if i == 10 {
-            frames[8].stamp_ns
-        } else {
-            f.stamp_ns
-        };
-        writeln!(s, "{stamp},{:?}", f.axes[0]).unwrap();
+    let stamps = [
+        ("back", frames[8].stamp_ns.to_string()),
+        ("abc", "abc".to_string()),
+        ("empty", String::new()),
+    ];
+    for (name, bad) in stamps {
+        let mut s = "t_ns,gx\n".to_string();
+        for (i, f) in frames.iter().enumerate() {
+            let stamp = if i == 10 {
+                bad.clone()
+            } else {
+                f.stamp_ns.to_string()
+            };
+            writeln!(s, "{stamp},{:?}", f.axes[0]).unwrap();
+        }
+        let file = dir.join(format!("{name}.csv"));
+        std::fs::write(&file, s).unwrap();
+        let out = imu_ar(&["noise", path(&file), "--column", "gx", "--rate", "200"]);
+        assert_one_line_failure(&out);
+        assert!(
+            stderr(&out).contains("--rate 200: the timestamps give 100"),
+            "{name}: {}",
+            stderr(&out)
+        );
+        // The rate the stamps give is taken, the sample kept.
+        let got = json(&imu_ar(&[
+            "noise",
+            path(&file),
+            "--column",
+            "gx",
+            "--rate",
+            "100",
+            "--json",
+        ]));
+        assert_eq!(got["n"], 1000, "{name}");
     }
-    let file = dir.join("back.csv");
-    std::fs::write(&file, s).unwrap();
-    let out = imu_ar(&["noise", path(&file), "--column", "gx", "--rate", "200"]);
-    assert_one_line_failure(&out);
-    assert!(
-        stderr(&out).contains("--rate 200: the timestamps give"),
-        "{}",
-        stderr(&out)
-    );
-    // The rate the stamps give is taken, the sample kept.
-    let got = json(&imu_ar(&[
-        "noise",
-        path(&file),
-        "--column",
-        "gx",
-        "--rate",
-        "100",
-        "--json",
-    ]));
-    assert_eq!(got["n"], 1000);
 }
 
 #[test]
