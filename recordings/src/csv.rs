@@ -872,11 +872,11 @@ mod tests {
                         text.extend_from_slice(
                             format!("{},{} ,{}", r % 1000, r % 7, r % 3).as_bytes(),
                         );
-                        text.extend_from_slice(if r % 5 == 0 { b"\r\n" } else { b"\n" });
+                        text.extend_from_slice(if r.is_multiple_of(5) { b"\r\n" } else { b"\n" });
                     }
                 }
             }
-            if next() % 4 == 0 {
+            if next().is_multiple_of(4) {
                 text.pop();
             }
             let column = (next() % 3) as usize;

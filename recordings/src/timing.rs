@@ -573,7 +573,7 @@ mod tests {
             let mut next = crate::xorshift(0x9e37_79b9_7f4a_7c15);
             let mut t = vec![1_600_000_000_000_000_000i64];
             for _ in 0..1_000_000 {
-                let iv = if next() % 12 == 0 {
+                let iv = if next().is_multiple_of(12) {
                     (low + next() % (high - low)) as i64
                 } else {
                     2_500_000
