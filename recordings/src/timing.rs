@@ -225,7 +225,7 @@ impl Bucket {
 }
 
 /// Timestamps taken one by one: their intervals in a histogram of buckets about 0.1 % wide,
-/// each with the exact sum, spread and extremes of its intervals (see [`BITS`]).
+/// each with the exact sum, spread and extremes of its intervals.
 #[derive(Clone, Debug, Default)]
 pub struct Timing {
     first: Option<i64>,
