@@ -275,6 +275,13 @@ item(f"- On an AR(2) whose dynamics drift, the lattice's mean squared one-step p
 item(f"- The composite noise model explains the Allan deviation of **{len(every)} of {len(gyros)}** "
       "gyro axes of the two real records at every averaging time "
       "([Noise model](docs/noise-model.md#the-composite-noise-model)).")
+versus = {r[next(iter(r))]: r["wall (s)"] for r in rows("perf-versus-pandas")}
+tool = next(v for k, v in versus.items() if k.startswith("imu-ar characterise"))
+notebook = next(v for k, v in versus.items() if k.startswith("pandas"))
+item(f"- `imu-ar characterise` of a 1-hour, 400 Hz six-axis EuRoC CSV (Allan deviation, models, "
+      f"plots and seven parameter files) takes **{tool} s**, **{versus['ratio']}** times the "
+      f"**{notebook} s** that pandas and allantools take to read the file and compute its Allan "
+      "deviations (`tools/csv-versus-pandas.sh`, [Recordings](docs/recordings.md)).")
 PY
     replace headline "$tmp/headline.md"
 fi

@@ -367,9 +367,15 @@ pub fn shown(cell: &str) -> String {
     }
 }
 
+/// A cell as a number, as `str::parse::<f64>` reads it (the same values and the same
+/// refusals), faster.
+fn number(cell: &str) -> Option<f64> {
+    fast_float2::parse::<f64, _>(cell).ok()
+}
+
 /// A cell as a finite number, or what is wrong with it.
 pub fn finite(column: &str) -> impl Fn(&str) -> Result<f64, String> + '_ {
-    move |cell| match cell.parse::<f64>() {
+    move |cell| match number(cell).ok_or(()) {
         Ok(v) if v.is_finite() => Ok(v),
         Ok(_) => Err(format!(
             "column '{column}': '{}' is not a finite number",
@@ -927,5 +933,45 @@ mod tests {
         assert_eq!(last, Ok(vec![2.0, 4.0]));
         let last_quoted = parse_column(label, b"t,x\n1,\"2\"\n3,4\n# end, \"of log", "x");
         assert_eq!(last_quoted, Ok(vec![2.0, 4.0]));
+    }
+
+    /// The fast parser reads every text as the standard library does: the same bits, or both
+    /// refuse. Random texts of a number's characters, a million of them.
+    #[test]
+    fn numbers_read_as_the_standard_library_reads_them() {
+        const CHARS: &[u8] = b"0123456789012345678901234567890123456789..--++eEeE_ xinfINFnaNty";
+        let mut next = crate::xorshift(0x1234_5678_9abc_def1);
+        let mut text = String::new();
+        for case in 0..1_000_000 {
+            text.clear();
+            for _ in 0..next() % 26 {
+                text.push(char::from(CHARS[(next() % CHARS.len() as u64) as usize]));
+            }
+            let want = text.parse::<f64>().ok();
+            let got = number(&text);
+            assert_eq!(
+                got.map(f64::to_bits),
+                want.map(f64::to_bits),
+                "case {case}: {text:?}"
+            );
+        }
+        // And the shortest, longest and nearest-to-halfway decimals.
+        for text in [
+            "4.9406564584124654e-324",
+            "2.2250738585072011e-308",
+            "1.7976931348623157e308",
+            "9007199254740993",
+            "0.015574726745215603",
+            "-0.06183358072315851",
+            "1e400",
+            "-1e-400",
+            "2.47032822920623272088e-324",
+        ] {
+            assert_eq!(
+                number(text).map(f64::to_bits),
+                text.parse::<f64>().ok().map(f64::to_bits),
+                "{text}"
+            );
+        }
     }
 }

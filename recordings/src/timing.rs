@@ -145,8 +145,33 @@ pub enum Step {
 /// never more than about 55,000 buckets, whatever the gaps.
 const BITS: u32 = 11;
 
-/// Intervals taken before they are sorted into the histogram, all at once.
-const PENDING: usize = 1 << 15;
+/// Buckets that wait before they are sorted into the histogram, all at once.
+const PENDING: usize = 1 << 12;
+
+/// Buckets open at once (see [`Timing::push`]).
+const SLOTS: usize = 64;
+
+/// `buckets` (in the order of their keys) with `more` (emptied) merged in, in that order.
+fn merged(buckets: &[Bucket], more: &mut Vec<Bucket>) -> Vec<Bucket> {
+    more.sort_by_key(|b| b.key);
+    let mut out: Vec<Bucket> = Vec::with_capacity(buckets.len() + more.len());
+    let mut add = |b: &Bucket| match out.last_mut() {
+        Some(last) if last.key == b.key => last.merge(b),
+        _ => out.push(*b),
+    };
+    let mut old = buckets.iter().peekable();
+    for b in more.drain(..) {
+        while let Some(&o) = old.peek()
+            && o.key <= b.key
+        {
+            add(o);
+            old.next();
+        }
+        add(&b);
+    }
+    old.for_each(add);
+    out
+}
 
 /// The intervals of one bucket, with their exact sum and extremes: the rate and the jitter are
 /// those of the intervals themselves, not of the buckets' centres.
@@ -164,6 +189,17 @@ struct Bucket {
 }
 
 impl Bucket {
+    /// No interval.
+    const EMPTY: Self = Self {
+        key: 0,
+        count: 0,
+        first: 0,
+        sum: 0,
+        sq: 0.0,
+        min: 0,
+        max: 0,
+    };
+
     /// The bucket of an interval `iv` (at least 1 ns): `iv` with its bits below its `BITS`
     /// highest cleared.
     fn key(iv: i64) -> i64 {
@@ -234,9 +270,11 @@ pub struct Timing {
     dropped: u64,
     /// The histogram, in the order of the intervals.
     buckets: Vec<Bucket>,
-    /// Intervals not yet in the histogram (sorting them in at once costs a fraction of a
-    /// table's lookup per interval).
-    pending: Vec<i64>,
+    /// The buckets being filled, by a hash of their key (most intervals land in a bucket that
+    /// is already open); a bucket that gives its slot up waits in `pending`.
+    open: Vec<Bucket>,
+    /// Buckets not yet in the histogram, sorted in all at once.
+    pending: Vec<Bucket>,
 }
 
 impl Timing {
@@ -257,10 +295,23 @@ impl Timing {
         if t <= self.last {
             return Step::Backward { last: self.last };
         }
-        self.pending.push(t.saturating_sub(self.last));
-        if self.pending.len() == PENDING {
-            self.buckets = self.histogram();
-            self.pending.clear();
+        let iv = t.saturating_sub(self.last);
+        let key = Bucket::key(iv);
+        if self.open.is_empty() {
+            self.open = vec![Bucket::EMPTY; SLOTS];
+        }
+        let slot = ((key as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 58) as usize % SLOTS;
+        let b = &mut self.open[slot];
+        if b.count > 0 && b.key == key {
+            b.take(iv);
+        } else {
+            if b.count > 0 {
+                self.pending.push(*b);
+            }
+            *b = Bucket::of(iv);
+            if self.pending.len() >= PENDING {
+                self.buckets = merged(&self.buckets, &mut self.pending);
+            }
         }
         self.last = t;
         self.accepted += 1;
@@ -283,31 +334,11 @@ impl Timing {
         (i128::from(self.last) - i128::from(first)) as f64
     }
 
-    /// The histogram with the pending intervals in.
+    /// The histogram with the open and pending buckets in.
     fn histogram(&self) -> Vec<Bucket> {
-        let mut pending = self.pending.clone();
-        pending.sort_unstable();
-        let mut merged: Vec<Bucket> = Vec::with_capacity(self.buckets.len() + 64);
-        let add = |merged: &mut Vec<Bucket>, b: &Bucket| match merged.last_mut() {
-            Some(last) if last.key == b.key => last.merge(b),
-            _ => merged.push(*b),
-        };
-        let mut counted = self.buckets.iter().peekable();
-        for iv in pending {
-            let key = Bucket::key(iv);
-            while let Some(&b) = counted.peek()
-                && b.key <= key
-            {
-                add(&mut merged, b);
-                counted.next();
-            }
-            match merged.last_mut() {
-                Some(last) if last.key == key => last.take(iv),
-                _ => merged.push(Bucket::of(iv)),
-            }
-        }
-        counted.for_each(|b| add(&mut merged, b));
-        merged
+        let mut rest: Vec<Bucket> = self.pending.clone();
+        rest.extend(self.open.iter().filter(|b| b.count > 0));
+        merged(&self.buckets, &mut rest)
     }
 
     /// The summary of the stamps taken; an error when they give no rate (fewer than two) or
