@@ -241,8 +241,10 @@ fn all_numbers(record: &::csv::StringRecord) -> bool {
 }
 
 /// The header of a file whose header is a comment: when the first record that is not a
-/// comment holds only numbers and a comment line comes before it, that comment line without
-/// its `#`. `None` when the file has an ordinary header row (or no comment before its data).
+/// comment holds only numbers and comment lines come before it, the last of them with as many
+/// fields as that record (else the last of them), without its `#`: a line of prose after the
+/// header is passed over.
+/// `None` when the file has an ordinary header row (or no such comment before its data).
 ///
 /// Read line by line as the row reader reads them: a comment is a line whose first byte is `#`
 /// (after a UTF-8 byte order mark on the first line), running to the next `\n`, and whatever
@@ -264,7 +266,8 @@ fn comment_header(source: Source) -> Result<Option<Vec<String>>, String> {
         }
     };
     let mut lines = BufReader::new(source.open_at(0).map_err(|e| cannot(&e))?);
-    let mut last_comment = None;
+    // The last comment of each width.
+    let mut comments: Vec<Vec<String>> = Vec::new();
     let mut line = Vec::new();
     let mut first = true;
     loop {
@@ -278,7 +281,9 @@ fn comment_header(source: Source) -> Result<Option<Vec<String>>, String> {
         }
         if let Some(rest) = text.strip_prefix(b"#") {
             if let Some(record) = record_of(rest)? {
-                last_comment = Some(record.iter().map(|c| c.trim().to_string()).collect());
+                let names: Vec<String> = record.iter().map(|c| c.trim().to_string()).collect();
+                comments.retain(|c| c.len() != names.len());
+                comments.push(names);
             }
             continue;
         }
@@ -287,11 +292,15 @@ fn comment_header(source: Source) -> Result<Option<Vec<String>>, String> {
             // An empty line (or one of carriage returns only).
             continue;
         };
-        return Ok(if all_numbers(&record) {
-            last_comment
-        } else {
-            None
-        });
+        if !all_numbers(&record) {
+            return Ok(None);
+        }
+        // As wide as the data, else the last (a header shorter or longer than its rows is
+        // refused as such when the rows are read).
+        let same = comments.iter().rposition(|c| c.len() == record.len());
+        return Ok(same
+            .or(comments.len().checked_sub(1))
+            .map(|i| comments.swap_remove(i)));
     }
 }
 
@@ -933,6 +942,9 @@ mod tests {
         assert_eq!(last, Ok(vec![2.0, 4.0]));
         let last_quoted = parse_column(label, b"t,x\n1,\"2\"\n3,4\n# end, \"of log", "x");
         assert_eq!(last_quoted, Ok(vec![2.0, 4.0]));
+        // The header, then a line of prose: the comment as wide as the data is the header.
+        let prose = b"#t [ns],x\n# recorded by logger v2\n1,2\n3,4\n";
+        assert_eq!(parse_column(label, prose, "x"), Ok(vec![2.0, 4.0]));
     }
 
     /// The fast parser reads every text as the standard library does: the same bits, or both

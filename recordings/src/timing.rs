@@ -90,11 +90,11 @@ impl TimeUnit {
             Ok(v) if v.is_finite() && (v * scale as f64).abs() < 9.2e18 => {
                 Ok((v * scale as f64).round() as i64)
             }
-            Ok(_) => Err(format!(
+            Ok(v) if !v.is_nan() => Err(format!(
                 "timestamp '{cell}' {} is out of range",
                 self.name()
             )),
-            Err(_) => Err(format!("timestamp '{cell}' is not a number")),
+            _ => Err(format!("timestamp '{cell}' is not a number")),
         }
     }
 }
@@ -140,16 +140,27 @@ pub enum Step {
     },
 }
 
-/// Significant bits of an interval's bucket: intervals below 2^BITS ns have a bucket each;
-/// above, a bucket spans at most 2^-(BITS-1) of its intervals (about 0.1 %), so that there are
-/// never more than about 55,000 buckets, whatever the gaps.
-const BITS: u32 = 11;
+/// The most buckets held: past them, every bucket's width doubles (one significant bit less).
+const DISTINCT: usize = 1 << 16;
 
 /// Buckets that wait before they are sorted into the histogram, all at once.
 const PENDING: usize = 1 << 12;
 
 /// Buckets open at once (see [`Timing::push`]).
 const SLOTS: usize = 64;
+
+/// `buckets` (in the order of their keys) at `bits` significant bits, neighbours merged.
+fn coarser(buckets: &[Bucket], bits: u32) -> Vec<Bucket> {
+    let mut out: Vec<Bucket> = Vec::with_capacity(buckets.len() / 2 + 1);
+    for b in buckets {
+        let key = Bucket::key(b.key, bits);
+        match out.last_mut() {
+            Some(last) if last.key == key => last.merge(b),
+            _ => out.push(Bucket { key, ..*b }),
+        }
+    }
+    out
+}
 
 /// `buckets` (in the order of their keys) with `more` (emptied) merged in, in that order.
 fn merged(buckets: &[Bucket], more: &mut Vec<Bucket>) -> Vec<Bucket> {
@@ -200,17 +211,17 @@ impl Bucket {
         max: 0,
     };
 
-    /// The bucket of an interval `iv` (at least 1 ns): `iv` with its bits below its `BITS`
-    /// highest cleared.
-    fn key(iv: i64) -> i64 {
-        let bits = 64 - iv.leading_zeros();
-        let shift = bits.saturating_sub(BITS);
+    /// The bucket of an interval `iv` (at least 1 ns) at `bits` significant bits: `iv` with
+    /// its bits below its `bits` highest cleared (every interval its own below `2^bits` ns; a
+    /// bucket `2^-(bits-1)` of its intervals wide at most above).
+    fn key(iv: i64, bits: u32) -> i64 {
+        let shift = (64 - iv.leading_zeros()).saturating_sub(bits);
         (iv >> shift) << shift
     }
 
-    fn of(iv: i64) -> Self {
+    fn of(iv: i64, bits: u32) -> Self {
         Self {
-            key: Self::key(iv),
+            key: Self::key(iv, bits),
             count: 1,
             first: iv,
             sum: 0,
@@ -260,8 +271,10 @@ impl Bucket {
     }
 }
 
-/// Timestamps taken one by one: their intervals in a histogram of buckets about 0.1 % wide,
-/// each with the exact sum, spread and extremes of its intervals.
+/// Timestamps taken one by one: their intervals in a histogram, each bucket with the exact sum,
+/// spread and extremes of its intervals. An interval has a bucket of its own while there are
+/// at most 65,536 of them; past that, the buckets are made wider, a bit of resolution at a
+/// time (to about 0.01 % with gaps of every length).
 #[derive(Clone, Debug, Default)]
 pub struct Timing {
     first: Option<i64>,
@@ -275,12 +288,17 @@ pub struct Timing {
     open: Vec<Bucket>,
     /// Buckets not yet in the histogram, sorted in all at once.
     pending: Vec<Bucket>,
+    /// Significant bits of the buckets' keys (64: every interval its own).
+    bits: u32,
 }
 
 impl Timing {
     /// No stamps yet.
     pub fn new() -> Self {
-        Self::default()
+        Self {
+            bits: 64,
+            ..Self::default()
+        }
     }
 
     /// Takes the stamp `t` (ns) of the next sample: [`Step::Forward`] when it is later than the
@@ -296,7 +314,7 @@ impl Timing {
             return Step::Backward { last: self.last };
         }
         let iv = t.saturating_sub(self.last);
-        let key = Bucket::key(iv);
+        let key = Bucket::key(iv, self.bits);
         if self.open.is_empty() {
             self.open = vec![Bucket::EMPTY; SLOTS];
         }
@@ -308,9 +326,17 @@ impl Timing {
             if b.count > 0 {
                 self.pending.push(*b);
             }
-            *b = Bucket::of(iv);
+            *b = Bucket::of(iv, self.bits);
             if self.pending.len() >= PENDING {
                 self.buckets = merged(&self.buckets, &mut self.pending);
+                while self.buckets.len() > DISTINCT && self.bits > 1 {
+                    self.bits -= 1;
+                    self.buckets = coarser(&self.buckets, self.bits);
+                    // The open buckets too, so that every key has this resolution.
+                    for b in self.open.iter_mut().filter(|b| b.count > 0) {
+                        b.key = Bucket::key(b.key, self.bits);
+                    }
+                }
             }
         }
         self.last = t;
@@ -437,7 +463,14 @@ fn classes(buckets: &[Bucket], reference: f64) -> Classes {
             c.short += n;
         } else if r > 1.25 {
             c.gaps += n;
-            c.missing += n * ((r.round() as u64).saturating_sub(1));
+            // Each gap misses the periods it spans less one: per interval where the bucket's
+            // intervals all round alike, else from their sum.
+            let periods = |iv: i64| (iv as f64 / reference).round();
+            c.missing += if periods(b.min) == periods(b.max) {
+                n * (periods(b.min) as u64).saturating_sub(1)
+            } else {
+                (b.total() / reference - n as f64).round().max(0.0) as u64
+            };
         } else {
             c.regular += n;
             c.sum += b.total();
@@ -663,5 +696,43 @@ mod tests {
         assert!(s.nanoseconds(".").is_err());
         assert!(s.nanoseconds("1.2.3").is_err());
         assert!(s.nanoseconds("9300000000.0").is_err());
+        assert_eq!(
+            s.nanoseconds("nan"),
+            Err("timestamp 'nan' is not a number".into())
+        );
+    }
+
+    #[test]
+    fn intervals_either_side_of_a_threshold_and_the_samples_gaps_miss_are_counted_one_by_one() {
+        // A 1 kHz clock; 500 intervals 1 ns under 1.25 periods and 500 1 ns over.
+        let mut t = vec![0i64];
+        for i in 0..20_000 {
+            let iv = match i % 40 {
+                0 => 1_249_999,
+                1 => 1_250_001,
+                _ => 1_000_000,
+            };
+            t.push(t[t.len() - 1] + iv);
+        }
+        let s = summary_of(&t);
+        assert_eq!((s.gaps, s.missing_samples), (500, 0));
+        let mean = (19_000.0 * 1e6 + 500.0 * 1_249_999.0) / 19_500.0;
+        assert!(
+            (s.rate_hz / (1e9 / mean) - 1.0).abs() < 1e-12,
+            "{}",
+            s.rate_hz
+        );
+        // Gaps of 1000.4 and 1000.6 periods of 2.5 ms: 999 and 1000 samples missing.
+        let mut t = vec![0i64];
+        for i in 0..10_000 {
+            let iv = match i {
+                100 => 2_501_000_000,
+                200 => 2_501_500_000,
+                _ => 2_500_000,
+            };
+            t.push(t[t.len() - 1] + iv);
+        }
+        let s = summary_of(&t);
+        assert_eq!((s.gaps, s.missing_samples), (2, 1999));
     }
 }

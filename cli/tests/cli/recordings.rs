@@ -775,6 +775,29 @@ fn a_bad_stamp_does_not_switch_off_the_check_of_a_given_rate() {
         ]));
         assert_eq!(got["n"], 1000, "{name}");
     }
+    // A time column without a unit: an empty first stamp leaves the unit to the next one.
+    let mut s = "timestamp,gx\n".to_string();
+    for (i, f) in frames.iter().enumerate() {
+        let stamp = if i == 0 {
+            String::new()
+        } else {
+            f.stamp_ns.to_string()
+        };
+        writeln!(s, "{stamp},{:?}", f.axes[0]).unwrap();
+    }
+    let file = dir.join("first-empty.csv");
+    std::fs::write(&file, s).unwrap();
+    let out = imu_ar(&["noise", path(&file), "--column", "gx", "--rate", "200"]);
+    assert_one_line_failure(&out);
+    assert!(
+        stderr(&out).contains("--rate 200: the timestamps give 100"),
+        "{}",
+        stderr(&out)
+    );
+    let out = imu_ar(&["noise", path(&file), "--column", "gx"]);
+    assert_one_line_failure(&out);
+    let e = stderr(&out);
+    assert!(e.contains(":2: timestamp '' is not a number"), "{e}");
 }
 
 #[test]
