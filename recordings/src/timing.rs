@@ -143,11 +143,8 @@ pub enum Step {
 /// The most buckets held: past them, every bucket's width doubles (one significant bit less).
 const DISTINCT: usize = 1 << 16;
 
-/// Buckets that wait before they are sorted into the histogram, all at once.
-const PENDING: usize = 1 << 12;
-
-/// Buckets open at once (see [`Timing::push`]).
-const SLOTS: usize = 64;
+/// Intervals taken before they are sorted into the histogram, all at once.
+const PENDING: usize = 1 << 15;
 
 /// `buckets` (in the order of their keys) at `bits` significant bits, neighbours merged.
 fn coarser(buckets: &[Bucket], bits: u32) -> Vec<Bucket> {
@@ -162,25 +159,30 @@ fn coarser(buckets: &[Bucket], bits: u32) -> Vec<Bucket> {
     out
 }
 
-/// `buckets` (in the order of their keys) with `more` (emptied) merged in, in that order.
-fn merged(buckets: &[Bucket], more: &mut Vec<Bucket>) -> Vec<Bucket> {
-    more.sort_by_key(|b| b.key);
-    let mut out: Vec<Bucket> = Vec::with_capacity(buckets.len() + more.len());
-    let mut add = |b: &Bucket| match out.last_mut() {
+/// `buckets` (in the order of their keys) with the intervals `more` (emptied) in, at `bits`
+/// significant bits.
+fn merged(buckets: &[Bucket], more: &mut Vec<i64>, bits: u32) -> Vec<Bucket> {
+    more.sort_unstable();
+    let mut out: Vec<Bucket> = Vec::with_capacity(buckets.len() + 64);
+    let add = |out: &mut Vec<Bucket>, b: &Bucket| match out.last_mut() {
         Some(last) if last.key == b.key => last.merge(b),
         _ => out.push(*b),
     };
     let mut old = buckets.iter().peekable();
-    for b in more.drain(..) {
+    for iv in more.drain(..) {
+        let key = Bucket::key(iv, bits);
         while let Some(&o) = old.peek()
-            && o.key <= b.key
+            && o.key <= key
         {
-            add(o);
+            add(&mut out, o);
             old.next();
         }
-        add(&b);
+        match out.last_mut() {
+            Some(last) if last.key == key => last.take(iv),
+            _ => out.push(Bucket::of(iv, bits)),
+        }
     }
-    old.for_each(add);
+    old.for_each(|o| add(&mut out, o));
     out
 }
 
@@ -200,17 +202,6 @@ struct Bucket {
 }
 
 impl Bucket {
-    /// No interval.
-    const EMPTY: Self = Self {
-        key: 0,
-        count: 0,
-        first: 0,
-        sum: 0,
-        sq: 0.0,
-        min: 0,
-        max: 0,
-    };
-
     /// The bucket of an interval `iv` (at least 1 ns) at `bits` significant bits: `iv` with
     /// its bits below its `bits` highest cleared (every interval its own below `2^bits` ns; a
     /// bucket `2^-(bits-1)` of its intervals wide at most above).
@@ -283,11 +274,9 @@ pub struct Timing {
     dropped: u64,
     /// The histogram, in the order of the intervals.
     buckets: Vec<Bucket>,
-    /// The buckets being filled, by a hash of their key (most intervals land in a bucket that
-    /// is already open); a bucket that gives its slot up waits in `pending`.
-    open: Vec<Bucket>,
-    /// Buckets not yet in the histogram, sorted in all at once.
-    pending: Vec<Bucket>,
+    /// Intervals not yet in the histogram, sorted in all at once (a fraction of a table
+    /// lookup per interval).
+    pending: Vec<i64>,
     /// Significant bits of the buckets' keys (64: every interval its own).
     bits: u32,
 }
@@ -313,30 +302,12 @@ impl Timing {
         if t <= self.last {
             return Step::Backward { last: self.last };
         }
-        let iv = t.saturating_sub(self.last);
-        let key = Bucket::key(iv, self.bits);
-        if self.open.is_empty() {
-            self.open = vec![Bucket::EMPTY; SLOTS];
-        }
-        let slot = ((key as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 58) as usize % SLOTS;
-        let b = &mut self.open[slot];
-        if b.count > 0 && b.key == key {
-            b.take(iv);
-        } else {
-            if b.count > 0 {
-                self.pending.push(*b);
-            }
-            *b = Bucket::of(iv, self.bits);
-            if self.pending.len() >= PENDING {
-                self.buckets = merged(&self.buckets, &mut self.pending);
-                while self.buckets.len() > DISTINCT && self.bits > 1 {
-                    self.bits -= 1;
-                    self.buckets = coarser(&self.buckets, self.bits);
-                    // The open buckets too, so that every key has this resolution.
-                    for b in self.open.iter_mut().filter(|b| b.count > 0) {
-                        b.key = Bucket::key(b.key, self.bits);
-                    }
-                }
+        self.pending.push(t.saturating_sub(self.last));
+        if self.pending.len() >= PENDING {
+            self.buckets = merged(&self.buckets, &mut self.pending, self.bits);
+            while self.buckets.len() > DISTINCT && self.bits > 1 {
+                self.bits -= 1;
+                self.buckets = coarser(&self.buckets, self.bits);
             }
         }
         self.last = t;
@@ -360,11 +331,9 @@ impl Timing {
         (i128::from(self.last) - i128::from(first)) as f64
     }
 
-    /// The histogram with the open and pending buckets in.
+    /// The histogram with the pending intervals in.
     fn histogram(&self) -> Vec<Bucket> {
-        let mut rest: Vec<Bucket> = self.pending.clone();
-        rest.extend(self.open.iter().filter(|b| b.count > 0));
-        merged(&self.buckets, &mut rest)
+        merged(&self.buckets, &mut self.pending.clone(), self.bits)
     }
 
     /// The summary of the stamps taken; an error when they give no rate (fewer than two) or
