@@ -47,6 +47,19 @@ fn the_ros_corpus_reads_without_a_panic() {
     replay("ros_read", 290, checks::ros_read);
 }
 
+/// Two MCAP inputs on which the sanitised `ros_read` runs out of its 2 GB: read here (no limit)
+/// without a panic; their allocation is still to be bounded.
+#[test]
+fn the_inputs_that_exhaust_the_fuzzers_memory_read_without_a_panic() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz/recordings/oom");
+    for file in std::fs::read_dir(dir)
+        .expect("the folder")
+        .map(|e| e.expect("an entry").path())
+    {
+        checks::ros_read(&std::fs::read(file).expect("the file"));
+    }
+}
+
 #[test]
 fn the_metadata_corpus_reads_without_a_panic() {
     replay("rosbag2_metadata", 550, checks::rosbag2_metadata);
