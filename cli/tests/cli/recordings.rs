@@ -734,35 +734,38 @@ fn messages_stored_out_of_order_inside_a_chunk_are_read_in_time_order() {
     assert_bits(&got, &ros::noise_frames(), "swapped.bag");
 }
 
+/// `frames`' gx under `header`, the stamp of row `row` written as `bad`.
+fn stamped_csv(dir: &Path, name: &str, header: &str, row: usize, bad: &str) -> PathBuf {
+    let mut s = format!("{header},gx\n");
+    for (i, f) in noise(1000, 2).iter().enumerate() {
+        let stamp = if i == row {
+            bad.to_string()
+        } else {
+            f.stamp_ns.to_string()
+        };
+        writeln!(s, "{stamp},{:?}", f.axes[0]).unwrap();
+    }
+    let file = dir.join(format!("{name}.csv"));
+    std::fs::write(&file, s).unwrap();
+    file
+}
+
+/// `--rate 200` on a 100 Hz record is refused, naming what the stamps give.
+fn refuses_rate_200(file: &Path) {
+    let out = imu_ar(&["noise", path(file), "--column", "gx", "--rate", "200"]);
+    assert_one_line_failure(&out);
+    let e = stderr(&out);
+    assert!(e.contains("--rate 200: the timestamps give 100"), "{e}");
+}
+
 #[test]
 fn a_bad_stamp_does_not_switch_off_the_check_of_a_given_rate() {
     let dir = temp_dir("backward-rate");
     // 1000 rows at 100 Hz; row 10 stamped as row 8, not a number, or empty.
-    let frames = noise(1000, 2);
-    let stamps = [
-        ("back", frames[8].stamp_ns.to_string()),
-        ("abc", "abc".to_string()),
-        ("empty", String::new()),
-    ];
-    for (name, bad) in stamps {
-        let mut s = "t_ns,gx\n".to_string();
-        for (i, f) in frames.iter().enumerate() {
-            let stamp = if i == 10 {
-                bad.clone()
-            } else {
-                f.stamp_ns.to_string()
-            };
-            writeln!(s, "{stamp},{:?}", f.axes[0]).unwrap();
-        }
-        let file = dir.join(format!("{name}.csv"));
-        std::fs::write(&file, s).unwrap();
-        let out = imu_ar(&["noise", path(&file), "--column", "gx", "--rate", "200"]);
-        assert_one_line_failure(&out);
-        assert!(
-            stderr(&out).contains("--rate 200: the timestamps give 100"),
-            "{name}: {}",
-            stderr(&out)
-        );
+    let back = noise(1000, 2)[8].stamp_ns.to_string();
+    for (name, bad) in [("back", back.as_str()), ("abc", "abc"), ("empty", "")] {
+        let file = stamped_csv(&dir, name, "t_ns", 10, bad);
+        refuses_rate_200(&file);
         // The rate the stamps give is taken, the sample kept.
         let got = json(&imu_ar(&[
             "noise",
@@ -776,24 +779,8 @@ fn a_bad_stamp_does_not_switch_off_the_check_of_a_given_rate() {
         assert_eq!(got["n"], 1000, "{name}");
     }
     // A time column without a unit: an empty first stamp leaves the unit to the next one.
-    let mut s = "timestamp,gx\n".to_string();
-    for (i, f) in frames.iter().enumerate() {
-        let stamp = if i == 0 {
-            String::new()
-        } else {
-            f.stamp_ns.to_string()
-        };
-        writeln!(s, "{stamp},{:?}", f.axes[0]).unwrap();
-    }
-    let file = dir.join("first-empty.csv");
-    std::fs::write(&file, s).unwrap();
-    let out = imu_ar(&["noise", path(&file), "--column", "gx", "--rate", "200"]);
-    assert_one_line_failure(&out);
-    assert!(
-        stderr(&out).contains("--rate 200: the timestamps give 100"),
-        "{}",
-        stderr(&out)
-    );
+    let file = stamped_csv(&dir, "first-empty", "timestamp", 0, "");
+    refuses_rate_200(&file);
     let out = imu_ar(&["noise", path(&file), "--column", "gx"]);
     assert_one_line_failure(&out);
     let e = stderr(&out);
