@@ -270,7 +270,6 @@ impl Bucket {
 pub struct Timing {
     first: Option<i64>,
     last: i64,
-    accepted: u64,
     dropped: u64,
     /// The histogram, in the order of the intervals.
     buckets: Vec<Bucket>,
@@ -296,7 +295,6 @@ impl Timing {
         let Some(_) = self.first else {
             self.first = Some(t);
             self.last = t;
-            self.accepted = 1;
             return Step::Forward;
         };
         if t <= self.last {
@@ -311,7 +309,6 @@ impl Timing {
             }
         }
         self.last = t;
-        self.accepted += 1;
         Step::Forward
     }
 
