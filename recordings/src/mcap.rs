@@ -122,10 +122,10 @@ pub fn read_selected(
                 opcode: op::CHUNK,
                 data,
             } => {
-                let records = match ::mcap::parse_record(op::CHUNK, data) {
+                let records = match parse(op::CHUNK, data) {
                     Ok(Record::Chunk { header, data }) => chunk_records(&header, data, limit),
                     Ok(_) => Err("a chunk record that is not one".into()),
-                    Err(e) => Err(e.to_string()),
+                    Err(e) => Err(e),
                 }
                 .map_err(|e| corrupt(&e, state.messages))?;
                 let mut rest: &[u8] = &records;
@@ -207,8 +207,7 @@ impl State<'_> {
     fn record(&mut self, opcode: u8, data: &[u8], topic: &str) -> Result<(), Refusal> {
         match opcode {
             op::SCHEMA | op::CHANNEL => {
-                let record = ::mcap::parse_record(opcode, data)
-                    .map_err(|e| Refusal::Corrupt(e.to_string()))?;
+                let record = parse(opcode, data).map_err(Refusal::Corrupt)?;
                 // The summary repeats schemas and channels: the same again is no news, a
                 // different definition of an ID is a damaged file.
                 let redefined = match &record {
@@ -238,7 +237,7 @@ impl State<'_> {
             }
             op::CHUNK => Err(Refusal::Corrupt("a chunk inside a chunk".into())),
             op::STATISTICS => {
-                if let Ok(Record::Statistics(stats)) = ::mcap::parse_record(opcode, data) {
+                if let Ok(Record::Statistics(stats)) = parse(opcode, data) {
                     self.counted = Some(stats.channel_message_counts);
                 }
                 Ok(())
@@ -267,6 +266,43 @@ impl State<'_> {
             _ => Ok(()),
         }
     }
+}
+
+/// The record `data` of kind `opcode`, parsed by the [`mcap`] crate once its strings are
+/// known to fit in it: the crate allocates the length a string declares before it reads the
+/// string, so a corrupt length of 4 GB would be 4 GB allocated.
+fn parse(opcode: u8, data: &[u8]) -> Result<Record<'_>, String> {
+    // Where the strings start, how many there are, and whether a map of strings follows.
+    let (fixed, strings, map) = match opcode {
+        op::SCHEMA => (2, 2, false),
+        op::CHANNEL => (4, 2, true),
+        op::CHUNK => (28, 1, false),
+        _ => (0, 0, false),
+    };
+    let overrun = || "a string overruns its record".to_string();
+    let mut rest = data.get(fixed..).unwrap_or_default();
+    for _ in 0..strings {
+        rest = skip_string(rest).ok_or_else(overrun)?;
+    }
+    if map {
+        // The map's length in bytes, then key and value strings while they are within it.
+        let len = bytes_at::<4>(rest, 0).map_or(0, u32::from_le_bytes);
+        let start = rest.len().saturating_sub(4);
+        rest = rest.get(4..).unwrap_or_default();
+        while start - rest.len() < len as usize && !rest.is_empty() {
+            rest = skip_string(rest)
+                .and_then(skip_string)
+                .ok_or_else(overrun)?;
+        }
+    }
+    ::mcap::parse_record(opcode, data).map_err(|e| e.to_string())
+}
+
+/// What follows the string (length u32, then its bytes) at the start of `bytes`; `None` when
+/// its length overruns `bytes`.
+fn skip_string(bytes: &[u8]) -> Option<&[u8]> {
+    let len = usize::try_from(u32::from_le_bytes(bytes_at::<4>(bytes, 0)?)).ok()?;
+    bytes.get(4..)?.get(len..)
 }
 
 /// The first record of `bytes` (opcode u8, length u64, body): its opcode, body and what
