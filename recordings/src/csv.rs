@@ -619,25 +619,25 @@ impl Rows<'_> {
                 let rest = &buf[at..held];
                 let special = memchr::memchr2(b'"', b'\r', rest).unwrap_or(rest.len());
                 let valid = match std::str::from_utf8(&rest[..special]) {
-                    Ok(_) => special,
-                    Err(e) => e.valid_up_to(),
+                    Ok(text) => text,
+                    Err(e) => std::str::from_utf8(&rest[..e.valid_up_to()]).unwrap_or_default(),
                 };
-                let clean = memchr::memrchr(b'\n', &rest[..valid]).map_or(0, |n| n + 1);
-                if let Ok(text) = std::str::from_utf8(&rest[..clean]) {
-                    // Commas and line ends in one pass: the fields of each line in `bounds`.
-                    let (mut line, mut field) = (0, 0);
-                    bounds.clear();
-                    for n in memchr::memchr2_iter(b',', b'\n', text.as_bytes()) {
-                        bounds.push((field, n));
-                        field = n + 1;
-                        if text.as_bytes()[n] == b'\n' {
-                            let record = &text[line..n];
-                            if !record.is_empty() && !record.starts_with('#') {
-                                self.fields(text, &bounds, offset + (at + line) as u64)?;
-                            }
-                            bounds.clear();
-                            line = n + 1;
+                // Up to the last line end: a character boundary.
+                let clean = memchr::memrchr(b'\n', valid.as_bytes()).map_or(0, |n| n + 1);
+                let text = &valid[..clean];
+                // Commas and line ends in one pass: the fields of each line in `bounds`.
+                let (mut line, mut field) = (0, 0);
+                bounds.clear();
+                for n in memchr::memchr2_iter(b',', b'\n', text.as_bytes()) {
+                    bounds.push((field, n));
+                    field = n + 1;
+                    if text.as_bytes()[n] == b'\n' {
+                        let record = &text[line..n];
+                        if !record.is_empty() && !record.starts_with('#') {
+                            self.fields(text, &bounds, offset + (at + line) as u64)?;
                         }
+                        bounds.clear();
+                        line = n + 1;
                     }
                 }
                 at += clean;

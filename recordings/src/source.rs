@@ -484,15 +484,16 @@ fn csv_stream(
         let (cells, stamp) = match time.get() {
             Some((i, unit)) => {
                 let (last, cells) = cells.split_last().ok_or("no cells")?;
-                let first = last.parse::<f64>().ok().filter(|v| v.is_finite());
-                let unit = match unit.or_else(|| TimeUnit::by_magnitude(first?)) {
+                // Asked only while the unit is not known yet.
+                let first = || last.parse::<f64>().ok().filter(|v| v.is_finite());
+                let unit = match unit.or_else(|| TimeUnit::by_magnitude(first()?)) {
                     Some(u) => u,
                     // A first stamp that is no number says nothing of the unit: its sample is
                     // kept (with --rate) and the next stamp is asked, or it is refused as such.
-                    None if first.is_none() && !strict => {
+                    None if first().is_none() && !strict => {
                         return row_values(&mut values, cells, request, &mut *each);
                     }
-                    None if first.is_none() => {
+                    None if first().is_none() => {
                         return Err(format!("timestamp '{}' is not a number", csv::shown(last)));
                     }
                     None if strict => {
