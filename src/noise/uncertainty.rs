@@ -2,7 +2,7 @@
 //! variances ([`NoiseModel::uncertainty`]).
 
 use super::component;
-use super::fit::{Column, Problem};
+use super::fit::{Column, Problem, RECORD_OCTAVES};
 use super::model::NoiseModel;
 use super::{NoiseError, NoiseType, Octaves, indexed};
 
@@ -214,10 +214,10 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
             self.white * self.white + n_ar2,
             libm::sqrt(n2_variance.max(0.0)),
         ));
-        // The random walk's rise may be shared with a Gauss-Markov term too long for the
-        // record to tell from it (`tau_max / 4`, its Allan deviation peaking half an octave
-        // before the record's end): K's interval allows for one.
-        let reach = octaves.tau(rows.saturating_sub(1)) / 4.0;
+        // The random walk's rise may be shared with a Gauss-Markov term as long as the record
+        // tells (`tau_max / RECORD_OCTAVES`: a longer one the identification takes as the walk
+        // itself): K's interval allows for one.
+        let reach = octaves.tau(rows.saturating_sub(1)) / RECORD_OCTAVES;
         let near = self
             .gauss_markov()
             .iter()

@@ -9,7 +9,12 @@ use imu_ar_host::campaign::{self, CASES};
 #[test]
 fn the_identified_fit_finds_the_truth_of_the_campaign() {
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let records = campaign::run(12, threads);
+    // IMU_AR_CAMPAIGN_SEED=S runs the seeds S..S+12 instead (the figures below are those of 0..12).
+    let first = std::env::var("IMU_AR_CAMPAIGN_SEED")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(0);
+    let records = campaign::run_from(first, 12, threads);
     println!("{}", campaign::table(&records));
     let s = campaign::summary(&records, true);
     assert_eq!(s.records, 192);
@@ -41,17 +46,14 @@ fn the_identified_fit_finds_the_truth_of_the_campaign() {
         s.white_spurious_k, s.white_spurious_k_reaching_zero,
         "{s:?}"
     );
-    // The 95 % intervals of N and K contain the truth in 85 to 99 % of the records. Measured,
-    // K's contain it on 143 of 144 (99.3 %): allowing for a Gauss-Markov term at tau_max / 4
-    // sharing the walk's rise makes them conservative. Held where it stands.
-    for (covered, of, most) in [
-        (s.n_covered, s.n_intervals, 0.99),
-        (s.k_covered, s.k_intervals, 0.995),
-    ] {
+    // The 95 % intervals of N and K contain the truth in 85 to 99 % of the records. Measured
+    // on seeds 0..12: N 184 of 192 (96 %), K 131 of 144 (91 %); on seeds 12..24: N 183 of 192
+    // (95 %), K 136 of 144 (94 %).
+    for (covered, of) in [(s.n_covered, s.n_intervals), (s.k_covered, s.k_intervals)] {
         assert!(of > 0);
         let rate = covered as f64 / of as f64;
         assert!(
-            (0.85..=most).contains(&rate),
+            (0.85..=0.99).contains(&rate),
             "coverage {covered} of {of}: {s:?}"
         );
     }
