@@ -180,13 +180,24 @@ impl<C: Chip> ImuReader for Driver<C> {
     /// and [`Error::SensorReset`] is returned (see [`Driver::recover`]); a FIFO reset finds
     /// such a chip by its power mode, and returns the same. Otherwise the whole packets in the
     /// FIFO (up to `out.len()`) are read, 8 per bus transfer; a partial packet stays in the
-    /// FIFO for the next call. Packets are parsed as the chip's type describes: skipped
-    /// packets are counted in [`FifoStats::malformed`] or [`FifoStats::invalid`].
+    /// FIFO for the next call. When the count left room for fewer than 8 packets, a sample
+    /// arriving during the read may have overwritten bytes not yet read: INT_STATUS is read
+    /// after it, and on the overflow flag (or a bus error there) the samples read are counted
+    /// as discarded instead of delivered, the FIFO is reset, and [`Error::FifoOverflow`]
+    /// ([`Error::FifoResync`] after the bus error) is returned. Packets are parsed as the
+    /// chip's type describes: packets the chip marked invalid are skipped and counted in
+    /// [`FifoStats::invalid`]. A header that is
+    /// not one (the ICM-42688-P's) most likely means misaligned packets (a byte lost or added
+    /// on the wire): the call's packets are dropped, the malformed ones counted in
+    /// [`FifoStats::malformed`] and the rest in [`FifoStats::discarded`], the FIFO is reset,
+    /// which realigns it, and [`Error::FifoResync`] is returned.
     ///
     /// A read that fails part-way would leave the FIFO misaligned for good (the MPU-6050's
     /// packets have no header). So, as TDK's drivers do, the FIFO is then reset: the samples
     /// of the call and those left in the FIFO are counted as discarded and
-    /// [`Error::FifoResync`] is returned. A reset that meets a bus error itself is remembered
+    /// [`Error::FifoResync`] is returned; what the failed transfer clocked out is counted as
+    /// [`FifoStats::discarded`] and [`FifoStats::unsure`]. A reset that meets a bus error
+    /// itself is remembered
     /// and finished by the next call, so an overflow, whose flag is cleared by reading it, is
     /// never lost.
     fn read_fifo(&mut self, out: &mut [RawSample]) -> Result<usize, Error<C::BusError>> {

@@ -47,6 +47,9 @@ pub(crate) struct PendingReset {
     /// A failed data read whose clocked-out bytes are not known yet: resolved by the next
     /// count read.
     unresolved: Option<Unresolved>,
+    /// Whole packets a failed data read may have clocked out beyond those counted in
+    /// `consumed` (see [`PendingReset::observe`]).
+    unsure: u32,
 }
 
 /// A failed data read not yet matched with a count.
@@ -62,9 +65,12 @@ impl PendingReset {
     /// A count of the FIFO read while the reset is pending (before it empties the FIFO).
     ///
     /// The bytes a failed transfer clocked out are `left - count` when nothing entered the
-    /// FIFO in between. When more came in than went out (the count grew), the samples that
-    /// entered are whole packets, so the bytes clocked out are congruent to `left - count`
-    /// modulo the packet size: the smallest such number is taken.
+    /// FIFO in between. Samples that entered are whole packets, so the bytes clocked out are
+    /// congruent to `left - count` modulo the packet size: the smallest such number is counted
+    /// (exact when no sample entered between the last count and this one, or when the count
+    /// grew), and the whole packets by which the transfer's length leaves room for more are
+    /// counted as unsure (a sample that entered while a transfer clocked out one packet more
+    /// looks the same to the counts).
     fn observe(&mut self, count: u16, packet: usize) {
         if let Some(u) = self.unresolved.take() {
             let out = if u.left >= count {
@@ -75,6 +81,10 @@ impl PendingReset {
                 u16::try_from(out).unwrap_or(0).min(u.len)
             };
             self.consumed = self.consumed.saturating_add(u32::from(out));
+            let room = usize::from(u.len - out) / packet;
+            self.unsure = self
+                .unsure
+                .saturating_add(u32::try_from(room).unwrap_or(u32::MAX));
         }
         self.held = self.held.max(count);
     }
@@ -243,6 +253,37 @@ pub(crate) fn read_fifo<C: Chip>(
         if batch.parse::<C>(bytes, out) {
             remaining = 0;
         }
+        if batch.malformed > 0 {
+            // A header that is not one: the packets are most likely misaligned (a byte lost or
+            // added on the wire), and a misaligned packet passes the header test now and then.
+            // The batch is dropped (the malformed packets counted as such, the rest as
+            // discarded) and the FIFO reset, which realigns it.
+            state.stats.malformed = state.stats.malformed.saturating_add(batch.malformed);
+            let bad = u32::try_from(batch.malformed).unwrap_or(u32::MAX);
+            let bad = bad.saturating_mul(u32::try_from(packet).unwrap_or(u32::MAX));
+            let taken = u32::try_from(taken).unwrap_or(u32::MAX);
+            let pending = state.pending.get_or_insert_with(PendingReset::default);
+            pending.resync = true;
+            pending.consumed = pending.consumed.saturating_add(taken.saturating_sub(bad));
+            return finish_reset(chip, state);
+        }
+    }
+    // A sample that arrived while a nearly full FIFO was read may have overwritten its oldest
+    // bytes before they were read: every packet after them would be misaligned. The overflow
+    // flag says; with it (or when it cannot be read) the batch is dropped and counted, and the
+    // FIFO reset.
+    let room = usize::from(C::MAP.fifo_bytes).saturating_sub(usize::from(latest));
+    if room < CHUNK * packet {
+        let flag = chip.read_u8(C::MAP.int_status);
+        if !matches!(flag, Ok(f) if f & C::MAP.int_fifo_overflow == 0) {
+            let pending = state.pending.get_or_insert_with(PendingReset::default);
+            pending.overflow |= flag.is_ok();
+            pending.resync |= flag.is_err();
+            pending.consumed = pending
+                .consumed
+                .saturating_add(u32::try_from(taken).unwrap_or(u32::MAX));
+            return finish_reset(chip, state);
+        }
     }
     batch.count(&mut state.stats);
     Ok(batch.delivered)
@@ -349,6 +390,7 @@ fn count_reset(stats: &mut FifoStats, p: PendingReset, packet: usize) -> u16 {
     let discarded = bytes / u32::try_from(packet.max(1)).unwrap_or(1);
     stats.discarded = stats.discarded.saturating_add(u64::from(discarded));
     stats.discarded_bytes = stats.discarded_bytes.saturating_add(u64::from(bytes));
+    stats.unsure = stats.unsure.saturating_add(u64::from(p.unsure));
     if p.overflow {
         stats.overflows = stats.overflows.saturating_add(1);
     } else if p.resync {

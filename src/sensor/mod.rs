@@ -226,6 +226,13 @@ pub struct FifoStats {
     pub discarded: u64,
     /// Bytes dropped by FIFO resets, partial packets included.
     pub discarded_bytes: u64,
+    /// Samples a data read that failed part-way may have dropped beyond those counted in
+    /// `discarded`: `discarded` is exact when this is 0, and short by at most this many
+    /// otherwise. The counts before and after a failed transfer tell the bytes it clocked out
+    /// only modulo a packet: a sample that entered the FIFO while the transfer clocked out one
+    /// packet more leaves the same counts. The smaller number is counted in `discarded`; the
+    /// packets the transfer's length leaves room for beyond it are counted here.
+    pub unsure: u64,
     /// FIFO resets after a data read that failed part-way ([`Error::FifoResync`]).
     pub resyncs: u64,
     /// FIFO packets rejected as malformed (wrong header, including a "FIFO empty" marker or a

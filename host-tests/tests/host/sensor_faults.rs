@@ -262,7 +262,11 @@ fn icm_empty_marker_inside_the_count_is_malformed() {
         0,
         Action::Overwrite(vec![(16, 0xFF)]),
     );
-    let k = imu.read_fifo(&mut out).unwrap();
+    let k = match imu.read_fifo(&mut out) {
+        Ok(k) => k,
+        Err(Error::FifoResync { .. }) => 0,
+        Err(e) => panic!("{e:?}"),
+    };
     let s = imu.fifo_stats();
     let accounted = k as u64
         + (s.malformed - before.malformed)
@@ -425,10 +429,10 @@ fn icm_header_20_packet_is_malformed() {
         Action::Overwrite(vec![(0, 0x78)]),
     );
     let malformed = imu.fifo_stats().malformed;
-    let k = imu.read_fifo(&mut out).unwrap();
+    let r = imu.read_fifo(&mut out);
     assert_eq!(
-        (k, imu.fifo_stats().malformed - malformed),
-        (0, 1),
+        (r, imu.fifo_stats().malformed - malformed),
+        (Err(Error::FifoResync { discarded: 0 }), 1),
         "a packet with HEADER_20 set was delivered as a 16-byte sample"
     );
 }
@@ -452,4 +456,114 @@ fn mpu_enable_fifo_before_init_is_an_error() {
         results.iter().any(|r| *r != Ok(0)),
         "100 sample periods, Ok(0) every time: {results:?}"
     );
+}
+
+/// MPU-6050: the FIFO holds 85 packets (1020 of its 1024 bytes), INT_STATUS shows no overflow
+/// and both FIFO_COUNT reads say 1020; one sample arrives before the first FIFO_R_W transfer.
+/// The full FIFO overwrites its 8 oldest bytes, so every packet read is shifted by 8 bytes:
+/// the reader delivered 85 misaligned samples, counted nowhere.
+/// Expected: no malformed sample delivered; the FIFO reset as an overflow, and what it drops
+/// counted.
+#[test]
+fn mpu_overflow_during_a_near_full_read_delivers_no_misaligned_sample() {
+    let (sim, hooks, mut imu) = mpu(11);
+    let mut out = [RawSample::default(); 128];
+    sim.borrow_mut().tick(85);
+    hooks.add(Kind::Read(mpu::FIFO_R_W), 0, Action::TickBefore(1));
+    let r = imu.read_fifo(&mut out);
+    if let Ok(k) = r {
+        let garbage = out[..k].iter().filter(|s| decode(s).is_none()).count();
+        assert_eq!(garbage, 0, "{garbage} of {k} samples delivered misaligned");
+    }
+    assert!(
+        matches!(r, Err(Error::FifoOverflow { .. })),
+        "{r:?}: the overflow during the read is reported"
+    );
+    // The next calls deliver aligned samples again.
+    sim.borrow_mut().tick(20);
+    let k = imu.read_fifo(&mut out).unwrap();
+    assert_eq!(k, 20);
+    assert!(out[..k].iter().all(|s| decode(s).is_some()));
+}
+
+/// Both chips: 10 packets in the FIFO, a sample arrives just before the FIFO_R_W transfer,
+/// which then fails after clocking out all of its bytes. The reset
+/// drops 11 samples, but the reader reported `FifoResync { discarded: 10 }`: one sample
+/// neither delivered nor counted.
+/// Expected: the sample counted as unsure (`FifoStats::unsure`: the counts cannot tell it from
+/// a transfer that clocked out one packet more), so that discarded <= dropped <= discarded +
+/// unsure; the unsure samples no more than the transfer's length leaves room for.
+#[test]
+fn resync_after_a_sample_arrived_before_the_failed_read_counts_it_as_unsure() {
+    // The first transfer asks for 96 bytes (8 packets, one chunk) of 132, clocks out
+    // `clock_out` and fails; the count after it is 132 - clock_out, taken as clock_out - 12
+    // bytes out (nothing entered): the packets the 96 leave room for beyond those are unsure.
+    for (clock_out, unsure) in [(usize::MAX, 1), (60, 4), (0, 8)] {
+        let (sim, hooks, mut imu) = mpu(12);
+        let mut out = [RawSample::default(); 128];
+        sim.borrow_mut().tick(10);
+        hooks.add(Kind::Read(mpu::FIFO_R_W), 0, Action::TickBefore(1));
+        sim.borrow_mut()
+            .fail(Kind::Read(mpu::FIFO_R_W), 0, clock_out);
+        let r = imu.read_fifo(&mut out);
+        assert!(matches!(r, Err(Error::FifoResync { .. })), "{r:?}");
+        let s = imu.fifo_stats();
+        let sim = sim.borrow();
+        let dropped = sim.produced - sim.fifo_packets();
+        assert!(
+            s.discarded <= dropped && dropped <= s.discarded + s.unsure,
+            "clock-out {clock_out}: {dropped} dropped, {s:?}"
+        );
+        assert_eq!(s.unsure, unsure, "clock-out {clock_out}: {s:?}");
+    }
+}
+
+/// ICM-42688-P: one FIFO_DATA transfer takes one byte fewer out of the FIFO than it returns,
+/// and reports success (SPI has no acknowledge). From then on every header the reader assumed
+/// was the previous packet's last byte: the packets were counted as malformed but the FIFO
+/// never flushed, so `read_fifo` returned Ok(0) call after call on a healthy bus, and about 1
+/// in 16 shifted packets passed the header test and was delivered.
+/// Expected: the malformed header flushes the FIFO (a resync); no misaligned sample is
+/// delivered; samples flow again; every sample accounted for.
+#[test]
+fn icm_byte_slip_is_resynchronised() {
+    for seed in 0..16 {
+        let (sim, hooks, mut imu) = icm(100 + seed);
+        let mut out = [RawSample::default(); 160];
+        let before = imu.fifo_stats();
+        let produced = sim.borrow().produced;
+        sim.borrow_mut().tick(12);
+        hooks.add(Kind::Read(icm::FIFO_DATA), 0, Action::Slip);
+        let mut delivered = 0u64;
+        let mut resynced = false;
+        for _ in 0..5 {
+            match imu.read_fifo(&mut out) {
+                Ok(k) => {
+                    let garbage = out[..k].iter().filter(|s| decode(s).is_none()).count();
+                    assert_eq!(garbage, 0, "seed {seed}: misaligned samples delivered");
+                    delivered += k as u64;
+                }
+                Err(Error::FifoResync { .. }) => resynced = true,
+                Err(e) => panic!("seed {seed}: {e:?}"),
+            }
+            sim.borrow_mut().tick(10);
+        }
+        assert!(resynced, "seed {seed}: the slip was never resynchronised");
+        let k = imu.read_fifo(&mut out).unwrap();
+        assert!(k >= 10, "seed {seed}: samples do not flow again ({k})");
+        delivered += k as u64;
+        let s = imu.fifo_stats();
+        let sim = sim.borrow();
+        let counted = delivered
+            + (s.discarded - before.discarded)
+            + (s.malformed - before.malformed)
+            + (s.invalid - before.invalid)
+            + sim.fifo_packets();
+        // The slipped byte leaves a partial packet: the counts reckon whole packets.
+        let written = sim.produced - produced;
+        assert!(
+            counted <= written && written <= counted + (s.unsure - before.unsure) + 1,
+            "seed {seed}: wrote {written}, accounted {counted}: {s:?}"
+        );
+    }
 }

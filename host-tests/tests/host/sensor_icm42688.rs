@@ -204,21 +204,34 @@ fn icm42688_wrong_device_is_a_typed_error() {
     imu.destroy().done();
 }
 
+/// A header that is not one (a wrong layout, or the "FIFO empty" marker inside the counted
+/// bytes) most likely means misaligned packets: the call's packets are dropped (the malformed
+/// ones counted as such, the rest as discarded) and the FIFO is flushed, which realigns it.
 #[test]
 fn icm42688_fifo_packets_malformed_empty_and_partial() {
     let mut expect = icm_init();
     expect.extend(icm_fifo_enable());
     expect.extend(spi_read(0x2D, vec![0x08])); // INT_STATUS: data ready
-    expect.extend(spi_read(0x2E, vec![0, 3 * 16 + 7])); // 3 packets and 7 stray bytes
+    expect.extend(spi_read(0x2E, vec![0, 2 * 16 + 7])); // 2 packets and 7 stray bytes
     let data = [
         icm_packet(0x68, [1, 2, 3], [4, 5, 6], 10),
-        icm_packet(0x28, [0; 3], [7, 8, 9], 0), // gyro only: malformed for this layout
         icm_packet(0x6A, [-1, -2, -3], [-4, -5, -6], -5),
     ]
     .concat();
     expect.extend(spi_read(0x30, data));
-    // An empty-FIFO header inside the counted bytes is a damaged header: counted as malformed;
-    // the packet after it, clocked out in the same transaction, is delivered.
+    // The partial packet stays for the next call; the next packet is gyro only: malformed
+    // for this layout.
+    expect.extend(spi_read(0x2D, vec![0x00]));
+    expect.extend(spi_read(0x2E, vec![0, 3 * 16 + 7]));
+    let data = [
+        icm_packet(0x68, [7; 3], [7; 3], 0),
+        icm_packet(0x28, [0; 3], [7, 8, 9], 0),
+        icm_packet(0x68, [8; 3], [8; 3], 0),
+    ]
+    .concat();
+    expect.extend(spi_read(0x30, data));
+    expect.extend(icm_fifo_reset(7));
+    // An empty-FIFO header inside the counted bytes is a damaged header too.
     expect.extend(spi_read(0x2D, vec![0x00]));
     expect.extend(spi_read(0x2E, vec![0, 32]));
     expect.extend(spi_read(
@@ -229,6 +242,7 @@ fn icm42688_fifo_packets_malformed_empty_and_partial() {
         ]
         .concat(),
     ));
+    expect.extend(icm_fifo_reset(0));
     let mut imu = Icm42688::new(SpiMock::new(&expect));
     let mut out = [RawSample::default(); 8];
     assert_eq!(imu.read_fifo(&mut out), Err(Error::FifoDisabled));
@@ -249,10 +263,25 @@ fn icm42688_fifo_packets_malformed_empty_and_partial() {
     );
     let celsius = imu.die_temperature(&out[0]).unwrap();
     assert!((celsius - (10.0 / 2.07 + 25.0)).abs() < 1e-4, "{celsius}");
-    assert_eq!(imu.read_fifo(&mut out), Ok(1));
-    assert_eq!((out[0].accel, out[0].gyro), ([9; 3], [9; 3]));
+    // 2 good packets and the 7 stray bytes dropped with the malformed one: 2 discarded.
+    assert_eq!(
+        imu.read_fifo(&mut out),
+        Err(Error::FifoResync { discarded: 2 })
+    );
+    assert_eq!(
+        imu.read_fifo(&mut out),
+        Err(Error::FifoResync { discarded: 1 })
+    );
     let stats = imu.fifo_stats();
-    assert_eq!((stats.samples, stats.malformed), (3, 2));
+    assert_eq!(
+        (
+            stats.samples,
+            stats.malformed,
+            stats.discarded,
+            stats.resyncs
+        ),
+        (2, 2, 3, 2)
+    );
     imu.destroy().done();
 }
 

@@ -20,6 +20,9 @@ pub enum Action {
     TickBefore(u64),
     /// The read returns these bytes at these offsets (after the chip's own answer).
     Overwrite(Vec<(usize, u8)>),
+    /// The read takes one byte fewer out of the chip than it returns, and reports success (a
+    /// byte slip: SPI has no acknowledge); its last byte repeats the one before.
+    Slip,
 }
 
 /// An action at the `skip`-th next transfer of `kind`.
@@ -63,6 +66,12 @@ impl Hooks {
             sim.borrow_mut().tick(*n);
         }
         match buf {
+            Some(buf) if matches!(action, Some(Action::Slip)) && buf.len() > 1 => {
+                let last = buf.len() - 1;
+                let ok = transfer(Some(&mut buf[..last]));
+                buf[last] = buf[last - 1];
+                ok
+            }
             Some(buf) => {
                 let ok = transfer(Some(&mut *buf));
                 if let Some(Action::Overwrite(bytes)) = action {
