@@ -18,6 +18,7 @@
 //! packet layout are all that differs. `init`, `recover`, `enable_fifo` and the FIFO routine
 //! (overflow, resync after a failed read, chip-reset detection) are written once.
 
+mod board;
 mod chip;
 mod driver;
 mod fifo;
@@ -27,6 +28,7 @@ mod replay;
 
 use core::fmt;
 
+pub use board::{CycleClock, FifoLoop, Pass, Recover};
 pub use driver::Driver;
 pub use icm42688::{Icm42688, Icm42688Bus, Icm42688Config, IcmAccelRange, IcmGyroRange, Odr};
 pub use mpu6050::{AccelRange, Dlpf, GyroRange, Mpu6050, Mpu6050Bus, Mpu6050Config};

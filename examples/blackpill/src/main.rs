@@ -25,7 +25,9 @@ use defmt_rtt as _;
 use imu_ar::ArModel;
 use imu_ar::persist::{FlashStore, Record, StoreError};
 use imu_ar::recursive::{Channel, Config, Estimator, Lattice};
-use imu_ar::sensor::{AccelUnit, Error, GyroUnit, ImuReader, Mpu6050, Mpu6050Config, RawSample};
+use imu_ar::sensor::{
+    AccelUnit, CycleClock, FifoLoop, GyroUnit, ImuReader, Mpu6050, Mpu6050Config, Pass, RawSample,
+};
 use panic_probe as _;
 use stm32f4xx_hal::flash::{FlashExt, LockedFlash};
 use stm32f4xx_hal::{i2c::I2c, pac, prelude::*};
@@ -40,24 +42,6 @@ const STORE: core::ops::Range<u32> = 0x4_0000..0x8_0000;
 const SAVE_EVERY: u32 = 30_000;
 /// The wait after DEVICE_RESET inside `init` and `recover`.
 const INIT_DELAY_US: u64 = 100_000;
-
-/// Microseconds since start from the DWT cycle counter, extended to 64 bits: it must be read
-/// at least once per wrap of the 32-bit counter (51 s at 84 MHz); the loop reads it every
-/// 50 ms.
-struct Clock {
-    cycles_per_us: u64,
-    last: u32,
-    cycles: u64,
-}
-
-impl Clock {
-    fn now_us(&mut self) -> u64 {
-        let now = DWT::cycle_count();
-        self.cycles += u64::from(now.wrapping_sub(self.last));
-        self.last = now;
-        self.cycles / self.cycles_per_us
-    }
-}
 
 /// The models saved last, if any.
 fn load(flash: &mut LockedFlash) -> Option<Models> {
@@ -109,11 +93,9 @@ fn main() -> ! {
     let i2c = I2c::new(dp.I2C1, (gpiob.pb6, gpiob.pb7), 400.kHz(), &clocks);
     cp.DCB.enable_trace();
     cp.DWT.enable_cycle_counter();
-    let mut clock = Clock {
-        cycles_per_us: u64::from(clocks.sysclk().raw() / 1_000_000),
-        last: DWT::cycle_count(),
-        cycles: 0,
-    };
+    // Microseconds from the 32-bit cycle counter, extended on every pass of the loop (it wraps
+    // every 51 s at 84 MHz, and the sensor may be away for longer).
+    let clock = CycleClock::new(clocks.sysclk().raw() / 1_000_000, DWT::cycle_count());
     let mut delay = cp.SYST.delay(&clocks);
     let mut flash = LockedFlash::new(dp.FLASH);
     let saved = load(&mut flash);
@@ -144,7 +126,8 @@ fn main() -> ! {
     // from the channel's range: a clipped reading (at the rails of the i16 counts) is at or
     // beyond it.
     let scale = imu.scale();
-    let shared = Config::new(0.9995f32, 1.0 / config.sample_rate_hz()).expect("valid configuration");
+    let shared =
+        Config::new(0.9995f32, 1.0 / config.sample_rate_hz()).expect("valid configuration");
     let gyro = Channel::new(1e-4)
         .and_then(|c| c.with_saturation(scale.gyro_saturation(GyroUnit::DegPerSec)))
         .expect("valid gyro channel");
@@ -163,37 +146,32 @@ fn main() -> ! {
     });
     let mut batch = [RawSample::default(); 32];
     let mut samples = 0u32;
-    // When a read last accounted for the FIFO: the start of an outage, by the board's clock.
-    let mut accounted_us = clock.now_us();
+    // The loop's FIFO logic is the library's (`FifoLoop`), tested on the host against the
+    // chip simulator: each pass reads the clock, then the FIFO, and recovers the chip with the
+    // outage since the last read that accounted for the FIFO (init's reset takes 100 ms).
+    let mut fifo = FifoLoop::new(clock, DWT::cycle_count(), INIT_DELAY_US);
     loop {
         delay.delay_ms(50u32);
-        let n = match imu.read_fifo(&mut batch) {
-            Ok(n) => n,
-            Err(e @ (Error::FifoOverflow { .. } | Error::FifoResync { .. })) => {
-                accounted_us = clock.now_us();
+        let n = match fifo.pass(DWT::cycle_count(), &mut imu, &mut delay, &mut batch) {
+            Pass::Samples(n) => n,
+            Pass::Dropped(e) => {
                 defmt::warn!("FIFO: {}", defmt::Debug2Format(&e));
                 continue;
             }
-            Err(e @ (Error::SensorReset | Error::FifoNotRunning)) => {
-                defmt::warn!("FIFO: {}: recovering", defmt::Debug2Format(&e));
-                // The outage runs until the FIFO is on again, after init's 100 ms.
-                let outage_us = clock.now_us() - accounted_us + INIT_DELAY_US;
-                match imu.recover(&mut delay, outage_us) {
-                    Ok(_) => {
-                        accounted_us = clock.now_us();
-                        defmt::warn!("MPU-6050 recovered after {=u64} us", outage_us);
-                    }
-                    // read_fifo says FifoNotRunning until a recovery succeeds.
-                    Err(e) => defmt::warn!("recovery failed: {}", defmt::Debug2Format(&e)),
-                }
+            Pass::Recovered { outage_us } => {
+                defmt::warn!("MPU-6050 recovered after {=u64} us", outage_us);
                 continue;
             }
-            Err(e) => {
+            // read_fifo says FifoNotRunning until a recovery succeeds.
+            Pass::RecoveryFailed(e) => {
+                defmt::warn!("recovery failed: {}", defmt::Debug2Format(&e));
+                continue;
+            }
+            Pass::Failed(e) => {
                 defmt::warn!("FIFO: {}", defmt::Debug2Format(&e));
                 continue;
             }
         };
-        accounted_us = clock.now_us();
         for s in &batch[..n] {
             let gyro = scale.gyro(s.gyro, GyroUnit::DegPerSec);
             let accel = scale.accel(s.accel, AccelUnit::G);

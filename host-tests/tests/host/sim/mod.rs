@@ -118,6 +118,8 @@ pub struct Sim {
     pub rate: f64,
     /// Every read returns 0xFF (SDA stuck high).
     pub stuck_high: bool,
+    /// The sensor is unplugged: every transfer fails and does nothing.
+    pub unplugged: bool,
     /// WHO_AM_I answered by the chip.
     pub who_am_i: u8,
     /// Transfers by kind.
@@ -173,6 +175,7 @@ impl Sim {
             rules: Vec::new(),
             rate: 0.0,
             stuck_high: false,
+            unplugged: false,
             who_am_i: model.chip().id,
             transfers: BTreeMap::new(),
             injected: BTreeMap::new(),
@@ -302,6 +305,12 @@ impl Sim {
 
     fn decide(&mut self, kind: Kind, len: usize) -> Option<Fault> {
         *self.transfers.entry(kind).or_default() += 1;
+        if self.unplugged {
+            return Some(Fault {
+                clock_out: 0,
+                apply: false,
+            });
+        }
         let mut fault = None;
         if let Some(i) = self.rules.iter().position(|r| r.kind == kind) {
             if self.rules[i].skip == 0 {

@@ -1,0 +1,145 @@
+//! The loop a board runs around a FIFO reader, written once so that the same code runs on the
+//! board and, against the project's chip simulator, on the host: each pass reads the board's
+//! clock, then the FIFO, and recovers the chip when the reader asks for it, passing the outage
+//! since the last read that accounted for the FIFO ([`Driver::recover`]).
+
+use embedded_hal::delay::DelayNs;
+
+use super::chip::Chip;
+use super::{Driver, Error, ImuReader, RawSample};
+
+/// Microseconds since start from a wrapping 32-bit cycle counter (the Cortex-M DWT's CYCCNT),
+/// extended to 64 bits. Exact as long as the counter is read at least once per wrap (51 s at
+/// 84 MHz, 21 s at 200 MHz): [`FifoLoop::pass`] reads it on every pass, whatever the pass
+/// meets.
+#[derive(Clone, Copy, Debug)]
+pub struct CycleClock {
+    cycles_per_us: u64,
+    last: u32,
+    cycles: u64,
+}
+
+impl CycleClock {
+    /// A clock counting `cycles_per_us` cycles per microsecond (at least 1), started at the
+    /// counter's value `counter`.
+    pub fn new(cycles_per_us: u32, counter: u32) -> Self {
+        Self {
+            cycles_per_us: u64::from(cycles_per_us.max(1)),
+            last: counter,
+            cycles: 0,
+        }
+    }
+
+    /// Microseconds since the start, with the counter now at `counter`.
+    pub fn now_us(&mut self, counter: u32) -> u64 {
+        self.cycles = self
+            .cycles
+            .saturating_add(u64::from(counter.wrapping_sub(self.last)));
+        self.last = counter;
+        self.cycles / self.cycles_per_us
+    }
+}
+
+/// A reader that can bring its chip back after a reset or an outage: [`Driver::recover`].
+pub trait Recover: ImuReader {
+    /// [`Driver::recover`].
+    ///
+    /// # Errors
+    ///
+    /// As [`Driver::recover`].
+    fn recover(
+        &mut self,
+        delay: &mut impl DelayNs,
+        outage_us: u64,
+    ) -> Result<u8, Error<Self::BusError>>;
+}
+
+impl<C: Chip> Recover for Driver<C> {
+    fn recover(
+        &mut self,
+        delay: &mut impl DelayNs,
+        outage_us: u64,
+    ) -> Result<u8, Error<Self::BusError>> {
+        Driver::recover(self, delay, outage_us)
+    }
+}
+
+/// What one [`FifoLoop::pass`] did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pass<E> {
+    /// This many samples were read into `out`.
+    Samples(usize),
+    /// The reader dropped and counted the FIFO's samples ([`Error::FifoOverflow`],
+    /// [`Error::FifoResync`]): nothing to process.
+    Dropped(Error<E>),
+    /// The chip was recovered ([`Error::SensorReset`], [`Error::FifoNotRunning`]); the
+    /// samples of the outage are counted in [`FifoStats::lost`](super::FifoStats::lost).
+    Recovered {
+        /// The outage passed to `recover`, microseconds.
+        outage_us: u64,
+    },
+    /// A recovery failed; the next pass tries again.
+    RecoveryFailed(Error<E>),
+    /// Any other error (a bus error: the sensor unplugged, say); the next pass tries again.
+    Failed(Error<E>),
+}
+
+/// The FIFO loop of a board: call [`FifoLoop::pass`] once per loop iteration.
+#[derive(Clone, Copy, Debug)]
+pub struct FifoLoop {
+    clock: CycleClock,
+    /// When a read last accounted for the FIFO, or a recovery started it again, by the clock.
+    accounted_us: u64,
+    recovery_us: u64,
+}
+
+impl FifoLoop {
+    /// A loop on `clock`, from the counter's value `counter` (the FIFO accounted for then);
+    /// `recovery_us` is the time from the call of `recover` to the FIFO running again (the
+    /// chip's reset and start delays: 100 ms on the MPU-6050, 2 ms on the ICM-42688-P).
+    pub fn new(mut clock: CycleClock, counter: u32, recovery_us: u64) -> Self {
+        let accounted_us = clock.now_us(counter);
+        Self {
+            clock,
+            accounted_us,
+            recovery_us,
+        }
+    }
+
+    /// One pass, with the cycle counter at `counter`: reads the clock (on every pass, so that
+    /// it never misses a wrap however long the sensor is away), then the FIFO into `out`; on
+    /// [`Error::SensorReset`] or [`Error::FifoNotRunning`] recovers the chip, passing the
+    /// outage from the last read that accounted for the FIFO to the end of the recovery.
+    pub fn pass<R: Recover>(
+        &mut self,
+        counter: u32,
+        imu: &mut R,
+        delay: &mut impl DelayNs,
+        out: &mut [RawSample],
+    ) -> Pass<R::BusError> {
+        let now = self.clock.now_us(counter);
+        match imu.read_fifo(out) {
+            Ok(n) => {
+                self.accounted_us = now;
+                Pass::Samples(n)
+            }
+            Err(e @ (Error::FifoOverflow { .. } | Error::FifoResync { .. })) => {
+                self.accounted_us = now;
+                Pass::Dropped(e)
+            }
+            Err(Error::SensorReset | Error::FifoNotRunning) => {
+                let outage_us = now
+                    .saturating_sub(self.accounted_us)
+                    .saturating_add(self.recovery_us);
+                match imu.recover(delay, outage_us) {
+                    Ok(_) => {
+                        self.accounted_us = now.saturating_add(self.recovery_us);
+                        Pass::Recovered { outage_us }
+                    }
+                    Err(e) => Pass::RecoveryFailed(e),
+                }
+            }
+            Err(e) => Pass::Failed(e),
+        }
+    }
+}
