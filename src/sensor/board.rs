@@ -106,34 +106,41 @@ impl FifoLoop {
         }
     }
 
-    /// One pass, with the cycle counter at `counter`: reads the clock (on every pass, so that
-    /// it never misses a wrap however long the sensor is away), then the FIFO into `out`; on
-    /// [`Error::SensorReset`] or [`Error::FifoNotRunning`] recovers the chip, passing the
-    /// outage from the last read that accounted for the FIFO to the end of the recovery.
+    /// One pass, reading the cycle counter with `counter`: reads the clock (on every pass, so
+    /// that it never misses a wrap however long the sensor is away), then the FIFO into `out`,
+    /// then the clock again; on [`Error::SensorReset`] or [`Error::FifoNotRunning`] recovers
+    /// the chip, passing the outage from the last accounting to the end of the recovery.
+    ///
+    /// A read that returns samples accounts for the FIFO as it was when the read began (the
+    /// samples that arrive during it stay in the FIFO for the next pass); a FIFO reset
+    /// ([`Pass::Dropped`]) accounts for it as it was when the read ended (the reset drops, and
+    /// counts, what arrived during the read).
     pub fn pass<R: Recover>(
         &mut self,
-        counter: u32,
+        mut counter: impl FnMut() -> u32,
         imu: &mut R,
         delay: &mut impl DelayNs,
         out: &mut [RawSample],
     ) -> Pass<R::BusError> {
-        let now = self.clock.now_us(counter);
-        match imu.read_fifo(out) {
+        let before = self.clock.now_us(counter());
+        let result = imu.read_fifo(out);
+        let after = self.clock.now_us(counter());
+        match result {
             Ok(n) => {
-                self.accounted_us = now;
+                self.accounted_us = before;
                 Pass::Samples(n)
             }
             Err(e @ (Error::FifoOverflow { .. } | Error::FifoResync { .. })) => {
-                self.accounted_us = now;
+                self.accounted_us = after;
                 Pass::Dropped(e)
             }
             Err(Error::SensorReset | Error::FifoNotRunning) => {
-                let outage_us = now
+                let outage_us = after
                     .saturating_sub(self.accounted_us)
                     .saturating_add(self.recovery_us);
                 match imu.recover(delay, outage_us) {
                     Ok(_) => {
-                        self.accounted_us = now.saturating_add(self.recovery_us);
+                        self.accounted_us = after.saturating_add(self.recovery_us);
                         Pass::Recovered { outage_us }
                     }
                     Err(e) => Pass::RecoveryFailed(e),

@@ -180,11 +180,11 @@ impl<C: Chip> ImuReader for Driver<C> {
     /// and [`Error::SensorReset`] is returned (see [`Driver::recover`]); a FIFO reset finds
     /// such a chip by its power mode, and returns the same. Otherwise the whole packets in the
     /// FIFO (up to `out.len()`) are read, 8 per bus transfer; a partial packet stays in the
-    /// FIFO for the next call. When the count left room for fewer than 8 packets, a sample
-    /// arriving during the read may have overwritten bytes not yet read: INT_STATUS is read
-    /// after it, and on the overflow flag (or a bus error there) the samples read are counted
-    /// as discarded instead of delivered, the FIFO is reset, and [`Error::FifoOverflow`]
-    /// ([`Error::FifoResync`] after the bus error) is returned. Packets are parsed as the
+    /// FIFO for the next call. A sample arriving during the read may overwrite bytes not yet
+    /// read: INT_STATUS is read after every read, and on the overflow flag (or a bus error
+    /// there) the samples read are counted as discarded instead of delivered, the FIFO is
+    /// reset, and [`Error::FifoOverflow`] ([`Error::FifoResync`] after the bus error) is
+    /// returned. Packets are parsed as the
     /// chip's type describes: packets the chip marked invalid are skipped and counted in
     /// [`FifoStats::invalid`]. A header that is
     /// not one (the ICM-42688-P's) most likely means misaligned packets (a byte lost or added

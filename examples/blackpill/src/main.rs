@@ -152,7 +152,7 @@ fn main() -> ! {
     let mut fifo = FifoLoop::new(clock, DWT::cycle_count(), INIT_DELAY_US);
     loop {
         delay.delay_ms(50u32);
-        let n = match fifo.pass(DWT::cycle_count(), &mut imu, &mut delay, &mut batch) {
+        let n = match fifo.pass(DWT::cycle_count, &mut imu, &mut delay, &mut batch) {
             Pass::Samples(n) => n,
             Pass::Dropped(e) => {
                 defmt::warn!("FIFO: {}", defmt::Debug2Format(&e));

@@ -32,6 +32,11 @@ fn mpu_config() -> Mpu6050Config {
 }
 
 fn mpu(seed: u64) -> (Rc<RefCell<Sim>>, Hooks, Mpu6050<HookedI2c>) {
+    mpu_with(seed, mpu_config())
+}
+
+/// An MPU-6050 with `config` and its FIFO on.
+fn mpu_with(seed: u64, config: Mpu6050Config) -> (Rc<RefCell<Sim>>, Hooks, Mpu6050<HookedI2c>) {
     let sim = Sim::new(Model::Mpu6050, seed);
     let hooks = Hooks::default();
     let bus = HookedI2c {
@@ -40,7 +45,7 @@ fn mpu(seed: u64) -> (Rc<RefCell<Sim>>, Hooks, Mpu6050<HookedI2c>) {
         hooks: hooks.clone(),
     };
     let mut imu = Mpu6050::new(bus, 0x68);
-    imu.init(&mut NoDelay, mpu_config()).unwrap();
+    imu.init(&mut NoDelay, config).unwrap();
     imu.enable_fifo().unwrap();
     (sim, hooks, imu)
 }
@@ -612,7 +617,7 @@ fn board_loop_counts_a_two_minute_unplug() {
         } else {
             chip_us = t_us;
         }
-        match board.pass(counter(t_us), &mut imu, &mut NoDelay, &mut out) {
+        match board.pass(|| counter(t_us), &mut imu, &mut NoDelay, &mut out) {
             Pass::Samples(n) => {
                 assert!(out[..n].iter().all(|s| decode(s).is_some()));
                 delivered += n as u64;
@@ -637,4 +642,200 @@ fn board_loop_counts_a_two_minute_unplug() {
         sim.produced,
         "{s:?}"
     );
+}
+
+/// MPU-6050 at 1 kHz on 100 kHz I2C: a 96-byte FIFO_R_W transfer takes about 9 ms, so about 9
+/// samples arrive per 8 packets read and the FIFO grows by a packet per transfer. With 77
+/// packets at the count (100 bytes of room) the FIFO overflowed before the 10th transfer: the
+/// reader delivered Ok(77) with misaligned samples and no overflow counted, since it checked
+/// INT_STATUS after a read only when the count left less than 8 packets of room.
+/// Expected: no misaligned sample delivered; the overflow counted.
+#[test]
+fn mpu_samples_arriving_during_a_read_with_eight_packets_of_room_misalign_nothing() {
+    let (_, imu, r) = read_through_an_overflow(32);
+    assert!(matches!(r, Err(Error::FifoOverflow { .. })), "{r:?}");
+    assert_eq!(imu.fifo_stats().overflows, 1);
+}
+
+/// What [`read_through_an_overflow`] leaves: the chip, the reader and what its read returned.
+type Overflowed = (
+    Rc<RefCell<Sim>>,
+    Mpu6050<HookedI2c>,
+    Result<usize, Error<embedded_hal::i2c::ErrorKind>>,
+);
+
+/// An MPU-6050 at 1 kHz read from 77 packets while 9 samples arrive before each of its
+/// transfers after the first (the FIFO overflows before the 10th).
+fn read_through_an_overflow(seed: u64) -> Overflowed {
+    let (sim, hooks, mut imu) = mpu(seed);
+    let r = read_while_samples_arrive(&sim, &hooks, &mut imu, 77, 9);
+    (sim, imu, r)
+}
+
+/// `held` samples in the FIFO, then `arriving` more before each FIFO_R_W transfer after the
+/// first, for the transfers of one read: what the read returns, checked to deliver no
+/// misaligned sample.
+fn read_while_samples_arrive(
+    sim: &Rc<RefCell<Sim>>,
+    hooks: &Hooks,
+    imu: &mut Mpu6050<HookedI2c>,
+    held: u64,
+    arriving: u64,
+) -> Result<usize, Error<embedded_hal::i2c::ErrorKind>> {
+    let mut out = [RawSample::default(); 128];
+    sim.borrow_mut().tick(held);
+    hooks.add(Kind::Read(mpu::FIFO_R_W), 1, Action::TickBefore(arriving));
+    for _ in 0..held.div_ceil(8) {
+        hooks.add(Kind::Read(mpu::FIFO_R_W), 0, Action::TickBefore(arriving));
+    }
+    let r = imu.read_fifo(&mut out);
+    let garbage = match r {
+        Ok(k) => out[..k].iter().filter(|s| decode(s).is_none()).count(),
+        Err(_) => 0,
+    };
+    assert_eq!(garbage, 0, "{r:?}: {garbage} misaligned samples delivered");
+    r
+}
+
+/// As above at 8 kHz (`Dlpf::Hz260`, divider 0) on 400 kHz I2C: about 18 samples arrive
+/// during each 96-byte transfer; 65 packets at the count (20 packets of room): Ok(65) with 41
+/// misaligned.
+#[test]
+fn mpu_8khz_read_with_twenty_packets_of_room_misaligns_nothing() {
+    let config = Mpu6050Config {
+        dlpf: Dlpf::Hz260,
+        sample_rate_divider: 0,
+        ..mpu_config()
+    };
+    let (sim, hooks, mut imu) = mpu_with(90, config);
+    let r = read_while_samples_arrive(&sim, &hooks, &mut imu, 65, 18);
+    assert!(matches!(r, Err(Error::FifoOverflow { .. })), "{r:?}");
+}
+
+/// The read above, then the next call's INT_STATUS read fails after clearing the flag: with
+/// the overflow missed, the FIFO stayed 8 bytes off and every later sample was garbage (570 of
+/// them), with no error and no overflow counted.
+/// Expected: no garbage; samples flow.
+#[test]
+fn mpu_an_overflow_during_a_read_leaves_no_misaligned_fifo_behind() {
+    let (sim, mut imu, _) = read_through_an_overflow(32);
+    let mut out = [RawSample::default(); 128];
+    sim.borrow_mut()
+        .fail_applied(Kind::Read(mpu::INT_STATUS), 0);
+    assert!(matches!(imu.read_fifo(&mut out), Err(Error::Bus(_))));
+    let (mut good, mut garbage) = (0, 0);
+    for _ in 0..50 {
+        if let Ok(k) = imu.read_fifo(&mut out) {
+            for s in &out[..k] {
+                if decode(s).is_some() {
+                    good += 1;
+                } else {
+                    garbage += 1;
+                }
+            }
+        }
+        sim.borrow_mut().tick(10);
+    }
+    assert_eq!(garbage, 0, "{good} good, {garbage} garbage");
+    assert!(good >= 400, "{good} good");
+}
+
+/// MPU-6050: a reset is pending (a failed data read whose FIFO reset failed); the next call's
+/// first FIFO_COUNT reads 0x0273 instead of 0x0073 (one bit of FIFO_COUNTH). A pending reset
+/// took the largest count seen as what it drops, unconfirmed: 52 samples "discarded" of the
+/// 10 the chip wrote.
+/// Expected: discarded no more than the chip wrote.
+#[test]
+fn mpu_corrupted_count_during_a_pending_reset_discards_only_what_was_written() {
+    let (sim, hooks, mut imu) = mpu(34);
+    let mut out = [RawSample::default(); 128];
+    sim.borrow_mut().tick(10);
+    sim.borrow_mut().fail(Kind::Read(mpu::FIFO_R_W), 0, 5);
+    sim.borrow_mut().fail(Kind::Write(mpu::FIFO_EN), 0, 0);
+    assert!(matches!(imu.read_fifo(&mut out), Err(Error::Bus(_))));
+    hooks.add(
+        Kind::Read(mpu::FIFO_COUNTH),
+        0,
+        Action::Overwrite(vec![(0, 0x02)]),
+    );
+    let r = imu.read_fifo(&mut out);
+    let s = imu.fifo_stats();
+    assert!(
+        s.discarded <= sim.borrow().produced,
+        "{r:?}: the chip wrote 10: {s:?}"
+    );
+    assert_accounted(&sim, &imu, 0, "a corrupted count while a reset is pending");
+}
+
+/// FifoLoop: samples the chip writes while a pass's read runs, and that its FIFO reset drops,
+/// are counted in `discarded`; the pass's clock was read before the read only, so when the
+/// next pass found a chip reset, the outage passed to `recover` covered them again (`lost`):
+/// 55 counted for 50 sample periods.
+/// Expected: every sample period counted once.
+#[test]
+fn board_loop_counts_samples_written_during_a_resync_pass_once() {
+    use imu_ar::sensor::{CycleClock, FifoLoop, Pass};
+    let (sim, hooks, mut imu) = mpu(50); // 1 kHz: one tick per ms
+    let counter = |t_ms: u64| ((t_ms * 84_000) % (1 << 32)) as u32;
+    let mut board = FifoLoop::new(CycleClock::new(84, counter(0)), counter(0), 0);
+    let mut out = [RawSample::default(); 128];
+    sim.borrow_mut().tick(10);
+    let p0 = board.pass(|| counter(10), &mut imu, &mut NoDelay, &mut out);
+    assert_eq!(p0, Pass::Samples(10));
+    sim.borrow_mut().tick(10);
+    sim.borrow_mut().fail(Kind::Read(mpu::FIFO_R_W), 0, 5);
+    hooks.add(Kind::Write(mpu::FIFO_EN), 0, Action::TickBefore(5));
+    // The pass takes 5 ms: the counter reads 20 ms before the read and 25 ms after it.
+    let mut t = [20u64, 25].into_iter();
+    let p1 = board.pass(
+        || counter(t.next().unwrap_or(25)),
+        &mut imu,
+        &mut NoDelay,
+        &mut out,
+    );
+    assert_eq!(p1, Pass::Dropped(Error::FifoResync { discarded: 15 }));
+    // Then the chip resets and writes nothing for 25 ms.
+    sim.borrow_mut().glitch();
+    sim.borrow_mut().tick(25);
+    let p2 = board.pass(|| counter(50), &mut imu, &mut NoDelay, &mut out);
+    assert!(matches!(p2, Pass::Recovered { .. }), "{p2:?}");
+    let s = imu.fifo_stats();
+    let sim = sim.borrow();
+    let accounted = s.samples + s.discarded + s.lost + sim.fifo_packets();
+    assert_eq!(accounted, sim.ticks, "{p2:?}: {s:?}");
+}
+
+/// FifoLoop, ICM-42688-P: a malformed header was counted in `malformed` at once, but the call
+/// ended in Err(Bus) (its FIFO reset failed), which accounts for nothing; the chip reset, and
+/// the outage passed to `recover` ran from the pass before: the packet was counted in
+/// `malformed` and in `lost` (21 for 20).
+/// Expected: every sample period counted once.
+#[test]
+fn board_loop_counts_a_malformed_packet_of_a_failed_call_once() {
+    use imu_ar::sensor::{CycleClock, FifoLoop, Pass};
+    let (sim, hooks, mut imu) = icm(80);
+    let counter = |t_ms: u64| ((t_ms * 84_000) % (1 << 32)) as u32;
+    let t0 = sim.borrow().ticks;
+    let mut board = FifoLoop::new(CycleClock::new(84, counter(0)), counter(0), 0);
+    let mut out = [RawSample::default(); 160];
+    sim.borrow_mut().tick(10);
+    let p0 = board.pass(|| counter(10), &mut imu, &mut NoDelay, &mut out);
+    assert_eq!(p0, Pass::Samples(10));
+    sim.borrow_mut().tick(4);
+    hooks.add(
+        Kind::Read(icm::FIFO_DATA),
+        0,
+        Action::Overwrite(vec![(48, 0x00)]),
+    );
+    sim.borrow_mut().fail(Kind::Write(icm::FIFO_CONFIG1), 0, 0);
+    let p1 = board.pass(|| counter(14), &mut imu, &mut NoDelay, &mut out);
+    assert!(matches!(p1, Pass::Failed(Error::Bus(_))), "{p1:?}");
+    sim.borrow_mut().glitch();
+    sim.borrow_mut().tick(6);
+    let p2 = board.pass(|| counter(20), &mut imu, &mut NoDelay, &mut out);
+    assert!(matches!(p2, Pass::Recovered { .. }), "{p2:?}");
+    let s = imu.fifo_stats();
+    let sim = sim.borrow();
+    let accounted = s.samples + s.discarded + s.malformed + s.lost + sim.fifo_packets();
+    assert_eq!(accounted, sim.ticks - t0, "{p2:?}: {s:?}");
 }

@@ -219,6 +219,7 @@ fn icm42688_fifo_packets_malformed_empty_and_partial() {
     ]
     .concat();
     expect.extend(spi_read(0x30, data));
+    expect.extend(spi_read(0x2D, vec![0x00])); // INT_STATUS after the read
     // The partial packet stays for the next call; the next packet is gyro only: malformed
     // for this layout.
     expect.extend(spi_read(0x2D, vec![0x00]));
@@ -295,6 +296,7 @@ fn icm42688_fifo_overflow_is_counted_and_recovered() {
     expect.extend(spi_read(0x2D, vec![0x00]));
     expect.extend(spi_read(0x2E, vec![0, 16]));
     expect.extend(spi_read(0x30, icm_packet(0x68, [1; 3], [2; 3], 0)));
+    expect.extend(spi_read(0x2D, vec![0x00])); // INT_STATUS after the read
     let mut imu = icm_with_fifo(&expect);
     common::overflow_then_one_sample(&mut imu, 128);
     imu.destroy().done();
@@ -309,6 +311,7 @@ fn icm42688_resetting_itself_is_detected_recovered_and_counted() {
     expect.extend(spi_read(0x2D, vec![0x08]));
     expect.extend(spi_read(0x2E, vec![0, 16]));
     expect.extend(spi_read(0x30, icm_packet(0x68, [1; 3], [2; 3], 0)));
+    expect.extend(spi_read(0x2D, vec![0x00])); // INT_STATUS after the read
     expect.extend(spi_read(0x2D, vec![0x00]));
     expect.extend(spi_read(0x2E, vec![0, 0]));
     expect.extend(spi_read(0x16, vec![0x00])); // FIFO_CONFIG after a reset: bypass
@@ -404,6 +407,7 @@ fn icm42688_invalid_marker_is_skipped_and_counted() {
     ]
     .concat();
     expect.extend(spi_read(0x30, data));
+    expect.extend(spi_read(0x2D, vec![0x00])); // INT_STATUS after the read
     let mut burst = Vec::new();
     for v in [1325i16, 0, 0, 0, i16::MIN, i16::MIN, i16::MIN] {
         burst.extend(v.to_be_bytes());

@@ -220,11 +220,13 @@ fn mpu6050_fifo_whole_packets_chunks_and_partial_packets() {
         .collect();
     expect.push(I2c::write_read(ADDR, vec![0x74], packets[..8].concat()));
     expect.push(I2c::write_read(ADDR, vec![0x74], packets[8..].concat()));
+    expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x00])); // INT_STATUS after the read
     // The next call asks for fewer samples than there are.
     expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x00]));
     expect.push(I2c::write_read(ADDR, vec![0x72], vec![0, 41])); // 3 packets + 5 bytes
     expect.push(I2c::write_read(ADDR, vec![0x72], vec![0, 41]));
     expect.push(I2c::write_read(ADDR, vec![0x74], packets[..2].concat()));
+    expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x00])); // INT_STATUS after the read
     let mut imu = Mpu6050::new(I2cMock::new(&expect), ADDR);
     let mut out = [RawSample::default(); 16];
     assert_eq!(imu.read_fifo(&mut out), Err(Error::FifoDisabled));
@@ -249,6 +251,7 @@ fn mpu6050_fifo_overflow_is_counted_and_recovered() {
     expect.extend(mpu_fifo_enable());
     expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x10])); // FIFO_OFLOW_INT
     expect.push(I2c::write_read(ADDR, vec![0x72], vec![0x04, 0x00])); // 1024 bytes
+    expect.push(I2c::write_read(ADDR, vec![0x72], vec![0x04, 0x00])); // confirmed
     expect.extend(mpu_fifo_reset(1024));
     expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x00]));
     expect.push(I2c::write_read(ADDR, vec![0x72], vec![0, 12]));
@@ -258,6 +261,7 @@ fn mpu6050_fifo_overflow_is_counted_and_recovered() {
         vec![0x74],
         mpu_packet([1, 2, 3], [4, 5, 6]),
     ));
+    expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x00])); // INT_STATUS after the read
     let mut imu = mpu_with_fifo(&expect);
     common::overflow_then_one_sample(&mut imu, 85);
     imu.destroy().done();
@@ -312,6 +316,7 @@ fn mpu6050_resetting_itself_is_detected_recovered_and_counted() {
     expect.push(I2c::write_read(ADDR, vec![0x72], vec![0, 24]));
     let packets = [mpu_packet([1; 3], [2; 3]), mpu_packet([3; 3], [4; 3])];
     expect.push(I2c::write_read(ADDR, vec![0x74], packets.concat()));
+    expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x00])); // INT_STATUS after the read
     expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x00]));
     expect.push(I2c::write_read(ADDR, vec![0x72], vec![0, 0]));
     // USER_CTRL and PWR_MGMT_1 after a reset: FIFO off, asleep.
@@ -328,6 +333,7 @@ fn mpu6050_resetting_itself_is_detected_recovered_and_counted() {
         vec![0x74],
         mpu_packet([5; 3], [6; 3]),
     ));
+    expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x00])); // INT_STATUS after the read
     let mut imu = mpu_with_fifo(&expect);
     let mut out = [RawSample::default(); 4];
     assert_eq!(imu.read_fifo(&mut out), Ok(2));
