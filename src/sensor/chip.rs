@@ -81,10 +81,11 @@ pub enum Packet {
     Sample(RawSample),
     /// A packet the chip marked invalid: skipped and counted.
     Invalid,
-    /// A packet of the wrong layout: skipped and counted.
+    /// A packet of the wrong layout, most likely misaligned: counted, and the call's other
+    /// packets dropped (counted as discarded) by a FIFO reset that realigns them.
     Malformed,
-    /// The chip's "FIFO empty" marker: inside the counted bytes, a damaged header (counted as
-    /// malformed); the batch ends with it.
+    /// The chip's "FIFO empty" marker: inside the counted bytes, a damaged header (as
+    /// [`Packet::Malformed`]).
     End,
 }
 

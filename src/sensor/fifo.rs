@@ -255,39 +255,30 @@ pub(crate) fn read_fifo<C: Chip>(
         }
         taken += n * packet;
         remaining -= n;
-        if batch.parse::<C>(bytes, out) {
-            remaining = 0;
-        }
+        batch.parse::<C>(bytes, out);
         if batch.malformed > 0 {
-            // A header that is not one: the packets are most likely misaligned (a byte lost or
-            // added on the wire), and a misaligned packet passes the header test now and then.
-            // The batch is dropped (the malformed packets counted as such, the rest as
-            // discarded) and the FIFO reset, which realigns it.
-            let bad = u32::try_from(batch.malformed).unwrap_or(u32::MAX);
-            let bad = bad.saturating_mul(u32::try_from(packet).unwrap_or(u32::MAX));
-            let taken = u32::try_from(taken).unwrap_or(u32::MAX);
-            let pending = state.pending.get_or_insert_with(PendingReset::default);
-            pending.resync = true;
-            pending.malformed = pending.malformed.saturating_add(batch.malformed);
-            pending.consumed = pending.consumed.saturating_add(taken.saturating_sub(bad));
-            return finish_reset(chip, state);
+            // A header that is not one (the "FIFO empty" marker inside the counted bytes
+            // too): the packets are most likely misaligned (a byte lost or added on the
+            // wire), and a misaligned packet passes the header test now and then. The call's
+            // packets are dropped, the malformed ones counted as such.
+            let malformed = batch.malformed;
+            let bad = usize::try_from(malformed).map_or(usize::MAX, |m| m.saturating_mul(packet));
+            return drop_call(chip, state, taken.saturating_sub(bad), |p| {
+                p.resync = true;
+                p.malformed = p.malformed.saturating_add(malformed);
+            });
         }
     }
     // Samples keep arriving while the FIFO is read (a 96-byte transfer takes 2.4 ms at
     // 400 kHz, 9.6 ms at 100 kHz): one that overwrote bytes not yet read misaligned every
     // packet after them. The overflow flag says; with it (or when it cannot be read) the
-    // batch is dropped and counted, and the FIFO reset.
-    {
-        let flag = chip.read_u8(C::MAP.int_status);
-        if !matches!(flag, Ok(f) if f & C::MAP.int_fifo_overflow == 0) {
-            let pending = state.pending.get_or_insert_with(PendingReset::default);
-            pending.overflow |= flag.is_ok();
-            pending.resync |= flag.is_err();
-            pending.consumed = pending
-                .consumed
-                .saturating_add(u32::try_from(taken).unwrap_or(u32::MAX));
-            return finish_reset(chip, state);
-        }
+    // call's packets are dropped.
+    let flag = chip.read_u8(C::MAP.int_status);
+    if !matches!(flag, Ok(f) if f & C::MAP.int_fifo_overflow == 0) {
+        return drop_call(chip, state, taken, |p| {
+            p.overflow |= flag.is_ok();
+            p.resync |= flag.is_err();
+        });
     }
     batch.count(&mut state.stats);
     Ok(batch.delivered)
@@ -303,10 +294,8 @@ struct Batch {
 }
 
 impl Batch {
-    /// Parses the packets in `bytes` into `out`, after the samples already delivered. Returns
-    /// `true` when one of them ends the batch.
-    fn parse<C: Chip>(&mut self, bytes: &[u8], out: &mut [RawSample]) -> bool {
-        let mut end = false;
+    /// Parses the packets in `bytes` into `out`, after the samples already delivered.
+    fn parse<C: Chip>(&mut self, bytes: &[u8], out: &mut [RawSample]) {
         for p in bytes.chunks_exact(packet::<C>()) {
             match C::parse(p) {
                 Packet::Sample(s) => {
@@ -317,23 +306,16 @@ impl Batch {
                     }
                 }
                 Packet::Invalid => self.invalid += 1,
-                Packet::Malformed => self.malformed += 1,
-                Packet::End => {
-                    // The "FIFO empty" marker inside the counted bytes: a damaged header. The
-                    // packets after it in this transfer are parsed; the batch ends with it.
-                    self.malformed += 1;
-                    end = true;
-                }
+                // The "FIFO empty" marker inside the counted bytes is a damaged header.
+                Packet::Malformed | Packet::End => self.malformed += 1,
             }
         }
-        end
     }
 
-    /// Adds the batch to `stats`.
+    /// Adds a batch that is delivered (one without malformed packets) to `stats`.
     fn count(&self, stats: &mut FifoStats) {
         stats.samples = stats.samples.saturating_add(self.delivered as u64);
         stats.invalid = stats.invalid.saturating_add(self.invalid);
-        stats.malformed = stats.malformed.saturating_add(self.malformed);
         stats.clipped = stats.clipped.saturating_add(self.clipped);
     }
 }
@@ -361,6 +343,22 @@ fn resync<C: Chip>(chip: &mut C, state: &mut FifoState, latest: u16, taken: usiz
             Err(_) => {}
         }
     }
+}
+
+/// Drops the packets of a call instead of delivering them: their `bytes` (already read) are
+/// counted as discarded by the FIFO reset that follows, whose cause `mark` sets.
+fn drop_call<C: Chip>(
+    chip: &mut C,
+    state: &mut FifoState,
+    bytes: usize,
+    mark: impl FnOnce(&mut PendingReset),
+) -> Result<usize, Error<C::BusError>> {
+    let pending = state.pending.get_or_insert_with(PendingReset::default);
+    mark(pending);
+    pending.consumed = pending
+        .consumed
+        .saturating_add(u32::try_from(bytes).unwrap_or(u32::MAX));
+    finish_reset(chip, state)
 }
 
 /// The FIFO reset: channels off, the count of what it drops (stable now), a check that the
