@@ -443,7 +443,7 @@ enum Source<'a> {
 
 impl<'a> Source<'a> {
     /// The bytes from `byte` on.
-    fn open_at(self, byte: u64) -> std::io::Result<Box<dyn Read + 'a>> {
+    fn open_at(self, byte: u64) -> std::io::Result<Box<dyn Read + Send + 'a>> {
         match self {
             Self::Held(bytes) => {
                 let at = usize::try_from(byte).map_or(bytes.len(), |b| b.min(bytes.len()));
@@ -474,19 +474,19 @@ fn read_source(
         select,
         each,
         locate,
-        1 << 20,
+        (1 << 20, false),
     )
 }
 
 /// [`read_source`] with a buffer of `buffer` bytes to start with (lines longer than it
-/// enlarge it).
+/// enlarge it), scanned on a thread of its own also when the source is short (`force_thread`).
 fn read_source_in(
     path: &Path,
     (source, comment_header): (Source, Option<Vec<String>>),
     select: &mut Select,
     each: &mut dyn FnMut(&[&str]) -> Result<(), String>,
     locate: &dyn Fn(u64) -> Option<u64>,
-    buffer: usize,
+    (buffer, force_thread): (usize, bool),
 ) -> Result<(), DataError> {
     let cannot_read = |e: std::io::Error| error(path, None, format!("cannot read: {e}"));
     let (header, start) = match comment_header {
@@ -526,7 +526,11 @@ fn read_source_in(
         buffer: buffer.max(1),
         count: 0,
     };
-    rows.read(source.open_at(start).map_err(cannot_read)?, start)?;
+    let threaded = match source {
+        Source::Held(bytes) => bytes.len() > SCAN_THREAD_FROM || force_thread,
+        Source::File(_) => true,
+    };
+    rows.read(source.open_at(start).map_err(cannot_read)?, start, threaded)?;
     if rows.count == 0 {
         return Err(error(path, None, "no data rows"));
     }
@@ -559,7 +563,62 @@ fn malformed(e: &::csv::Error) -> String {
     }
 }
 
-/// The records after a source's header, checked and passed on.
+/// Records scanned from a source, for [`Rows::take`]: their fields' text in one string.
+#[derive(Default)]
+struct Batch {
+    text: String,
+    /// Each field's bounds in `text`.
+    fields: Vec<(usize, usize)>,
+    /// Each record: the file's byte where it starts, and where its fields end in `fields`
+    /// (they start where the record before ends).
+    records: Vec<(u64, usize)>,
+}
+
+impl Batch {
+    fn clear(&mut self) {
+        self.text.clear();
+        self.fields.clear();
+        self.records.clear();
+    }
+
+    /// The line `text`, starting at byte `start` of the file, as one record.
+    fn line(&mut self, text: &str, start: u64) {
+        let base = self.text.len();
+        self.text.push_str(text);
+        let mut from = 0;
+        for comma in memchr::memchr_iter(b',', text.as_bytes()) {
+            self.fields.push((base + from, base + comma));
+            from = comma + 1;
+        }
+        self.fields.push((base + from, base + text.len()));
+        self.records.push((start, self.fields.len()));
+    }
+}
+
+/// Text of a batch, bytes, past which it is handed on mid-scan.
+const BATCH_TEXT: usize = 1 << 20;
+
+/// Held sources longer than this, bytes, are scanned on a thread of their own.
+const SCAN_THREAD_FROM: usize = 1 << 20;
+
+/// Why a scan stopped early: its consumer stopped it (`None`), or a problem with the file's
+/// byte to blame, where there is one.
+type Stop = Option<(Option<u64>, String)>;
+
+/// Hands `batch` to `sink` when it holds records, and takes back an empty one.
+fn hand_on(batch: &mut Batch, sink: &mut dyn FnMut(Batch) -> Option<Batch>) -> Result<(), Stop> {
+    if batch.records.is_empty() {
+        return Ok(());
+    }
+    let mut back = sink(std::mem::take(batch)).ok_or(None)?;
+    back.clear();
+    *batch = back;
+    Ok(())
+}
+
+/// The records of `source`, which starts at byte `base` of the file, in batches to `sink`
+/// (which hands each back to go on, or `None` to stop), read `buffer` bytes at a time at
+/// least: the end, or the problem that ended it, after every record before it.
 ///
 /// Lines are split here, without the CSV reader, while they are plain: no quote, no carriage
 /// return but a line's last byte, valid UTF-8. There the CSV reader's records and these lines
@@ -567,6 +626,167 @@ fn malformed(e: &::csv::Error) -> String {
 /// and runs a comment, a line whose first byte is `#`, to the next `\n`). From the first line
 /// that is not plain to the end of the source, the CSV reader reads, so that quoting and its
 /// errors are its own.
+fn scan(
+    source: impl Read,
+    base: u64,
+    buffer: usize,
+    sink: &mut dyn FnMut(Batch) -> Option<Batch>,
+) -> Result<(), (Option<u64>, String)> {
+    let mut batch = Batch::default();
+    let end = scan_into(source, base, buffer, &mut batch, sink);
+    // The records before a problem go first, so that one of theirs is found first.
+    match hand_on(&mut batch, sink).and(end) {
+        Ok(()) | Err(None) => Ok(()),
+        Err(Some(problem)) => Err(problem),
+    }
+}
+
+/// [`scan`] into `batch`, handed on at every refill of the buffer.
+fn scan_into(
+    mut source: impl Read,
+    base: u64,
+    buffer: usize,
+    batch: &mut Batch,
+    sink: &mut dyn FnMut(Batch) -> Option<Batch>,
+) -> Result<(), Stop> {
+    let mut buf = vec![0u8; buffer.max(1)];
+    // Bytes held, and the file's byte of `buf[0]`.
+    let mut held = 0;
+    let mut offset = base;
+    let mut end = false;
+    // A byte order mark first in the file is no part of its first line.
+    let mut bom = base == 0;
+    while !(end && held == 0) {
+        if !end {
+            if held == buf.len() {
+                // A line longer than the buffer.
+                buf.resize(2 * buf.len(), 0);
+            }
+            match source.read(&mut buf[held..]) {
+                Ok(0) => end = true,
+                Ok(n) => held += n,
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+                Err(e) => return Err(Some((None, format!("cannot read: {e}")))),
+            }
+        }
+        let mut at = 0;
+        if bom {
+            if held < BOM.len() && !end {
+                continue;
+            }
+            bom = false;
+            if buf[..held].starts_with(BOM) {
+                at = BOM.len();
+            }
+        }
+        loop {
+            // The lines before the first quote, carriage return or invalid UTF-8, all at
+            // once: one scan of each kind over many lines.
+            let rest = &buf[at..held];
+            let special = memchr::memchr2(b'"', b'\r', rest).unwrap_or(rest.len());
+            let valid = match std::str::from_utf8(&rest[..special]) {
+                Ok(text) => text,
+                Err(e) => std::str::from_utf8(&rest[..e.valid_up_to()]).unwrap_or_default(),
+            };
+            // Up to the last line end: a character boundary.
+            let clean = memchr::memrchr(b'\n', valid.as_bytes()).map_or(0, |n| n + 1);
+            let text = &valid[..clean];
+            // Commas and line ends in one pass: the fields of each line.
+            let t0 = batch.text.len();
+            batch.text.push_str(text);
+            let (mut line, mut field) = (0, 0);
+            let mut first = batch.fields.len();
+            for n in memchr::memchr2_iter(b',', b'\n', text.as_bytes()) {
+                batch.fields.push((t0 + field, t0 + n));
+                field = n + 1;
+                if text.as_bytes()[n] == b'\n' {
+                    let record = &text[line..n];
+                    if record.is_empty() || record.starts_with('#') {
+                        batch.fields.truncate(first);
+                    } else {
+                        let start = offset + (at + line) as u64;
+                        batch.records.push((start, batch.fields.len()));
+                    }
+                    first = batch.fields.len();
+                    line = n + 1;
+                }
+            }
+            at += clean;
+            // Then one line as it comes.
+            let rest = &buf[at..held];
+            let (line, next) = match memchr::memchr(b'\n', rest) {
+                Some(n) => (&rest[..n], at + n + 1),
+                None if end && !rest.is_empty() => (rest, held),
+                None => break,
+            };
+            if line.first() == Some(&b'#') {
+                at = next;
+                continue;
+            }
+            let line = line.strip_suffix(b"\r").unwrap_or(line);
+            let plain = memchr::memchr2(b'"', b'\r', line).is_none();
+            match std::str::from_utf8(line) {
+                Ok(text) if plain => {
+                    if !text.is_empty() {
+                        batch.line(text, offset + at as u64);
+                    }
+                }
+                _ => {
+                    // A line end after the last line: a comment there is one without it
+                    // too (the CSV reader would take it for a record).
+                    let tail = std::io::Cursor::new(&buf[at..held])
+                        .chain(source)
+                        .chain(&b"\n"[..]);
+                    return scan_quoted(tail, offset + at as u64, batch, sink);
+                }
+            }
+            at = next;
+        }
+        hand_on(batch, sink)?;
+        buf.copy_within(at..held, 0);
+        held -= at;
+        offset += at as u64;
+    }
+    Ok(())
+}
+
+/// The records from byte `base` on, by the CSV reader, into `batch` (handed on when it is
+/// full).
+fn scan_quoted(
+    source: impl Read,
+    base: u64,
+    batch: &mut Batch,
+    sink: &mut dyn FnMut(Batch) -> Option<Batch>,
+) -> Result<(), Stop> {
+    let mut reader = ::csv::ReaderBuilder::new()
+        .comment(Some(b'#'))
+        .flexible(true)
+        .has_headers(false)
+        .from_reader(source);
+    let mut record = ::csv::StringRecord::new();
+    loop {
+        match reader.read_record(&mut record) {
+            Ok(false) => return Ok(()),
+            Ok(true) => {}
+            Err(e) => {
+                let at = e.position().map(|p| base + p.byte());
+                return Err(Some((at, malformed(&e))));
+            }
+        }
+        let start = base + record.position().map_or(0, |p| p.byte());
+        for field in &record {
+            let from = batch.text.len();
+            batch.text.push_str(field);
+            batch.fields.push((from, batch.text.len()));
+        }
+        batch.records.push((start, batch.fields.len()));
+        if batch.text.len() >= BATCH_TEXT {
+            hand_on(batch, sink)?;
+        }
+    }
+}
+
+/// The records after a source's header, checked and passed on.
 struct Rows<'a> {
     path: &'a Path,
     header: &'a [String],
@@ -580,155 +800,73 @@ struct Rows<'a> {
 }
 
 impl Rows<'_> {
-    /// Reads the records of `source`, which starts at byte `base` of the file.
-    fn read(&mut self, mut source: impl Read, base: u64) -> Result<(), DataError> {
-        let mut buf = vec![0u8; self.buffer];
-        // Bytes held, and the file's byte of `buf[0]`.
-        let mut held = 0;
-        let mut offset = base;
-        let mut end = false;
-        let mut bounds = Vec::with_capacity(self.header.len() + 1);
-        // A byte order mark first in the file is no part of its first line.
-        let mut bom = base == 0;
-        while !(end && held == 0) {
-            if !end {
-                if held == buf.len() {
-                    // A line longer than the buffer.
-                    buf.resize(2 * buf.len(), 0);
-                }
-                match source.read(&mut buf[held..]) {
-                    Ok(0) => end = true,
-                    Ok(n) => held += n,
-                    Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
-                    Err(e) => return Err(error(self.path, None, format!("cannot read: {e}"))),
-                }
-            }
-            let mut at = 0;
-            if bom {
-                if held < BOM.len() && !end {
-                    continue;
-                }
-                bom = false;
-                if buf[..held].starts_with(BOM) {
-                    at = BOM.len();
-                }
-            }
-            loop {
-                // The lines before the first quote, carriage return or invalid UTF-8, all at
-                // once: one scan of each kind over many lines.
-                let rest = &buf[at..held];
-                let special = memchr::memchr2(b'"', b'\r', rest).unwrap_or(rest.len());
-                let valid = match std::str::from_utf8(&rest[..special]) {
-                    Ok(text) => text,
-                    Err(e) => std::str::from_utf8(&rest[..e.valid_up_to()]).unwrap_or_default(),
-                };
-                // Up to the last line end: a character boundary.
-                let clean = memchr::memrchr(b'\n', valid.as_bytes()).map_or(0, |n| n + 1);
-                let text = &valid[..clean];
-                // Commas and line ends in one pass: the fields of each line in `bounds`.
-                let (mut line, mut field) = (0, 0);
-                bounds.clear();
-                for n in memchr::memchr2_iter(b',', b'\n', text.as_bytes()) {
-                    bounds.push((field, n));
-                    field = n + 1;
-                    if text.as_bytes()[n] == b'\n' {
-                        let record = &text[line..n];
-                        if !record.is_empty() && !record.starts_with('#') {
-                            self.fields(text, &bounds, offset + (at + line) as u64)?;
-                        }
-                        bounds.clear();
-                        line = n + 1;
+    /// Reads the records of `source`, which starts at byte `base` of the file; scanned on a
+    /// thread of its own (`threaded`) while the records are checked and passed on here, the
+    /// batches in order, so that the first problem in the file is the one found.
+    fn read(
+        &mut self,
+        source: impl Read + Send,
+        base: u64,
+        threaded: bool,
+    ) -> Result<(), DataError> {
+        let buffer = self.buffer;
+        let mut failed = None;
+        let end = if threaded {
+            std::thread::scope(|scope| {
+                let (send, receive) = std::sync::mpsc::sync_channel::<Batch>(2);
+                let (back, spent) = std::sync::mpsc::channel::<Batch>();
+                let scanner = scope.spawn(move || {
+                    scan(source, base, buffer, &mut |batch| {
+                        send.send(batch).ok()?;
+                        Some(spent.try_recv().unwrap_or_default())
+                    })
+                });
+                for batch in receive.iter() {
+                    if let Err(e) = self.records(&batch) {
+                        // The scanner stops at its next batch, the channel closed.
+                        failed = Some(e);
+                        break;
                     }
+                    let _ = back.send(batch);
                 }
-                at += clean;
-                // Then one line as it comes.
-                let rest = &buf[at..held];
-                let (line, next) = match memchr::memchr(b'\n', rest) {
-                    Some(n) => (&rest[..n], at + n + 1),
-                    None if end && !rest.is_empty() => (rest, held),
-                    None => break,
-                };
-                if line.first() == Some(&b'#') {
-                    at = next;
-                    continue;
-                }
-                let line = line.strip_suffix(b"\r").unwrap_or(line);
-                let plain = memchr::memchr2(b'"', b'\r', line).is_none();
-                match std::str::from_utf8(line) {
-                    Ok(text) if plain => {
-                        if !text.is_empty() {
-                            self.record(text, &mut bounds, offset + at as u64)?;
-                        }
+                drop(receive);
+                scanner
+                    .join()
+                    .unwrap_or_else(|_| Err((None, "the scanner stopped".into())))
+            })
+        } else {
+            scan(
+                source,
+                base,
+                buffer,
+                &mut |batch| match self.records(&batch) {
+                    Ok(()) => Some(batch),
+                    Err(e) => {
+                        failed = Some(e);
+                        None
                     }
-                    _ => {
-                        // A line end after the last line: a comment there is one without it
-                        // too (the CSV reader would take it for a record).
-                        let tail = std::io::Cursor::new(&buf[at..held])
-                            .chain(source)
-                            .chain(&b"\n"[..]);
-                        return self.read_quoted(tail, offset + at as u64);
-                    }
-                }
-                at = next;
-            }
-            buf.copy_within(at..held, 0);
-            held -= at;
-            offset += at as u64;
+                },
+            )
+        };
+        if let Some(e) = failed {
+            return Err(e);
+        }
+        end.map_err(|(at, problem)| error(self.path, at.and_then(self.locate), problem))
+    }
+
+    /// The records of `batch`, in order.
+    fn records(&mut self, batch: &Batch) -> Result<(), DataError> {
+        let mut from = 0;
+        for &(start, to) in &batch.records {
+            let fields = &batch.fields[from..to];
+            from = to;
+            self.take(
+                fields.len(),
+                |i| fields.get(i).map(|&(a, b)| &batch.text[a..b]),
+                start,
+            )?;
         }
         Ok(())
-    }
-
-    /// One plain record, the line `text` starting at byte `start` of the file.
-    fn record(
-        &mut self,
-        text: &str,
-        bounds: &mut Vec<(usize, usize)>,
-        start: u64,
-    ) -> Result<(), DataError> {
-        bounds.clear();
-        let mut from = 0;
-        for comma in memchr::memchr_iter(b',', text.as_bytes()) {
-            bounds.push((from, comma));
-            from = comma + 1;
-        }
-        bounds.push((from, text.len()));
-        self.fields(text, bounds, start)
-    }
-
-    /// The record of the fields `bounds` of `text`, starting at byte `start` of the file.
-    fn fields(
-        &mut self,
-        text: &str,
-        bounds: &[(usize, usize)],
-        start: u64,
-    ) -> Result<(), DataError> {
-        self.take(
-            bounds.len(),
-            |i| bounds.get(i).map(|&(a, b)| &text[a..b]),
-            start,
-        )
-    }
-
-    /// The records from byte `base` on, by the CSV reader.
-    fn read_quoted(&mut self, source: impl Read, base: u64) -> Result<(), DataError> {
-        let mut reader = ::csv::ReaderBuilder::new()
-            .comment(Some(b'#'))
-            .flexible(true)
-            .has_headers(false)
-            .from_reader(source);
-        let mut record = ::csv::StringRecord::new();
-        loop {
-            match reader.read_record(&mut record) {
-                Ok(false) => return Ok(()),
-                Ok(true) => {}
-                Err(e) => {
-                    let line = e.position().and_then(|p| (self.locate)(base + p.byte()));
-                    return Err(error(self.path, line, malformed(&e)));
-                }
-            }
-            let start = base + record.position().map_or(0, |p| p.byte());
-            self.take(record.len(), |i| record.get(i), start)?;
-        }
     }
 
     /// Checks a record of `fields` fields (`field(i)` the `i`-th, untrimmed) starting at byte
@@ -818,11 +956,13 @@ mod tests {
         }
     }
 
-    /// The same by [`read_source_in`], with a buffer of `buffer` bytes.
+    /// The same by [`read_source_in`], with a buffer of `buffer` bytes, scanned on a thread
+    /// of its own (`threaded`) or not.
     fn by_the_reader(
         bytes: &[u8],
         column: usize,
         buffer: usize,
+        threaded: bool,
     ) -> Result<Vec<String>, (Option<u64>, String)> {
         let mut out = Vec::new();
         let locate = |byte| line_at(bytes, byte);
@@ -841,7 +981,7 @@ mod tests {
                 Ok(())
             },
             &locate,
-            buffer,
+            (buffer, threaded),
         );
         match read {
             Ok(()) => Ok(out),
@@ -898,7 +1038,7 @@ mod tests {
             let want = by_the_csv_reader(&text, column);
             // Buffers of a few bytes too: lines split over refills, and longer than a buffer.
             let buffer = [1 << 20, 1, 2, 3, 7, 16, 64][(next() % 7) as usize];
-            let got = by_the_reader(&text, column, buffer);
+            let got = by_the_reader(&text, column, buffer, case % 2 == 1);
             // No rows is the reader's own error; the reference gives an empty list.
             let got = match got {
                 Err((None, p)) if p == "no data rows" => Ok(Vec::new()),
@@ -914,6 +1054,50 @@ mod tests {
         }
         // Both outcomes were tried, many times.
         assert!(agreed.iter().all(|&n| n > cases / 20), "{agreed:?}");
+    }
+
+    /// Scanned on a thread of its own, in many batches: a row the consumer refuses is the
+    /// error (at its line), not a line after it that the scanner refused (not UTF-8) when it
+    /// reached it first, and nothing after the refused row is passed on; a line the scanner
+    /// refuses before it is the error.
+    #[test]
+    fn the_first_problem_in_the_file_is_the_one_found_when_scanning_ahead() {
+        let mut text = b"t,x\n".to_vec();
+        for i in 0..50_000 {
+            text.extend_from_slice(format!("{i},{}\n", i % 7).as_bytes());
+        }
+        let malformed = |text: &mut Vec<u8>| text.extend_from_slice(b"1,\"\xff\"\n");
+        let read = |text: &[u8], refuse: usize| {
+            let mut seen = 0;
+            let got = read_source_in(
+                Path::new("t.csv"),
+                (Source::Held(text), None),
+                &mut |_| Ok(vec![0, 1]),
+                &mut |cells| {
+                    seen += 1;
+                    match cells[0].parse::<usize>() {
+                        Ok(i) if i == refuse => Err(format!("refused {i}")),
+                        _ => Ok(()),
+                    }
+                },
+                &|byte| line_at(text, byte),
+                (4096, true),
+            );
+            (got.map_err(|e| (e.line, e.problem)), seen)
+        };
+        let mut after = text.clone();
+        malformed(&mut after);
+        assert_eq!(
+            read(&after, 30_000),
+            (Err((Some(30_002), "refused 30000".into())), 30_001)
+        );
+        let mut before = b"t,x\n0,1\n".to_vec();
+        malformed(&mut before);
+        before.extend_from_slice(&text[4..]);
+        let (got, seen) = read(&before, 30_000);
+        assert_eq!((got.map_err(|(line, _)| line), seen), (Err(Some(3)), 1));
+        // Read to the end, with the rows counted, when nothing is refused.
+        assert_eq!(read(&text, usize::MAX), (Ok(()), 50_000));
     }
 
     /// A header row whose first cell is a quoted `"#..."` is a header row, not a comment (the
