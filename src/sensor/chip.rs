@@ -53,9 +53,6 @@ pub struct Map {
     pub packet: usize,
     /// The FIFO's size in bytes: a count at it is an overflow, a count above it no count.
     pub fifo_bytes: u16,
-    /// FIFO_COUNT is read a second time before data are read, and the smaller count is used:
-    /// for packets without a header, whose data cannot show a count that was wrong.
-    pub confirm_count: bool,
     /// The first writes of `enable_fifo`, before its FIFO reset.
     pub fifo_prepare: &'static [Write],
     /// Takes the channels off the FIFO (and, where needed, the FIFO itself).

@@ -171,7 +171,9 @@ impl<C: Chip> ImuReader for Driver<C> {
         C::sample(&b).ok_or(Error::NoData)
     }
 
-    /// Reads INT_STATUS and FIFO_COUNT first. A count above the FIFO's size is no count
+    /// Reads INT_STATUS and FIFO_COUNT first (the count twice when it holds a packet, and the
+    /// smaller taken: a count corrupted high would read past the FIFO's end). A count above
+    /// the FIFO's size is no count
     /// ([`Error::BadFifoCount`], nothing read). On the FIFO overflow flag, or a count at the
     /// FIFO's size (a full FIFO overwrites its oldest bytes, so its packets are misaligned),
     /// the FIFO is reset (its complete packets are counted as discarded) and

@@ -214,11 +214,11 @@ pub(crate) fn read_fifo<C: Chip>(
     }
     let first = count(chip)?;
     // The count the data are read by, and the latest count, which the bytes of a failed read
-    // are reckoned from. A chip whose packets have no header has its count confirmed (a count
-    // corrupted on the wire would be read past the FIFO's end, or dropped by a pending reset
-    // as samples never written): the smaller of two is taken.
+    // are reckoned from. The count is confirmed (a count corrupted high on the wire would be
+    // read past the FIFO's end, or dropped by a pending reset as samples never written): the
+    // smaller of two is taken.
     let (mut readable, mut latest) = (first, first);
-    if C::MAP.confirm_count && (usize::from(first) >= packet || state.pending.is_some()) {
+    if usize::from(first) >= packet || state.pending.is_some() {
         latest = count(chip)?;
         readable = readable.min(latest);
     }

@@ -343,13 +343,16 @@ impl Icm42688Config {
 ///   [`Error::NoData`](super::Error::NoData).
 /// - `enable_fifo` puts the FIFO in stream mode (FIFO_CONFIG) with packet 3 (FIFO_CONFIG1:
 ///   header, accelerometer, gyro, temperature, timestamp: 16 bytes); the FIFO holds 2048
-///   bytes, and INT_STATUS.FIFO_FULL_INT flags an overflow. A packet whose header does not
-///   announce accelerometer and gyro data, or announces a 20-byte packet (HEADER_20), is
-///   skipped and counted as malformed, one carrying the invalid-data marker (-32768, or -128
-///   for the temperature) is skipped and counted as invalid, and a header with HEADER_MSG set
-///   (FIFO empty) inside the counted bytes is a damaged header: counted as malformed, the
-///   packets after it in the same transaction parsed, and the batch ended (the rest stays in
-///   the FIFO). A FIFO reset takes the channels off (FIFO_CONFIG1 = 0), reads FIFO_COUNT,
+///   bytes, and INT_STATUS.FIFO_FULL_INT flags an overflow. `read_fifo` reads FIFO_COUNT
+///   twice and takes the smaller (a count corrupted high on the wire would read past the
+///   FIFO's end). A packet carrying the invalid-data marker (-32768, or -128 for the
+///   temperature) is skipped and counted as invalid. A header that does not announce
+///   accelerometer and gyro data, announces a 20-byte packet (HEADER_20), or has HEADER_MSG
+///   set (FIFO empty) inside the counted bytes is malformed: the packets are most likely
+///   misaligned, so the call's packets are dropped (the malformed ones counted as such, the
+///   others as discarded) and the FIFO is reset, which realigns it
+///   ([`Error::FifoResync`](super::Error::FifoResync)). A FIFO reset takes the channels off
+///   (FIFO_CONFIG1 = 0), reads FIFO_COUNT,
 ///   then flushes the FIFO (SIGNAL_PATH_RESET.FIFO_FLUSH) and starts the channels again. An
 ///   empty FIFO is checked against FIFO_CONFIG (bypass mode after a chip reset); a FIFO reset
 ///   that finds the FIFO empty checks PWR_MGMT0 (sensors off after a chip reset).
@@ -441,7 +444,6 @@ const MAP: Map = Map {
     fifo_data: FIFO_DATA,
     packet: PACKET,
     fifo_bytes: FIFO_BYTES,
-    confirm_count: false,
     fifo_prepare: FIFO_STREAM,
     fifo_stop: FIFO_STOP,
     fifo_empty: FIFO_FLUSHED,

@@ -375,7 +375,6 @@ const MAP: Map = Map {
     fifo_data: FIFO_R_W,
     packet: PACKET,
     fifo_bytes: FIFO_BYTES,
-    confirm_count: true,
     fifo_prepare: OVERFLOW_FLAG_ON,
     fifo_stop: FIFO_STOP,
     fifo_empty: FIFO_EMPTY,

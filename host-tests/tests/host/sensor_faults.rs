@@ -366,6 +366,27 @@ fn mpu_corrupted_fifo_count_delivers_no_garbage() {
     );
 }
 
+/// ICM-42688-P: a FIFO_COUNT read corrupted high on the wire (0x00A0 = 10 packets while the
+/// FIFO holds 2) was trusted: the reader read past the FIFO's end, took the bytes there for 8
+/// malformed packets, and dropped the call: the 2 real samples discarded and 8 samples that
+/// were never written counted as malformed. (The count is confirmed as the MPU-6050's is.)
+/// Expected: the 2 samples delivered, and every sample accounted for exactly.
+#[test]
+fn icm_corrupted_fifo_count_counts_no_phantom_samples() {
+    let (sim, hooks, mut imu) = icm(12);
+    let mut out = [RawSample::default(); 160];
+    let delivered = imu.fifo_stats().samples;
+    sim.borrow_mut().tick(2);
+    hooks.add(
+        Kind::Read(icm::FIFO_COUNTH),
+        0,
+        Action::Overwrite(vec![(0, 0x00), (1, 0xA0)]),
+    );
+    assert_eq!(imu.read_fifo(&mut out), Ok(2));
+    assert_eq!(imu.fifo_stats().malformed, 0);
+    assert_accounted(&sim, &imu, delivered + 2, "a count corrupted high");
+}
+
 /// ICM-42688-P: `FifoStats::invalid` counts FIFO packets the chip marked invalid, and README's
 /// accounting ("every sample the chip writes into its FIFO is delivered or counted ...
 /// invalid") relies on it; `Icm42688::read()` (a data-register read, no FIFO packet) added to

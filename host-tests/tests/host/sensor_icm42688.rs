@@ -213,6 +213,7 @@ fn icm42688_fifo_packets_malformed_empty_and_partial() {
     expect.extend(icm_fifo_enable());
     expect.extend(spi_read(0x2D, vec![0x08])); // INT_STATUS: data ready
     expect.extend(spi_read(0x2E, vec![0, 2 * 16 + 7])); // 2 packets and 7 stray bytes
+    expect.extend(spi_read(0x2E, vec![0, 2 * 16 + 7])); // the count confirmed
     let data = [
         icm_packet(0x68, [1, 2, 3], [4, 5, 6], 10),
         icm_packet(0x6A, [-1, -2, -3], [-4, -5, -6], -5),
@@ -224,6 +225,7 @@ fn icm42688_fifo_packets_malformed_empty_and_partial() {
     // for this layout.
     expect.extend(spi_read(0x2D, vec![0x00]));
     expect.extend(spi_read(0x2E, vec![0, 3 * 16 + 7]));
+    expect.extend(spi_read(0x2E, vec![0, 3 * 16 + 7])); // the count confirmed
     let data = [
         icm_packet(0x68, [7; 3], [7; 3], 0),
         icm_packet(0x28, [0; 3], [7, 8, 9], 0),
@@ -235,6 +237,7 @@ fn icm42688_fifo_packets_malformed_empty_and_partial() {
     // An empty-FIFO header inside the counted bytes is a damaged header too.
     expect.extend(spi_read(0x2D, vec![0x00]));
     expect.extend(spi_read(0x2E, vec![0, 32]));
+    expect.extend(spi_read(0x2E, vec![0, 32])); // the count confirmed
     expect.extend(spi_read(
         0x30,
         [
@@ -292,9 +295,11 @@ fn icm42688_fifo_overflow_is_counted_and_recovered() {
     expect.extend(icm_fifo_enable());
     expect.extend(spi_read(0x2D, vec![0x02])); // FIFO_FULL_INT
     expect.extend(spi_read(0x2E, vec![0x08, 0x00])); // 2048 bytes
+    expect.extend(spi_read(0x2E, vec![0x08, 0x00])); // the count confirmed
     expect.extend(icm_fifo_reset(2048));
     expect.extend(spi_read(0x2D, vec![0x00]));
     expect.extend(spi_read(0x2E, vec![0, 16]));
+    expect.extend(spi_read(0x2E, vec![0, 16])); // the count confirmed
     expect.extend(spi_read(0x30, icm_packet(0x68, [1; 3], [2; 3], 0)));
     expect.extend(spi_read(0x2D, vec![0x00])); // INT_STATUS after the read
     let mut imu = icm_with_fifo(&expect);
@@ -310,6 +315,7 @@ fn icm42688_resetting_itself_is_detected_recovered_and_counted() {
     expect.extend(icm_fifo_enable());
     expect.extend(spi_read(0x2D, vec![0x08]));
     expect.extend(spi_read(0x2E, vec![0, 16]));
+    expect.extend(spi_read(0x2E, vec![0, 16])); // the count confirmed
     expect.extend(spi_read(0x30, icm_packet(0x68, [1; 3], [2; 3], 0)));
     expect.extend(spi_read(0x2D, vec![0x00])); // INT_STATUS after the read
     expect.extend(spi_read(0x2D, vec![0x00]));
@@ -399,6 +405,7 @@ fn icm42688_invalid_marker_is_skipped_and_counted() {
     expect.extend(icm_fifo_enable());
     expect.extend(spi_read(0x2D, vec![0x00]));
     expect.extend(spi_read(0x2E, vec![0, 4 * 16]));
+    expect.extend(spi_read(0x2E, vec![0, 4 * 16])); // the count confirmed
     let data = [
         icm_packet(0x68, [1, 2, 3], [i16::MIN; 3], 10),
         icm_packet(0x68, [i16::MIN, 0, 0], [4, 5, 6], 10),
