@@ -6,7 +6,9 @@
 //! returns a typed result, and that result's text. What the commands share: [`input`] reads a
 //! record ([`input::csv`] is the CSV reader), [`method`] names the estimators, [`predict`] runs
 //! them for `compare` and `report`, [`output`] prints a result as JSON or text, [`error`] is
-//! the one-line error. The binary (`src/main.rs`) parses the command line and dispatches.
+//! the one-line error. [`thermal`] fits the autopilots' thermal calibrations (bins, a robust cubic,
+//! PX4's and ArduPilot's parameters and corrections). The binary (`src/main.rs`) parses the
+//! command line and dispatches.
 #![deny(missing_docs)]
 #![forbid(unsafe_code)]
 
@@ -27,3 +29,4 @@ pub mod parity;
 pub mod predict;
 pub mod report;
 pub mod simulate;
+pub mod thermal;
