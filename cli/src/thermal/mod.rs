@@ -14,7 +14,7 @@ pub mod autopilot;
 pub mod bins;
 pub mod cubic;
 
-use bins::{Bin, bins};
+use bins::Bin;
 use cubic::{Poly, fit};
 
 /// The smallest temperature span a calibration is fitted over, deg C (ArduPilot's
@@ -51,7 +51,7 @@ pub fn fit_axis(
     width: f64,
     min_count: usize,
 ) -> Result<AxisFit, String> {
-    let bins = bins(celsius, x, width, min_count)?;
+    let bins = bins::bins(celsius, x, width, min_count)?;
     let (Some(first), Some(last)) = (bins.first(), bins.last()) else {
         return Err("no temperature bin holds samples".into());
     };
