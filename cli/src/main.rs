@@ -16,6 +16,8 @@
 //!     [--filter-rate HZ] [--json]
 //! imu-ar parity
 //! imu-ar simulate --a A1,A2,.. [--a-end B1,B2,..] --sigma S --n N --seed K [--rate HZ] [--burn-in B]
+//! imu-ar thermal FILE.. --out DIR [--columns C,..] [--temperature-column T] [--format px4,ardupilot,json]
+//!     [--device-id GYRO,ACCEL] [--px4-slot J] [--imu N] [--bin-width C] [--min-bin K] [--json]
 //! ```
 //!
 //! Several files are read as one record, in order. Bad input exits with status 2 and one line
@@ -30,7 +32,7 @@ use clap::{CommandFactory, Parser, Subcommand};
 use imu_ar_cli::error::{Fail, clap_error, escaped};
 use imu_ar_cli::output::{json_line, render};
 use imu_ar_cli::{
-    adev, characterise, compare, fit, kalman, noise, order, parity, report, simulate,
+    adev, characterise, compare, fit, kalman, noise, order, parity, report, simulate, thermal,
 };
 
 #[derive(Parser)]
@@ -79,6 +81,11 @@ enum Command {
     Parity,
     /// Simulate an AR process; CSV `t_s,x` on stdout.
     Simulate(simulate::Args),
+    /// The thermal calibration PX4 and ArduPilot ask for, from a warm-up record: per axis the
+    /// bias against temperature (binned, a robust cubic), the TC_* and INS_TCALn_* parameters,
+    /// each applied back through the autopilot's own formula, and a check on bins held out of
+    /// the fit (exit status 1 when a fit does not generalise).
+    Thermal(thermal::Args),
 }
 
 fn main() -> ExitCode {
@@ -90,15 +97,23 @@ fn main() -> ExitCode {
         Err(e) => return fail(&clap_error(&e, &Cli::command(), &args)),
     };
     match run(cli.command) {
-        Ok(out) => write_stdout(&out),
+        Ok((out, passed)) => match write_stdout(&out) {
+            ExitCode::SUCCESS if !passed => ExitCode::FAILURE,
+            code => code,
+        },
         Err(Fail(msg)) => fail(&escaped(&msg)),
     }
 }
 
-/// Runs a command and returns everything it prints, so that a failure prints nothing.
-/// (`simulate` streams its record itself.)
-fn run(command: Command) -> Result<String, Fail> {
-    match command {
+/// Runs a command and returns everything it prints, so that a failure prints nothing, and
+/// whether its checks passed (status 1 when not: `thermal`). (`simulate` streams its record
+/// itself.)
+fn run(command: Command) -> Result<(String, bool), Fail> {
+    if let Command::Thermal(args) = command {
+        let t = thermal::run(&args)?;
+        return Ok((render(&t, args.json)?, t.generalises));
+    }
+    let out = match command {
         Command::Fit(args) => render(&fit::run(&args)?, args.json),
         Command::Compare(args) => render(&compare::run(&args)?, args.json),
         Command::Report(args) => json_line(&report::run(&args)?),
@@ -109,7 +124,9 @@ fn run(command: Command) -> Result<String, Fail> {
         Command::Adev(args) => render(&adev::run(&args)?, args.json),
         Command::Parity => render(&parity::run()?, false),
         Command::Simulate(args) => simulate::run(&args).map(|()| String::new()),
-    }
+        Command::Thermal(_) => Ok(String::new()),
+    }?;
+    Ok((out, true))
 }
 
 /// Prints the one line of an error on stderr; status 2.

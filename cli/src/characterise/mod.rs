@@ -474,7 +474,7 @@ fn columns(args: &Args) -> Result<Vec<String>, Fail> {
 const BATCH: usize = 4096;
 
 /// A `--gyro-unit` or `--accel-unit`.
-fn parse_unit(name: &str) -> Result<Unit, Fail> {
+pub(crate) fn parse_unit(name: &str) -> Result<Unit, Fail> {
     Unit::parse(name).ok_or_else(|| {
         Fail(format!(
             "unit '{}': rad/s, deg/s, deg/h (gyros) or m/s^2, g, mg (accelerometers)",
@@ -486,7 +486,7 @@ fn parse_unit(name: &str) -> Result<Unit, Fail> {
 /// The unit of axis `i`: its header's (or the message's), else the flag's, checked to measure
 /// what the axis measures. `bracket` is a header bracket that names no unit known here;
 /// `messages`: the axes are a ROS message's, not CSV columns.
-fn axis_unit(
+pub(crate) fn axis_unit(
     i: usize,
     read: Option<Unit>,
     bracket: Option<&str>,

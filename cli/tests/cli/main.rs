@@ -21,3 +21,4 @@ mod recordings;
 mod report;
 mod report_prior;
 mod streams;
+mod thermal;

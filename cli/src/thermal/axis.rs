@@ -1,0 +1,191 @@
+//! One axis's bias against temperature: binned, fitted, and checked on bins held out.
+
+use super::bins::{self, Bin};
+use super::cubic::{Poly, fit};
+
+/// The smallest temperature span a calibration is fitted over, deg C (ArduPilot's
+/// `TEMP_RANGE_MIN`).
+pub const MIN_SPAN: f64 = 10.0;
+
+/// The polynomial degree both autopilots use.
+pub const DEGREE: usize = 3;
+
+/// One axis's bias against temperature, with how well it is known.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AxisFit {
+    /// The fitted bias, about the middle of the range.
+    pub poly: Poly,
+    /// The bins it was fitted to.
+    pub bins: Vec<Bin>,
+    /// The temperatures of the lowest and the highest bin, deg C.
+    pub range: (f64, f64),
+    /// The bins' values' spread, largest less smallest: the bias change to correct.
+    pub change: f64,
+    /// The largest `|bin - fit|` over the bins.
+    pub residual: f64,
+    /// The largest `|bin - fit|` over bins left out of the fit: fitted to the even bins and
+    /// checked on the odd ones, and the other way round.
+    pub held_out: f64,
+    /// The root mean square of the held-out bins' `(bin - fit) / se`, `se` the standard error
+    /// of a bin's median (`1.2533 spread / sqrt(count)`, normal noise): about 1 when the fit
+    /// explains the bins to their noise.
+    pub held_out_z: f64,
+}
+
+/// The standard error of the median of a bin, for normal noise (1.2533 = sqrt(pi / 2)).
+pub fn standard_error(bin: &Bin) -> f64 {
+    1.2533 * bin.spread / (bin.count as f64).sqrt()
+}
+
+/// Fits the bias of one axis, the samples `x` at the temperatures `celsius` in bins of
+/// `width` deg C (those with fewer than `min_count` samples left out): an error when fewer
+/// than 8 bins hold samples, or the bins span less than [`MIN_SPAN`].
+pub fn fit_axis(
+    celsius: &[f64],
+    x: &[f64],
+    width: f64,
+    min_count: usize,
+) -> Result<AxisFit, String> {
+    let bins = bins::bins(celsius, x, width, min_count)?;
+    let (Some(first), Some(last)) = (bins.first(), bins.last()) else {
+        return Err("no temperature bin holds samples".into());
+    };
+    let range = (first.celsius, last.celsius);
+    if range.1 - range.0 < MIN_SPAN {
+        return Err(format!(
+            "the temperature spans {:.1} to {:.1} deg C: at least {MIN_SPAN} deg C are needed for a \
+             thermal calibration",
+            range.0, range.1
+        ));
+    }
+    if bins.len() < 8 {
+        return Err(format!(
+            "{} temperature bins of {width} deg C hold samples: at least 8 are needed",
+            bins.len()
+        ));
+    }
+    let reference = 0.5 * (range.0 + range.1);
+    let points: Vec<(f64, f64)> = bins.iter().map(|b| (b.celsius, b.value)).collect();
+    let no_fit = || "the bins do not determine a cubic".to_string();
+    let poly = fit(&points, DEGREE, reference).ok_or_else(no_fit)?;
+    let worst = |p: &Poly, of: &mut dyn Iterator<Item = &(f64, f64)>| {
+        of.map(|&(t, y)| (y - p.at(t)).abs()).fold(0.0, f64::max)
+    };
+    let residual = worst(&poly, &mut points.iter());
+    let mut held_out: f64 = 0.0;
+    let mut z2 = 0.0;
+    for parity in 0..2 {
+        let kept: Vec<(f64, f64)> = points.iter().skip(parity).step_by(2).copied().collect();
+        let p = fit(&kept, DEGREE, reference).ok_or_else(no_fit)?;
+        held_out = held_out.max(worst(&p, &mut points.iter().skip(1 - parity).step_by(2)));
+        for b in bins.iter().skip(1 - parity).step_by(2) {
+            // A bin of identical values (a quantised sensor standing still) has no spread:
+            // its error is taken as a part in 1e12 of its value.
+            let se = standard_error(b)
+                .max(1e-12 * b.value.abs())
+                .max(f64::MIN_POSITIVE);
+            z2 += ((b.value - p.at(b.celsius)) / se).powi(2);
+        }
+    }
+    let held_out_z = (z2 / bins.len() as f64).sqrt();
+    let (low, high) = points
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
+            (l.min(p.1), h.max(p.1))
+        });
+    Ok(AxisFit {
+        poly,
+        bins,
+        range,
+        change: high - low,
+        residual,
+        held_out,
+        held_out_z,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::autopilot::{ArduPilot, Px4, Sensor};
+    use super::*;
+    use rand_chacha::ChaCha8Rng;
+    use rand_core::{RngCore, SeedableRng};
+
+    /// A simulated warm-up: 20 to 60 deg C, fast at first and slow at the end (an uneven
+    /// heating rate), the temperature reported in whole degrees, a cubic gyro bias and white
+    /// noise, with a few knocks.
+    fn warm_up(seed: u64, bias: impl Fn(f64) -> f64, noise: f64) -> (Vec<f64>, Vec<f64>) {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let mut normal = || {
+            let u = (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+            let v = (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+            (-2.0 * (u.max(1e-300)).ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+        };
+        let n = 200_000;
+        let (mut t, mut x) = (Vec::with_capacity(n), Vec::with_capacity(n));
+        for i in 0..n {
+            let s = i as f64 / n as f64;
+            // Temperature against time: a first-order rise, most of the time near the top.
+            let celsius = 20.0 + 40.0 * (1.0 - (-4.0 * s).exp()) / (1.0 - (-4.0f64).exp());
+            let mut v = bias(celsius) + noise * normal();
+            if i % 40_000 == 17 {
+                v += 50.0 * noise;
+            }
+            t.push(celsius.round());
+            x.push(v);
+        }
+        (t, x)
+    }
+
+    fn gyro_bias(t: f64) -> f64 {
+        0.004 + 2e-4 * (t - 30.0) - 8e-6 * (t - 30.0).powi(2) + 1e-7 * (t - 30.0).powi(3)
+    }
+
+    /// The written parameters applied through each autopilot's formula leave at most 10 % of
+    /// the bias change, on the bins fitted and on bins held out.
+    #[test]
+    fn a_warm_up_is_calibrated_for_both_autopilots() {
+        let (t, x) = warm_up(1, gyro_bias, 2e-3);
+        let f = fit_axis(&t, &x, 1.0, 20).unwrap();
+        assert_eq!(f.range, (20.0, 60.0));
+        assert!(
+            f.residual < 0.1 * f.change,
+            "{} of {}",
+            f.residual,
+            f.change
+        );
+        assert!(
+            f.held_out < 0.1 * f.change,
+            "{} of {}",
+            f.held_out,
+            f.change
+        );
+        let axes = [f.poly; 3];
+        let px4 = Px4::new(Sensor::Gyro, 1, &axes, f.range.0, f.range.1);
+        let ap = ArduPilot::new(&axes, &axes, f.range.0, f.range.1);
+        for b in &f.bins {
+            let px4_left = b.value - f64::from(px4.offset(0, b.celsius as f32));
+            assert!(
+                px4_left.abs() < 0.1 * f.change,
+                "PX4 at {}: {px4_left}",
+                b.celsius
+            );
+            let change = b.value - gyro_bias(35.0);
+            let ap_left =
+                change - f64::from(ap.correction(Sensor::Gyro, 0, b.celsius as f32, 35.0));
+            assert!(
+                ap_left.abs() < 0.1 * f.change,
+                "ArduPilot at {}: {ap_left}",
+                b.celsius
+            );
+        }
+    }
+
+    #[test]
+    fn a_short_span_is_refused() {
+        let t: Vec<f64> = (0..1000).map(|i| 30.0 + f64::from(i) * 0.008).collect();
+        let x = vec![0.0; 1000];
+        let e = fit_axis(&t, &x, 1.0, 1).unwrap_err();
+        assert!(e.contains("at least 10 deg C"), "{e}");
+    }
+}

@@ -1,0 +1,236 @@
+//! `imu-ar thermal`: simulated warm-up records with known cubic biases, the written
+//! parameters parsed from the files and applied through each autopilot's correction, written
+//! again here from the autopilots' sources (PX4 `TemperatureCompensation::calc_thermal_offsets_3D`,
+//! ArduPilot `AP_InertialSensor::TCal::correct_sensor`), against the simulated truth.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use crate::common::{assert_one_line_failure, imu_ar, json, stdout, temp_file, temp_path};
+
+/// The true biases, about 30 deg C: gyros in rad/s, accelerometers in m/s^2.
+const TRUTH: [[f64; 4]; 6] = [
+    [0.004, 2e-4, -8e-6, 1e-7],
+    [-0.01, -1e-4, 3e-6, 0.0],
+    [0.002, 5e-5, 0.0, -2e-8],
+    [0.1, 2e-3, -1e-5, 1e-7],
+    [-0.2, -1e-3, 2e-5, 0.0],
+    [9.81, 3e-3, 0.0, -1e-7],
+];
+
+fn bias(axis: usize, celsius: f64) -> f64 {
+    let d = celsius - 30.0;
+    let c = TRUTH[axis];
+    c[0] + d * (c[1] + d * (c[2] + d * c[3]))
+}
+
+/// A warm-up from 20 to 60 deg C, fast at first and slow at the end, the temperature in whole
+/// degrees, white noise on every axis; gyros written in deg/s and accelerometers in g (the
+/// tool converts). `bump` adds a bump of that many rad/s at 45 deg C to gx.
+fn warm_up(name: &str, bump: f64) -> PathBuf {
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut uniform = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut normal = move || {
+        let (u, v) = (uniform().max(1e-300), uniform());
+        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+    };
+    let n = 120_000;
+    let mut text =
+        String::from("t,gx [deg/s],gy [deg/s],gz [deg/s],ax [g],ay [g],az [g],temperature\n");
+    for i in 0..n {
+        let s = i as f64 / n as f64;
+        let celsius = 20.0 + 40.0 * (1.0 - (-4.0 * s).exp()) / (1.0 - (-4.0f64).exp());
+        text += &format!("{:.3}", i as f64 * 0.01);
+        for axis in 0..6 {
+            let mut v = bias(axis, celsius);
+            if axis == 0 {
+                v += bump * (-((celsius - 45.0) / 2.5).powi(2)).exp();
+            }
+            let (noise, to_unit) = if axis < 3 {
+                (2e-3, 180.0 / std::f64::consts::PI)
+            } else {
+                (2e-2, 1.0 / 9.80665)
+            };
+            text += &format!(",{:.9e}", (v + noise * normal()) * to_unit);
+        }
+        text += &format!(",{:.0}\n", celsius.round());
+    }
+    temp_file(name, text)
+}
+
+/// The `NAME -> value` of a parameter file: QGroundControl's tab-separated rows or
+/// ArduPilot's `NAME,VALUE` lines; comments left out.
+fn params(path: &Path) -> HashMap<String, f32> {
+    let text = std::fs::read_to_string(path).unwrap();
+    text.lines()
+        .filter(|l| !l.starts_with('#') && !l.is_empty())
+        .filter_map(|l| {
+            let cells: Vec<&str> = if l.contains('\t') {
+                l.split('\t').skip(2).take(2).collect()
+            } else {
+                l.split(',').collect()
+            };
+            Some((cells[0].to_string(), cells.get(1)?.parse().ok()?))
+        })
+        .collect()
+}
+
+/// PX4's offset (src/modules/temperature_compensation/TemperatureCompensation.cpp,
+/// `calc_thermal_offsets_3D`, in float): `p` the parameters, `s` "G" or "A", slot 0.
+fn px4_offset(p: &HashMap<String, f32>, s: &str, axis: usize, celsius: f32) -> f32 {
+    let get = |name: &str| p[&format!("TC_{s}0_{name}")];
+    let (tref, tmin, tmax) = (get("TREF"), get("TMIN"), get("TMAX"));
+    let delta = if celsius > tmax {
+        tmax - tref
+    } else if celsius < tmin {
+        tmin - tref
+    } else {
+        celsius - tref
+    };
+    let (d2, d3) = (delta * delta, delta * delta * delta);
+    let x = |k: usize| get(&format!("X{k}_{axis}"));
+    x(0) + x(1) * delta + x(2) * d2 + x(3) * d3
+}
+
+/// ArduPilot's correction (libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp,
+/// `correct_sensor`, in float): what is subtracted at `celsius`, the offsets taken at
+/// `caltemp`; `s` "ACC" or "GYR", IMU 1.
+fn ardupilot_correction(
+    p: &HashMap<String, f32>,
+    s: &str,
+    axis: usize,
+    celsius: f32,
+    caltemp: f32,
+) -> f32 {
+    let xyz = ["X", "Y", "Z"][axis];
+    let c = |k: usize| p[&format!("INS_TCAL1_{s}{k}_{xyz}")];
+    let eval = |t: f32| (c(1) + (c(2) + c(3) * t) * t) * t * 1e-6;
+    let (tmin, tmax) = (p["INS_TCAL1_TMIN"], p["INS_TCAL1_TMAX"]);
+    let t = celsius.clamp(tmin, tmax);
+    let tc = caltemp.clamp(tmin, tmax);
+    eval(t - 35.0) - eval(tc - 35.0)
+}
+
+/// The written parameters, applied through each autopilot's formula, cancel the simulated
+/// bias across the range: gyros to 1e-4 rad/s, accelerometers to 1e-3 m/s^2 (an
+/// accelerometer's constant, and ArduPilot's, left to the offsets the autopilot calibrates at
+/// its reference); the table and the JSON say every fit generalises.
+#[test]
+fn the_written_parameters_cancel_a_simulated_bias() {
+    let record = warm_up("warm.csv", 0.0);
+    let out = temp_path("thermal-out");
+    let run = imu_ar(&[
+        "thermal",
+        record.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--device-id",
+        "2359330,2359331",
+        "--json",
+    ]);
+    let j = json(&run);
+    assert_eq!(j["generalises"], true, "{j}");
+    assert_eq!(j["range_c"], serde_json::json!([20.0, 60.0]));
+    let px4 = params(&out.join("px4_thermal.params"));
+    let ap = params(&out.join("ardupilot_tcal.parm"));
+    assert_eq!(px4["TC_G0_ID"], 2359330.0);
+    assert_eq!(px4["TC_A0_ID"], 2359331.0);
+    assert_eq!((px4["TC_G_ENABLE"], px4["TC_A_ENABLE"]), (1.0, 1.0));
+    assert_eq!(px4["TC_G0_TREF"], 40.0);
+    assert_eq!(ap["INS_TCAL1_ENABLE"], 1.0);
+    assert_eq!((ap["INS_TCAL1_TMIN"], ap["INS_TCAL1_TMAX"]), (20.0, 60.0));
+    let caltemp = 33.0;
+    for axis in 0..6 {
+        let (s, a, tolerance) = if axis < 3 {
+            ("G", "GYR", 1e-4)
+        } else {
+            ("A", "ACC", 1e-3)
+        };
+        let mut worst = [0.0f64; 2];
+        for step in 0..=400 {
+            let celsius = 20.0 + 0.1 * f64::from(step);
+            let c = celsius as f32;
+            // PX4: a gyro's X0 holds its bias; an accelerometer keeps its value at TREF.
+            let kept = if axis < 3 { 0.0 } else { bias(axis, 40.0) };
+            let px4_left = bias(axis, celsius) - f64::from(px4_offset(&px4, s, axis % 3, c)) - kept;
+            // ArduPilot: the offsets keep the bias at CALTEMP.
+            let ap_left = bias(axis, celsius)
+                - f64::from(ardupilot_correction(&ap, a, axis % 3, c, caltemp as f32))
+                - bias(axis, caltemp);
+            worst[0] = worst[0].max(px4_left.abs());
+            worst[1] = worst[1].max(ap_left.abs());
+        }
+        assert!(
+            worst[0] < tolerance && worst[1] < tolerance,
+            "axis {axis}: PX4 leaves {:.3e}, ArduPilot {:.3e} (tolerance {tolerance:e})",
+            worst[0],
+            worst[1]
+        );
+    }
+}
+
+/// A bump the cubic cannot follow: the held-out check fails, exit status 1, the files still
+/// written, and the table says which axis.
+#[test]
+fn a_bump_fails_the_held_out_check_with_status_1() {
+    let record = warm_up("bump.csv", 1.5e-3);
+    let out = temp_path("thermal-bump");
+    let run = imu_ar(&[
+        "thermal",
+        record.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--format",
+        "ardupilot",
+    ]);
+    assert_eq!(run.status.code(), Some(1), "{}", stdout(&run));
+    let text = stdout(&run);
+    let gx = text.lines().find(|l| l.starts_with("gx ")).unwrap();
+    assert!(gx.ends_with("false"), "{gx}");
+    assert!(text.contains("does not generalise"), "{text}");
+    assert!(out.join("ardupilot_tcal.parm").is_file());
+}
+
+/// One clear line each: a span under 10 deg C, PX4 from a CSV without device ids, a missing
+/// temperature column.
+#[test]
+fn bad_warm_ups_are_refused_in_one_line() {
+    let mut short = String::from("gx,gy,gz,ax,ay,az,temperature\n");
+    for i in 0..2000 {
+        short += &format!("0.1,0.2,0.3,0,0,1,{}\n", 30 + i % 8);
+    }
+    let short = temp_file("short.csv", short);
+    let out = temp_path("thermal-short");
+    let args = |extra: &[&str]| {
+        let mut a = vec![
+            "thermal",
+            short.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        a.extend(extra);
+        imu_ar(&a)
+    };
+    let run = args(&[
+        "--format",
+        "ardupilot",
+        "--gyro-unit",
+        "rad/s",
+        "--accel-unit",
+        "g",
+    ]);
+    assert_one_line_failure(&run);
+    let e = String::from_utf8_lossy(&run.stderr);
+    assert!(e.contains("at least 10 deg C"), "{e}");
+    let run = args(&["--gyro-unit", "rad/s", "--accel-unit", "g"]);
+    assert_one_line_failure(&run);
+    assert!(String::from_utf8_lossy(&run.stderr).contains("--device-id"));
+    let run = args(&["--format", "json", "--temperature-column", "temp"]);
+    assert_one_line_failure(&run);
+    assert!(String::from_utf8_lossy(&run.stderr).contains("temp"));
+}
