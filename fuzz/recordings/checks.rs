@@ -7,8 +7,10 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use imu_ar_recordings::csv::{DataError, parse_column};
+use imu_ar_recordings::dataflash::{self, Kind};
 use imu_ar_recordings::frame::{Frame, Select, Skipped};
 use imu_ar_recordings::rosbag2::Metadata;
+use imu_ar_recordings::ulog::{self, Topic, Which};
 use imu_ar_recordings::{bag, mcap, rosbag2};
 
 /// The CSV reader on arbitrary bytes: a column of finite numbers, or an error naming the source
@@ -75,4 +77,90 @@ pub fn rosbag2_metadata(data: &[u8]) {
     if let Ok(meta) = Metadata::parse(text) {
         assert!(!meta.storage.is_empty());
     }
+}
+
+/// The PX4 ULog reader on arbitrary bytes, written to a scratch file, surveyed, then read for
+/// every topic by instance and by device_id. Every delivered sample is finite, a success
+/// delivered at least one, an error names the file and fits on one line, and nothing panics.
+pub fn ulog_read(data: &[u8]) {
+    let path = scratch("ulg");
+    std::fs::write(&path, data).expect("a scratch file in the temporary folder");
+    match ulog::survey(&path) {
+        Ok(survey) => {
+            for topic in Topic::ALL {
+                let mut which = vec![Which::Only];
+                for t in survey.instances(topic) {
+                    which.push(Which::Instance(t.instance));
+                    which.extend(t.device_ids.iter().map(|&d| Which::DeviceId(d)));
+                }
+                for which in which {
+                    let mut samples = 0u64;
+                    let result = ulog::read_surveyed(
+                        &path,
+                        &survey,
+                        &ulog::Select { topic, which },
+                        &mut |s| {
+                            assert!(s.time_us.is_finite() && s.xyz.iter().all(|v| v.is_finite()));
+                            assert!(s.temperature.is_none_or(f64::is_finite));
+                            samples += 1;
+                        },
+                    );
+                    match result {
+                        Ok(report) => assert!(samples > 0 && report.delivered == samples),
+                        Err(e) => {
+                            assert_eq!(e.file, path);
+                            assert!(!e.problem.contains('\n'));
+                        }
+                    }
+                }
+            }
+        }
+        Err(e) => {
+            assert_eq!(e.file, path);
+            assert!(!e.problem.contains('\n'));
+        }
+    }
+    let _ = std::fs::remove_file(&path);
+}
+
+/// The ArduPilot DataFlash reader on arbitrary bytes, written to a scratch file, surveyed, then
+/// read for every kind and instance, and asked whether each instance's samples were
+/// temperature-corrected. Every delivered sample is finite, a success delivered at least one,
+/// an error names the file and fits on one line, and nothing panics.
+pub fn dataflash_read(data: &[u8]) {
+    let path = scratch("bin");
+    std::fs::write(&path, data).expect("a scratch file in the temporary folder");
+    match dataflash::survey(&path) {
+        Ok(survey) => {
+            for kind in Kind::ALL {
+                let mut instances = vec![None];
+                instances.extend(survey.instances(kind).iter().map(|s| Some(s.instance)));
+                for instance in instances {
+                    if let Some(i) = instance {
+                        let _ = survey.temperature_corrected(kind, i);
+                    }
+                    let mut samples = 0u64;
+                    let select = dataflash::Select { kind, instance };
+                    let result = dataflash::read_surveyed(&path, &survey, &select, &mut |s| {
+                        let values = s.gyro.iter().chain(&s.accel).flatten();
+                        assert!(s.time_us.is_finite() && values.clone().all(|v| v.is_finite()));
+                        assert!(s.temperature.is_none_or(f64::is_finite));
+                        samples += 1;
+                    });
+                    match result {
+                        Ok(report) => assert!(samples > 0 && report.delivered == samples),
+                        Err(e) => {
+                            assert_eq!(e.file, path);
+                            assert!(!e.problem.contains('\n'));
+                        }
+                    }
+                }
+            }
+        }
+        Err(e) => {
+            assert_eq!(e.file, path);
+            assert!(!e.problem.contains('\n'));
+        }
+    }
+    let _ = std::fs::remove_file(&path);
 }

@@ -87,6 +87,8 @@ fn no_input_allocates_what_its_lengths_merely_declare() {
         ("csv_column", checks::csv_column as fn(&[u8])),
         ("ros_read", checks::ros_read),
         ("rosbag2_metadata", checks::rosbag2_metadata),
+        ("ulog_read", checks::ulog_read),
+        ("dataflash_read", checks::dataflash_read),
     ] {
         replay(target, 1, check);
     }
@@ -97,4 +99,14 @@ fn no_input_allocates_what_its_lengths_merely_declare() {
 #[test]
 fn the_metadata_corpus_reads_without_a_panic() {
     replay("rosbag2_metadata", 550, checks::rosbag2_metadata);
+}
+
+#[test]
+fn the_ulog_corpus_reads_without_a_panic() {
+    replay("ulog_read", 100, checks::ulog_read);
+}
+
+#[test]
+fn the_dataflash_corpus_reads_without_a_panic() {
+    replay("dataflash_read", 100, checks::dataflash_read);
 }
