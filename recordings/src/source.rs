@@ -26,6 +26,10 @@ pub enum Kind {
     Rosbag2,
     /// An SQLite database: a rosbag2 `.db3` storage file.
     Db3,
+    /// A PX4 ULog file (`.ulg`).
+    Ulog,
+    /// An ArduPilot DataFlash log (`.bin`): a stream of messages, its formats first.
+    DataFlash,
     /// A file none of the readers takes, with what it is.
     Other(&'static str),
     /// A file that cannot be opened.
@@ -67,6 +71,9 @@ impl Kind {
             // A cut MCAP file: its magic's first bytes.
             h if !h.is_empty() && b"\x89MCAP".starts_with(h) => Kind::Mcap,
             h if h.starts_with(rosbag2::SQLITE_MAGIC) => Kind::Db3,
+            h if h.starts_with(&crate::ulog::MAGIC) => Kind::Ulog,
+            // A DataFlash log starts with its FMT messages (the FMT of FMT first).
+            [0xa3, 0x95, crate::dataflash::FMT_TYPE, ..] => Kind::DataFlash,
             [0x28, 0xb5, 0x2f, 0xfd, ..] => Kind::Other(
                 "a zstd-compressed file (a rosbag2 folder compressed file by file: \
                  `ros2 bag decompress` writes one that can be read)",
@@ -109,6 +116,8 @@ impl Kind {
             Kind::Mcap => "an MCAP file",
             Kind::Rosbag2 => "a rosbag2 folder",
             Kind::Db3 => "a rosbag2 database",
+            Kind::Ulog => "a PX4 ULog file",
+            Kind::DataFlash => "an ArduPilot DataFlash log",
             Kind::Other(what) => what,
             Kind::Unreadable => "a file that cannot be read",
         }
@@ -226,6 +235,16 @@ pub fn stream(
                 "--frame-id {}: the file is CSV; --frame-id picks an IMU of a bag's or an MCAP \
                  file's topic",
                 escaped(f)
+            ),
+        ));
+    }
+    if matches!(kind, Kind::Ulog | Kind::DataFlash) {
+        return Err(with_file(
+            files,
+            format!(
+                "{}: read by `imu-ar thermal`; this command reads CSV files, ROS 1 bags, MCAP \
+                 files and rosbag2 folders",
+                kind.name()
             ),
         ));
     }

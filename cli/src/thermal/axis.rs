@@ -17,7 +17,7 @@ pub struct AxisFit {
     pub poly: Poly,
     /// The bins it was fitted to.
     pub bins: Vec<Bin>,
-    /// The temperatures of the lowest and the highest bin, deg C.
+    /// The lowest and the highest temperature of the samples, deg C.
     pub range: (f64, f64),
     /// The bins' values' spread, largest less smallest: the bias change to correct.
     pub change: f64,
@@ -30,6 +30,13 @@ pub struct AxisFit {
     /// of a bin's median (`1.2533 spread / sqrt(count)`, normal noise): about 1 when the fit
     /// explains the bins to their noise.
     pub held_out_z: f64,
+}
+
+/// The robust cubic of `bins` about their middle, when they determine one.
+fn first_fit(bins: &[Bin]) -> Option<Poly> {
+    let (first, last) = (bins.first()?, bins.last()?);
+    let points: Vec<(f64, f64)> = bins.iter().map(|b| (b.celsius, b.value)).collect();
+    fit(&points, DEGREE, 0.5 * (first.celsius + last.celsius))
 }
 
 /// The standard error of the median of a bin, for normal noise (1.2533 = sqrt(pi / 2)).
@@ -46,11 +53,24 @@ pub fn fit_axis(
     width: f64,
     min_count: usize,
 ) -> Result<AxisFit, String> {
-    let bins = bins::bins(celsius, x, width, min_count)?;
+    let first = bins::bins(celsius, x, width, min_count)?;
+    // The samples moved along a first fit to their bins' mean temperatures, and binned again.
+    let bins = match first_fit(&first) {
+        Some(p) => bins::along(celsius, x, width, min_count, Some(&|t| p.at(t)))?,
+        None => first,
+    };
     let (Some(first), Some(last)) = (bins.first(), bins.last()) else {
         return Err("no temperature bin holds samples".into());
     };
-    let range = (first.celsius, last.celsius);
+    // The samples' range (the bins' mean temperatures lie inside it): the autopilots hold
+    // the correction at its ends beyond it.
+    let range = celsius
+        .iter()
+        .zip(x)
+        .filter(|(t, v)| t.is_finite() && v.is_finite())
+        .fold((first.celsius, last.celsius), |(l, h), (t, _)| {
+            (l.min(*t), h.max(*t))
+        });
     if range.1 - range.0 < MIN_SPAN {
         return Err(format!(
             "the temperature spans {:.1} to {:.1} deg C: at least {MIN_SPAN} deg C are needed for a \

@@ -28,6 +28,21 @@ pub struct Bin {
 /// temperature or a value that is not finite are left out. An error when the temperatures span
 /// more than [`MAX_BINS`] bins, or the width is not a positive number.
 pub fn bins(celsius: &[f64], x: &[f64], width: f64, min_count: usize) -> Result<Vec<Bin>, String> {
+    along(celsius, x, width, min_count, None)
+}
+
+/// [`bins`] with each sample first moved along `curve` to its bin's mean temperature:
+/// `x - (curve(T) - curve(T_bin))`. Within a bin the samples are seldom spread evenly (a
+/// warm-up slows down as it ends), so that the median of the raw values belongs to another
+/// temperature than the mean; moved along a first fit, they belong to the bin's mean
+/// temperature to the curve's accuracy.
+pub fn along(
+    celsius: &[f64],
+    x: &[f64],
+    width: f64,
+    min_count: usize,
+    curve: Option<&dyn Fn(f64) -> f64>,
+) -> Result<Vec<Bin>, String> {
     let pairs = || {
         celsius
             .iter()
@@ -56,21 +71,29 @@ pub fn bins(celsius: &[f64], x: &[f64], width: f64, min_count: usize) -> Result<
     let first = (low / width).floor();
     let index = |t: f64| ((t / width).floor() - first) as usize;
     let high = pairs().map(|(t, _)| index(*t)).max().unwrap_or(0);
-    let mut groups: Vec<(f64, Vec<f64>)> = vec![(0.0, Vec::new()); high + 1];
+    let mut groups: Vec<(f64, Vec<(f64, f64)>)> = vec![(0.0, Vec::new()); high + 1];
     for (&t, &v) in pairs() {
         let g = &mut groups[index(t)];
         g.0 += t;
-        g.1.push(v);
+        g.1.push((t, v));
     }
     Ok(groups
         .into_iter()
-        .filter(|(_, values)| !values.is_empty() && values.len() >= min_count)
-        .map(|(sum, mut values)| {
-            let count = values.len();
+        .filter(|(_, samples)| !samples.is_empty() && samples.len() >= min_count)
+        .map(|(sum, samples)| {
+            let count = samples.len();
+            let mean = sum / count as f64;
+            let mut values: Vec<f64> = match curve {
+                Some(c) => {
+                    let at = c(mean);
+                    samples.iter().map(|&(t, v)| v - (c(t) - at)).collect()
+                }
+                None => samples.iter().map(|&(_, v)| v).collect(),
+            };
             let value = median(&mut values);
             let mut deviations: Vec<f64> = values.iter().map(|v| (v - value).abs()).collect();
             Bin {
-                celsius: sum / count as f64,
+                celsius: mean,
                 value,
                 count,
                 spread: 1.4826 * median(&mut deviations),

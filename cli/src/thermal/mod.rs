@@ -16,22 +16,24 @@ pub mod axis;
 pub mod bins;
 pub mod cubic;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
 use crate::characterise::{axis_unit, parse_unit};
 use crate::error::{Fail, escaped, with_file};
-use crate::input::source::{self, AXES, Request};
+use crate::input::source::{self, AXES, Kind, Request};
 use crate::output::Output;
 use autopilot::{ArduPilot, Px4, Sensor, Value};
 use axis::{AxisFit, fit_axis};
+use imu_ar_recordings::{dataflash, ulog};
 
 /// The arguments of `imu-ar thermal`.
 #[derive(clap::Args)]
 pub struct Args {
     /// The warm-up record: CSV files read as one record (`-` is standard input), with the six
-    /// axes and the die temperature (deg C) in every row.
+    /// axes and the die temperature (deg C) in every row; or a PX4 ULog file (sensor_gyro and
+    /// sensor_accel, or their FIFO topics); or an ArduPilot DataFlash log (IMU messages).
     #[arg(required = true)]
     files: Vec<PathBuf>,
     /// The six CSV columns: gyro x, y, z, then accelerometer x, y, z [default: gx .. az].
@@ -62,12 +64,17 @@ pub struct Args {
     /// PX4 matches the calibration to; needed for px4 from a CSV record.
     #[arg(long, value_delimiter = ',')]
     device_id: Option<Vec<u32>>,
-    /// PX4: the calibration slot j of TC_Gj_* and TC_Aj_* (0 to 3).
-    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u8).range(0..=3))]
-    px4_slot: u8,
-    /// ArduPilot: the IMU n of INS_TCALn_* (1 to 5).
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u8).range(1..=5))]
-    imu: u8,
+    /// PX4: the calibration slot j of TC_Gj_* and TC_Aj_* (0 to 3) [default: the instance read,
+    /// as PX4's process_sensor_caldata.py numbers them, or 0].
+    #[arg(long, value_parser = clap::value_parser!(u8).range(0..=3))]
+    px4_slot: Option<u8>,
+    /// ArduPilot: the IMU n of INS_TCALn_* (1 to 5) [default: the instance read plus 1, or 1].
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=5))]
+    imu: Option<u8>,
+    /// The IMU of a PX4 ULog file (the uORB instance of sensor_gyro and sensor_accel) or of an
+    /// ArduPilot DataFlash log (the `I` of its IMU messages), when it holds several.
+    #[arg(long)]
+    instance: Option<u8>,
     /// Print one JSON object instead of the table.
     #[arg(long)]
     pub json: bool,
@@ -120,8 +127,13 @@ impl Format {
 pub struct Thermal {
     /// Samples read.
     pub n: usize,
-    /// The temperature range of the bins, deg C: TMIN and TMAX of the files.
-    pub range_c: (f64, f64),
+    /// The IMU's instance in the log, where it has one.
+    pub instance: Option<u8>,
+    /// The temperature range of the bins of the gyro and of the accelerometer, deg C: PX4's
+    /// TMIN and TMAX of each, ArduPilot's of the accelerometer's.
+    pub ranges_c: [(f64, f64); 2],
+    /// The CALTEMP the ArduPilot check assumes: the middle of its range, deg C.
+    pub caltemp_c: f64,
     /// Per axis (gx .. az), in rad/s or m/s^2.
     pub axes: Vec<AxisResult>,
     /// Every axis's fit generalises: its held-out residual is at most
@@ -171,6 +183,23 @@ pub struct AxisResult {
     pub generalises: bool,
 }
 
+/// One sensor of a warm-up record: its temperatures and its three axes, in SI units.
+struct Record {
+    celsius: Vec<f64>,
+    axes: [Vec<f64>; 3],
+    /// rad/s or m/s^2.
+    unit: &'static str,
+}
+
+/// A warm-up record: the gyro and the accelerometer of one IMU.
+struct WarmUp {
+    sensors: [Record; 2],
+    /// Their PX4 device ids, where the record holds them.
+    device_ids: Option<[u32; 2]>,
+    /// The IMU's instance in the log (ULog multi_id, DataFlash `I`).
+    instance: Option<u8>,
+}
+
 /// Reads the record, fits every axis, checks the fits through the autopilots' formulas and
 /// writes the files.
 pub fn run(args: &Args) -> Result<Thermal, Fail> {
@@ -181,43 +210,47 @@ pub fn run(args: &Args) -> Result<Thermal, Fail> {
         )));
     }
     let formats = Format::list(&args.format)?;
-    let device = match (&args.device_id, formats.contains(&Format::Px4)) {
-        (Some(ids), _) if ids.len() == 2 => Some([ids[0], ids[1]]),
-        (Some(ids), _) => {
+    let given = match &args.device_id {
+        Some(ids) if ids.len() == 2 => Some([ids[0], ids[1]]),
+        Some(ids) => {
             return Err(Fail(format!(
                 "--device-id: {} ids given; two are needed (the gyro's, then the \
                  accelerometer's)",
                 ids.len()
             )));
         }
-        (None, true) => {
-            return Err(Fail(
-                "px4: PX4 matches TC_Gj_ID and TC_Aj_ID to the sensors' device ids, which a CSV \
-                 record does not hold: give --device-id GYRO,ACCEL (PX4's sensor_gyro and \
-                 sensor_accel device_id), or leave px4 out of --format"
-                    .into(),
-            ));
-        }
-        (None, false) => None,
+        None => None,
     };
-    let (celsius, axes, units) = read(args)?;
-    let n = celsius.len();
-    let mut fits: Vec<AxisFit> = Vec::with_capacity(6);
-    for (i, x) in axes.iter().enumerate() {
-        let fit = fit_axis(&celsius, x, args.bin_width, args.min_bin)
-            .map_err(|e| with_file(&args.files, format!("{}: {e}", AXES[i])))?;
-        fits.push(fit);
+    let warm = read(args)?;
+    let device = given.or(warm.device_ids);
+    if device.is_none() && formats.contains(&Format::Px4) {
+        return Err(Fail(
+            "px4: PX4 matches TC_Gj_ID and TC_Aj_ID to the sensors' device ids, which this \
+             record does not hold: give --device-id GYRO,ACCEL (PX4's sensor_gyro and \
+             sensor_accel device_id), or leave px4 out of --format"
+                .into(),
+        ));
     }
-    let range = fits[0].range;
+    let mut fits: Vec<AxisFit> = Vec::with_capacity(6);
+    for (s, record) in warm.sensors.iter().enumerate() {
+        for (k, x) in record.axes.iter().enumerate() {
+            let fit = fit_axis(&record.celsius, x, args.bin_width, args.min_bin)
+                .map_err(|e| with_file(&args.files, format!("{}: {e}", AXES[3 * s + k])))?;
+            fits.push(fit);
+        }
+    }
+    let ranges = [fits[0].range, fits[3].range];
     let polys = |from: usize| [fits[from].poly, fits[from + 1].poly, fits[from + 2].poly];
     let (gyro, accel) = (polys(0), polys(3));
     let px4 = device.map(|[g, a]| {
         [
-            Px4::new(Sensor::Gyro, g, &gyro, range.0, range.1),
-            Px4::new(Sensor::Accel, a, &accel, range.0, range.1),
+            Px4::new(Sensor::Gyro, g, &gyro, ranges[0].0, ranges[0].1),
+            Px4::new(Sensor::Accel, a, &accel, ranges[1].0, ranges[1].1),
         ]
     });
-    let ardupilot = ArduPilot::new(&accel, &gyro, range.0, range.1);
+    // ArduPilot has one range per IMU: its script takes the accelerometer's.
+    let ardupilot = ArduPilot::new(&accel, &gyro, ranges[1].0, ranges[1].1);
+    let caltemp = 0.5 * (ranges[1].0 + ranges[1].1);
     let mut results = Vec::with_capacity(6);
     for (i, fit) in fits.iter().enumerate() {
         let sensor = if i < 3 { Sensor::Gyro } else { Sensor::Accel };
@@ -229,24 +262,24 @@ pub fn run(args: &Args) -> Result<Thermal, Fail> {
         };
         let largest =
             |v: Vec<f64>, offset: f64| v.iter().fold(0.0f64, |m, x| m.max((x - offset).abs()));
-        // The middle of the range: PX4's TREF, and the CALTEMP of the check.
-        let middle = 0.5 * (range.0 + range.1);
+        // PX4's TREF: the middle of the sensor's range.
+        let tref = 0.5 * (ranges[i / 3].0 + ranges[i / 3].1);
         let px4_left = px4.map_or(f64::NAN, |p| {
             let left = corrected(&|t| p[i / 3].offset(i % 3, t));
             match sensor {
                 Sensor::Gyro => largest(left, 0.0),
-                Sensor::Accel => largest(left, fit.poly.at(middle)),
+                Sensor::Accel => largest(left, fit.poly.at(tref)),
             }
         });
         let ardupilot_left = largest(
-            corrected(&|t| ardupilot.correction(sensor, i % 3, t, middle as f32)),
-            fit.poly.at(middle),
+            corrected(&|t| ardupilot.correction(sensor, i % 3, t, caltemp as f32)),
+            fit.poly.at(caltemp),
         );
         let generalises =
             fit.held_out <= HELD_OUT_FRACTION * fit.change || fit.held_out_z <= HELD_OUT_Z;
         results.push(AxisResult {
             axis: AXES[i],
-            unit: units[i],
+            unit: warm.sensors[i / 3].unit,
             coefficients: fit.poly.coefficients,
             reference_c: fit.poly.reference,
             bins: fit.bins.len(),
@@ -262,19 +295,31 @@ pub fn run(args: &Args) -> Result<Thermal, Fail> {
     std::fs::create_dir_all(&args.out)
         .map_err(|e| Fail(format!("--out {}: cannot create: {e}", args.out.display())))?;
     let mut thermal = Thermal {
-        n,
-        range_c: range,
+        n: warm.sensors[0].celsius.len(),
+        instance: warm.instance,
+        ranges_c: ranges,
+        caltemp_c: caltemp,
         generalises: results.iter().all(|a| a.generalises),
         axes: results,
         files: Vec::new(),
     };
+    let px4_slot = args.px4_slot.or(warm.instance).unwrap_or(0).min(3);
+    let imu = args
+        .imu
+        .unwrap_or_else(|| warm.instance.map_or(1, |i| i.saturating_add(1)));
+    if !(1..=5).contains(&imu) {
+        return Err(Fail(format!(
+            "ardupilot: instance {} is no IMU 1 to 5 of INS_TCALn; give --imu",
+            imu - 1
+        )));
+    }
     for format in formats {
         let text = match format {
             Format::Px4 => match &px4 {
-                Some(p) => px4_file(p, args.px4_slot.into(), &thermal),
+                Some(p) => px4_file(p, px4_slot.into(), &thermal),
                 None => continue,
             },
-            Format::ArduPilot => ardupilot_file(&ardupilot, args.imu.into(), &thermal),
+            Format::ArduPilot => ardupilot_file(&ardupilot, imu.into(), &thermal),
             Format::Json => format!("{}\n", serde_json::to_value(&thermal)?),
         };
         let path = args.out.join(format.file_name());
@@ -284,9 +329,223 @@ pub fn run(args: &Args) -> Result<Thermal, Fail> {
     Ok(thermal)
 }
 
-/// The temperatures, the six axes in SI units, and the units' names, of a CSV record.
-#[allow(clippy::type_complexity)]
-fn read(args: &Args) -> Result<(Vec<f64>, [Vec<f64>; 6], [&'static str; 6]), Fail> {
+/// The warm-up record of `args.files`: a CSV record, a PX4 ULog file or an ArduPilot
+/// DataFlash log.
+fn read(args: &Args) -> Result<WarmUp, Fail> {
+    let kind = Kind::of(&args.files[0]);
+    if matches!(kind, Kind::Ulog | Kind::DataFlash) {
+        if args.files.len() > 1 {
+            return Err(with_file(
+                &args.files,
+                "one autopilot log at a time (a CSV record may span several files)",
+            ));
+        }
+        if args.columns.is_some() || args.gyro_unit.is_some() || args.accel_unit.is_some() {
+            return Err(with_file(
+                &args.files,
+                "--columns, --gyro-unit and --accel-unit are for CSV records: an autopilot \
+                 log names its fields and units",
+            ));
+        }
+        let path = &args.files[0];
+        return if kind == Kind::Ulog {
+            read_ulog(path, args.instance)
+        } else {
+            read_dataflash(path, args.instance)
+        };
+    }
+    if args.instance.is_some() {
+        return Err(with_file(
+            &args.files,
+            "--instance picks an IMU of a PX4 ULog file or an ArduPilot DataFlash log",
+        ));
+    }
+    read_csv(args)
+}
+
+/// The samples of one sensor of a ULog file with their temperatures: the sensor topic, or
+/// its FIFO topic when the log has no sensor topic.
+fn read_ulog(path: &Path, instance: Option<u8>) -> Result<WarmUp, Fail> {
+    let fail = |e: String| with_file(std::slice::from_ref(&path.to_path_buf()), e);
+    let survey = ulog::survey(path).map_err(|e| Fail(e.to_string()))?;
+    let mut sensors: Vec<Record> = Vec::with_capacity(2);
+    let mut ids = [0u32; 2];
+    for (s, (topic, fifo, unit)) in [
+        (ulog::Topic::Gyro, ulog::Topic::GyroFifo, "rad/s"),
+        (ulog::Topic::Accel, ulog::Topic::AccelFifo, "m/s^2"),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let topic = if survey.instances(topic).is_empty() && !survey.instances(fifo).is_empty() {
+            fifo
+        } else {
+            topic
+        };
+        let instances = survey.instances(topic);
+        if instances.is_empty() {
+            return Err(fail(format!(
+                "no {} messages: a thermal calibration needs sensor_gyro and sensor_accel (PX4's \
+                 SDLOG_PROFILE thermal calibration bit logs them)",
+                topic.name()
+            )));
+        }
+        let which = match instance {
+            Some(i) => ulog::Which::Instance(i),
+            None if instances.len() == 1 => ulog::Which::Only,
+            None => {
+                let list: Vec<String> = instances
+                    .iter()
+                    .map(|t| {
+                        let ids: Vec<String> = t.device_ids.iter().map(|d| d.to_string()).collect();
+                        format!("{} (device_id {})", t.instance, ids.join(", "))
+                    })
+                    .collect();
+                return Err(fail(format!(
+                    "{} instances of {}: {}; choose one with --instance",
+                    instances.len(),
+                    topic.name(),
+                    list.join(", ")
+                )));
+            }
+        };
+        let mut record = Record {
+            celsius: Vec::new(),
+            axes: Default::default(),
+            unit,
+        };
+        let mut without = 0u64;
+        let select = ulog::Select { topic, which };
+        ulog::read_surveyed(path, &survey, &select, &mut |sample| {
+            ids[s] = sample.device_id;
+            let Some(t) = sample.temperature else {
+                without += 1;
+                return;
+            };
+            record.celsius.push(t);
+            for (axis, x) in record.axes.iter_mut().zip(sample.xyz) {
+                axis.push(x);
+            }
+        })
+        .map_err(|e| Fail(e.to_string()))?;
+        if record.celsius.is_empty() {
+            return Err(fail(format!(
+                "{} has no temperature ({} samples without one{}): a thermal calibration needs \
+                 the sensor's temperature",
+                topic.name(),
+                without,
+                if topic.is_fifo() {
+                    ", and no sensor topic of that device to take it from"
+                } else {
+                    ""
+                }
+            )));
+        }
+        sensors.push(record);
+    }
+    let [gyro, accel]: [Record; 2] = sensors
+        .try_into()
+        .map_err(|_| Fail("two sensors expected".into()))?;
+    Ok(WarmUp {
+        sensors: [gyro, accel],
+        device_ids: Some(ids),
+        instance: Some(instance.unwrap_or(0)),
+    })
+}
+
+/// The `IMU` messages of one instance of a DataFlash log: refused when ArduPilot had already
+/// corrected them for temperature, or rotated them by AHRS_ORIENTATION (the calibration lives
+/// in the sensor's frame before it).
+fn read_dataflash(path: &Path, instance: Option<u8>) -> Result<WarmUp, Fail> {
+    let fail = |e: String| with_file(std::slice::from_ref(&path.to_path_buf()), e);
+    let survey = dataflash::survey(path).map_err(|e| Fail(e.to_string()))?;
+    let kind = dataflash::Kind::Imu;
+    let instances = survey.instances(kind);
+    let chosen = match instance {
+        Some(i) => i,
+        None if instances.len() == 1 => instances[0].instance,
+        None if instances.is_empty() => {
+            return Err(fail(
+                "no IMU messages (LOG_BITMASK's IMU bit logs them; a thermal calibration needs \
+                 them with their temperature)"
+                    .into(),
+            ));
+        }
+        None => {
+            let list: Vec<String> = instances.iter().map(|s| s.instance.to_string()).collect();
+            return Err(fail(format!(
+                "IMU messages of {} instances ({}): choose one with --instance",
+                instances.len(),
+                list.join(", ")
+            )));
+        }
+    };
+    let correction = survey.temperature_corrected(kind, chosen);
+    if matches!(
+        correction.corrected,
+        dataflash::Corrected::Yes | dataflash::Corrected::Mixed
+    ) {
+        return Err(fail(format!(
+            "the IMU samples of instance {chosen} were already temperature-corrected by \
+             ArduPilot ({}): a thermal calibration is fitted on uncorrected data; log a warm-up \
+             with INS_TCAL{}_ENABLE 0",
+            correction.reason,
+            chosen.saturating_add(1)
+        )));
+    }
+    if let Some(p) = survey.parameter("AHRS_ORIENTATION")
+        && (p.value != 0.0 || p.changed())
+    {
+        return Err(fail(format!(
+            "the IMU samples are rotated by AHRS_ORIENTATION {}: ArduPilot's thermal \
+             calibration lives in the sensor's frame before that rotation; log a warm-up with \
+             AHRS_ORIENTATION 0",
+            p.value
+        )));
+    }
+    let mut gyro = Record {
+        celsius: Vec::new(),
+        axes: Default::default(),
+        unit: "rad/s",
+    };
+    let mut accel = Record {
+        celsius: Vec::new(),
+        axes: Default::default(),
+        unit: "m/s^2",
+    };
+    let select = dataflash::Select {
+        kind,
+        instance: Some(chosen),
+    };
+    dataflash::read_surveyed(path, &survey, &select, &mut |sample| {
+        let Some(t) = sample.temperature else {
+            return;
+        };
+        for (record, xyz) in [(&mut gyro, sample.gyro), (&mut accel, sample.accel)] {
+            if let Some(xyz) = xyz {
+                record.celsius.push(t);
+                for (axis, x) in record.axes.iter_mut().zip(xyz) {
+                    axis.push(x);
+                }
+            }
+        }
+    })
+    .map_err(|e| Fail(e.to_string()))?;
+    if gyro.celsius.is_empty() || accel.celsius.is_empty() {
+        return Err(fail(format!(
+            "the IMU messages of instance {chosen} carry no temperature: a thermal \
+             calibration needs it"
+        )));
+    }
+    Ok(WarmUp {
+        sensors: [gyro, accel],
+        device_ids: None,
+        instance: Some(chosen),
+    })
+}
+
+/// The temperatures and the six axes in SI units of a CSV record.
+fn read_csv(args: &Args) -> Result<WarmUp, Fail> {
     let mut columns = match &args.columns {
         Some(c) if c.len() == 6 => c.clone(),
         Some(c) => {
@@ -334,7 +593,23 @@ fn read(args: &Args) -> Result<(Vec<f64>, [Vec<f64>; 6], [&'static str; 6]), Fai
         }
         names[i] = unit.si().name;
     }
-    Ok((celsius, axes, names))
+    let [gx, gy, gz, ax, ay, az] = axes;
+    Ok(WarmUp {
+        sensors: [
+            Record {
+                celsius: celsius.clone(),
+                axes: [gx, gy, gz],
+                unit: names[0],
+            },
+            Record {
+                celsius,
+                axes: [ax, ay, az],
+                unit: names[3],
+            },
+        ],
+        device_ids: None,
+        instance: None,
+    })
 }
 
 /// `#` comment lines of `lines`.
@@ -355,9 +630,11 @@ fn value(v: Value) -> String {
 fn summary(thermal: &Thermal) -> Vec<String> {
     let mut lines = vec![
         format!(
-            "imu-ar thermal: a cubic per axis over {:.1} to {:.1} deg C, fitted to temperature bins",
-            thermal.range_c.0, thermal.range_c.1
+            "imu-ar thermal: a cubic per axis over {} (gyro), {} (accelerometer),",
+            span(thermal.ranges_c[0]),
+            span(thermal.ranges_c[1])
         ),
+        "fitted to temperature bins".into(),
         "(median per bin, Huber loss). Per axis: the bias change over the range, and what the"
             .into(),
         "correction below leaves of it, applied through the autopilot's formula to the bins;"
@@ -434,10 +711,7 @@ fn ardupilot_file(a: &ArduPilot, imu: usize, thermal: &Thermal) -> String {
         "accelerometer or gyro calibration (INS_ACCn_CALTEMP, INS_GYRn_CALTEMP). Checked above"
             .into(),
     );
-    lines.push(format!(
-        "with CALTEMP at {:.1} deg C.",
-        0.5 * (thermal.range_c.0 + thermal.range_c.1)
-    ));
+    lines.push(format!("with CALTEMP at {:.1} deg C.", thermal.caltemp_c));
     let mut text = comments(&lines);
     for (name, v) in a.params(imu) {
         text += &format!("{name},{}\n", value(v));
@@ -448,8 +722,12 @@ fn ardupilot_file(a: &ArduPilot, imu: usize, thermal: &Thermal) -> String {
 impl Output for Thermal {
     fn text(&self) -> String {
         let mut s = format!(
-            "{} samples, bins from {:.1} to {:.1} deg C\n",
-            self.n, self.range_c.0, self.range_c.1
+            "{} samples{}; bins over {} (gyro), {} (accelerometer)\n",
+            self.n,
+            self.instance
+                .map_or(String::new(), |i| format!(" of instance {i}")),
+            span(self.ranges_c[0]),
+            span(self.ranges_c[1])
         );
         s += "axis unit   bins change     residual   held_out   held_z PX4_left   AP_left    generalises\n";
         for a in &self.axes {
@@ -477,6 +755,11 @@ impl Output for Thermal {
         }
         s
     }
+}
+
+/// A temperature range as the table and the files' comments give it.
+fn span((low, high): (f64, f64)) -> String {
+    format!("{low:.1} to {high:.1} deg C")
 }
 
 /// A value of the table: `-` where there is none (PX4's without its file).

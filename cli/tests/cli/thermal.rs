@@ -8,6 +8,11 @@ use std::path::{Path, PathBuf};
 
 use crate::common::{assert_one_line_failure, imu_ar, json, stdout, temp_file, temp_path};
 
+#[path = "../../../recordings/tests/writers/mod.rs"]
+mod writers;
+
+use writers::{Df, SENSOR_ACCEL, SENSOR_GYRO, ULog, sensor};
+
 /// The true biases, about 30 deg C: gyros in rad/s, accelerometers in m/s^2.
 const TRUTH: [[f64; 4]; 6] = [
     [0.004, 2e-4, -8e-6, 1e-7],
@@ -24,10 +29,10 @@ fn bias(axis: usize, celsius: f64) -> f64 {
     c[0] + d * (c[1] + d * (c[2] + d * c[3]))
 }
 
-/// A warm-up from 20 to 60 deg C, fast at first and slow at the end, the temperature in whole
-/// degrees, white noise on every axis; gyros written in deg/s and accelerometers in g (the
-/// tool converts). `bump` adds a bump of that many rad/s at 45 deg C to gx.
-fn warm_up(name: &str, bump: f64) -> PathBuf {
+/// A warm-up of `n` samples from 20 to 60 deg C, fast at first and slow at the end, white
+/// noise on every axis (SI units): `(temperature, axes)`. `bump` adds a bump of that many
+/// rad/s at 45 deg C to gx.
+fn samples(n: usize, bump: f64) -> Vec<(f64, [f64; 6])> {
     let mut state = 0x2545_f491_4f6c_dd1du64;
     let mut uniform = move || {
         state ^= state << 13;
@@ -39,24 +44,36 @@ fn warm_up(name: &str, bump: f64) -> PathBuf {
         let (u, v) = (uniform().max(1e-300), uniform());
         (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
     };
-    let n = 120_000;
+    (0..n)
+        .map(|i| {
+            let s = i as f64 / n as f64;
+            let celsius = 20.0 + 40.0 * (1.0 - (-4.0 * s).exp()) / (1.0 - (-4.0f64).exp());
+            let axes = std::array::from_fn(|axis| {
+                let mut v = bias(axis, celsius);
+                if axis == 0 {
+                    v += bump * (-((celsius - 45.0) / 2.5).powi(2)).exp();
+                }
+                v + if axis < 3 { 2e-3 } else { 2e-2 } * normal()
+            });
+            (celsius, axes)
+        })
+        .collect()
+}
+
+/// [`samples`] as a CSV record, the temperature in whole degrees, gyros in deg/s and
+/// accelerometers in g (the tool converts).
+fn warm_up(name: &str, bump: f64) -> PathBuf {
     let mut text =
         String::from("t,gx [deg/s],gy [deg/s],gz [deg/s],ax [g],ay [g],az [g],temperature\n");
-    for i in 0..n {
-        let s = i as f64 / n as f64;
-        let celsius = 20.0 + 40.0 * (1.0 - (-4.0 * s).exp()) / (1.0 - (-4.0f64).exp());
+    for (i, (celsius, axes)) in samples(120_000, bump).into_iter().enumerate() {
         text += &format!("{:.3}", i as f64 * 0.01);
-        for axis in 0..6 {
-            let mut v = bias(axis, celsius);
-            if axis == 0 {
-                v += bump * (-((celsius - 45.0) / 2.5).powi(2)).exp();
-            }
-            let (noise, to_unit) = if axis < 3 {
-                (2e-3, 180.0 / std::f64::consts::PI)
+        for (axis, v) in axes.iter().enumerate() {
+            let to_unit = if axis < 3 {
+                180.0 / std::f64::consts::PI
             } else {
-                (2e-2, 1.0 / 9.80665)
+                1.0 / 9.80665
             };
-            text += &format!(",{:.9e}", (v + noise * normal()) * to_unit);
+            text += &format!(",{:.9e}", v * to_unit);
         }
         text += &format!(",{:.0}\n", celsius.round());
     }
@@ -81,9 +98,9 @@ fn params(path: &Path) -> HashMap<String, f32> {
 }
 
 /// PX4's offset (src/modules/temperature_compensation/TemperatureCompensation.cpp,
-/// `calc_thermal_offsets_3D`, in float): `p` the parameters, `s` "G" or "A", slot 0.
-fn px4_offset(p: &HashMap<String, f32>, s: &str, axis: usize, celsius: f32) -> f32 {
-    let get = |name: &str| p[&format!("TC_{s}0_{name}")];
+/// `calc_thermal_offsets_3D`, in float): `p` the parameters, `s` "G" or "A".
+fn px4_offset(p: &HashMap<String, f32>, s: &str, slot: usize, axis: usize, celsius: f32) -> f32 {
+    let get = |name: &str| p[&format!("TC_{s}{slot}_{name}")];
     let (tref, tmin, tmax) = (get("TREF"), get("TMIN"), get("TMAX"));
     let delta = if celsius > tmax {
         tmax - tref
@@ -99,18 +116,22 @@ fn px4_offset(p: &HashMap<String, f32>, s: &str, axis: usize, celsius: f32) -> f
 
 /// ArduPilot's correction (libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp,
 /// `correct_sensor`, in float): what is subtracted at `celsius`, the offsets taken at
-/// `caltemp`; `s` "ACC" or "GYR", IMU 1.
+/// `caltemp`; `s` "ACC" or "GYR".
 fn ardupilot_correction(
     p: &HashMap<String, f32>,
     s: &str,
+    imu: usize,
     axis: usize,
     celsius: f32,
     caltemp: f32,
 ) -> f32 {
     let xyz = ["X", "Y", "Z"][axis];
-    let c = |k: usize| p[&format!("INS_TCAL1_{s}{k}_{xyz}")];
+    let c = |k: usize| p[&format!("INS_TCAL{imu}_{s}{k}_{xyz}")];
     let eval = |t: f32| (c(1) + (c(2) + c(3) * t) * t) * t * 1e-6;
-    let (tmin, tmax) = (p["INS_TCAL1_TMIN"], p["INS_TCAL1_TMAX"]);
+    let (tmin, tmax) = (
+        p[&format!("INS_TCAL{imu}_TMIN")],
+        p[&format!("INS_TCAL{imu}_TMAX")],
+    );
     let t = celsius.clamp(tmin, tmax);
     let tc = caltemp.clamp(tmin, tmax);
     eval(t - 35.0) - eval(tc - 35.0)
@@ -135,7 +156,10 @@ fn the_written_parameters_cancel_a_simulated_bias() {
     ]);
     let j = json(&run);
     assert_eq!(j["generalises"], true, "{j}");
-    assert_eq!(j["range_c"], serde_json::json!([20.0, 60.0]));
+    assert_eq!(
+        j["ranges_c"],
+        serde_json::json!([[20.0, 60.0], [20.0, 60.0]])
+    );
     let px4 = params(&out.join("px4_thermal.params"));
     let ap = params(&out.join("ardupilot_tcal.parm"));
     assert_eq!(px4["TC_G0_ID"], 2359330.0);
@@ -144,6 +168,19 @@ fn the_written_parameters_cancel_a_simulated_bias() {
     assert_eq!(px4["TC_G0_TREF"], 40.0);
     assert_eq!(ap["INS_TCAL1_ENABLE"], 1.0);
     assert_eq!((ap["INS_TCAL1_TMIN"], ap["INS_TCAL1_TMAX"]), (20.0, 60.0));
+    assert_cancelled(&px4, &ap, 0, 1);
+}
+
+/// The parameters of PX4 slot `slot` and ArduPilot IMU `imu`, applied through each
+/// autopilot's formula, cancel the simulated bias across 20 to 60 deg C: gyros to 1e-4 rad/s,
+/// accelerometers to 1e-3 m/s^2 (an accelerometer's constant, and ArduPilot's, left to the
+/// offsets the autopilot calibrates at its reference).
+fn assert_cancelled(
+    px4: &HashMap<String, f32>,
+    ap: &HashMap<String, f32>,
+    slot: usize,
+    imu: usize,
+) {
     let caltemp = 33.0;
     for axis in 0..6 {
         let (s, a, tolerance) = if axis < 3 {
@@ -157,10 +194,18 @@ fn the_written_parameters_cancel_a_simulated_bias() {
             let c = celsius as f32;
             // PX4: a gyro's X0 holds its bias; an accelerometer keeps its value at TREF.
             let kept = if axis < 3 { 0.0 } else { bias(axis, 40.0) };
-            let px4_left = bias(axis, celsius) - f64::from(px4_offset(&px4, s, axis % 3, c)) - kept;
+            let px4_left =
+                bias(axis, celsius) - f64::from(px4_offset(px4, s, slot, axis % 3, c)) - kept;
             // ArduPilot: the offsets keep the bias at CALTEMP.
             let ap_left = bias(axis, celsius)
-                - f64::from(ardupilot_correction(&ap, a, axis % 3, c, caltemp as f32))
+                - f64::from(ardupilot_correction(
+                    ap,
+                    a,
+                    imu,
+                    axis % 3,
+                    c,
+                    caltemp as f32,
+                ))
                 - bias(axis, caltemp);
             worst[0] = worst[0].max(px4_left.abs());
             worst[1] = worst[1].max(ap_left.abs());
@@ -233,4 +278,137 @@ fn bad_warm_ups_are_refused_in_one_line() {
     let run = args(&["--format", "json", "--temperature-column", "temp"]);
     assert_one_line_failure(&run);
     assert!(String::from_utf8_lossy(&run.stderr).contains("temp"));
+}
+
+/// A PX4 ULog warm-up: sensor_gyro and sensor_accel of `instances` IMUs at 100 Hz (instance i
+/// with device ids 2359330 + 2 i and 2359331 + 2 i), the same simulated biases on each.
+fn ulog_warm_up(name: &str, instances: u8) -> PathBuf {
+    let mut log = ULog::new(0);
+    log.format(SENSOR_GYRO);
+    log.format(SENSOR_ACCEL);
+    let mut id = 0u16;
+    for i in 0..instances {
+        log.subscribe(i, id, "sensor_gyro");
+        log.subscribe(i, id + 1, "sensor_accel");
+        id += 2;
+    }
+    for (k, (celsius, axes)) in samples(60_000, 0.0).into_iter().enumerate() {
+        let t = 1_000_000 + 10_000 * k as u64;
+        for i in 0..instances {
+            let device = 2_359_330 + 2 * u32::from(i);
+            let f = |a: usize| axes[a] as f32;
+            let msg = 2 * u16::from(i);
+            log.data(
+                msg,
+                &sensor(t, t, device, [f(0), f(1), f(2)], celsius as f32),
+            );
+            log.data(
+                msg + 1,
+                &sensor(t, t, device + 1, [f(3), f(4), f(5)], celsius as f32),
+            );
+        }
+    }
+    temp_file(name, log.bytes)
+}
+
+/// A DataFlash warm-up: IMU messages of instance 0 at 100 Hz, with `params` first.
+fn dataflash_warm_up(name: &str, params: &[(&str, f32)]) -> PathBuf {
+    let mut log = Df::new();
+    for (p, v) in params {
+        log.parm(0, p, *v);
+    }
+    for (k, (celsius, axes)) in samples(60_000, 0.0).into_iter().enumerate() {
+        let f = |a: usize| axes[a] as f32;
+        let t = 1_000_000 + 10_000 * k as u64;
+        log.imu(t, 0, [f(0), f(1), f(2)], [f(3), f(4), f(5)], celsius as f32);
+    }
+    temp_file(name, log.bytes)
+}
+
+/// `imu-ar thermal LOG --out DIR EXTRA..`, successful: its PX4 and ArduPilot parameters.
+fn calibrated(log: &Path, extra: &[&str]) -> (HashMap<String, f32>, HashMap<String, f32>) {
+    let out = temp_path("thermal-out");
+    let mut args = vec![
+        "thermal",
+        log.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend(extra);
+    let run = imu_ar(&args);
+    let e = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{e}");
+    (
+        params(&out.join("px4_thermal.params")),
+        params(&out.join("ardupilot_tcal.parm")),
+    )
+}
+
+/// `imu-ar thermal` of a PX4 ULog file: the device ids from the log, no other flag; with two
+/// IMUs, --instance picks one and numbers the PX4 slot and the ArduPilot IMU after it.
+#[test]
+fn a_ulog_warm_up_is_calibrated_with_its_device_ids() {
+    let one = ulog_warm_up("one.ulg", 1);
+    let out = temp_path("thermal-ulog");
+    let j = json(&imu_ar(&[
+        "thermal",
+        one.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]));
+    assert_eq!(j["generalises"], true, "{j}");
+    let px4 = params(&out.join("px4_thermal.params"));
+    let ap = params(&out.join("ardupilot_tcal.parm"));
+    assert_eq!((px4["TC_G0_ID"], px4["TC_A0_ID"]), (2359330.0, 2359331.0));
+    assert_cancelled(&px4, &ap, 0, 1);
+    let two = ulog_warm_up("two.ulg", 2);
+    let run = imu_ar(&[
+        "thermal",
+        two.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_one_line_failure(&run);
+    let e = String::from_utf8_lossy(&run.stderr);
+    assert!(e.contains("--instance") && e.contains("2359332"), "{e}");
+    let (px4, ap) = calibrated(&two, &["--instance", "1"]);
+    assert_eq!((px4["TC_G1_ID"], px4["TC_A1_ID"]), (2359332.0, 2359333.0));
+    assert_cancelled(&px4, &ap, 1, 2);
+}
+
+/// `imu-ar thermal` of an ArduPilot DataFlash log: calibrated from its IMU messages; refused
+/// when ArduPilot had already corrected them (INS_TCAL1_ENABLE 1) or rotated them
+/// (AHRS_ORIENTATION); the other commands name `thermal` for these logs.
+#[test]
+fn a_dataflash_warm_up_is_calibrated_unless_already_corrected() {
+    let log = dataflash_warm_up("warm.bin", &[("INS_TCAL1_ENABLE", 0.0)]);
+    let (px4, ap) = calibrated(&log, &["--device-id", "1,2"]);
+    assert_cancelled(&px4, &ap, 0, 1);
+    let out = temp_path("thermal-bin");
+    for (p, v, says) in [
+        ("INS_TCAL1_ENABLE", 1.0, "already temperature-corrected"),
+        ("AHRS_ORIENTATION", 2.0, "AHRS_ORIENTATION"),
+    ] {
+        let log = dataflash_warm_up("refused.bin", &[(p, v)]);
+        let run = imu_ar(&[
+            "thermal",
+            log.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_one_line_failure(&run);
+        let e = String::from_utf8_lossy(&run.stderr);
+        assert!(e.contains(says), "{e}");
+    }
+    let run = imu_ar(&[
+        "noise",
+        log.to_str().unwrap(),
+        "--column",
+        "gx",
+        "--rate",
+        "100",
+    ]);
+    assert_one_line_failure(&run);
+    assert!(String::from_utf8_lossy(&run.stderr).contains("imu-ar thermal"));
 }
