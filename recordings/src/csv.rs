@@ -598,6 +598,10 @@ impl Batch {
 /// Text of a batch, bytes, past which it is handed on mid-scan.
 const BATCH_TEXT: usize = 1 << 20;
 
+/// Fields of a batch past which it is handed on mid-scan: empty cells hold no text, and each
+/// field's bounds take 16 bytes.
+const BATCH_FIELDS: usize = 1 << 16;
+
 /// Held sources longer than this, bytes, are scanned on a thread of their own.
 const SCAN_THREAD_FROM: usize = 1 << 20;
 
@@ -780,7 +784,7 @@ fn scan_quoted(
             batch.fields.push((from, batch.text.len()));
         }
         batch.records.push((start, batch.fields.len()));
-        if batch.text.len() >= BATCH_TEXT {
+        if batch.text.len() >= BATCH_TEXT || batch.fields.len() >= BATCH_FIELDS {
             hand_on(batch, sink)?;
         }
     }
@@ -1098,6 +1102,28 @@ mod tests {
         assert_eq!((got.map_err(|(line, _)| line), seen), (Err(Some(3)), 1));
         // Read to the end, with the rows counted, when nothing is refused.
         assert_eq!(read(&text, usize::MAX), (Ok(()), 50_000));
+    }
+
+    /// Past a quote the CSV reader's records are batched by their text and by their fields: a
+    /// file of empty cells (no text) was scanned whole into one batch, 24 times the file's size
+    /// in memory, before its first row was checked.
+    #[test]
+    fn a_batch_of_quoted_records_is_bounded_by_its_fields_too() {
+        let mut text = b"t,x\n\"0\",\n".to_vec();
+        for _ in 0..200_000 {
+            text.extend_from_slice(b",\n");
+        }
+        let (mut batches, mut largest, mut records) = (0, 0, 0);
+        let end = scan(&text[4..], 4, 1 << 20, &mut |batch| {
+            batches += 1;
+            largest = largest.max(batch.fields.len());
+            records += batch.records.len();
+            Some(batch)
+        });
+        assert_eq!(end, Ok(()));
+        assert_eq!(records, 200_001);
+        assert!(largest <= BATCH_FIELDS + 2, "{largest} fields in one batch");
+        assert!(batches >= 6, "{batches} batches");
     }
 
     /// A header row whose first cell is a quoted `"#..."` is a header row, not a comment (the
