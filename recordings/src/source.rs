@@ -11,7 +11,7 @@ use crate::error::{Fail, escaped, with_file};
 use crate::frame::{Frame, Select, Skipped};
 use crate::timing::{Step, TimeUnit, Timing};
 use crate::units::Unit;
-use crate::{bag, mcap, rosbag2};
+use crate::{bag, dataflash, mcap, rosbag2, ulog};
 
 /// The kinds of recording.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -158,6 +158,8 @@ pub struct Request<'a> {
     pub want_time: bool,
     /// Drop (and count) samples whose stamp is not after the last one, instead of refusing them.
     pub drop_backward: bool,
+    /// The IMU of an autopilot log (ULog multi_id, DataFlash `I`), when it holds several.
+    pub instance: Option<u8>,
 }
 
 /// What a read gave besides the samples.
@@ -239,11 +241,14 @@ pub fn stream(
         ));
     }
     if matches!(kind, Kind::Ulog | Kind::DataFlash) {
+        return autopilot_stream(files, kind, request, each);
+    }
+    if let Some(i) = request.instance {
         return Err(with_file(
             files,
             format!(
-                "{}: read by `imu-ar thermal`; this command reads CSV files, ROS 1 bags, MCAP \
-                 files and rosbag2 folders",
+                "--instance {i}: the file is {}; --instance picks an IMU of a PX4 ULog file or \
+                 an ArduPilot DataFlash log",
                 kind.name()
             ),
         ));
@@ -265,6 +270,197 @@ pub fn stream(
         )),
         (kind, topic) => messages(files, kind, topic, request, each),
     }
+}
+
+/// The instance to read of an autopilot log's IMUs `instances` (as `(instance, what)`, `what`
+/// naming it in messages): the requested one, the only one, or an error that lists them.
+fn choose(
+    files: &[PathBuf],
+    request: &Request,
+    what: &str,
+    instances: &[(u8, String)],
+) -> Result<u8, Fail> {
+    match (request.instance, instances) {
+        (Some(i), _) if instances.iter().any(|(j, _)| *j == i) => Ok(i),
+        (Some(i), _) => Err(with_file(
+            files,
+            format!("--instance {i}: the log has no {what} of that instance"),
+        )),
+        (None, [(i, _)]) => Ok(*i),
+        (None, []) => Err(with_file(files, format!("the log has no {what}"))),
+        (None, many) => {
+            let list: Vec<&str> = many.iter().map(|(_, w)| w.as_str()).collect();
+            Err(with_file(
+                files,
+                format!(
+                    "{} instances of {what}: {}; choose one with --instance",
+                    many.len(),
+                    list.join(", ")
+                ),
+            ))
+        }
+    }
+}
+
+/// A PX4 ULog file's or an ArduPilot DataFlash log's IMU samples: a DataFlash log's `IMU`
+/// messages (gyro and accelerometer together); a ULog file's `sensor_gyro` or `sensor_accel`
+/// (their FIFO topics when the log has no sensor topic), one of them: the two are separate
+/// topics, published at times of their own.
+fn autopilot_stream(
+    files: &[PathBuf],
+    kind: Kind,
+    request: &Request,
+    each: &mut dyn FnMut(&[f64]),
+) -> Result<Read, Fail> {
+    if files.len() > 1 {
+        return Err(with_file(
+            files,
+            format!("{}: one log at a time", kind.name()),
+        ));
+    }
+    if let Some(t) = request.topic {
+        return Err(with_file(
+            files,
+            format!(
+                "--topic {}: the file is {}, whose IMUs --instance picks",
+                escaped(t),
+                kind.name()
+            ),
+        ));
+    }
+    let picks = picks(
+        files,
+        request,
+        "an autopilot log's IMU has gx, gy, gz (rad/s) and ax, ay, az (m/s^2)",
+    )?;
+    let path = &files[0];
+    let mut timing = Timing::new();
+    let mut backward: Option<(u64, i64, i64)> = None;
+    let mut count = 0u64;
+    let mut values = vec![0.0; picks.len()];
+    let mut take = |time_us: f64, axes: [f64; 6]| {
+        count += 1;
+        // Microseconds since boot, to nanoseconds.
+        let stamp = (time_us * 1e3).round() as i64;
+        if let Step::Backward { last } = timing.push(stamp) {
+            timing.drop_one();
+            backward.get_or_insert((count, stamp, last));
+            return;
+        }
+        for (v, &i) in values.iter_mut().zip(&picks) {
+            *v = axes[i];
+        }
+        each(&values);
+    };
+    let mut skipped = Skipped::default();
+    if kind == Kind::DataFlash {
+        let survey = dataflash::survey(path).map_err(|e| Fail(e.to_string()))?;
+        let found: Vec<(u8, String)> = survey
+            .instances(dataflash::Kind::Imu)
+            .iter()
+            .map(|s| (s.instance, s.instance.to_string()))
+            .collect();
+        let instance = choose(files, request, "IMU messages", &found)?;
+        let select = dataflash::Select {
+            kind: dataflash::Kind::Imu,
+            instance: Some(instance),
+        };
+        let report = dataflash::read_surveyed(path, &survey, &select, &mut |s| {
+            if let (Some(g), Some(a)) = (s.gyro, s.accel) {
+                take(s.time_us, [g[0], g[1], g[2], a[0], a[1], a[2]]);
+            }
+        })
+        .map_err(|e| Fail(e.to_string()))?;
+        skipped.non_finite = report.non_finite;
+    } else {
+        let gyro = picks.iter().all(|&i| i < 3);
+        if !gyro && !picks.iter().all(|&i| i >= 3) {
+            return Err(with_file(
+                files,
+                "a PX4 ULog file holds the gyro and the accelerometer in two topics \
+                 (sensor_gyro, sensor_accel), each at its own times: read the gyro axes and \
+                 the accelerometer axes apart",
+            ));
+        }
+        let survey = ulog::survey(path).map_err(|e| Fail(e.to_string()))?;
+        let (sensor, fifo) = if gyro {
+            (ulog::Topic::Gyro, ulog::Topic::GyroFifo)
+        } else {
+            (ulog::Topic::Accel, ulog::Topic::AccelFifo)
+        };
+        let topic = if survey.instances(sensor).is_empty() {
+            fifo
+        } else {
+            sensor
+        };
+        let found: Vec<(u8, String)> = survey
+            .instances(topic)
+            .iter()
+            .map(|t| {
+                let ids: Vec<String> = t.device_ids.iter().map(u32::to_string).collect();
+                (
+                    t.instance,
+                    format!("{} (device_id {})", t.instance, ids.join(", ")),
+                )
+            })
+            .collect();
+        let instance = choose(
+            files,
+            request,
+            &format!("{} messages", topic.name()),
+            &found,
+        )?;
+        let select = ulog::Select {
+            topic,
+            which: ulog::Which::Instance(instance),
+        };
+        let report = ulog::read_surveyed(path, &survey, &select, &mut |s| {
+            let [x, y, z] = s.xyz;
+            let axes = if gyro {
+                [x, y, z, 0.0, 0.0, 0.0]
+            } else {
+                [0.0, 0.0, 0.0, x, y, z]
+            };
+            take(s.time_us, axes);
+        })
+        .map_err(|e| Fail(e.to_string()))?;
+        skipped.undecodable = report.undecodable;
+        skipped.non_finite = report.non_finite;
+    }
+    stamped(files, request, &picks, (timing, backward), skipped)
+}
+
+/// The axes (of [`AXES`]) that `request.columns` name; an error naming the column that is none,
+/// and saying what `has` the message.
+fn picks(files: &[PathBuf], request: &Request, has: &str) -> Result<Vec<usize>, Fail> {
+    request
+        .columns
+        .iter()
+        .map(|c| axis(c).ok_or_else(|| with_file(files, format!("--column {}: {has}", escaped(c)))))
+        .collect()
+}
+
+/// What a read of messages gave: the axes `picks` in SI units, and their stamps' statistics;
+/// an error for the first stamp that went backwards (`backward`: message, stamp, the stamp
+/// before), unless `request` drops such messages.
+fn stamped(
+    files: &[PathBuf],
+    request: &Request,
+    picks: &[usize],
+    (timing, backward): (Timing, Option<(u64, i64, i64)>),
+    skipped: Skipped,
+) -> Result<Read, Fail> {
+    if let Some((at, stamp, last)) = backward
+        && !request.drop_backward
+    {
+        return Err(with_file(files, backward_text(&timing, at, stamp, last)));
+    }
+    Ok(Read {
+        unknown: vec![None; picks.len()],
+        units: picks.iter().map(|&i| si_unit(i)).collect(),
+        timing: Some((timing, TimeUnit::HeaderStamps)),
+        skipped,
+    })
 }
 
 /// A bag's or an MCAP file's messages.
@@ -298,22 +494,12 @@ fn messages(
             format!("{} needs --topic{topics}", kind.name()),
         ));
     };
-    let picks = request
-        .columns
-        .iter()
-        .map(|c| {
-            axis(c).ok_or_else(|| {
-                with_file(
-                    files,
-                    format!(
-                        "--column {}: a sensor_msgs/Imu message has gx, gy, gz (angular_velocity, \
-                         rad/s) and ax, ay, az (linear_acceleration, m/s^2)",
-                        escaped(c)
-                    ),
-                )
-            })
-        })
-        .collect::<Result<Vec<usize>, Fail>>()?;
+    let picks = picks(
+        files,
+        request,
+        "a sensor_msgs/Imu message has gx, gy, gz (angular_velocity, rad/s) and ax, ay, az \
+         (linear_acceleration, m/s^2)",
+    )?;
     let mut timing = Timing::new();
     let mut skipped = Skipped::default();
     let mut backward: Option<(u64, i64, i64)> = None;
@@ -381,17 +567,7 @@ fn messages(
             skipped,
         });
     }
-    if let Some((at, stamp, last)) = backward
-        && !request.drop_backward
-    {
-        return Err(with_file(files, backward_text(&timing, at, stamp, last)));
-    }
-    Ok(Read {
-        unknown: vec![None; picks.len()],
-        units: picks.iter().map(|&i| si_unit(i)).collect(),
-        timing: Some((timing, TimeUnit::HeaderStamps)),
-        skipped,
-    })
+    stamped(files, request, &picks, (timing, backward), skipped)
 }
 
 /// The unit of a message's axis `i` (of [`AXES`]).

@@ -44,6 +44,10 @@ pub struct Args {
     /// The header frame_id of the IMU to read, when the topic carries more than one.
     #[arg(long)]
     frame_id: Option<String>,
+    /// The IMU of an ArduPilot DataFlash log, when it holds several (the `I` of its IMU
+    /// messages).
+    #[arg(long)]
+    instance: Option<u8>,
     /// The six CSV columns: gyro x, y, z, then accelerometer x, y, z (names, names without
     /// their unit bracket, or 0-based indices) [default: w_RS_S_x .. a_RS_S_z (EuRoC), or
     /// gx .. az].
@@ -191,6 +195,7 @@ fn characterise(
         time_column: args.time_column.as_deref(),
         want_time: args.rate.is_none(),
         drop_backward: args.drop_backward,
+        instance: args.instance,
     };
     // The rows go in batches to a second thread, which keeps the six axes' statistics while
     // this one reads and parses: the two halves of the work overlap.

@@ -33,6 +33,10 @@ pub struct Input {
     /// The header frame_id of the IMU to read, when the topic carries more than one.
     #[arg(long)]
     pub frame_id: Option<String>,
+    /// The IMU of a PX4 ULog file or an ArduPilot DataFlash log, when it holds several (the
+    /// uORB instance of sensor_gyro / sensor_accel; the `I` of the IMU messages).
+    #[arg(long)]
+    pub instance: Option<u8>,
     /// The CSV column of the timestamps, when --rate is not given [default: the column named
     /// timestamp, time, t or t_UNIT; its unit from its bracket or suffix (s, ms, us, ns), else
     /// from its magnitude].
@@ -83,6 +87,7 @@ impl Input {
             time_column: self.time_column.as_deref(),
             want_time,
             drop_backward: self.drop_backward,
+            instance: self.instance,
         };
         let mut x = Vec::new();
         let read = source::stream(&self.files, &request, &mut |v| x.push(v[0]))?;

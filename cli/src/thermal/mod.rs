@@ -564,6 +564,7 @@ fn read_csv(args: &Args) -> Result<WarmUp, Fail> {
         time_column: None,
         want_time: false,
         drop_backward: false,
+        instance: None,
     };
     let mut celsius = Vec::new();
     let mut axes: [Vec<f64>; 6] = Default::default();

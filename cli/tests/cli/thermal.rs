@@ -1,4 +1,4 @@
-//! `imu-ar thermal`: simulated warm-up records with known cubic biases, the written
+//! `imu-ar thermal`, and the autopilots' logs as every command reads them: simulated warm-up records with
 //! parameters parsed from the files and applied through each autopilot's correction, written
 //! again here from the autopilots' sources (PX4 `TemperatureCompensation::calc_thermal_offsets_3D`,
 //! ArduPilot `AP_InertialSensor::TCal::correct_sensor`), against the simulated truth.
@@ -379,7 +379,7 @@ fn a_ulog_warm_up_is_calibrated_with_its_device_ids() {
 
 /// `imu-ar thermal` of an ArduPilot DataFlash log: calibrated from its IMU messages; refused
 /// when ArduPilot had already corrected them (INS_TCAL1_ENABLE 1) or rotated them
-/// (AHRS_ORIENTATION); the other commands name `thermal` for these logs.
+/// (AHRS_ORIENTATION); an instance the log does not hold is refused by every command.
 #[test]
 fn a_dataflash_warm_up_is_calibrated_unless_already_corrected() {
     let log = dataflash_warm_up("warm.bin", &[("INS_TCAL1_ENABLE", 0.0)]);
@@ -406,9 +406,76 @@ fn a_dataflash_warm_up_is_calibrated_unless_already_corrected() {
         log.to_str().unwrap(),
         "--column",
         "gx",
-        "--rate",
-        "100",
+        "--instance",
+        "3",
     ]);
     assert_one_line_failure(&run);
-    assert!(String::from_utf8_lossy(&run.stderr).contains("imu-ar thermal"));
+    let e = String::from_utf8_lossy(&run.stderr);
+    assert!(e.contains("no IMU messages of that instance"), "{e}");
+}
+
+/// The same samples (f32, as the logs hold them, at 100 Hz) as an ArduPilot DataFlash log, a
+/// PX4 ULog file and a CSV record: `imu-ar noise --json` gives the same model of every axis
+/// from the log as from the CSV, bit for bit, and `characterise` runs on the DataFlash log with
+/// no flag.
+#[test]
+fn autopilot_logs_give_the_csvs_noise_model() {
+    let rows: Vec<(u64, [f32; 6])> = samples(20_000, 0.0)
+        .into_iter()
+        .enumerate()
+        .map(|(k, (_, axes))| (1_000_000 + 10_000 * k as u64, axes.map(|v| v as f32)))
+        .collect();
+    let mut df = Df::new();
+    let mut ulog = ULog::new(0);
+    ulog.format(SENSOR_GYRO);
+    ulog.format(SENSOR_ACCEL);
+    ulog.subscribe(0, 0, "sensor_gyro");
+    ulog.subscribe(0, 1, "sensor_accel");
+    let mut csv =
+        String::from("t [us],gx [rad/s],gy [rad/s],gz [rad/s],ax [m/s^2],ay [m/s^2],az [m/s^2]\n");
+    for (t, a) in &rows {
+        df.imu(*t, 0, [a[0], a[1], a[2]], [a[3], a[4], a[5]], 30.0);
+        ulog.data(0, &sensor(*t, *t, 7, [a[0], a[1], a[2]], 30.0));
+        ulog.data(1, &sensor(*t, *t, 8, [a[3], a[4], a[5]], 30.0));
+        csv += &format!("{t}");
+        for v in a {
+            csv += &format!(",{}", f64::from(*v));
+        }
+        csv += "\n";
+    }
+    let df = temp_file("same.bin", df.bytes);
+    let ulog = temp_file("same.ulg", ulog.bytes);
+    let csv = temp_file("same.csv", csv);
+    // Everything but the unit the stamps were written in (the CSV's microseconds; the logs'
+    // message stamps, in nanoseconds).
+    let model = |file: &Path, column: &str| {
+        let args = [
+            "noise",
+            file.to_str().unwrap(),
+            "--column",
+            column,
+            "--json",
+        ];
+        let mut j = json(&imu_ar(&args));
+        j["timing"]["unit"] = serde_json::Value::Null;
+        j
+    };
+    for column in ["gx", "gy", "gz", "ax", "ay", "az"] {
+        let want = model(&csv, column);
+        assert_eq!(model(&df, column), want, "DataFlash {column}");
+        assert_eq!(model(&ulog, column), want, "ULog {column}");
+    }
+    let out = temp_path("characterise-bin");
+    let run = imu_ar(&[
+        "characterise",
+        df.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert!(out.join("px4.params").is_file());
 }
