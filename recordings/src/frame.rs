@@ -28,6 +28,9 @@ pub struct Skipped {
     pub non_finite: u64,
     /// Messages of another IMU on the topic than the one `--frame-id` chose.
     pub other_frame_id: u64,
+    /// Samples of a log's gyro or accelerometer without a partner of the same time in the
+    /// other (a PX4 ULog file's two topics read together).
+    pub unpaired: u64,
 }
 
 /// The `N` bytes at `at`, if `bytes` holds them.

@@ -373,21 +373,40 @@ fn autopilot_stream(
         .map_err(|e| Fail(e.to_string()))?;
         skipped.non_finite = report.non_finite;
     } else {
-        let gyro = picks.iter().all(|&i| i < 3);
-        if !gyro && !picks.iter().all(|&i| i >= 3) {
-            return Err(with_file(
-                files,
-                "a PX4 ULog file holds the gyro and the accelerometer in two topics \
-                 (sensor_gyro, sensor_accel), each at its own times: read the gyro axes and \
-                 the accelerometer axes apart",
-            ));
+        skipped = ulog_stream(files, request, &picks, &mut take)?;
+    }
+    stamped(files, request, &picks, (timing, backward), skipped)
+}
+
+/// The samples of a ULog file's gyro or accelerometer, or both (`picks`), to `take` (time in
+/// microseconds, the six axes): a sensor topic, or its FIFO topic when the log has no sensor
+/// topic. Gyro and accelerometer are separate topics: read together (on two threads), they are
+/// paired by equal sample times, as PX4's drivers publish the two halves of one FIFO read;
+/// samples without a partner are counted, and more than 1 % of them refused.
+fn ulog_stream(
+    files: &[PathBuf],
+    request: &Request,
+    picks: &[usize],
+    take: &mut dyn FnMut(f64, [f64; 6]),
+) -> Result<Skipped, Fail> {
+    let path = &files[0];
+    let survey = ulog::survey(path).map_err(|e| Fail(e.to_string()))?;
+    let mut selects = Vec::with_capacity(2);
+    for (wanted, sensor, fifo) in [
+        (
+            picks.iter().any(|&i| i < 3),
+            ulog::Topic::Gyro,
+            ulog::Topic::GyroFifo,
+        ),
+        (
+            picks.iter().any(|&i| i >= 3),
+            ulog::Topic::Accel,
+            ulog::Topic::AccelFifo,
+        ),
+    ] {
+        if !wanted {
+            continue;
         }
-        let survey = ulog::survey(path).map_err(|e| Fail(e.to_string()))?;
-        let (sensor, fifo) = if gyro {
-            (ulog::Topic::Gyro, ulog::Topic::GyroFifo)
-        } else {
-            (ulog::Topic::Accel, ulog::Topic::AccelFifo)
-        };
         let topic = if survey.instances(sensor).is_empty() {
             fifo
         } else {
@@ -410,24 +429,103 @@ fn autopilot_stream(
             &format!("{} messages", topic.name()),
             &found,
         )?;
-        let select = ulog::Select {
+        selects.push(ulog::Select {
             topic,
             which: ulog::Which::Instance(instance),
-        };
-        let report = ulog::read_surveyed(path, &survey, &select, &mut |s| {
+        });
+    }
+    let mut skipped = Skipped::default();
+    let fail = |e: DataError| Fail(e.to_string());
+    let [a, b] = selects[..] else {
+        let gyro =
+            selects[0].topic == ulog::Topic::Gyro || selects[0].topic == ulog::Topic::GyroFifo;
+        let report = ulog::read_surveyed(path, &survey, &selects[0], &mut |s| {
             let [x, y, z] = s.xyz;
-            let axes = if gyro {
-                [x, y, z, 0.0, 0.0, 0.0]
-            } else {
-                [0.0, 0.0, 0.0, x, y, z]
-            };
-            take(s.time_us, axes);
+            take(
+                s.time_us,
+                if gyro {
+                    [x, y, z, 0.0, 0.0, 0.0]
+                } else {
+                    [0.0, 0.0, 0.0, x, y, z]
+                },
+            );
         })
-        .map_err(|e| Fail(e.to_string()))?;
+        .map_err(fail)?;
         skipped.undecodable = report.undecodable;
         skipped.non_finite = report.non_finite;
+        return Ok(skipped);
+    };
+    type Batch = Vec<(f64, [f64; 3])>;
+    let survey = &survey;
+    let (reports, paired, unpaired) = std::thread::scope(|scope| {
+        let reader = |select: ulog::Select, send: std::sync::mpsc::SyncSender<Batch>| {
+            move || {
+                let mut batch = Vec::with_capacity(4096);
+                let report = ulog::read_surveyed(path, survey, &select, &mut |s| {
+                    batch.push((s.time_us, s.xyz));
+                    if batch.len() == 4096 {
+                        // A closed channel: the pairing stopped, its error says why.
+                        let _ = send.send(std::mem::replace(&mut batch, Vec::with_capacity(4096)));
+                    }
+                });
+                if !batch.is_empty() {
+                    let _ = send.send(batch);
+                }
+                report
+            }
+        };
+        let (gyro_send, gyro) = std::sync::mpsc::sync_channel::<Batch>(4);
+        let (accel_send, accel) = std::sync::mpsc::sync_channel::<Batch>(4);
+        let g = scope.spawn(reader(a, gyro_send));
+        let x = scope.spawn(reader(b, accel_send));
+        let (mut gyro, mut accel) = (gyro.iter().flatten(), accel.iter().flatten());
+        let (mut next_gyro, mut next_accel) = (gyro.next(), accel.next());
+        let (mut paired, mut unpaired) = (0u64, 0u64);
+        while let (Some((tg, wg)), Some((ta, wa))) = (next_gyro, next_accel) {
+            // Equal sample times, to the microsecond's rounding.
+            if (tg - ta).abs() < 0.5 {
+                take(tg, [wg[0], wg[1], wg[2], wa[0], wa[1], wa[2]]);
+                paired += 1;
+                (next_gyro, next_accel) = (gyro.next(), accel.next());
+            } else if tg < ta {
+                unpaired += 1;
+                next_gyro = gyro.next();
+            } else {
+                unpaired += 1;
+                next_accel = accel.next();
+            }
+        }
+        let rest =
+            next_gyro.iter().count() + next_accel.iter().count() + gyro.count() + accel.count();
+        unpaired += rest as u64;
+        let join = |h: std::thread::ScopedJoinHandle<'_, Result<ulog::Report, DataError>>| {
+            h.join().unwrap_or_else(|_| {
+                Err(DataError {
+                    file: path.clone(),
+                    line: None,
+                    problem: "the reader stopped".into(),
+                })
+            })
+        };
+        ((join(g), join(x)), paired, unpaired)
+    });
+    let (g, x) = (reports.0.map_err(fail)?, reports.1.map_err(fail)?);
+    if unpaired.saturating_mul(100) > paired.saturating_add(unpaired) {
+        return Err(with_file(
+            files,
+            format!(
+                "{} and {} share {paired} sample times; {unpaired} samples of one or the other \
+                 have no partner (more than 1 %): the two are published at times of their own \
+                 here, so read the gyro axes and the accelerometer axes apart",
+                a.topic.name(),
+                b.topic.name()
+            ),
+        ));
     }
-    stamped(files, request, &picks, (timing, backward), skipped)
+    skipped.undecodable = g.undecodable + x.undecodable;
+    skipped.non_finite = g.non_finite + x.non_finite;
+    skipped.unpaired = unpaired;
+    Ok(skipped)
 }
 
 /// The axes (of [`AXES`]) that `request.columns` name; an error naming the column that is none,

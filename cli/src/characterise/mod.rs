@@ -124,6 +124,9 @@ pub struct SkippedCounts {
     pub backward: u64,
     /// Messages of the topic's other IMUs (those --frame-id did not choose).
     pub other_frame_id: u64,
+    /// Samples of a PX4 ULog file's gyro or accelerometer without a partner of the same time
+    /// in the other.
+    pub unpaired: u64,
 }
 
 /// One axis.
@@ -346,6 +349,7 @@ fn characterise(
             non_finite: read.skipped.non_finite,
             backward,
             other_frame_id: read.skipped.other_frame_id,
+            unpaired: read.skipped.unpaired,
         },
         timing,
         axes: results,
@@ -590,13 +594,17 @@ impl Output for Characterisation {
     fn text(&self) -> String {
         let mut s = format!(
             "{} samples per axis at {} Hz; skipped: {} undecodable, {} not finite, {} backward, \
-             {} of other frame_ids\n",
+             {} of other frame_ids{}\n",
             self.n,
             json(&self.rate_hz),
             self.skipped.undecodable,
             self.skipped.non_finite,
             self.skipped.backward,
-            self.skipped.other_frame_id
+            self.skipped.other_frame_id,
+            match self.skipped.unpaired {
+                0 => String::new(),
+                n => format!(", {n} without a partner in the other sensor's topic"),
+            }
         );
         if let Some(t) = &self.timing {
             s += &t.text();

@@ -312,7 +312,7 @@ fn non_finite_and_undecodable_messages_are_counted() {
         let skipped = Skipped {
             undecodable: 0,
             non_finite: 3,
-            other_frame_id: 0,
+            ..Skipped::default()
         };
         assert_eq!(result, Ok(skipped), "{format}");
         let finite: Vec<Frame> = want
@@ -335,7 +335,7 @@ fn non_finite_and_undecodable_messages_are_counted() {
             Ok(Skipped {
                 undecodable: 1,
                 non_finite: 3,
-                other_frame_id: 0,
+                ..Skipped::default()
             }),
             "{format}"
         );

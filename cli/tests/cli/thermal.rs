@@ -416,8 +416,8 @@ fn a_dataflash_warm_up_is_calibrated_unless_already_corrected() {
 
 /// The same samples (f32, as the logs hold them, at 100 Hz) as an ArduPilot DataFlash log, a
 /// PX4 ULog file and a CSV record: `imu-ar noise --json` gives the same model of every axis
-/// from the log as from the CSV, bit for bit, and `characterise` runs on the DataFlash log with
-/// no flag.
+/// from the log as from the CSV, bit for bit, and so does `characterise` (with no other flag;
+/// the ULog file's two topics paired by their sample times).
 #[test]
 fn autopilot_logs_give_the_csvs_noise_model() {
     let rows: Vec<(u64, [f32; 6])> = samples(20_000, 0.0)
@@ -465,17 +465,62 @@ fn autopilot_logs_give_the_csvs_noise_model() {
         assert_eq!(model(&df, column), want, "DataFlash {column}");
         assert_eq!(model(&ulog, column), want, "ULog {column}");
     }
-    let out = temp_path("characterise-bin");
+    // characterise, with no other flag: the six axes of each, as of the CSV.
+    let axes = |file: &Path| {
+        let out = temp_path("characterise-log");
+        let args = [
+            "characterise",
+            file.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        let j = json(&imu_ar(&[&args[..], &["--json"]].concat()));
+        assert!(out.join("px4.params").is_file());
+        let mut axes = j["axes"].clone();
+        for a in axes.as_array_mut().unwrap() {
+            a["column"] = serde_json::Value::Null;
+            a["model"]["timing"]["unit"] = serde_json::Value::Null;
+        }
+        axes
+    };
+    let want = axes(&csv);
+    assert_eq!(axes(&df), want, "DataFlash");
+    assert_eq!(axes(&ulog), want, "ULog");
+}
+
+/// A ULog file whose accelerometer is published at times of its own (3 ms after the gyro):
+/// `characterise` refuses to pair the two, saying so; one sensor's axes still read.
+#[test]
+fn a_ulog_file_with_unpaired_topics_is_refused_for_six_axes() {
+    let mut ulog = ULog::new(0);
+    ulog.format(SENSOR_GYRO);
+    ulog.format(SENSOR_ACCEL);
+    ulog.subscribe(0, 0, "sensor_gyro");
+    ulog.subscribe(0, 1, "sensor_accel");
+    for (k, (_, a)) in samples(5_000, 0.0).into_iter().enumerate() {
+        let t = 1_000_000 + 10_000 * k as u64;
+        let f = |i: usize| a[i] as f32;
+        ulog.data(0, &sensor(t, t, 7, [f(0), f(1), f(2)], 30.0));
+        ulog.data(
+            1,
+            &sensor(t + 3_000, t + 3_000, 8, [f(3), f(4), f(5)], 30.0),
+        );
+    }
+    let file = temp_file("unpaired.ulg", ulog.bytes);
+    let out = temp_path("unpaired");
     let run = imu_ar(&[
         "characterise",
-        df.to_str().unwrap(),
+        file.to_str().unwrap(),
         "--out",
         out.to_str().unwrap(),
     ]);
+    assert_one_line_failure(&run);
+    let e = String::from_utf8_lossy(&run.stderr);
+    assert!(e.contains("no partner"), "{e}");
+    let run = imu_ar(&["noise", file.to_str().unwrap(), "--column", "az", "--json"]);
     assert!(
         run.status.success(),
         "{}",
         String::from_utf8_lossy(&run.stderr)
     );
-    assert!(out.join("px4.params").is_file());
 }
