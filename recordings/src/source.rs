@@ -378,9 +378,20 @@ fn autopilot_stream(
     stamped(files, request, &picks, (timing, backward), skipped)
 }
 
+/// Of a ULog file's sensor topic and its FIFO topic, the one with more samples: the FIFO
+/// topic at the sensor's full rate where the logger wrote it (SDLOG_PROFILE's raw FIFO bits),
+/// the sensor topic otherwise.
+pub fn fuller(survey: &ulog::Survey, sensor: ulog::Topic, fifo: ulog::Topic) -> ulog::Topic {
+    let samples = |t| -> u64 { survey.instances(t).iter().map(|i| i.samples).sum() };
+    if samples(fifo) > samples(sensor) {
+        fifo
+    } else {
+        sensor
+    }
+}
+
 /// The samples of a ULog file's gyro or accelerometer, or both (`picks`), to `take` (time in
-/// microseconds, the six axes): a sensor topic, or its FIFO topic when the log has no sensor
-/// topic. Gyro and accelerometer are separate topics: read together (on two threads), they are
+/// microseconds, the six axes): of the sensor topic and its FIFO topic, the [`fuller`]. Gyro and accelerometer are separate topics: read together (on two threads), they are
 /// paired by equal sample times, as PX4's drivers publish the two halves of one FIFO read;
 /// samples without a partner are counted, and more than 1 % of them refused.
 fn ulog_stream(
@@ -407,11 +418,7 @@ fn ulog_stream(
         if !wanted {
             continue;
         }
-        let topic = if survey.instances(sensor).is_empty() {
-            fifo
-        } else {
-            sensor
-        };
+        let topic = fuller(&survey, sensor, fifo);
         let found: Vec<(u8, String)> = survey
             .instances(topic)
             .iter()

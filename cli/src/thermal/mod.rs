@@ -363,8 +363,9 @@ fn read(args: &Args) -> Result<WarmUp, Fail> {
     read_csv(args)
 }
 
-/// The samples of one sensor of a ULog file with their temperatures: the sensor topic, or
-/// its FIFO topic when the log has no sensor topic.
+/// The samples of one sensor of a ULog file with their temperatures: of the sensor topic and
+/// its FIFO topic, the one with more samples (the FIFO topic's temperatures interpolated from
+/// the sensor topic's).
 fn read_ulog(path: &Path, instance: Option<u8>) -> Result<WarmUp, Fail> {
     let fail = |e: String| with_file(std::slice::from_ref(&path.to_path_buf()), e);
     let survey = ulog::survey(path).map_err(|e| Fail(e.to_string()))?;
@@ -377,11 +378,7 @@ fn read_ulog(path: &Path, instance: Option<u8>) -> Result<WarmUp, Fail> {
     .into_iter()
     .enumerate()
     {
-        let topic = if survey.instances(topic).is_empty() && !survey.instances(fifo).is_empty() {
-            fifo
-        } else {
-            topic
-        };
+        let topic = source::fuller(&survey, topic, fifo);
         let instances = survey.instances(topic);
         if instances.is_empty() {
             return Err(fail(format!(

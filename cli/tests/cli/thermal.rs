@@ -11,7 +11,7 @@ use crate::common::{assert_one_line_failure, imu_ar, json, stdout, temp_file, te
 #[path = "../../../recordings/tests/writers/mod.rs"]
 mod writers;
 
-use writers::{Df, SENSOR_ACCEL, SENSOR_GYRO, ULog, sensor};
+use writers::{ACCEL_FIFO, Df, GYRO_FIFO, SENSOR_ACCEL, SENSOR_GYRO, ULog, fifo, sensor};
 
 /// The true biases, about 30 deg C: gyros in rad/s, accelerometers in m/s^2.
 const TRUTH: [[f64; 4]; 6] = [
@@ -523,4 +523,55 @@ fn a_ulog_file_with_unpaired_topics_is_refused_for_six_axes() {
         "{}",
         String::from_utf8_lossy(&run.stderr)
     );
+}
+
+/// A ULog file with the FIFO topics at the full rate and the sensor topics at 10 Hz, as PX4
+/// logs them with the raw FIFO bits of SDLOG_PROFILE: the FIFO topics are read, every sample.
+#[test]
+fn a_ulog_files_fifo_topics_are_read_at_the_full_rate() {
+    let mut ulog = ULog::new(0);
+    for format in [GYRO_FIFO, ACCEL_FIFO, SENSOR_GYRO, SENSOR_ACCEL] {
+        ulog.format(format);
+    }
+    for (id, name) in [
+        "sensor_gyro_fifo",
+        "sensor_accel_fifo",
+        "sensor_gyro",
+        "sensor_accel",
+    ]
+    .iter()
+    .enumerate()
+    {
+        ulog.subscribe(0, id as u16, name);
+    }
+    let rows = samples(32 * 400, 0.0);
+    for (k, block) in rows.chunks(32).enumerate() {
+        // 1 kHz: the newest sample of each message at its timestamp_sample.
+        let t = 1_000_000 + 1_000 * (32 * k as u64 + 31);
+        for (s, scale) in [(0usize, 1e-4f32), (1, 1e-3)] {
+            let mut xyz = [[0i16; 32]; 3];
+            for (i, (_, a)) in block.iter().enumerate() {
+                for (j, axis) in xyz.iter_mut().enumerate() {
+                    axis[i] = (a[3 * s + j] / f64::from(scale)).round() as i16;
+                }
+            }
+            ulog.data(s as u16, &fifo(t, 7 + s as u32, 1000.0, scale, 32, &xyz));
+        }
+        if k % 3 == 0 {
+            ulog.data(2, &sensor(t, t, 7, [0.0; 3], 30.0));
+            ulog.data(3, &sensor(t, t, 8, [0.0; 3], 30.0));
+        }
+    }
+    let file = temp_file("fifo.ulg", ulog.bytes);
+    let out = temp_path("fifo");
+    let args = [
+        "characterise",
+        file.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ];
+    let j = json(&imu_ar(&args));
+    assert_eq!(j["n"], 32 * 400);
+    assert_eq!(j["rate_hz"], 1000.0);
 }
