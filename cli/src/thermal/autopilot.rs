@@ -120,6 +120,16 @@ impl Px4 {
     }
 }
 
+/// The prefix of IMU `n`'s thermal-calibration parameters: `INS_TCALn_` for IMUs 1 to 3,
+/// `INSn_TCAL_` for the fourth and fifth (`AP_InertialSensor_Params.cpp`).
+pub fn ardupilot_prefix(n: usize) -> String {
+    if n <= 3 {
+        format!("INS_TCAL{n}_")
+    } else {
+        format!("INS{n}_TCAL_")
+    }
+}
+
 /// A parameter's value as an autopilot stores it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Value {
@@ -182,11 +192,7 @@ impl ArduPilot {
     /// The parameters, by name, of IMU `n` (1..=5): `INS_TCALn_*`, or `INSn_TCAL_*` for the
     /// fourth and fifth.
     pub fn params(&self, n: usize) -> Vec<(String, Value)> {
-        let prefix = if n <= 3 {
-            format!("INS_TCAL{n}_")
-        } else {
-            format!("INS{n}_TCAL_")
-        };
+        let prefix = ardupilot_prefix(n);
         let mut out = vec![
             (format!("{prefix}ENABLE"), Value::Int(1)),
             (format!("{prefix}TMIN"), Value::Float(self.tmin)),

@@ -1,7 +1,7 @@
 //! One axis's bias against temperature: binned, fitted, and checked on bins held out.
 
 use super::bins::{self, Bin};
-use super::cubic::{Poly, fit};
+use super::cubic::{Poly, fit, prediction_variance};
 
 /// The smallest temperature span a calibration is fitted over, deg C (ArduPilot's
 /// `TEMP_RANGE_MIN`).
@@ -39,6 +39,19 @@ fn first_fit(bins: &[Bin]) -> Option<Poly> {
     fit(&points, DEGREE, 0.5 * (first.celsius + last.celsius))
 }
 
+/// The smallest difference between two of the finite values `x`: their resolution (0 for
+/// fewer than two distinct values).
+fn resolution(x: &[f64]) -> f64 {
+    let mut v: Vec<f64> = x.iter().copied().filter(|v| v.is_finite()).collect();
+    v.sort_by(f64::total_cmp);
+    let step = v
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .filter(|d| *d > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    if step.is_finite() { step } else { 0.0 }
+}
+
 /// The standard error of the median of a bin, for normal noise (1.2533 = sqrt(pi / 2)).
 pub fn standard_error(bin: &Bin) -> f64 {
     1.2533 * bin.spread / (bin.count as f64).sqrt()
@@ -60,17 +73,13 @@ pub fn fit_axis(
         None => first,
     };
     let (Some(first), Some(last)) = (bins.first(), bins.last()) else {
-        return Err("no temperature bin holds samples".into());
+        return Err(format!(
+            "no temperature bin of {width} deg C holds {min_count} samples (--min-bin)"
+        ));
     };
-    // The samples' range (the bins' mean temperatures lie inside it): the autopilots hold
-    // the correction at its ends beyond it.
-    let range = celsius
-        .iter()
-        .zip(x)
-        .filter(|(t, v)| t.is_finite() && v.is_finite())
-        .fold((first.celsius, last.celsius), |(l, h), (t, _)| {
-            (l.min(*t), h.max(*t))
-        });
+    // The range of the samples in the bins fitted (a stray sample in a bin of its own, left
+    // out, does not widen it): the autopilots hold the correction at its ends beyond it.
+    let range = (first.span.0, last.span.1);
     if range.1 - range.0 < MIN_SPAN {
         return Err(format!(
             "the temperature spans {:.1} to {:.1} deg C: at least {MIN_SPAN} deg C are needed for a \
@@ -94,14 +103,25 @@ pub fn fit_axis(
     let residual = worst(&poly, &mut points.iter());
     let mut held_out: f64 = 0.0;
     let mut z2 = 0.0;
+    // A bin's error: its median's, and at least the values' resolution (a sensor quantised
+    // coarser than its noise has bins of identical values, whose median is still only known to
+    // within a step: a uniform error of the step over sqrt(12)).
+    let step = resolution(x);
+    let error = |b: &Bin| (standard_error(b).powi(2) + step * step / 12.0).sqrt();
     for parity in 0..2 {
         let kept: Vec<(f64, f64)> = points.iter().skip(parity).step_by(2).copied().collect();
         let p = fit(&kept, DEGREE, reference).ok_or_else(no_fit)?;
         held_out = held_out.max(worst(&p, &mut points.iter().skip(1 - parity).step_by(2)));
+        // The error of a held-out bin's residual: its own, and the fit's from the other bins.
+        let fitted: Vec<&Bin> = bins.iter().skip(parity).step_by(2).collect();
+        let temperatures: Vec<f64> = fitted.iter().map(|b| b.celsius).collect();
+        let errors: Vec<f64> = fitted.iter().map(|b| error(b)).collect();
+        let variance =
+            prediction_variance(&temperatures, &errors, DEGREE, reference).ok_or_else(no_fit)?;
         for b in bins.iter().skip(1 - parity).step_by(2) {
-            // A bin of identical values (a quantised sensor standing still) has no spread:
-            // its error is taken as a part in 1e12 of its value.
-            let se = standard_error(b)
+            // No error at all (identical values everywhere): a part in 1e12 of the value.
+            let se = (error(b).powi(2) + variance(b.celsius))
+                .sqrt()
                 .max(1e-12 * b.value.abs())
                 .max(f64::MIN_POSITIVE);
             z2 += ((b.value - p.at(b.celsius)) / se).powi(2);

@@ -21,6 +21,8 @@ pub struct Bin {
     /// The median absolute deviation of its samples from `value`, times 1.4826 (the standard
     /// deviation, for normal noise).
     pub spread: f64,
+    /// The lowest and the highest temperature of its samples, deg C.
+    pub span: (f64, f64),
 }
 
 /// The bins `[k width, (k + 1) width)` deg C of the samples `x` taken at
@@ -92,11 +94,18 @@ pub fn along(
             };
             let value = median(&mut values);
             let mut deviations: Vec<f64> = values.iter().map(|v| (v - value).abs()).collect();
+            let spread = 1.4826 * median(&mut deviations);
+            let span = samples
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &(t, _)| {
+                    (l.min(t), h.max(t))
+                });
             Bin {
                 celsius: mean,
                 value,
                 count,
-                spread: 1.4826 * median(&mut deviations),
+                spread,
+                span,
             }
         })
         .collect())

@@ -113,6 +113,98 @@ pub fn fit(points: &[(f64, f64)], degree: usize, reference: f64) -> Option<Poly>
     })
 }
 
+/// The variance of the least-squares polynomial of `degree` in `T - reference` at each
+/// temperature, fitted with equal weights to values at `temperatures` whose standard errors
+/// are `se`: `x(T)^T (X^T X)^-1 (sum_i se_i^2 x_i x_i^T) (X^T X)^-1 x(T)`, `x(T)` the powers of
+/// the normalised temperature. (The robust fit's weights are 1 but at outliers.) `None` when
+/// the temperatures do not determine the polynomial.
+pub fn prediction_variance(
+    temperatures: &[f64],
+    se: &[f64],
+    degree: usize,
+    reference: f64,
+) -> Option<impl Fn(f64) -> f64> {
+    let n = degree.min(3) + 1;
+    let h = temperatures
+        .iter()
+        .map(|t| (t - reference).abs())
+        .fold(0.0, f64::max)
+        .max(f64::MIN_POSITIVE);
+    let powers = move |t: f64| {
+        let u = (t - reference) / h;
+        let mut x = [0.0; 4];
+        let mut p = 1.0;
+        for v in x.iter_mut().take(n) {
+            *v = p;
+            p *= u;
+        }
+        x
+    };
+    let (mut m, mut s) = ([[0.0f64; 4]; 4], [[0.0f64; 4]; 4]);
+    for (&t, &e) in temperatures.iter().zip(se) {
+        let x = powers(t);
+        for i in 0..n {
+            for j in 0..n {
+                m[i][j] += x[i] * x[j];
+                s[i][j] += e * e * x[i] * x[j];
+            }
+        }
+    }
+    let inverse = invert(m, n)?;
+    let product = |a: &[[f64; 4]; 4], b: &[[f64; 4]; 4]| {
+        let mut c = [[0.0; 4]; 4];
+        for i in 0..n {
+            for j in 0..n {
+                c[i][j] = (0..n).map(|k| a[i][k] * b[k][j]).sum();
+            }
+        }
+        c
+    };
+    let covariance = product(&product(&inverse, &s), &inverse);
+    Some(move |t: f64| {
+        let x = powers(t);
+        let mut v = 0.0;
+        for i in 0..n {
+            for j in 0..n {
+                v += x[i] * covariance[i][j] * x[j];
+            }
+        }
+        v.max(0.0)
+    })
+}
+
+/// The inverse of the leading `n` by `n` block of `m` (Gauss-Jordan, partial pivoting).
+fn invert(mut m: [[f64; 4]; 4], n: usize) -> Option<[[f64; 4]; 4]> {
+    let mut inverse = [[0.0; 4]; 4];
+    for (i, row) in inverse.iter_mut().enumerate().take(n) {
+        row[i] = 1.0;
+    }
+    let largest = (0..n).map(|i| m[i][i].abs()).fold(0.0, f64::max);
+    for col in 0..n {
+        let pivot = (col..n).max_by(|&a, &b| m[a][col].abs().total_cmp(&m[b][col].abs()))?;
+        if m[pivot][col].abs() <= 1e-12 * largest {
+            return None;
+        }
+        m.swap(col, pivot);
+        inverse.swap(col, pivot);
+        let d = m[col][col];
+        for k in 0..n {
+            m[col][k] /= d;
+            inverse[col][k] /= d;
+        }
+        for row in 0..n {
+            if row != col {
+                let f = m[row][col];
+                for k in 0..n {
+                    m[row][k] -= f * m[col][k];
+                    inverse[row][k] -= f * inverse[col][k];
+                }
+            }
+        }
+    }
+    Some(inverse)
+}
+
 /// `sum_k a_k u^k`.
 fn eval(a: &[f64; 4], u: f64) -> f64 {
     a.iter().rev().fold(0.0, |acc, c| acc * u + c)
@@ -227,6 +319,17 @@ mod tests {
             plain > 5.0 * worst,
             "least squares: {plain}, robust: {worst}"
         );
+    }
+
+    /// A straight line through two points of error 1 at -1 and 1: its variance is 1 at the
+    /// points, 0.5 midway, and 5 at 3 (`(1 + t^2) / 2`).
+    #[test]
+    fn the_prediction_variance_of_a_line() {
+        let v = prediction_variance(&[-1.0, 1.0], &[1.0, 1.0], 1, 0.0).unwrap();
+        for (t, want) in [(-1.0, 1.0), (0.0, 0.5), (1.0, 1.0), (3.0, 5.0)] {
+            assert!((v(t) - want).abs() < 1e-12, "{t}: {}", v(t));
+        }
+        assert!(prediction_variance(&[1.0, 1.0], &[1.0, 1.0], 1, 0.0).is_none());
     }
 
     #[test]

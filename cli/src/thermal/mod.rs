@@ -149,7 +149,7 @@ pub struct Thermal {
 pub const HELD_OUT_FRACTION: f64 = 0.1;
 
 /// The largest root mean square of the held-out bins' standardised residuals that passes.
-pub const HELD_OUT_Z: f64 = 2.0;
+pub const HELD_OUT_Z: f64 = 2.5;
 
 /// One axis.
 #[derive(Serialize)]
@@ -303,15 +303,48 @@ pub fn run(args: &Args) -> Result<Thermal, Fail> {
         axes: results,
         files: Vec::new(),
     };
-    let px4_slot = args.px4_slot.or(warm.instance).unwrap_or(0).min(3);
-    let imu = args
-        .imu
-        .unwrap_or_else(|| warm.instance.map_or(1, |i| i.saturating_add(1)));
-    if !(1..=5).contains(&imu) {
-        return Err(Fail(format!(
-            "ardupilot: instance {} is no IMU 1 to 5 of INS_TCALn; give --imu",
-            imu - 1
-        )));
+    let px4_slot = match (args.px4_slot, warm.instance) {
+        (Some(j), _) => j,
+        (None, Some(i)) if i <= 3 => i,
+        (None, None) => 0,
+        (None, Some(i)) if formats.contains(&Format::Px4) => {
+            return Err(Fail(format!(
+                "px4: instance {i}: TC_Gj_* and TC_Aj_* have the slots 0 to 3; give --px4-slot"
+            )));
+        }
+        (None, Some(_)) => 0,
+    };
+    let imu = match (args.imu, warm.instance) {
+        (Some(n), _) => n,
+        (None, Some(i)) if i <= 4 => i + 1,
+        (None, None) => 1,
+        (None, Some(i)) if formats.contains(&Format::ArduPilot) => {
+            return Err(Fail(format!(
+                "ardupilot: instance {i}: INS_TCALn numbers the IMUs 1 to 5; give --imu"
+            )));
+        }
+        (None, Some(_)) => 1,
+    };
+    // A coefficient beyond f32 would be written as inf (a bias of 1e300, say).
+    let written: Vec<f32> = px4
+        .iter()
+        .flatten()
+        .flat_map(|p| p.x.iter().flatten().copied())
+        .chain(
+            ardupilot
+                .accel
+                .iter()
+                .chain(&ardupilot.gyro)
+                .flatten()
+                .copied(),
+        )
+        .collect();
+    if written.iter().any(|v| !v.is_finite()) {
+        return Err(with_file(
+            &args.files,
+            "a fitted coefficient is beyond what a 32-bit float parameter holds: not a sensor's \
+             bias (check the columns' units)",
+        ));
     }
     for format in formats {
         let text = match format {
@@ -371,6 +404,7 @@ fn read_ulog(path: &Path, instance: Option<u8>) -> Result<WarmUp, Fail> {
     let survey = ulog::survey(path).map_err(|e| Fail(e.to_string()))?;
     let mut sensors: Vec<Record> = Vec::with_capacity(2);
     let mut ids = [0u32; 2];
+    let mut chosen = 0u8;
     for (s, (topic, fifo, unit)) in [
         (ulog::Topic::Gyro, ulog::Topic::GyroFifo, "rad/s"),
         (ulog::Topic::Accel, ulog::Topic::AccelFifo, "m/s^2"),
@@ -388,8 +422,8 @@ fn read_ulog(path: &Path, instance: Option<u8>) -> Result<WarmUp, Fail> {
             )));
         }
         let which = match instance {
-            Some(i) => ulog::Which::Instance(i),
-            None if instances.len() == 1 => ulog::Which::Only,
+            Some(i) => i,
+            None if instances.len() == 1 => instances[0].instance,
             None => {
                 let list: Vec<String> = instances
                     .iter()
@@ -412,8 +446,16 @@ fn read_ulog(path: &Path, instance: Option<u8>) -> Result<WarmUp, Fail> {
             unit,
         };
         let mut without = 0u64;
-        let select = ulog::Select { topic, which };
+        chosen = which;
+        let select = ulog::Select {
+            topic,
+            which: ulog::Which::Instance(which),
+        };
+        let mut devices: Vec<u32> = Vec::new();
         ulog::read_surveyed(path, &survey, &select, &mut |sample| {
+            if !devices.contains(&sample.device_id) {
+                devices.push(sample.device_id);
+            }
             ids[s] = sample.device_id;
             let Some(t) = sample.temperature else {
                 without += 1;
@@ -425,6 +467,16 @@ fn read_ulog(path: &Path, instance: Option<u8>) -> Result<WarmUp, Fail> {
             }
         })
         .map_err(|e| Fail(e.to_string()))?;
+        if devices.len() > 1 {
+            let list: Vec<String> = devices.iter().map(u32::to_string).collect();
+            return Err(fail(format!(
+                "{} instance {which} holds the samples of {} devices ({}): one calibration is \
+                 one sensor's",
+                topic.name(),
+                devices.len(),
+                list.join(", ")
+            )));
+        }
         if record.celsius.is_empty() {
             return Err(fail(format!(
                 "{} has no temperature ({} samples without one{}): a thermal calibration needs \
@@ -446,7 +498,7 @@ fn read_ulog(path: &Path, instance: Option<u8>) -> Result<WarmUp, Fail> {
     Ok(WarmUp {
         sensors: [gyro, accel],
         device_ids: Some(ids),
-        instance: Some(instance.unwrap_or(0)),
+        instance: Some(chosen),
     })
 }
 
@@ -485,9 +537,9 @@ fn read_dataflash(path: &Path, instance: Option<u8>) -> Result<WarmUp, Fail> {
         return Err(fail(format!(
             "the IMU samples of instance {chosen} were already temperature-corrected by \
              ArduPilot ({}): a thermal calibration is fitted on uncorrected data; log a warm-up \
-             with INS_TCAL{}_ENABLE 0",
+             with {} 0",
             correction.reason,
-            chosen.saturating_add(1)
+            autopilot::ardupilot_prefix(usize::from(chosen) + 1) + "ENABLE"
         )));
     }
     if let Some(p) = survey.parameter("AHRS_ORIENTATION")
@@ -571,6 +623,27 @@ fn read_csv(args: &Args) -> Result<WarmUp, Fail> {
         }
         celsius.push(v[6]);
     })?;
+    // The temperature column's unit bracket, where it has one, must say deg C.
+    let bracket = match (read.units.get(6).copied().flatten(), read.unknown.get(6)) {
+        (Some(u), _) => Some(u.name.to_string()),
+        (None, Some(Some(b))) => Some(b.clone()),
+        _ => None,
+    };
+    if let Some(b) = bracket {
+        let plain: String = b.chars().filter(|c| !c.is_whitespace()).collect();
+        if !["C", "degC", "°C", "deg_C", "celsius", "Celsius", "degreesC"].contains(&plain.as_str())
+        {
+            return Err(with_file(
+                &args.files,
+                format!(
+                    "column '{}' is in [{}]: the temperature is read in deg C ([C], [degC] or \
+                     no bracket)",
+                    escaped(&args.temperature_column),
+                    escaped(&b)
+                ),
+            ));
+        }
+    }
     let given = [
         args.gyro_unit.as_deref().map(parse_unit).transpose()?,
         args.accel_unit.as_deref().map(parse_unit).transpose()?,
@@ -672,8 +745,11 @@ fn px4_file(p: &[Px4; 2], slot: usize, thermal: &Thermal) -> String {
         "(temperature_compensation, calc_thermal_offsets_3D); X0 of the accelerometer is 0:".into(),
     );
     lines.push(
-        "redo the accelerometer calibration after loading (PX4's thermal calibration guide)."
+        "redo the gyro and the accelerometer calibrations after loading, or the old CAL_*_OFF"
             .into(),
+    );
+    lines.push(
+        "offsets are subtracted on top (process_sensor_caldata.py; PX4's thermal guide).".into(),
     );
     lines.push(String::new());
     lines.push("Vehicle-Id\tComponent-Id\tName\tValue\tType".into());
@@ -748,7 +824,7 @@ impl Output for Thermal {
         }
         if !self.generalises {
             s += "a fit does not generalise: its error on bins held out exceeds 10 % of its bias \
-                  change and twice their noise; the files are written, but check the record \
+                  change and 2.5 times its expected error; the files are written, but check the record \
                   (a bump, a knock over many samples, too few bins)\n";
         }
         s

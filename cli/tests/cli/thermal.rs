@@ -280,24 +280,23 @@ fn bad_warm_ups_are_refused_in_one_line() {
     assert!(String::from_utf8_lossy(&run.stderr).contains("temp"));
 }
 
-/// A PX4 ULog warm-up: sensor_gyro and sensor_accel of `instances` IMUs at 100 Hz (instance i
-/// with device ids 2359330 + 2 i and 2359331 + 2 i), the same simulated biases on each.
-fn ulog_warm_up(name: &str, instances: u8) -> PathBuf {
+/// A PX4 ULog warm-up: sensor_gyro and sensor_accel of the IMUs `instances` at 100 Hz
+/// (instance i with device ids 2359330 + 2 i and 2359331 + 2 i), the same simulated biases on
+/// each.
+fn ulog_warm_up(name: &str, instances: std::ops::Range<u8>) -> PathBuf {
     let mut log = ULog::new(0);
     log.format(SENSOR_GYRO);
     log.format(SENSOR_ACCEL);
-    let mut id = 0u16;
-    for i in 0..instances {
-        log.subscribe(i, id, "sensor_gyro");
-        log.subscribe(i, id + 1, "sensor_accel");
-        id += 2;
+    for (k, i) in instances.clone().enumerate() {
+        log.subscribe(i, 2 * k as u16, "sensor_gyro");
+        log.subscribe(i, 2 * k as u16 + 1, "sensor_accel");
     }
     for (k, (celsius, axes)) in samples(60_000, 0.0).into_iter().enumerate() {
         let t = 1_000_000 + 10_000 * k as u64;
-        for i in 0..instances {
+        for (m, i) in instances.clone().enumerate() {
             let device = 2_359_330 + 2 * u32::from(i);
             let f = |a: usize| axes[a] as f32;
-            let msg = 2 * u16::from(i);
+            let msg = 2 * m as u16;
             log.data(
                 msg,
                 &sensor(t, t, device, [f(0), f(1), f(2)], celsius as f32),
@@ -348,7 +347,7 @@ fn calibrated(log: &Path, extra: &[&str]) -> (HashMap<String, f32>, HashMap<Stri
 /// IMUs, --instance picks one and numbers the PX4 slot and the ArduPilot IMU after it.
 #[test]
 fn a_ulog_warm_up_is_calibrated_with_its_device_ids() {
-    let one = ulog_warm_up("one.ulg", 1);
+    let one = ulog_warm_up("one.ulg", 0..1);
     let out = temp_path("thermal-ulog");
     let j = json(&imu_ar(&[
         "thermal",
@@ -362,7 +361,7 @@ fn a_ulog_warm_up_is_calibrated_with_its_device_ids() {
     let ap = params(&out.join("ardupilot_tcal.parm"));
     assert_eq!((px4["TC_G0_ID"], px4["TC_A0_ID"]), (2359330.0, 2359331.0));
     assert_cancelled(&px4, &ap, 0, 1);
-    let two = ulog_warm_up("two.ulg", 2);
+    let two = ulog_warm_up("two.ulg", 0..2);
     let run = imu_ar(&[
         "thermal",
         two.to_str().unwrap(),
@@ -574,4 +573,67 @@ fn a_ulog_files_fifo_topics_are_read_at_the_full_rate() {
     let j = json(&imu_ar(&args));
     assert_eq!(j["n"], 32 * 400);
     assert_eq!(j["rate_hz"], 1000.0);
+}
+
+/// What a red-team pass found, each fixed: a stray temperature sample set TMAX (150 deg C from
+/// one sample); a bias beyond f32 was written as `inf` with exit 0; a temperature column in
+/// [K] was read as deg C; values quantised coarser than their noise failed the held-out check;
+/// the one IMU of a ULog file at instance 3 was written as slot 0 and IMU 1.
+#[test]
+fn stray_temperatures_overflows_units_quantised_values_and_instances() {
+    let record = warm_up("stray.csv", 0.0);
+    let mut text = std::fs::read_to_string(&record).unwrap();
+    text += "1200.0,0,0,0,0,0,1,150\n";
+    let stray = temp_file("stray.csv", text);
+    let (px4, ap) = calibrated(&stray, &["--device-id", "1,2"]);
+    assert_eq!((px4["TC_G0_TMIN"], px4["TC_G0_TMAX"]), (20.0, 60.0));
+    assert_eq!(ap["INS_TCAL1_TMAX"], 60.0);
+    assert_cancelled(&px4, &ap, 0, 1);
+
+    let rows = samples(20_000, 0.0);
+    let csv = |name: &str, header: &str, value: &dyn Fn(f64, f64) -> f64| {
+        let mut text = format!("gx,gy,gz,ax,ay,az,{header}\n");
+        for (celsius, axes) in &rows {
+            for v in axes {
+                text += &format!("{},", value(*v, *celsius));
+            }
+            text += &format!("{celsius}\n");
+        }
+        temp_file(name, text)
+    };
+    let run = |file: &Path| {
+        let out = temp_path("red");
+        imu_ar(&[
+            "thermal",
+            file.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--format",
+            "ardupilot",
+            "--gyro-unit",
+            "rad/s",
+            "--accel-unit",
+            "m/s^2",
+        ])
+    };
+    let huge = csv("huge.csv", "temperature", &|_, t| 1e300 * (t - 40.0));
+    let failed = run(&huge);
+    assert_one_line_failure(&failed);
+    assert!(String::from_utf8_lossy(&failed.stderr).contains("32-bit float"));
+    let kelvin = csv("kelvin.csv", "temperature [K]", &|v, _| v);
+    let failed = run(&kelvin);
+    assert_one_line_failure(&failed);
+    assert!(String::from_utf8_lossy(&failed.stderr).contains("[K]"));
+    // Steps of 1e-3 on a noise of 2e-4: bins of identical values, known to a step.
+    let quantised = csv("quantised.csv", "temperature", &|v, t| {
+        let truth = v - 0.9 * (v - bias(0, t));
+        (truth / 1e-3).round() * 1e-3
+    });
+    let passed = run(&quantised);
+    assert!(passed.status.success(), "{}", stdout(&passed));
+
+    let third = ulog_warm_up("third.ulg", 3..4);
+    let (px4, ap) = calibrated(&third, &[]);
+    assert_eq!(px4["TC_G3_ID"], 2359336.0);
+    assert_eq!(ap["INS4_TCAL_ENABLE"], 1.0);
 }
