@@ -210,8 +210,8 @@ fn eval(a: &[f64; 4], u: f64) -> f64 {
     a.iter().rev().fold(0.0, |acc, c| acc * u + c)
 }
 
-/// Weighted least squares in `u = (T - reference) / h`: the normal equations, solved by
-/// Gaussian elimination with partial pivoting (at most 4 unknowns, `|u| <= 1`).
+/// Weighted least squares in `u = (T - reference) / h`: the normal equations, solved by their
+/// inverse ([`invert`]).
 fn solve(
     points: &[(f64, f64)],
     weights: &[f64],
@@ -220,7 +220,7 @@ fn solve(
     h: f64,
 ) -> Option<[f64; 4]> {
     let n = degree + 1;
-    let mut m = [[0.0f64; 5]; 4];
+    let (mut m, mut b) = ([[0.0f64; 4]; 4], [0.0f64; 4]);
     for (&(t, y), &w) in points.iter().zip(weights) {
         let u = (t - reference) / h;
         let mut phi = [0.0; 4];
@@ -233,28 +233,14 @@ fn solve(
             for j in 0..n {
                 m[i][j] += w * phi[i] * phi[j];
             }
-            m[i][4] += w * phi[i] * y;
+            b[i] += w * phi[i] * y;
         }
     }
-    let largest = (0..n).map(|i| m[i][i].abs()).fold(0.0, f64::max);
-    for col in 0..n {
-        let pivot = (col..n).max_by(|&a, &b| m[a][col].abs().total_cmp(&m[b][col].abs()))?;
-        if m[pivot][col].abs() <= 1e-12 * largest {
-            return None;
-        }
-        m.swap(col, pivot);
-        let top = m[col];
-        for row in m.iter_mut().take(n).skip(col + 1) {
-            let f = row[col] / top[col];
-            for (r, t) in row.iter_mut().zip(top).skip(col) {
-                *r -= f * t;
-            }
-        }
-    }
+    // At most 4 unknowns with |u| <= 1: the normal equations are well conditioned.
+    let inverse = invert(m, n)?;
     let mut a = [0.0; 4];
-    for i in (0..n).rev() {
-        let s: f64 = (i + 1..n).map(|j| m[i][j] * a[j]).sum();
-        a[i] = (m[i][4] - s) / m[i][i];
+    for (ai, row) in a.iter_mut().zip(&inverse).take(n) {
+        *ai = row.iter().zip(&b).take(n).map(|(x, y)| x * y).sum();
     }
     a.iter().all(|v| v.is_finite()).then_some(a)
 }
