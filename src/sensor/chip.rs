@@ -61,9 +61,9 @@ pub struct Map {
     pub fifo_empty: &'static [Write],
     /// Starts the FIFO and its channels.
     pub fifo_start: &'static [Write],
-    /// The FIFO is on: read back after an empty count, it fails when the chip has reset
-    /// itself.
-    pub fifo_on: Check,
+    /// The FIFO is on: read back after an empty count, one of them fails when the chip has
+    /// reset itself (or a configuration write was corrupted on the wire, leaving the FIFO off).
+    pub fifo_on: &'static [Check],
     /// A register of the configuration that no FIFO reset writes: read back when a FIFO reset
     /// finds the FIFO empty, it fails when the chip has reset itself.
     pub configured: Check,

@@ -27,7 +27,11 @@ impl<C: Chip> Driver<C> {
     pub(crate) fn with_chip(chip: C) -> Self {
         const {
             assert!(C::MAP.packet > 0 && C::MAP.packet <= MAX_PACKET);
-            assert!(C::MAP.fifo_on.fields.len() <= CHECK_REGS);
+            let mut i = 0;
+            while i < C::MAP.fifo_on.len() {
+                assert!(C::MAP.fifo_on[i].fields.len() <= CHECK_REGS);
+                i += 1;
+            }
             assert!(C::MAP.configured.fields.len() <= CHECK_REGS);
         }
         Self {

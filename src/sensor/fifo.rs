@@ -233,12 +233,13 @@ pub(crate) fn read_fifo<C: Chip>(
     let available = usize::from(readable) / packet;
     if available == 0 {
         // An empty FIFO may be a chip that reset itself: its FIFO is then off.
-        return if chip.check(C::MAP.fifo_on)? {
-            Ok(0)
-        } else {
-            state.reset_seen = true;
-            Err(Error::SensorReset)
-        };
+        for &check in C::MAP.fifo_on {
+            if !chip.check(check)? {
+                state.reset_seen = true;
+                return Err(Error::SensorReset);
+            }
+        }
+        return Ok(0);
     }
     let mut buf = [0u8; MAX_PACKET * CHUNK];
     let mut batch = Batch::default();

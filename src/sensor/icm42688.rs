@@ -138,6 +138,13 @@ const STREAMING: Check = Check {
     fields: &[(u8::MAX, FIFO_MODE_STREAM)],
 };
 
+/// FIFO_CONFIG1 as a whole: packet 3's channels on (0 after a chip reset; a write of it
+/// corrupted on the wire would leave the FIFO empty for ever).
+const CHANNELS_ON: Check = Check {
+    reg: FIFO_CONFIG1,
+    fields: &[(u8::MAX, FIFO_PACKET_3)],
+};
+
 /// PWR_MGMT0: gyro and accelerometer in low-noise mode (off after a chip reset).
 const SENSORS_ON: Check = Check {
     reg: PWR_MGMT0,
@@ -354,7 +361,9 @@ impl Icm42688Config {
 ///   ([`Error::FifoResync`](super::Error::FifoResync)). A FIFO reset takes the channels off
 ///   (FIFO_CONFIG1 = 0), reads FIFO_COUNT,
 ///   then flushes the FIFO (SIGNAL_PATH_RESET.FIFO_FLUSH) and starts the channels again. An
-///   empty FIFO is checked against FIFO_CONFIG (bypass mode after a chip reset); a FIFO reset
+///   empty FIFO is checked against FIFO_CONFIG (bypass mode after a chip reset) and
+///   FIFO_CONFIG1 (its channels: 0 after a chip reset, or wrong after a write corrupted on the
+///   wire); a FIFO reset
 ///   that finds the FIFO empty checks PWR_MGMT0 (sensors off after a chip reset).
 ///
 /// ```
@@ -448,7 +457,7 @@ const MAP: Map = Map {
     fifo_stop: FIFO_STOP,
     fifo_empty: FIFO_FLUSHED,
     fifo_start: FIFO_START,
-    fifo_on: STREAMING,
+    fifo_on: &[STREAMING, CHANNELS_ON],
     configured: SENSORS_ON,
     thermometer: Thermometer::ICM42688,
 };

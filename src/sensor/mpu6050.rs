@@ -379,7 +379,7 @@ const MAP: Map = Map {
     fifo_stop: FIFO_STOP,
     fifo_empty: FIFO_EMPTY,
     fifo_start: FIFO_START,
-    fifo_on: FIFO_ON,
+    fifo_on: &[FIFO_ON],
     configured: AWAKE_ON_PLL,
     thermometer: Thermometer::MPU6050,
 };

@@ -387,6 +387,29 @@ fn icm_corrupted_fifo_count_counts_no_phantom_samples() {
     assert_accounted(&sim, &imu, delivered + 2, "a count corrupted high");
 }
 
+/// ICM-42688-P: the FIFO_CONFIG1 write of `enable_fifo` corrupted on the wire (0x00: no
+/// channel into the FIFO; SPI reports success). The FIFO stayed empty, and as FIFO_CONFIG still
+/// read stream mode, `read_fifo` returned Ok(0) call after call on a healthy bus.
+/// Expected: the FIFO found off ([`Error::SensorReset`]), and samples flowing after `recover`.
+#[test]
+fn icm_corrupted_channel_write_is_found_and_recovered() {
+    let (sim, hooks, mut imu) = icm(13);
+    let mut out = [RawSample::default(); 160];
+    hooks.add(
+        Kind::Write(icm::FIFO_CONFIG1),
+        1,
+        Action::Corrupt(vec![(1, 0x00)]),
+    );
+    // The reset's two writes of FIFO_CONFIG1: channels off, then (corrupted) on.
+    assert!(imu.enable_fifo().is_ok());
+    sim.borrow_mut().tick(20);
+    assert_eq!(imu.read_fifo(&mut out), Err(Error::SensorReset));
+    imu.recover(&mut NoDelay, 2_000).unwrap();
+    // The gyro starts again: its first samples carry the invalid marker.
+    sim.borrow_mut().tick(u64::from(icm::GYRO_STARTUP) + 20);
+    assert_eq!(imu.read_fifo(&mut out), Ok(20));
+}
+
 /// ICM-42688-P: `FifoStats::invalid` counts FIFO packets the chip marked invalid, and README's
 /// accounting ("every sample the chip writes into its FIFO is delivered or counted ...
 /// invalid") relies on it; `Icm42688::read()` (a data-register read, no FIFO packet) added to

@@ -23,6 +23,9 @@ pub enum Action {
     /// The read takes one byte fewer out of the chip than it returns, and reports success (a
     /// byte slip: SPI has no acknowledge); its last byte repeats the one before.
     Slip,
+    /// The write carries these bytes at these offsets instead of its own (a bit error on the
+    /// wire, which SPI does not see).
+    Corrupt(Vec<(usize, u8)>),
 }
 
 /// An action at the `skip`-th next transfer of `kind`.
@@ -73,6 +76,11 @@ impl Hooks {
                 ok
             }
             Some(buf) => {
+                if let Some(Action::Corrupt(bytes)) = &action {
+                    for &(i, b) in bytes {
+                        buf[i] = b;
+                    }
+                }
                 let ok = transfer(Some(&mut *buf));
                 if let Some(Action::Overwrite(bytes)) = action {
                     for (i, b) in bytes {
@@ -147,9 +155,9 @@ impl SpiDevice for HookedSpi {
         match ops {
             [Operation::Write(w)] => {
                 let kind = Kind::Write(w[0]);
-                let w: &[u8] = w;
-                self.hooks.around(&self.sim, kind, None, |_| {
-                    result = inner.write(w);
+                let mut sent = w.to_vec();
+                self.hooks.around(&self.sim, kind, Some(&mut sent), |w| {
+                    result = inner.write(w.unwrap_or_default());
                     result.is_ok()
                 });
             }
