@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The cost of `imu-ar characterise` on a long recording: a generated static IMU, six axes at
 # 400 Hz for 4 hours (5.76 M messages), as a EuRoC CSV, a ROS 1 bag and a rosbag2 SQLite
-# database (written by the Python package rosbags), each characterised by the release build;
+# database (written by the Python package rosbags), and a 1-hour, 1 kHz PX4 ULog file of the raw
+# FIFO topics (tools/ulog-fifo.py), each characterised by the release build;
 # wall time and peak memory (maximum resident set) from GNU time, as the table
 # perf-characterise of docs/recordings.md.
 #
@@ -33,12 +34,17 @@ if [ ! -f "$dir/imu.db3" ]; then
     python3 cli/tests/fixtures/write_ros.py one "$dir/imu.db3" sqlite3 /imu0 none "$dir/plain.csv"
     rm "$dir/plain.csv"
 fi
+if [ ! -f "$dir/fifo.ulg" ]; then
+    # A PX4 ULog file with the raw FIFO topics: 1 hour at 1 kHz.
+    python3 tools/ulog-fifo.py "$dir/fifo.ulg" 3600 1000 7
+fi
 cargo build --release -p imu-ar-cli --quiet
 {
     echo "| input | size | wall (s) | peak resident (MB) |"
     echo "|---|---|---|---|"
     for input in "EuRoC CSV=imu.csv" "ROS 1 bag, lz4 chunks=imu.bag --topic /imu0" \
-        "ROS 2 database (.db3)=imu.db3 --topic /imu0"; do
+        "ROS 2 database (.db3)=imu.db3 --topic /imu0" \
+        "PX4 ULog, FIFO topics, 1 hour at 1 kHz=fifo.ulg"; do
         label=${input%%=*}
         # shellcheck disable=SC2086
         set -- ${input#*=}
