@@ -107,18 +107,12 @@ pub fn ulog_read(data: &[u8]) {
                     );
                     match result {
                         Ok(report) => assert!(samples > 0 && report.delivered == samples),
-                        Err(e) => {
-                            assert_eq!(e.file, path);
-                            assert!(!e.problem.contains('\n'));
-                        }
+                        Err(e) => assert_one_line(&e, &path),
                     }
                 }
             }
         }
-        Err(e) => {
-            assert_eq!(e.file, path);
-            assert!(!e.problem.contains('\n'));
-        }
+        Err(e) => assert_one_line(&e, &path),
     }
     let _ = std::fs::remove_file(&path);
 }
@@ -149,18 +143,18 @@ pub fn dataflash_read(data: &[u8]) {
                     });
                     match result {
                         Ok(report) => assert!(samples > 0 && report.delivered == samples),
-                        Err(e) => {
-                            assert_eq!(e.file, path);
-                            assert!(!e.problem.contains('\n'));
-                        }
+                        Err(e) => assert_one_line(&e, &path),
                     }
                 }
             }
         }
-        Err(e) => {
-            assert_eq!(e.file, path);
-            assert!(!e.problem.contains('\n'));
-        }
+        Err(e) => assert_one_line(&e, &path),
     }
     let _ = std::fs::remove_file(&path);
+}
+
+/// An autopilot log reader's error: it names the file, on one line.
+fn assert_one_line(e: &DataError, path: &Path) {
+    assert_eq!(e.file, path);
+    assert!(!e.problem.contains('\n'));
 }

@@ -33,6 +33,12 @@ pub struct Skipped {
     pub unpaired: u64,
 }
 
+/// The item of `sorted` (sorted by `name`) named `wanted`.
+pub(crate) fn by_name<'a, T>(sorted: &'a [T], wanted: &str, name: fn(&T) -> &str) -> Option<&'a T> {
+    let i = sorted.binary_search_by(|t| name(t).cmp(wanted)).ok()?;
+    sorted.get(i)
+}
+
 /// The `N` bytes at `at`, if `bytes` holds them.
 pub(crate) fn bytes_at<const N: usize>(bytes: &[u8], at: usize) -> Option<[u8; N]> {
     let end = at.checked_add(N)?;

@@ -255,10 +255,7 @@ pub struct Survey {
 impl Survey {
     /// The parameter `name`.
     pub fn parameter(&self, name: &str) -> Option<&Parameter> {
-        self.parameters
-            .binary_search_by(|p| p.name.as_str().cmp(name))
-            .ok()
-            .and_then(|i| self.parameters.get(i))
+        crate::frame::by_name(&self.parameters, name, |p| &p.name)
     }
 
     /// The instances of `topic` that hold messages.
