@@ -381,6 +381,7 @@ impl Icm42688Config {
 /// #                     if reg == 0xF5 { b[0] = 0x47; } // WHO_AM_I
 /// #                     if reg == 0x96 { b[0] = 0x40; } // FIFO_CONFIG: stream mode
 /// #                     if reg == 0xCE { b[0] = 0x0F; } // PWR_MGMT0: low noise
+/// #                     if reg == 0xDF { b[0] = 0x07; } // FIFO_CONFIG1: packet 3
 /// #                 }
 /// #                 _ => {}
 /// #             }
