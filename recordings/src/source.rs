@@ -303,7 +303,8 @@ fn choose(
 }
 
 /// A PX4 ULog file's or an ArduPilot DataFlash log's IMU samples: a DataFlash log's `IMU`
-/// messages (gyro and accelerometer together); a ULog file's `sensor_gyro` or `sensor_accel`
+/// messages (gyro and accelerometer together) or its batches at the sensor's rate (one sensor's
+/// axes, [`fuller_dataflash`]); a ULog file's `sensor_gyro` or `sensor_accel`
 /// (their FIFO topics when the log has no sensor topic), one of them: the two are separate
 /// topics, published at times of their own.
 fn autopilot_stream(
@@ -355,27 +356,56 @@ fn autopilot_stream(
     let mut skipped = Skipped::default();
     if kind == Kind::DataFlash {
         let survey = dataflash::survey(path).map_err(|e| Fail(e.to_string()))?;
+        let source = fuller_dataflash(&survey, &picks);
         let found: Vec<(u8, String)> = survey
-            .instances(dataflash::Kind::Imu)
+            .instances(source)
             .iter()
             .map(|s| (s.instance, s.instance.to_string()))
             .collect();
-        let instance = choose(files, request, "IMU messages", &found)?;
+        let what = match source {
+            dataflash::Kind::Imu => "IMU messages",
+            dataflash::Kind::BatchGyro => "ISB gyro batches",
+            dataflash::Kind::BatchAccel => "ISB accel batches",
+        };
+        let instance = choose(files, request, what, &found)?;
         let select = dataflash::Select {
-            kind: dataflash::Kind::Imu,
+            kind: source,
             instance: Some(instance),
         };
         let report = dataflash::read_surveyed(path, &survey, &select, &mut |s| {
-            if let (Some(g), Some(a)) = (s.gyro, s.accel) {
-                take(s.time_us, [g[0], g[1], g[2], a[0], a[1], a[2]]);
-            }
+            // A batch holds one sensor: the other's three axes are never picked.
+            let g = s.gyro.unwrap_or([f64::NAN; 3]);
+            let a = s.accel.unwrap_or([f64::NAN; 3]);
+            take(s.time_us, [g[0], g[1], g[2], a[0], a[1], a[2]]);
         })
         .map_err(|e| Fail(e.to_string()))?;
         skipped.non_finite = report.non_finite;
+        skipped.undecodable = report.dropped_batches + report.undecodable_batches;
     } else {
         skipped = ulog_stream(files, request, &picks, &mut take)?;
     }
     stamped(files, request, &picks, (timing, backward), skipped)
+}
+
+/// What a DataFlash log's axes `picks` are read from: the batch sampler's batches (`ISBH`,
+/// `ISBD`) of the one sensor they are all of, when those hold more samples than the `IMU`
+/// messages (the batches at the sensor's rate, the `IMU` messages at the loop's); the `IMU`
+/// messages otherwise, and always for axes of both sensors, which batches take at times of
+/// their own. A dropped or undecodable batch counts as undecodable.
+fn fuller_dataflash(survey: &dataflash::Survey, picks: &[usize]) -> dataflash::Kind {
+    let samples = |k| -> u64 { survey.instances(k).iter().map(|s| s.samples).sum() };
+    let batch = if picks.iter().all(|&i| i < 3) {
+        dataflash::Kind::BatchGyro
+    } else if picks.iter().all(|&i| i >= 3) {
+        dataflash::Kind::BatchAccel
+    } else {
+        return dataflash::Kind::Imu;
+    };
+    if samples(batch) > samples(dataflash::Kind::Imu) {
+        batch
+    } else {
+        dataflash::Kind::Imu
+    }
 }
 
 /// Of a ULog file's sensor topic and its FIFO topic, the one with more samples: the FIFO

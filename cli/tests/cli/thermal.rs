@@ -575,6 +575,121 @@ fn a_ulog_files_fifo_topics_are_read_at_the_full_rate() {
     assert_eq!(j["rate_hz"], 1000.0);
 }
 
+/// The sensors' full-rate samples, quantised as the autopilots log them (PX4's FIFO topics:
+/// `x[i] * scale`; ArduPilot's batch sampler: `raw / mul`), give the noise model of the CSV of
+/// the same values, bit for bit: one sensor's axes are read from the FIFO topic or the batches
+/// when they hold more samples than the sensor topic or the `IMU` messages.
+#[test]
+fn fifo_topics_and_batches_give_the_csvs_noise_model() {
+    const BLOCKS: usize = 400;
+    let rows = samples(32 * BLOCKS, 0.0);
+    // (FIFO scale, batch mul) of the gyro and the accelerometer.
+    let quanta = [(1e-4f32, 10_000u16), (1e-3, 1_000)];
+    let raw: Vec<[i16; 6]> = rows
+        .iter()
+        .map(|(_, a)| std::array::from_fn(|i| (a[i] / f64::from(quanta[i / 3].0)).round() as i16))
+        .collect();
+    let mut ulog = ULog::new(0);
+    for format in [GYRO_FIFO, ACCEL_FIFO, SENSOR_GYRO, SENSOR_ACCEL] {
+        ulog.format(format);
+    }
+    for (id, name) in [
+        "sensor_gyro_fifo",
+        "sensor_accel_fifo",
+        "sensor_gyro",
+        "sensor_accel",
+    ]
+    .iter()
+    .enumerate()
+    {
+        ulog.subscribe(0, id as u16, name);
+    }
+    let mut df = Df::new();
+    // One batch of each sensor, 1 kHz from 1 s; a few IMU messages at the loop's rate.
+    for (n, ty) in [(0u16, 1u8), (1, 0)] {
+        let mul = quanta[usize::from(ty == 0)].1;
+        df.isbh(
+            1_000_000,
+            n,
+            ty,
+            0,
+            mul,
+            raw.len() as u16,
+            1_000_000,
+            1000.0,
+        );
+    }
+    for (k, block) in raw.chunks(32).enumerate() {
+        let t = 1_000_000 + 1_000 * (32 * k as u64 + 31);
+        for s in 0..2 {
+            let xyz: [[i16; 32]; 3] =
+                std::array::from_fn(|j| std::array::from_fn(|i| block[i][3 * s + j]));
+            ulog.data(
+                s as u16,
+                &fifo(t, 7 + s as u32, 1000.0, quanta[s].0, 32, &xyz),
+            );
+            // The batch's blocks carry the same raw values, scaled back by mul.
+            let scaled: [[i16; 32]; 3] = std::array::from_fn(|j| {
+                std::array::from_fn(|i| {
+                    let v = f64::from(block[i][3 * s + j]) * f64::from(quanta[s].0);
+                    (v * f64::from(quanta[s].1)).round() as i16
+                })
+            });
+            df.isbd(t, if s == 0 { 0 } else { 1 }, k as u16, &scaled);
+        }
+        if k % 8 == 0 {
+            ulog.data(2, &sensor(t, t, 7, [0.0; 3], 30.0));
+            ulog.data(3, &sensor(t, t, 8, [0.0; 3], 30.0));
+            df.imu(t, 0, [0.0; 3], [0.0; 3], 30.0);
+        }
+    }
+    let mut csv =
+        String::from("t [us],gx [rad/s],gy [rad/s],gz [rad/s],ax [m/s^2],ay [m/s^2],az [m/s^2]\n");
+    for (k, r) in raw.iter().enumerate() {
+        csv += &format!("{}", 1_000_000 + 1_000 * k as u64);
+        for (i, v) in r.iter().enumerate() {
+            csv += &format!(",{}", f64::from(*v) * f64::from(quanta[i / 3].0));
+        }
+        csv += "\n";
+    }
+    // The batch values: raw / mul, with raw = value * mul as written above.
+    let mut batch_csv =
+        String::from("t [us],gx [rad/s],gy [rad/s],gz [rad/s],ax [m/s^2],ay [m/s^2],az [m/s^2]\n");
+    for (k, r) in raw.iter().enumerate() {
+        batch_csv += &format!("{}", 1_000_000 + 1_000 * k as u64);
+        for (i, v) in r.iter().enumerate() {
+            let (scale, mul) = quanta[i / 3];
+            let back = (f64::from(*v) * f64::from(scale) * f64::from(mul)).round();
+            batch_csv += &format!(",{}", back / f64::from(mul));
+        }
+        batch_csv += "\n";
+    }
+    let ulog = temp_file("fifo-same.ulg", ulog.bytes);
+    let df = temp_file("batch-same.bin", df.bytes);
+    let csv = temp_file("fifo-same.csv", csv);
+    let batch_csv = temp_file("batch-same.csv", batch_csv);
+    let model = |file: &Path, column: &str| {
+        let args = [
+            "noise",
+            file.to_str().unwrap(),
+            "--column",
+            column,
+            "--json",
+        ];
+        let mut j = json(&imu_ar(&args));
+        j["timing"]["unit"] = serde_json::Value::Null;
+        j
+    };
+    for column in ["gx", "gy", "gz", "ax", "ay", "az"] {
+        let fifo = model(&ulog, column);
+        assert_eq!(fifo["n"], 32 * BLOCKS, "ULog FIFO {column}");
+        assert_eq!(fifo, model(&csv, column), "ULog FIFO {column}");
+        let batch = model(&df, column);
+        assert_eq!(batch["n"], 32 * BLOCKS, "DataFlash batch {column}");
+        assert_eq!(batch, model(&batch_csv, column), "DataFlash batch {column}");
+    }
+}
+
 /// What a red-team pass found, each fixed: a stray temperature sample set TMAX (150 deg C from
 /// one sample); a bias beyond f32 was written as `inf` with exit 0; a temperature column in
 /// [K] was read as deg C; values quantised coarser than their noise failed the held-out check;
