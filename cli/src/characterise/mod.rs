@@ -308,6 +308,7 @@ fn characterise(
         filter_rate_hz: args.model.filter_rate,
         loop_rate_hz: args.loop_rate,
         sysid: args.sysid,
+        origin: None,
     };
     let draw = |dir: &Path| -> Result<Vec<PathBuf>, Fail> {
         let mut drawn = Vec::new();
@@ -360,7 +361,7 @@ fn characterise(
 /// Writes every file of `formats` and the plots `draw` makes, or none: each into a fresh
 /// folder in `out` first, moved into `out` once all are written (and moved back out when a
 /// move fails midway).
-fn write_all(
+pub(crate) fn write_all(
     formats: &[Format],
     imu: &ImuModel,
     horizon: Option<f64>,
@@ -409,7 +410,7 @@ fn write_all(
 
 /// One axis's composite, with the AR part (order by BIC, 0 to [`LAGS`]) from its streamed
 /// autocovariances; without one when none fits.
-fn fit_axis<'a>(
+pub(crate) fn fit_axis<'a>(
     fit: &'a Fitting,
     axis: &AxisStream<OCTAVES>,
     octaves: &'a Octaves<OCTAVES>,

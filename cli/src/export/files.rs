@@ -129,6 +129,7 @@ pub fn header(model: &ImuModel, target: &str, convention: &[&str]) -> Vec<String
         ),
         "Units: SI (gyroscope rad/s, accelerometer m/s^2).".to_string(),
     ];
+    lines.extend(model.origin.iter().cloned());
     lines.extend(convention.iter().map(|l| l.to_string()));
     lines
 }

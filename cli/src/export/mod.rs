@@ -152,6 +152,9 @@ pub struct ImuModel {
     pub loop_rate_hz: Option<f64>,
     /// The vehicle ID of PX4's parameter file (`MAV_SYS_ID`) [default: 1].
     pub sysid: Option<u8>,
+    /// What part of the record the models come from, when not the whole of it (a comment
+    /// line of every file).
+    pub origin: Option<String>,
 }
 
 /// The names of the six axes.

@@ -8,11 +8,14 @@
 //! - [`cubic`]: the bias as a polynomial in temperature, fitted to the bins with a robust
 //!   (Huber) loss, on all bins or on a chosen subset for a held-out check;
 //! - [`axis`]: one axis's fit with its checks;
+//! - [`bands`]: each axis's noise model per temperature band, and the worst band's for the
+//!   noise parameter files;
 //! - [`autopilot`]: the written parameters (PX4 `TC_*`, ArduPilot `INS_TCALn_*`) and their
 //!   corrections, re-implemented from the autopilots' sources.
 
 pub mod autopilot;
 pub mod axis;
+pub mod bands;
 pub mod bins;
 pub mod cubic;
 
@@ -22,10 +25,14 @@ use serde::Serialize;
 
 use crate::characterise::{axis_unit, parse_unit};
 use crate::error::{Fail, escaped, with_file};
+use crate::export::{self, ImuModel};
 use crate::input::source::{self, AXES, Kind, Request};
+use crate::input::{check_rate, resolve_rate};
+use crate::noise::ModelArgs;
 use crate::output::Output;
 use autopilot::{ArduPilot, Px4, Sensor, Value};
 use axis::{AxisFit, fit_axis};
+use bands::AxisBands;
 use imu_ar_recordings::{dataflash, ulog};
 
 /// The arguments of `imu-ar thermal`.
@@ -75,10 +82,28 @@ pub struct Args {
     /// ArduPilot DataFlash log (the `I` of its IMU messages), when it holds several.
     #[arg(long)]
     instance: Option<u8>,
+    /// The sample rate of a CSV record, Hz [default: from its time column]: the noise bands
+    /// need it.
+    #[arg(long, allow_negative_numbers = true)]
+    rate: Option<f64>,
+    /// The temperature bands in which each axis's noise model is fitted (0: none).
+    #[arg(long, default_value_t = 4)]
+    bands: usize,
+    /// The composite's settings, per band.
+    #[command(flatten)]
+    model: ModelArgs,
+    /// Noise parameter files to write from each axis's worst band (the largest N), as
+    /// `characterise --format` names them: kalibr, openvins, vins, orbslam3, px4, ardupilot,
+    /// state-space, comma-separated, or all [default: none].
+    #[arg(long)]
+    noise_format: Option<String>,
     /// Print one JSON object instead of the table.
     #[arg(long)]
     pub json: bool,
 }
+
+/// The most temperature bands.
+pub const MAX_BANDS: usize = 16;
 
 /// A parameter file format.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -141,6 +166,11 @@ pub struct Thermal {
     /// have a root mean square of at most [`HELD_OUT_Z`] (the fit explains them to their
     /// noise).
     pub generalises: bool,
+    /// Per axis, the noise model in each temperature band (none with `--bands 0`).
+    pub noise_bands: Vec<AxisBands>,
+    /// Why there are no noise bands, when there are none.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub noise_bands_note: Option<String>,
     /// The files written.
     pub files: Vec<String>,
 }
@@ -189,6 +219,8 @@ struct Record {
     axes: [Vec<f64>; 3],
     /// rad/s or m/s^2.
     unit: &'static str,
+    /// The sample rate, Hz, when the record gives it.
+    rate: Option<f64>,
 }
 
 /// A warm-up record: the gyro and the accelerometer of one IMU.
@@ -210,6 +242,23 @@ pub fn run(args: &Args) -> Result<Thermal, Fail> {
         )));
     }
     let formats = Format::list(&args.format)?;
+    let config = args.model.config()?;
+    if args.bands > MAX_BANDS {
+        return Err(Fail(format!("--bands {}: at most {MAX_BANDS}", args.bands)));
+    }
+    if let Some(r) = args.rate {
+        check_rate(r)?;
+    }
+    let noise_formats = args
+        .noise_format
+        .as_deref()
+        .map(export::Format::list)
+        .transpose()?;
+    if noise_formats.is_some() && args.bands == 0 {
+        return Err(Fail(
+            "--noise-format writes the worst band's models: --bands must be 1 or more".into(),
+        ));
+    }
     let given = match &args.device_id {
         Some(ids) if ids.len() == 2 => Some([ids[0], ids[1]]),
         Some(ids) => {
@@ -292,6 +341,7 @@ pub fn run(args: &Args) -> Result<Thermal, Fail> {
             generalises,
         });
     }
+    let (noise_bands, worst, noise_bands_note) = noise_bands(args, &warm, &fits, ranges, &config)?;
     std::fs::create_dir_all(&args.out)
         .map_err(|e| Fail(format!("--out {}: cannot create: {e}", args.out.display())))?;
     let mut thermal = Thermal {
@@ -301,6 +351,8 @@ pub fn run(args: &Args) -> Result<Thermal, Fail> {
         caltemp_c: caltemp,
         generalises: results.iter().all(|a| a.generalises),
         axes: results,
+        noise_bands,
+        noise_bands_note,
         files: Vec::new(),
     };
     let px4_slot = match (args.px4_slot, warm.instance) {
@@ -346,6 +398,46 @@ pub fn run(args: &Args) -> Result<Thermal, Fail> {
              bias (check the columns' units)",
         ));
     }
+    if let Some(noise_formats) = noise_formats {
+        let Some((axes, rate)) = worst else {
+            return Err(with_file(
+                &args.files,
+                format!(
+                    "--noise-format: {}",
+                    thermal
+                        .noise_bands_note
+                        .as_deref()
+                        .unwrap_or("an axis has no band model")
+                ),
+            ));
+        };
+        let origin: Vec<String> = thermal
+            .noise_bands
+            .iter()
+            .filter_map(|a| {
+                let b = &a.bands[a.worst?];
+                Some(format!("{} {:.1} to {:.1} deg C", a.axis, b.from_c, b.to_c))
+            })
+            .collect();
+        let imu = ImuModel {
+            axes,
+            rate_hz: rate,
+            topic: None,
+            filter_rate_hz: args.model.filter_rate,
+            loop_rate_hz: None,
+            sysid: None,
+            origin: Some(format!(
+                "Each axis from its worst temperature band (the largest N), the thermal bias \
+                 taken out (imu-ar thermal): {}.",
+                origin.join(", ")
+            )),
+        };
+        let written =
+            crate::characterise::write_all(&noise_formats, &imu, None, &args.out, &|_| {
+                Ok(Vec::new())
+            })?;
+        thermal.files.extend(written);
+    }
     for format in formats {
         let text = match format {
             Format::Px4 => match &px4 {
@@ -362,6 +454,79 @@ pub fn run(args: &Args) -> Result<Thermal, Fail> {
     Ok(thermal)
 }
 
+/// Each axis's noise model per temperature band ([`bands`]); with the worst band's models of
+/// the six axes for the files and the gyro's rate, when every axis has one; or why there are
+/// none.
+#[allow(clippy::type_complexity)]
+fn noise_bands(
+    args: &Args,
+    warm: &WarmUp,
+    fits: &[AxisFit],
+    ranges: [(f64, f64); 2],
+    config: &imu_ar::noise::FitConfig,
+) -> Result<
+    (
+        Vec<AxisBands>,
+        Option<([export::AxisModel; 6], f64)>,
+        Option<String>,
+    ),
+    Fail,
+> {
+    if args.bands == 0 {
+        return Ok((Vec::new(), None, Some("--bands 0".into())));
+    }
+    let (Some(gyro_rate), Some(accel_rate)) = (warm.sensors[0].rate, warm.sensors[1].rate) else {
+        return Ok((
+            Vec::new(),
+            None,
+            Some(
+                "the record gives no sample rate: give --rate, or a time column, for the noise \
+                 bands"
+                    .into(),
+            ),
+        ));
+    };
+    let mut all = Vec::with_capacity(6);
+    let mut models = Vec::with_capacity(6);
+    for (s, rate) in [gyro_rate, accel_rate].into_iter().enumerate() {
+        let r = &warm.sensors[s];
+        let sensor = bands::Sensor {
+            celsius: &r.celsius,
+            axes: [&r.axes[0], &r.axes[1], &r.axes[2]],
+            fits: [&fits[3 * s], &fits[3 * s + 1], &fits[3 * s + 2]],
+            range: ranges[s],
+            rate,
+            unit: r.unit,
+        };
+        let names = [AXES[3 * s], AXES[3 * s + 1], AXES[3 * s + 2]];
+        for (axis, model) in bands::fit(&sensor, names, args.bands, config, args.model.filter_rate)?
+        {
+            all.push(axis);
+            models.push(model);
+        }
+    }
+    let worst: Option<Vec<export::AxisModel>> = models.into_iter().collect();
+    let worst = worst
+        .and_then(|m| <[export::AxisModel; 6]>::try_from(m).ok())
+        .map(|m| (m, gyro_rate));
+    Ok((all, worst, None))
+}
+
+/// The sample rate of sample times `us` (µs): one over their median interval.
+fn rate_of(us: &[f64]) -> Option<f64> {
+    let mut d: Vec<f64> = us
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .filter(|d| *d > 0.0)
+        .collect();
+    if d.is_empty() {
+        return None;
+    }
+    let mid = d.len() / 2;
+    let (_, median, _) = d.select_nth_unstable_by(mid, f64::total_cmp);
+    Some(1e6 / *median)
+}
+
 /// The warm-up record of `args.files`: a CSV record, a PX4 ULog file or an ArduPilot
 /// DataFlash log.
 fn read(args: &Args) -> Result<WarmUp, Fail> {
@@ -373,11 +538,15 @@ fn read(args: &Args) -> Result<WarmUp, Fail> {
                 "one autopilot log at a time (a CSV record may span several files)",
             ));
         }
-        if args.columns.is_some() || args.gyro_unit.is_some() || args.accel_unit.is_some() {
+        if args.columns.is_some()
+            || args.gyro_unit.is_some()
+            || args.accel_unit.is_some()
+            || args.rate.is_some()
+        {
             return Err(with_file(
                 &args.files,
-                "--columns, --gyro-unit and --accel-unit are for CSV records: an autopilot \
-                 log names its fields and units",
+                "--columns, --gyro-unit, --accel-unit and --rate are for CSV records: an \
+                 autopilot log names its fields and units, and times its samples",
             ));
         }
         let path = &args.files[0];
@@ -444,7 +613,9 @@ fn read_ulog(path: &Path, instance: Option<u8>) -> Result<WarmUp, Fail> {
             celsius: Vec::new(),
             axes: Default::default(),
             unit,
+            rate: None,
         };
+        let mut times = Vec::new();
         let mut without = 0u64;
         chosen = which;
         let select = ulog::Select {
@@ -462,11 +633,13 @@ fn read_ulog(path: &Path, instance: Option<u8>) -> Result<WarmUp, Fail> {
                 return;
             };
             record.celsius.push(t);
+            times.push(sample.time_us);
             for (axis, x) in record.axes.iter_mut().zip(sample.xyz) {
                 axis.push(x);
             }
         })
         .map_err(|e| Fail(e.to_string()))?;
+        record.rate = rate_of(&times);
         if devices.len() > 1 {
             let list: Vec<String> = devices.iter().map(u32::to_string).collect();
             return Err(fail(format!(
@@ -556,12 +729,15 @@ fn read_dataflash(path: &Path, instance: Option<u8>) -> Result<WarmUp, Fail> {
         celsius: Vec::new(),
         axes: Default::default(),
         unit: "rad/s",
+        rate: None,
     };
     let mut accel = Record {
         celsius: Vec::new(),
         axes: Default::default(),
         unit: "m/s^2",
+        rate: None,
     };
+    let mut times = Vec::new();
     let select = dataflash::Select {
         kind,
         instance: Some(chosen),
@@ -570,6 +746,7 @@ fn read_dataflash(path: &Path, instance: Option<u8>) -> Result<WarmUp, Fail> {
         let Some(t) = sample.temperature else {
             return;
         };
+        times.push(sample.time_us);
         for (record, xyz) in [(&mut gyro, sample.gyro), (&mut accel, sample.accel)] {
             if let Some(xyz) = xyz {
                 record.celsius.push(t);
@@ -586,6 +763,8 @@ fn read_dataflash(path: &Path, instance: Option<u8>) -> Result<WarmUp, Fail> {
              calibration needs it"
         )));
     }
+    gyro.rate = rate_of(&times);
+    accel.rate = gyro.rate;
     Ok(WarmUp {
         sensors: [gyro, accel],
         device_ids: None,
@@ -611,6 +790,8 @@ fn read_csv(args: &Args) -> Result<WarmUp, Fail> {
         topic: None,
         frame_id: None,
         time_column: None,
+        // Stamps are read where their unit is clear: the calibration needs none, the noise
+        // bands a rate (from them or --rate).
         want_time: false,
         drop_backward: false,
         instance: None,
@@ -648,6 +829,13 @@ fn read_csv(args: &Args) -> Result<WarmUp, Fail> {
         args.gyro_unit.as_deref().map(parse_unit).transpose()?,
         args.accel_unit.as_deref().map(parse_unit).transpose()?,
     ];
+    // The rate from --rate or the time column; without either, the noise bands say why not.
+    let timing =
+        crate::input::summary(read.timing, false).map_err(|e| with_file(&args.files, e))?;
+    let rate = match (args.rate, &timing) {
+        (None, None) => None,
+        (r, t) => Some(resolve_rate(r, t.as_ref()).map_err(|e| with_file(&args.files, e.0))?),
+    };
     let mut names = [""; 6];
     for (i, axis) in axes.iter_mut().enumerate() {
         let unit = axis_unit(
@@ -671,11 +859,13 @@ fn read_csv(args: &Args) -> Result<WarmUp, Fail> {
                 celsius: celsius.clone(),
                 axes: [gx, gy, gz],
                 unit: names[0],
+                rate,
             },
             Record {
                 celsius,
                 axes: [ax, ay, az],
                 unit: names[3],
+                rate,
             },
         ],
         device_ids: None,
@@ -818,6 +1008,33 @@ impl Output for Thermal {
                 shown(a.ardupilot_left),
                 a.generalises
             );
+        }
+        if !self.noise_bands.is_empty() {
+            s += "noise against temperature, the thermal bias taken out (* the worst band, largest N):\n";
+            s += "axis band (deg C)      samples  N (u/sqrt(Hz))  K (u/s/sqrt(Hz))  B (u)\n";
+        }
+        for a in &self.noise_bands {
+            for (i, b) in a.bands.iter().enumerate() {
+                let value = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3e}"));
+                s += &format!(
+                    "{:<4} {:>5.1} to {:<5.1}{} {:<8} {:<15} {:<17} {}{}\n",
+                    a.axis,
+                    b.from_c,
+                    b.to_c,
+                    if a.worst == Some(i) { "*" } else { " " },
+                    b.n,
+                    value(b.white_noise),
+                    value(b.random_walk),
+                    value(b.bias_instability),
+                    b.note.as_ref().map_or(String::new(), |n| format!(" ({n})"))
+                );
+            }
+        }
+        if let Some(note) = &self.noise_bands_note
+            && self.noise_bands.is_empty()
+            && note != "--bands 0"
+        {
+            s += &format!("no noise bands: {note}\n");
         }
         for f in &self.files {
             s += &format!("wrote {f}\n");

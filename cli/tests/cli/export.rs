@@ -56,6 +56,7 @@ fn model() -> &'static ImuModel {
             filter_rate_hz: None,
             loop_rate_hz: None,
             sysid: None,
+            origin: None,
         }
     })
 }

@@ -575,6 +575,101 @@ fn a_ulog_files_fifo_topics_are_read_at_the_full_rate() {
     assert_eq!(j["rate_hz"], 1000.0);
 }
 
+/// Noise against temperature: a warm-up at 100 Hz whose white noise grows 50 % from 20 to
+/// 60 deg C (on top of the cubic bias and the uneven heating of [`samples`]); each band's N
+/// follows the truth of its samples (the root mean square of their standard deviations over
+/// sqrt(rate)) within 5 %, and the worst band's model goes into the noise files.
+#[test]
+fn the_noise_of_each_temperature_band_follows_the_truth() {
+    const RATE: f64 = 100.0;
+    let rows = samples(240_000, 0.0);
+    // The noise's growth: samples' white part scaled by 1 + 0.5 (T - 20) / 40 about the bias.
+    let grow = |celsius: f64| 1.0 + 0.5 * (celsius - 20.0) / 40.0;
+    let mut text = String::from(
+        "t [s],gx [rad/s],gy [rad/s],gz [rad/s],ax [m/s^2],ay [m/s^2],az [m/s^2],temperature\n",
+    );
+    for (i, (celsius, axes)) in rows.iter().enumerate() {
+        text += &format!("{:.2}", i as f64 / RATE);
+        for (axis, v) in axes.iter().enumerate() {
+            let b = bias(axis, *celsius);
+            text += &format!(",{:.9e}", b + (v - b) * grow(*celsius));
+        }
+        text += &format!(",{celsius:.3}\n");
+    }
+    let file = temp_file("growing.csv", text);
+    let out = temp_path("growing");
+    let args = [
+        "thermal",
+        file.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--device-id",
+        "1,2",
+        "--noise-format",
+        "kalibr",
+        "--json",
+    ];
+    let j = json(&imu_ar(&args));
+    let bands = j["noise_bands"].as_array().unwrap();
+    assert_eq!(bands.len(), 6);
+    let mut worst_gyro = 0.0f64;
+    let mut largest = 0.0f64;
+    for (axis, a) in bands.iter().enumerate() {
+        assert_eq!(a["rate_hz"], RATE);
+        let list = a["bands"].as_array().unwrap();
+        assert_eq!(list.len(), 4);
+        let low = list[0]["from_c"].as_f64().unwrap();
+        let high = list[3]["to_c"].as_f64().unwrap();
+        for (k, b) in list.iter().enumerate() {
+            let (from, to) = (b["from_c"].as_f64().unwrap(), b["to_c"].as_f64().unwrap());
+            // The truth: the mean variance of the band's samples, at the temperatures as
+            // written; those outside the range join the first or the last band.
+            let sigma = if axis < 3 { 2e-3 } else { 2e-2 };
+            let inside: Vec<f64> = rows
+                .iter()
+                .map(|(t, _)| format!("{t:.3}").parse::<f64>().unwrap())
+                .filter(|t| {
+                    let at = ((t - low) / (high - low) * 4.0).floor().clamp(0.0, 3.0);
+                    at as usize == k
+                })
+                .collect();
+            assert_eq!(b["n"], inside.len(), "{axis} {from}");
+            let variance = inside
+                .iter()
+                .map(|t| (sigma * grow(*t)).powi(2))
+                .sum::<f64>()
+                / inside.len() as f64;
+            let truth = (variance / RATE).sqrt();
+            let n = b["white_noise"].as_f64().unwrap();
+            largest = largest.max((n / truth - 1.0).abs());
+            assert!(
+                (n / truth - 1.0).abs() < 0.05,
+                "axis {axis}, {from:.1} to {to:.1} deg C: N {n:.4e}, truth {truth:.4e}"
+            );
+            if axis < 3 {
+                worst_gyro = worst_gyro.max(n);
+            }
+        }
+        // The hottest band is the noisiest.
+        assert_eq!(a["worst"], 3, "axis {axis}");
+    }
+    eprintln!("the largest |N / truth - 1| of a band: {largest:.4}");
+    let yaml = std::fs::read_to_string(out.join("imu.yaml")).unwrap();
+    assert!(yaml.contains("worst temperature band"), "{yaml}");
+    let density: f64 = yaml
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("gyroscope_noise_density:"))
+        .and_then(|v| v.split('#').next())
+        .unwrap()
+        .trim()
+        .parse()
+        .unwrap();
+    assert!(
+        density >= worst_gyro * 0.999 && density < worst_gyro * 1.05,
+        "{density} against the worst band's {worst_gyro}"
+    );
+}
+
 /// The sensors' full-rate samples, quantised as the autopilots log them (PX4's FIFO topics:
 /// `x[i] * scale`; ArduPilot's batch sampler: `raw / mul`), give the noise model of the CSV of
 /// the same values, bit for bit: one sensor's axes are read from the FIFO topic or the batches
