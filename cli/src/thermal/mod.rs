@@ -18,6 +18,7 @@ pub mod axis;
 pub mod bands;
 pub mod bins;
 pub mod cubic;
+pub mod plot;
 
 use std::path::{Path, PathBuf};
 
@@ -64,7 +65,8 @@ pub struct Args {
     /// Directory for the parameter files (created if needed).
     #[arg(long)]
     out: PathBuf,
-    /// The files to write: px4, ardupilot, json, comma-separated, or all.
+    /// The files to write: px4, ardupilot, json, png (thermal.png: per axis the bins, the fit
+    /// and what it leaves), comma-separated, or all.
     #[arg(long, default_value = "all")]
     format: String,
     /// PX4: the device id of the gyro and of the accelerometer (TC_Gj_ID, TC_Aj_ID), which
@@ -111,6 +113,7 @@ enum Format {
     Px4,
     ArduPilot,
     Json,
+    Png,
 }
 
 impl Format {
@@ -121,10 +124,11 @@ impl Format {
                 "px4" => &[Format::Px4],
                 "ardupilot" => &[Format::ArduPilot],
                 "json" => &[Format::Json],
-                "all" => &[Format::Px4, Format::ArduPilot, Format::Json],
+                "png" => &[Format::Png],
+                "all" => &[Format::Px4, Format::ArduPilot, Format::Json, Format::Png],
                 other => {
                     return Err(Fail(format!(
-                        "--format {}: px4, ardupilot, json, or all",
+                        "--format {}: px4, ardupilot, json, png, or all",
                         escaped(other)
                     )));
                 }
@@ -143,6 +147,7 @@ impl Format {
             Format::Px4 => "px4_thermal.params",
             Format::ArduPilot => "ardupilot_tcal.parm",
             Format::Json => "thermal.json",
+            Format::Png => "thermal.png",
         }
     }
 }
@@ -446,6 +451,14 @@ pub fn run(args: &Args) -> Result<Thermal, Fail> {
             },
             Format::ArduPilot => ardupilot_file(&ardupilot, imu.into(), &thermal),
             Format::Json => format!("{}\n", serde_json::to_value(&thermal)?),
+            Format::Png => {
+                let path = args.out.join(format.file_name());
+                let units = [warm.sensors[0].unit, warm.sensors[1].unit];
+                plot::png(&path, &fits, units)
+                    .map_err(|Fail(e)| Fail(format!("{}: {e}", path.display())))?;
+                thermal.files.push(path.display().to_string());
+                continue;
+            }
         };
         let path = args.out.join(format.file_name());
         std::fs::write(&path, text).map_err(|e| Fail(format!("{}: {e}", path.display())))?;

@@ -654,6 +654,13 @@ fn the_noise_of_each_temperature_band_follows_the_truth() {
         assert_eq!(a["worst"], 3, "axis {axis}");
     }
     eprintln!("the largest |N / truth - 1| of a band: {largest:.4}");
+    // thermal.png: a PNG of the bins, fits and residuals, with the default --format all.
+    let png = std::fs::read(out.join("thermal.png")).unwrap();
+    assert!(
+        png.starts_with(b"\x89PNG\r\n\x1a\n") && png.len() > 10_000,
+        "{}",
+        png.len()
+    );
     let yaml = std::fs::read_to_string(out.join("imu.yaml")).unwrap();
     assert!(yaml.contains("worst temperature band"), "{yaml}");
     let density: f64 = yaml
