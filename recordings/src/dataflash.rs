@@ -1436,6 +1436,11 @@ fn scan(path: &Path, visit: &mut dyn FnMut(Event)) -> Result<Log, DataError> {
         win.consume(len);
         messages += 1;
     }
+    if let (0, Some(at)) = (messages, truncated) {
+        return Err(fail(format!(
+            "truncated ArduPilot DataFlash log: it ends inside its first message (at byte {at})"
+        )));
+    }
     if messages == 0 {
         return Err(fail(format!(
             "not an ArduPilot DataFlash log: no message (A3 95 and a known type) in its {} bytes",

@@ -31,6 +31,19 @@ pub struct Skipped {
     /// Samples of a log's gyro or accelerometer without a partner of the same time in the
     /// other (a PX4 ULog file's two topics read together).
     pub unpaired: u64,
+    /// Logs whose last message the end of the file cuts short (a PX4 ULog file or an
+    /// ArduPilot DataFlash log written until the power went): the samples before it are read.
+    pub cut_short: u64,
+}
+
+impl Skipped {
+    /// The warning for a log cut short, when it is.
+    pub fn cut_short_warning(&self) -> Option<&'static str> {
+        (self.cut_short > 0).then_some(
+            "the log ends inside a message (cut short, as when the power goes): the samples \
+             before it are read",
+        )
+    }
 }
 
 /// The item of `sorted` (sorted by `name`) named `wanted`.

@@ -88,8 +88,18 @@ impl Kind {
                 Some("bag") => Kind::Other("an empty file, not a ROS 1 bag"),
                 Some("mcap") => Kind::Other("an empty file, not an MCAP file"),
                 Some("db3") => Kind::Other("an empty file, not a rosbag2 database"),
+                Some("ulg") => Kind::Other("an empty file, not a PX4 ULog file"),
+                Some("bin") => Kind::Other("an empty file, not an ArduPilot DataFlash log"),
                 _ => Kind::Csv,
             },
+            // A DataFlash log cut inside its first message's head.
+            h if h.len() < 3 && [0xa3, 0x95, crate::dataflash::FMT_TYPE].starts_with(h) => {
+                Kind::DataFlash
+            }
+            // A ULog file cut inside its magic.
+            h if h.len() < crate::ulog::MAGIC.len() && crate::ulog::MAGIC.starts_with(h) => {
+                Kind::Ulog
+            }
             // Text has no NUL and few control bytes: a file that starts otherwise is binary.
             h if h
                 .iter()
@@ -103,6 +113,7 @@ impl Kind {
                     Kind::Other("not an MCAP file (it does not start with the MCAP magic)")
                 }
                 Some("db3") => Kind::Other("not a rosbag2 database (not an SQLite file)"),
+                Some("ulg") => Kind::Other("not a PX4 ULog file (it does not start with 'ULog')"),
                 _ => Kind::Csv,
             },
         }
@@ -362,6 +373,15 @@ fn autopilot_stream(
             .iter()
             .map(|s| (s.instance, s.instance.to_string()))
             .collect();
+        if found.is_empty() && !survey.unreadable.is_empty() {
+            return Err(with_file(
+                files,
+                format!(
+                    "its IMU samples cannot be read: {}",
+                    survey.unreadable.join("; ")
+                ),
+            ));
+        }
         let what = match source {
             dataflash::Kind::Imu => "IMU messages",
             dataflash::Kind::BatchGyro => "ISB gyro batches",
@@ -381,6 +401,7 @@ fn autopilot_stream(
         .map_err(|e| Fail(e.to_string()))?;
         skipped.non_finite = report.non_finite;
         skipped.undecodable = report.dropped_batches + report.undecodable_batches;
+        skipped.cut_short = u64::from(survey.truncated.is_some());
     } else {
         skipped = ulog_stream(files, request, &picks, &mut take)?;
     }
@@ -471,7 +492,10 @@ fn ulog_stream(
             which: ulog::Which::Instance(instance),
         });
     }
-    let mut skipped = Skipped::default();
+    let mut skipped = Skipped {
+        cut_short: u64::from(survey.truncated.is_some()),
+        ..Skipped::default()
+    };
     let fail = |e: DataError| Fail(e.to_string());
     let [a, b] = selects[..] else {
         let gyro =

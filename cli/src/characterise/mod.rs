@@ -127,6 +127,8 @@ pub struct SkippedCounts {
     /// Samples of a PX4 ULog file's gyro or accelerometer without a partner of the same time
     /// in the other.
     pub unpaired: u64,
+    /// 1 when the log's last message is cut short by the end of the file.
+    pub cut_short: u64,
 }
 
 /// One axis.
@@ -239,6 +241,9 @@ fn characterise(
     });
     let axes = kept.map_err(|_| Fail("the statistics thread stopped".into()))?;
     let read = read?;
+    if let Some(w) = read.skipped.cut_short_warning() {
+        eprintln!("imu-ar: warning: {}", with_file(&args.files, w).0);
+    }
     progress.finish();
     let n = axes[0].samples();
     let backward = read.timing.as_ref().map_or(0, |(t, _)| t.dropped());
@@ -351,6 +356,7 @@ fn characterise(
             backward,
             other_frame_id: read.skipped.other_frame_id,
             unpaired: read.skipped.unpaired,
+            cut_short: read.skipped.cut_short,
         },
         timing,
         axes: results,

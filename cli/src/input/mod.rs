@@ -91,6 +91,9 @@ impl Input {
         };
         let mut x = Vec::new();
         let read = source::stream(&self.files, &request, &mut |v| x.push(v[0]))?;
+        if let Some(w) = read.skipped.cut_short_warning() {
+            eprintln!("imu-ar: warning: {}", self.fail(w).0);
+        }
         if let (Some(Some(bracket)), Some(to)) = (read.unknown.first(), &self.unit) {
             return Err(self.fail(format!(
                 "--unit {to}: column '{}' is in [{bracket}], which is not a unit converted here \

@@ -2,6 +2,7 @@
 
 use super::bins::{self, Bin};
 use super::cubic::{Poly, fit, prediction_variance};
+use crate::input::number;
 
 /// The smallest temperature span a calibration is fitted over, deg C (ArduPilot's
 /// `TEMP_RANGE_MIN`).
@@ -74,7 +75,8 @@ pub fn fit_axis(
     };
     let (Some(first), Some(last)) = (bins.first(), bins.last()) else {
         return Err(format!(
-            "no temperature bin of {width} deg C holds {min_count} samples (--min-bin)"
+            "no temperature bin of {} deg C holds {min_count} samples (--min-bin)",
+            number(width)
         ));
     };
     // The range of the samples in the bins fitted (a stray sample in a bin of its own, left
@@ -89,8 +91,9 @@ pub fn fit_axis(
     }
     if bins.len() < 8 {
         return Err(format!(
-            "{} temperature bins of {width} deg C hold samples: at least 8 are needed",
-            bins.len()
+            "{} temperature bins of {} deg C hold samples: at least 8 are needed",
+            bins.len(),
+            number(width)
         ));
     }
     let reference = 0.5 * (range.0 + range.1);

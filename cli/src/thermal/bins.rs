@@ -6,6 +6,8 @@
 //! its median and fitted with equal weight, give every temperature the same say; the median
 //! keeps a knock or a bump out of a bin's value.
 
+use crate::input::number;
+
 /// The most bins a record may span.
 pub const MAX_BINS: usize = 100_000;
 
@@ -53,7 +55,8 @@ pub fn along(
     };
     if !(width.is_finite() && width > 0.0) {
         return Err(format!(
-            "a bin width of {width} deg C: it must be a positive number"
+            "a bin width of {} deg C: it must be a positive number",
+            number(width)
         ));
     }
     let (Some(low), Some(top)) = (
@@ -62,10 +65,14 @@ pub fn along(
     ) else {
         return Ok(Vec::new());
     };
-    if (top / width).floor() - (low / width).floor() >= MAX_BINS as f64 {
+    // Not below: a count that overflows to infinity (or NaN) is too many too.
+    if !((top / width).floor() - (low / width).floor() < MAX_BINS as f64) {
         return Err(format!(
-            "temperatures from {low} to {top} deg C: more than {MAX_BINS} bins of {width} deg C \
-             (not a die temperature in deg C?)"
+            "temperatures from {} to {} deg C: more than {MAX_BINS} bins of {} deg C \
+             (not a die temperature in deg C, or --bin-width too small?)",
+            number(low),
+            number(top),
+            number(width)
         ));
     }
     // Bins at whole multiples of the width: a sensor that reports whole degrees has each step

@@ -525,6 +525,20 @@ fn noise_bands(
     Ok((all, worst, None))
 }
 
+/// Says so on standard error when the log at `path` ends inside a message (`truncated`, its
+/// offset).
+fn warn_cut_short(path: &Path, truncated: Option<u64>) {
+    if truncated.is_some() {
+        let skipped = imu_ar_recordings::frame::Skipped {
+            cut_short: 1,
+            ..Default::default()
+        };
+        if let Some(w) = skipped.cut_short_warning() {
+            eprintln!("imu-ar: warning: {}: {w}", path.display());
+        }
+    }
+}
+
 /// The sample rate of sample times `us` (µs): one over their median interval.
 fn rate_of(us: &[f64]) -> Option<f64> {
     let mut d: Vec<f64> = us
@@ -584,6 +598,7 @@ fn read(args: &Args) -> Result<WarmUp, Fail> {
 fn read_ulog(path: &Path, instance: Option<u8>) -> Result<WarmUp, Fail> {
     let fail = |e: String| with_file(std::slice::from_ref(&path.to_path_buf()), e);
     let survey = ulog::survey(path).map_err(|e| Fail(e.to_string()))?;
+    warn_cut_short(path, survey.truncated);
     let mut sensors: Vec<Record> = Vec::with_capacity(2);
     let mut ids = [0u32; 2];
     let mut chosen = 0u8;
@@ -694,8 +709,15 @@ fn read_ulog(path: &Path, instance: Option<u8>) -> Result<WarmUp, Fail> {
 fn read_dataflash(path: &Path, instance: Option<u8>) -> Result<WarmUp, Fail> {
     let fail = |e: String| with_file(std::slice::from_ref(&path.to_path_buf()), e);
     let survey = dataflash::survey(path).map_err(|e| Fail(e.to_string()))?;
+    warn_cut_short(path, survey.truncated);
     let kind = dataflash::Kind::Imu;
     let instances = survey.instances(kind);
+    if instances.is_empty() && !survey.unreadable.is_empty() {
+        return Err(fail(format!(
+            "its IMU messages cannot be read: {}",
+            survey.unreadable.join("; ")
+        )));
+    }
     let chosen = match instance {
         Some(i) => i,
         None if instances.len() == 1 => instances[0].instance,

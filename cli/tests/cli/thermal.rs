@@ -278,6 +278,101 @@ fn bad_warm_ups_are_refused_in_one_line() {
     let run = args(&["--format", "json", "--temperature-column", "temp"]);
     assert_one_line_failure(&run);
     assert!(String::from_utf8_lossy(&run.stderr).contains("temp"));
+    // A width whose bin count overflows: named, in a short number.
+    let run = args(&[
+        "--format",
+        "json",
+        "--bin-width",
+        "1e-310",
+        "--gyro-unit",
+        "rad/s",
+        "--accel-unit",
+        "g",
+    ]);
+    assert_one_line_failure(&run);
+    let e = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        e.contains("bins of 1e-310 deg C") && e.contains("too small"),
+        "{e}"
+    );
+}
+
+/// Autopilot logs that cannot be read are named for what they are, in one line, by every
+/// command: empty, cut inside the first message, IMU messages in units of their own; a log cut
+/// short after its samples is read, with a warning.
+#[test]
+fn bad_autopilot_logs_are_named_in_one_line() {
+    let mut wrong_units = Df::new();
+    // The accelerometer's fields said to be in rad/s.
+    wrong_units.fmtu(writers::IMU, "s#EEEEEE--O--zz", "F-000000-----00");
+    for k in 0..100u64 {
+        wrong_units.imu(1_000_000 + 10_000 * k, 0, [0.0; 3], [0.0, 0.0, 9.8], 30.0);
+    }
+    let cases: [(&str, Vec<u8>, &str); 5] = [
+        (
+            "empty.ulg",
+            Vec::new(),
+            "an empty file, not a PX4 ULog file",
+        ),
+        (
+            "empty.bin",
+            Vec::new(),
+            "an empty file, not an ArduPilot DataFlash log",
+        ),
+        ("cut.ulg", b"ULo".to_vec(), "truncated ULog file"),
+        (
+            "cut.bin",
+            vec![0xa3, 0x95],
+            "it ends inside its first message",
+        ),
+        ("units.bin", wrong_units.bytes, "IMU"),
+    ];
+    for (name, bytes, want) in cases {
+        let file = temp_file(name, bytes);
+        let out = temp_path("bad-log");
+        for args in [
+            vec!["noise", file.to_str().unwrap(), "--column", "gx"],
+            vec![
+                "thermal",
+                file.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ],
+        ] {
+            let run = imu_ar(&args);
+            assert_one_line_failure(&run);
+            let e = String::from_utf8_lossy(&run.stderr);
+            assert!(e.contains(want), "{name} {}: {e}", args[0]);
+            assert!(
+                !e.contains("CSV") && !e.contains("header row"),
+                "{name}: {e}"
+            );
+        }
+    }
+    // Cut short after its samples (the power went): read, with a warning.
+    let mut df = Df::new();
+    for (k, (_, a)) in samples(4_000, 0.0).into_iter().enumerate() {
+        let f = |i: usize| a[i] as f32;
+        df.imu(
+            1_000_000 + 10_000 * k as u64,
+            0,
+            [f(0), f(1), f(2)],
+            [f(3), f(4), f(5)],
+            30.0,
+        );
+    }
+    let mut bytes = df.bytes;
+    bytes.truncate(bytes.len() - 7);
+    let file = temp_file("cut-short.bin", bytes);
+    let run = imu_ar(&["noise", file.to_str().unwrap(), "--column", "gx", "--json"]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert_eq!(json(&run)["n"], 3_999);
+    let e = String::from_utf8_lossy(&run.stderr);
+    assert!(e.contains("warning") && e.contains("cut short"), "{e}");
 }
 
 /// A PX4 ULog warm-up: sensor_gyro and sensor_accel of the IMUs `instances` at 100 Hz
