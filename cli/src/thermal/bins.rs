@@ -65,8 +65,9 @@ pub fn along(
     ) else {
         return Ok(Vec::new());
     };
-    // Not below: a count that overflows to infinity (or NaN) is too many too.
-    if !((top / width).floor() - (low / width).floor() < MAX_BINS as f64) {
+    // A count that overflows to infinity (or NaN) is too many too.
+    let count = (top / width).floor() - (low / width).floor();
+    if count.is_nan() || count >= MAX_BINS as f64 {
         return Err(format!(
             "temperatures from {} to {} deg C: more than {MAX_BINS} bins of {} deg C \
              (not a die temperature in deg C, or --bin-width too small?)",
