@@ -4,9 +4,10 @@
 //! since the last read that accounted for the FIFO ([`Driver::recover`]).
 
 use embedded_hal::delay::DelayNs;
+use embedded_hal_async::delay::DelayNs as AsyncDelayNs;
 
 use super::chip::Chip;
-use super::{Driver, Error, ImuReader, RawSample};
+use super::{AsyncDriver, Driver, Error, ImuReader, RawSample};
 
 /// Microseconds since start from a wrapping 32-bit cycle counter (the Cortex-M DWT's CYCCNT),
 /// extended to 64 bits. Exact as long as the counter is read at least once per wrap (51 s at
@@ -125,28 +126,77 @@ impl FifoLoop {
         let before = self.clock.now_us(counter());
         let result = imu.read_fifo(out);
         let after = self.clock.now_us(counter());
+        match self.read(before, after, result) {
+            Next::Done(pass) => pass,
+            Next::Recover { outage_us } => {
+                let result = imu.recover(delay, outage_us);
+                self.recovered(after, outage_us, result)
+            }
+        }
+    }
+
+    /// [`FifoLoop::pass`] with an async reader ([`AsyncDriver`]): the same steps and
+    /// decisions, awaited.
+    pub async fn pass_async<C: Chip>(
+        &mut self,
+        mut counter: impl FnMut() -> u32,
+        imu: &mut AsyncDriver<C>,
+        delay: &mut impl AsyncDelayNs,
+        out: &mut [RawSample],
+    ) -> Pass<C::BusError> {
+        let before = self.clock.now_us(counter());
+        let result = imu.read_fifo(out).await;
+        let after = self.clock.now_us(counter());
+        match self.read(before, after, result) {
+            Next::Done(pass) => pass,
+            Next::Recover { outage_us } => {
+                let result = imu.recover(delay, outage_us).await;
+                self.recovered(after, outage_us, result)
+            }
+        }
+    }
+
+    /// What a FIFO read that began at `before` and ended at `after` (µs) leads to.
+    fn read<E>(&mut self, before: u64, after: u64, result: Result<usize, Error<E>>) -> Next<E> {
         match result {
             Ok(n) => {
                 self.accounted_us = before;
-                Pass::Samples(n)
+                Next::Done(Pass::Samples(n))
             }
             Err(e @ (Error::FifoOverflow { .. } | Error::FifoResync { .. })) => {
                 self.accounted_us = after;
-                Pass::Dropped(e)
+                Next::Done(Pass::Dropped(e))
             }
-            Err(Error::SensorReset | Error::FifoNotRunning) => {
-                let outage_us = after
+            Err(Error::SensorReset | Error::FifoNotRunning) => Next::Recover {
+                outage_us: after
                     .saturating_sub(self.accounted_us)
-                    .saturating_add(self.recovery_us);
-                match imu.recover(delay, outage_us) {
-                    Ok(_) => {
-                        self.accounted_us = after.saturating_add(self.recovery_us);
-                        Pass::Recovered { outage_us }
-                    }
-                    Err(e) => Pass::RecoveryFailed(e),
-                }
-            }
-            Err(e) => Pass::Failed(e),
+                    .saturating_add(self.recovery_us),
+            },
+            Err(e) => Next::Done(Pass::Failed(e)),
         }
     }
+
+    /// What a recovery called at `after` (µs) with `outage_us` gave.
+    fn recovered<E>(
+        &mut self,
+        after: u64,
+        outage_us: u64,
+        result: Result<u8, Error<E>>,
+    ) -> Pass<E> {
+        match result {
+            Ok(_) => {
+                self.accounted_us = after.saturating_add(self.recovery_us);
+                Pass::Recovered { outage_us }
+            }
+            Err(e) => Pass::RecoveryFailed(e),
+        }
+    }
+}
+
+/// What follows a FIFO read in a pass.
+enum Next<E> {
+    /// The pass is over.
+    Done(Pass<E>),
+    /// The chip is to be recovered, with this outage.
+    Recover { outage_us: u64 },
 }

@@ -87,20 +87,23 @@ pub enum Packet {
 }
 
 /// One chip on its bus: implemented by [`Mpu6050Bus`](super::Mpu6050Bus) and
-/// [`Icm42688Bus`](super::Icm42688Bus).
+/// [`Icm42688Bus`](super::Icm42688Bus), over a blocking bus or an async one
+/// ([`Async`](super::Async)). Its transfers are `async`: the chip logic is written once over
+/// them (see `io.rs`).
+#[allow(async_fn_in_trait)]
 pub trait Chip {
     /// The bus's error type.
     type BusError;
     /// The configuration written by `init`.
-    type Config: Copy + Default;
+    type Config: Copy + Default + core::fmt::Debug;
     /// The chip's registers.
     const MAP: Map;
 
     /// Writes `value` to register `reg`.
-    fn write(&mut self, reg: u8, value: u8) -> Result<(), Self::BusError>;
+    async fn write(&mut self, reg: u8, value: u8) -> Result<(), Self::BusError>;
 
     /// Reads `buf.len()` bytes from register `reg` on (from the FIFO, for its data register).
-    fn read(&mut self, reg: u8, buf: &mut [u8]) -> Result<(), Self::BusError>;
+    async fn read(&mut self, reg: u8, buf: &mut [u8]) -> Result<(), Self::BusError>;
 
     /// The configuration writes of `init`, in order, after the reset.
     fn setup(config: &Self::Config) -> impl IntoIterator<Item = Write>;
@@ -119,25 +122,25 @@ pub trait Chip {
     fn parse(packet: &[u8]) -> Packet;
 
     /// Writes `writes` in order; stops at the first that fails.
-    fn write_all(&mut self, writes: &[Write]) -> Result<(), Error<Self::BusError>> {
+    async fn write_all(&mut self, writes: &[Write]) -> Result<(), Error<Self::BusError>> {
         for &(reg, value) in writes {
-            self.write(reg, value)?;
+            self.write(reg, value).await?;
         }
         Ok(())
     }
 
     /// Reads register `reg`.
-    fn read_u8(&mut self, reg: u8) -> Result<u8, Error<Self::BusError>> {
+    async fn read_u8(&mut self, reg: u8) -> Result<u8, Error<Self::BusError>> {
         let mut b = [0];
-        self.read(reg, &mut b)?;
+        self.read(reg, &mut b).await?;
         Ok(b[0])
     }
 
     /// Reads the registers of `check` in one transfer: `true` when every field holds its value.
-    fn check(&mut self, check: Check) -> Result<bool, Error<Self::BusError>> {
+    async fn check(&mut self, check: Check) -> Result<bool, Error<Self::BusError>> {
         let mut b = [0u8; CHECK_REGS];
         let regs = b.get_mut(..check.fields.len()).unwrap_or_default();
-        self.read(check.reg, regs)?;
+        self.read(check.reg, regs).await?;
         Ok(regs
             .iter()
             .zip(check.fields)
@@ -145,9 +148,9 @@ pub trait Chip {
     }
 
     /// Reads FIFO_COUNT, in bytes.
-    fn fifo_count(&mut self) -> Result<u16, Error<Self::BusError>> {
+    async fn fifo_count(&mut self) -> Result<u16, Error<Self::BusError>> {
         let mut b = [0; 2];
-        self.read(Self::MAP.fifo_count, &mut b)?;
+        self.read(Self::MAP.fifo_count, &mut b).await?;
         Ok(u16::from_be_bytes(b))
     }
 }

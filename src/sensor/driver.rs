@@ -2,9 +2,11 @@
 //! reset, and the FIFO routine (`fifo.rs`), over the chip's registers ([`Chip`]).
 
 use embedded_hal::delay::DelayNs;
+use embedded_hal_async::delay::DelayNs as AsyncDelayNs;
 
 use super::chip::{CHECK_REGS, Chip};
 use super::fifo::{self, FifoState, MAX_PACKET};
+use super::io::{AsyncWait, BlockingWait, Wait, block};
 use super::{Error, FifoStats, ImuReader, RawSample, Scale, Thermometer};
 
 /// A six-axis reader of the chip `C` on its bus: [`Mpu6050`](super::Mpu6050) (I2C) and
@@ -17,14 +19,20 @@ use super::{Error, FifoStats, ImuReader, RawSample, Scale, Thermometer};
 /// MPU-6050, 0x47 for the ICM-42688-P).
 #[derive(Debug)]
 pub struct Driver<C: Chip> {
+    core: Core<C>,
+}
+
+/// What the blocking and the async drivers share: the chip, its configuration and the FIFO's
+/// bookkeeping, with every step written once as an `async` function over the chip's transfers.
+#[derive(Debug)]
+struct Core<C: Chip> {
     chip: C,
     config: C::Config,
     fifo: FifoState,
 }
 
-impl<C: Chip> Driver<C> {
-    /// A reader of `chip` with the default configuration; no bus traffic until `init`.
-    pub(crate) fn with_chip(chip: C) -> Self {
+impl<C: Chip> Core<C> {
+    fn new(chip: C) -> Self {
         const {
             assert!(C::MAP.packet > 0 && C::MAP.packet <= MAX_PACKET);
             let mut i = 0;
@@ -41,9 +49,91 @@ impl<C: Chip> Driver<C> {
         }
     }
 
+    async fn who_am_i(&mut self) -> Result<u8, Error<C::BusError>> {
+        self.chip.read_u8(C::MAP.who_am_i).await
+    }
+
+    async fn init(
+        &mut self,
+        wait: &mut impl Wait,
+        config: C::Config,
+    ) -> Result<u8, Error<C::BusError>> {
+        self.fifo.off();
+        let id = self.configure(wait, config).await?;
+        self.fifo.initialised = true;
+        Ok(id)
+    }
+
+    async fn configure(
+        &mut self,
+        wait: &mut impl Wait,
+        config: C::Config,
+    ) -> Result<u8, Error<C::BusError>> {
+        let map = C::MAP;
+        let id = self.who_am_i().await?;
+        if map.unsupported.contains(&id) {
+            return Err(Error::UnsupportedDevice { found: id });
+        }
+        if id != map.id {
+            return Err(Error::WrongDevice { found: id });
+        }
+        let (reg, value) = map.reset;
+        self.chip.write(reg, value).await?;
+        wait.ms(map.reset_ms).await;
+        for (reg, value) in C::setup(&config) {
+            self.chip.write(reg, value).await?;
+        }
+        if map.settle_ms > 0 {
+            wait.ms(map.settle_ms).await;
+        }
+        self.config = config;
+        Ok(id)
+    }
+
+    async fn recover(
+        &mut self,
+        wait: &mut impl Wait,
+        outage_us: u64,
+    ) -> Result<u8, Error<C::BusError>> {
+        if !self.fifo.initialised {
+            return Err(Error::NotInitialised);
+        }
+        self.fifo.recovering();
+        let id = self.configure(wait, self.config).await?;
+        if self.fifo.wanted {
+            self.enable_fifo().await?;
+        }
+        let (hz, div) = C::rate(&self.config);
+        self.fifo.recovered(outage_us, hz, div);
+        Ok(id)
+    }
+
+    async fn enable_fifo(&mut self) -> Result<(), Error<C::BusError>> {
+        fifo::enable(&mut self.chip, &mut self.fifo).await
+    }
+
+    async fn read(&mut self) -> Result<RawSample, Error<C::BusError>> {
+        let mut b = [0u8; 14];
+        self.chip.read(C::MAP.data, &mut b).await?;
+        C::sample(&b).ok_or(Error::NoData)
+    }
+
+    async fn read_fifo(&mut self, out: &mut [RawSample]) -> Result<usize, Error<C::BusError>> {
+        fifo::read_fifo(&mut self.chip, &mut self.fifo, out).await
+    }
+}
+
+impl<C: Chip> Driver<C> {
+    /// A reader of `chip` with the default configuration; no bus traffic until `init`.
+    pub(crate) fn with_chip(chip: C) -> Self {
+        Self {
+            core: Core::new(chip),
+        }
+    }
+
     /// The chip, for `destroy` to give its bus back.
     pub(crate) fn into_chip(self) -> C {
-        self.chip
+        self.core.chip
     }
 
     /// Reads WHO_AM_I.
@@ -52,7 +142,7 @@ impl<C: Chip> Driver<C> {
     ///
     /// [`Error::Bus`].
     pub fn who_am_i(&mut self) -> Result<u8, Error<C::BusError>> {
-        self.chip.read_u8(C::MAP.who_am_i)
+        block(self.core.who_am_i())
     }
 
     /// Probes WHO_AM_I, resets the chip (and waits for the reset to complete), writes
@@ -70,36 +160,7 @@ impl<C: Chip> Driver<C> {
         delay: &mut impl DelayNs,
         config: C::Config,
     ) -> Result<u8, Error<C::BusError>> {
-        self.fifo.off();
-        let id = self.configure(delay, config)?;
-        self.fifo.initialised = true;
-        Ok(id)
-    }
-
-    fn configure(
-        &mut self,
-        delay: &mut impl DelayNs,
-        config: C::Config,
-    ) -> Result<u8, Error<C::BusError>> {
-        let map = C::MAP;
-        let id = self.who_am_i()?;
-        if map.unsupported.contains(&id) {
-            return Err(Error::UnsupportedDevice { found: id });
-        }
-        if id != map.id {
-            return Err(Error::WrongDevice { found: id });
-        }
-        let (reg, value) = map.reset;
-        self.chip.write(reg, value)?;
-        delay.delay_ms(map.reset_ms);
-        for (reg, value) in C::setup(&config) {
-            self.chip.write(reg, value)?;
-        }
-        if map.settle_ms > 0 {
-            delay.delay_ms(map.settle_ms);
-        }
-        self.config = config;
-        Ok(id)
+        block(self.core.init(&mut BlockingWait(delay), config))
     }
 
     /// Brings the chip back after [`Error::SensorReset`], [`Error::FifoNotRunning`] (or any
@@ -126,22 +187,12 @@ impl<C: Chip> Driver<C> {
         delay: &mut impl DelayNs,
         outage_us: u64,
     ) -> Result<u8, Error<C::BusError>> {
-        if !self.fifo.initialised {
-            return Err(Error::NotInitialised);
-        }
-        self.fifo.recovering();
-        let id = self.configure(delay, self.config)?;
-        if self.fifo.wanted {
-            self.enable_fifo()?;
-        }
-        let (hz, div) = C::rate(&self.config);
-        self.fifo.recovered(outage_us, hz, div);
-        Ok(id)
+        block(self.core.recover(&mut BlockingWait(delay), outage_us))
     }
 
     /// The configuration written by the last `init`.
     pub fn config(&self) -> &C::Config {
-        &self.config
+        &self.core.config
     }
 
     /// Enables the FIFO (with the chip's overflow flag, in the chip's packet layout), and
@@ -154,7 +205,113 @@ impl<C: Chip> Driver<C> {
     /// reset itself (call `recover`); [`Error::Bus`] (or [`Error::BadFifoCount`]): until a
     /// later call (or `recover`) succeeds, `read_fifo` returns [`Error::FifoNotRunning`].
     pub fn enable_fifo(&mut self) -> Result<(), Error<C::BusError>> {
-        fifo::enable(&mut self.chip, &mut self.fifo)
+        block(self.core.enable_fifo())
+    }
+}
+
+/// The async reader of the chip `C` on an `embedded-hal-async` bus:
+/// [`Mpu6050Async`](super::Mpu6050Async) and [`Icm42688Async`](super::Icm42688Async). Every
+/// method is its blocking twin's ([`Driver`]), awaiting the bus instead of blocking on it: the
+/// same code decides every register access, packet check, count and recovery, so the two give
+/// the same samples and counts on the same bus.
+#[derive(Debug)]
+pub struct AsyncDriver<C: Chip> {
+    core: Core<C>,
+}
+
+impl<C: Chip> AsyncDriver<C> {
+    /// A reader of `chip` with the default configuration; no bus traffic until `init`.
+    pub(crate) fn with_chip(chip: C) -> Self {
+        Self {
+            core: Core::new(chip),
+        }
+    }
+
+    /// The chip, for `destroy` to give its bus back.
+    pub(crate) fn into_chip(self) -> C {
+        self.core.chip
+    }
+
+    /// [`Driver::who_am_i`].
+    ///
+    /// # Errors
+    ///
+    /// As [`Driver::who_am_i`].
+    pub async fn who_am_i(&mut self) -> Result<u8, Error<C::BusError>> {
+        self.core.who_am_i().await
+    }
+
+    /// [`Driver::init`], with an async delay.
+    ///
+    /// # Errors
+    ///
+    /// As [`Driver::init`].
+    pub async fn init(
+        &mut self,
+        delay: &mut impl AsyncDelayNs,
+        config: C::Config,
+    ) -> Result<u8, Error<C::BusError>> {
+        self.core.init(&mut AsyncWait(delay), config).await
+    }
+
+    /// [`Driver::recover`], with an async delay.
+    ///
+    /// # Errors
+    ///
+    /// As [`Driver::recover`].
+    pub async fn recover(
+        &mut self,
+        delay: &mut impl AsyncDelayNs,
+        outage_us: u64,
+    ) -> Result<u8, Error<C::BusError>> {
+        self.core.recover(&mut AsyncWait(delay), outage_us).await
+    }
+
+    /// The configuration written by the last `init`.
+    pub fn config(&self) -> &C::Config {
+        &self.core.config
+    }
+
+    /// [`Driver::enable_fifo`].
+    ///
+    /// # Errors
+    ///
+    /// As [`Driver::enable_fifo`].
+    pub async fn enable_fifo(&mut self) -> Result<(), Error<C::BusError>> {
+        self.core.enable_fifo().await
+    }
+
+    /// [`ImuReader::read`] of the blocking reader.
+    ///
+    /// # Errors
+    ///
+    /// As [`ImuReader::read`].
+    pub async fn read(&mut self) -> Result<RawSample, Error<C::BusError>> {
+        self.core.read().await
+    }
+
+    /// [`ImuReader::read_fifo`] of the blocking reader ([`Driver`]'s, which describes it).
+    ///
+    /// # Errors
+    ///
+    /// As [`ImuReader::read_fifo`].
+    pub async fn read_fifo(&mut self, out: &mut [RawSample]) -> Result<usize, Error<C::BusError>> {
+        self.core.read_fifo(out).await
+    }
+
+    /// The sensitivities of the configuration.
+    pub fn scale(&self) -> Scale {
+        C::scale(&self.core.config)
+    }
+
+    /// The FIFO's counts ([`ImuReader::fifo_stats`]).
+    pub fn fifo_stats(&self) -> FifoStats {
+        self.core.fifo.stats
+    }
+
+    /// The chip's temperature formula ([`ImuReader::thermometer`]).
+    pub fn thermometer(&self) -> Thermometer {
+        C::MAP.thermometer
     }
 }
 
@@ -162,7 +319,7 @@ impl<C: Chip> ImuReader for Driver<C> {
     type BusError = C::BusError;
 
     fn scale(&self) -> Scale {
-        C::scale(&self.config)
+        C::scale(&self.core.config)
     }
 
     /// One burst read of the 14 bytes of the data registers. Registers holding the chip's
@@ -170,9 +327,7 @@ impl<C: Chip> ImuReader for Driver<C> {
     /// [`Error::NoData`]; they are no FIFO packet, and are not counted in
     /// [`FifoStats::invalid`].
     fn read(&mut self) -> Result<RawSample, Error<C::BusError>> {
-        let mut b = [0u8; 14];
-        self.chip.read(C::MAP.data, &mut b)?;
-        C::sample(&b).ok_or(Error::NoData)
+        block(self.core.read())
     }
 
     /// Reads INT_STATUS and FIFO_COUNT first (the count twice when it holds a packet, and the
@@ -207,11 +362,11 @@ impl<C: Chip> ImuReader for Driver<C> {
     /// and finished by the next call, so an overflow, whose flag is cleared by reading it, is
     /// never lost.
     fn read_fifo(&mut self, out: &mut [RawSample]) -> Result<usize, Error<C::BusError>> {
-        fifo::read_fifo(&mut self.chip, &mut self.fifo, out)
+        block(self.core.read_fifo(out))
     }
 
     fn fifo_stats(&self) -> FifoStats {
-        self.fifo.stats
+        self.core.fifo.stats
     }
 
     /// The chip's temperature formula ([`Thermometer::MPU6050`], [`Thermometer::ICM42688`]).

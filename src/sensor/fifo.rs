@@ -159,8 +159,8 @@ fn packet<C: Chip>() -> usize {
 }
 
 /// Reads FIFO_COUNT; a count above the FIFO's size is [`Error::BadFifoCount`].
-fn count<C: Chip>(chip: &mut C) -> Result<u16, Error<C::BusError>> {
-    let count = chip.fifo_count()?;
+async fn count<C: Chip>(chip: &mut C) -> Result<u16, Error<C::BusError>> {
+    let count = chip.fifo_count().await?;
     if count > C::MAP.fifo_bytes {
         return Err(Error::BadFifoCount { count });
     }
@@ -177,7 +177,7 @@ fn observe<C: Chip>(state: &mut FifoState, count: u16) {
 /// `enable_fifo` of every chip: the chip's first write, then a FIFO reset. A FIFO that an
 /// earlier attempt left running is emptied by it: its samples are counted as discarded, and a
 /// reset still pending (an overflow, a failed read) is counted as done.
-pub(crate) fn enable<C: Chip>(
+pub(crate) async fn enable<C: Chip>(
     chip: &mut C,
     state: &mut FifoState,
 ) -> Result<(), Error<C::BusError>> {
@@ -187,8 +187,8 @@ pub(crate) fn enable<C: Chip>(
     state.wanted = true;
     state.running = false;
     state.pending.get_or_insert_with(PendingReset::default);
-    chip.write_all(C::MAP.fifo_prepare)?;
-    reset(chip, state)?;
+    chip.write_all(C::MAP.fifo_prepare).await?;
+    reset(chip, state).await?;
     state.running = true;
     if let Some(p) = state.pending.take() {
         count_reset(&mut state.stats, p, packet::<C>());
@@ -197,7 +197,7 @@ pub(crate) fn enable<C: Chip>(
 }
 
 /// `ImuReader::read_fifo` of every chip; see the readers' documentation.
-pub(crate) fn read_fifo<C: Chip>(
+pub(crate) async fn read_fifo<C: Chip>(
     chip: &mut C,
     state: &mut FifoState,
     out: &mut [RawSample],
@@ -209,17 +209,17 @@ pub(crate) fn read_fifo<C: Chip>(
     if !state.running {
         return Err(Error::FifoNotRunning);
     }
-    if chip.read_u8(C::MAP.int_status)? & C::MAP.int_fifo_overflow != 0 {
+    if chip.read_u8(C::MAP.int_status).await? & C::MAP.int_fifo_overflow != 0 {
         state.mark_overflow();
     }
-    let first = count(chip)?;
+    let first = count(chip).await?;
     // The count the data are read by, and the latest count, which the bytes of a failed read
     // are reckoned from. The count is confirmed (a count corrupted high on the wire would be
     // read past the FIFO's end, or dropped by a pending reset as samples never written): the
     // smaller of two is taken.
     let (mut readable, mut latest) = (first, first);
     if usize::from(first) >= packet || state.pending.is_some() {
-        latest = count(chip)?;
+        latest = count(chip).await?;
         readable = readable.min(latest);
     }
     observe::<C>(state, readable);
@@ -228,13 +228,13 @@ pub(crate) fn read_fifo<C: Chip>(
         state.mark_overflow();
     }
     if state.pending.is_some() {
-        return finish_reset(chip, state);
+        return finish_reset(chip, state).await;
     }
     let available = usize::from(readable) / packet;
     if available == 0 {
         // An empty FIFO may be a chip that reset itself: its FIFO is then off.
         for &check in C::MAP.fifo_on {
-            if !chip.check(check)? {
+            if !chip.check(check).await? {
                 state.reset_seen = true;
                 return Err(Error::SensorReset);
             }
@@ -247,9 +247,9 @@ pub(crate) fn read_fifo<C: Chip>(
     while remaining > 0 && batch.delivered < out.len() {
         let n = remaining.min(CHUNK).min(out.len() - batch.delivered);
         let bytes = &mut buf[..n * packet];
-        if let Err(e) = chip.read(C::MAP.fifo_data, bytes) {
-            resync(chip, state, latest, taken, n * packet);
-            return match finish_reset(chip, state) {
+        if let Err(e) = chip.read(C::MAP.fifo_data, bytes).await {
+            resync(chip, state, latest, taken, n * packet).await;
+            return match finish_reset(chip, state).await {
                 Err(Error::Bus(_)) => Err(Error::Bus(e)),
                 other => other,
             };
@@ -267,19 +267,21 @@ pub(crate) fn read_fifo<C: Chip>(
             return drop_call(chip, state, taken.saturating_sub(bad), |p| {
                 p.resync = true;
                 p.malformed = p.malformed.saturating_add(malformed);
-            });
+            })
+            .await;
         }
     }
     // Samples keep arriving while the FIFO is read (a 96-byte transfer takes 2.4 ms at
     // 400 kHz, 9.6 ms at 100 kHz): one that overwrote bytes not yet read misaligned every
     // packet after them. The overflow flag says; with it (or when it cannot be read) the
     // call's packets are dropped.
-    let flag = chip.read_u8(C::MAP.int_status);
+    let flag = chip.read_u8(C::MAP.int_status).await;
     if !matches!(flag, Ok(f) if f & C::MAP.int_fifo_overflow == 0) {
         return drop_call(chip, state, taken, |p| {
             p.overflow |= flag.is_ok();
             p.resync |= flag.is_err();
-        });
+        })
+        .await;
     }
     batch.count(&mut state.stats);
     Ok(batch.delivered)
@@ -325,7 +327,13 @@ impl Batch {
 /// `taken` of them read before: decides a reset, and learns from FIFO_COUNT how many bytes the
 /// failed transfer clocked out. Without a count, the first count read later (before the FIFO
 /// is emptied) settles it.
-fn resync<C: Chip>(chip: &mut C, state: &mut FifoState, latest: u16, taken: usize, len: usize) {
+async fn resync<C: Chip>(
+    chip: &mut C,
+    state: &mut FifoState,
+    latest: u16,
+    taken: usize,
+    len: usize,
+) {
     let taken = u16::try_from(taken).unwrap_or(u16::MAX).min(latest);
     let pending = state.pending.get_or_insert_with(PendingReset::default);
     pending.resync = true;
@@ -335,7 +343,7 @@ fn resync<C: Chip>(chip: &mut C, state: &mut FifoState, latest: u16, taken: usiz
         len: u16::try_from(len).unwrap_or(u16::MAX),
     });
     for _ in 0..COUNT_TRIES {
-        match count(chip) {
+        match count(chip).await {
             Ok(c) => {
                 observe::<C>(state, c);
                 break;
@@ -348,7 +356,7 @@ fn resync<C: Chip>(chip: &mut C, state: &mut FifoState, latest: u16, taken: usiz
 
 /// Drops the packets of a call instead of delivering them: their `bytes` (already read) are
 /// counted as discarded by the FIFO reset that follows, whose cause `mark` sets.
-fn drop_call<C: Chip>(
+async fn drop_call<C: Chip>(
     chip: &mut C,
     state: &mut FifoState,
     bytes: usize,
@@ -359,23 +367,23 @@ fn drop_call<C: Chip>(
     pending.consumed = pending
         .consumed
         .saturating_add(u32::try_from(bytes).unwrap_or(u32::MAX));
-    finish_reset(chip, state)
+    finish_reset(chip, state).await
 }
 
 /// The FIFO reset: channels off, the count of what it drops (stable now), a check that the
 /// chip has not reset itself when the FIFO is empty, then empty and start. Every step can be
 /// repeated: after a failure the whole sequence is simply run again.
-fn reset<C: Chip>(chip: &mut C, state: &mut FifoState) -> Result<(), Error<C::BusError>> {
-    chip.write_all(C::MAP.fifo_stop)?;
-    let held = count(chip)?;
+async fn reset<C: Chip>(chip: &mut C, state: &mut FifoState) -> Result<(), Error<C::BusError>> {
+    chip.write_all(C::MAP.fifo_stop).await?;
+    let held = count(chip).await?;
     observe::<C>(state, held);
-    if held == 0 && !chip.check(C::MAP.configured)? {
+    if held == 0 && !chip.check(C::MAP.configured).await? {
         // A chip that reset itself: starting its FIFO would hide the reset (the FIFO would
         // look configured, and stay empty).
         state.reset_seen = true;
         return Err(Error::SensorReset);
     }
-    let emptied = chip.write_all(C::MAP.fifo_empty);
+    let emptied = chip.write_all(C::MAP.fifo_empty).await;
     if emptied.is_ok()
         && let Some(p) = state.pending.as_mut()
     {
@@ -383,7 +391,7 @@ fn reset<C: Chip>(chip: &mut C, state: &mut FifoState) -> Result<(), Error<C::Bu
         p.held = 0;
     }
     emptied?;
-    chip.write_all(C::MAP.fifo_start)
+    chip.write_all(C::MAP.fifo_start).await
 }
 
 /// Counts a reset that has been carried out: its bytes as discarded, its cause. Returns the
@@ -405,8 +413,11 @@ fn count_reset(stats: &mut FifoStats, p: PendingReset, packet: usize) -> u16 {
 
 /// Carries out the pending reset and counts it: [`Error::FifoOverflow`] or
 /// [`Error::FifoResync`]; a bus error keeps it pending.
-fn finish_reset<C: Chip>(chip: &mut C, state: &mut FifoState) -> Result<usize, Error<C::BusError>> {
-    reset(chip, state)?;
+async fn finish_reset<C: Chip>(
+    chip: &mut C,
+    state: &mut FifoState,
+) -> Result<usize, Error<C::BusError>> {
+    reset(chip, state).await?;
     let Some(p) = state.pending.take() else {
         return Ok(0);
     };

@@ -6,9 +6,11 @@
 //! descriptions (register addresses below). SPI: bit 7 of the address byte set for a read.
 
 use embedded_hal::spi::{Operation, SpiDevice};
+use embedded_hal_async::spi::SpiDevice as AsyncSpiDevice;
 
 use super::chip::{Check, Chip, Map, Packet, Write};
-use super::driver::Driver;
+use super::driver::{AsyncDriver, Driver};
+use super::io::{Async, SpiIo};
 use super::{RawSample, Scale, Thermometer, be_i16, be_i16x3};
 
 /// SPI: bit 7 of the address byte, set for a read.
@@ -439,6 +441,23 @@ impl<SPI: SpiDevice> Icm42688<SPI> {
     }
 }
 
+/// An ICM-42688-P on an async SPI device (`embedded-hal-async`): the [`AsyncDriver`] of an
+/// [`Icm42688Bus`], the async twin of [`Icm42688`]: the same registers, checks and counts,
+/// awaited.
+pub type Icm42688Async<SPI> = AsyncDriver<Icm42688Bus<Async<SPI>>>;
+
+impl<SPI: AsyncSpiDevice> Icm42688Async<SPI> {
+    /// A reader on `spi` (mode 0 or 3); no bus traffic until `init`.
+    pub fn new(spi: SPI) -> Self {
+        AsyncDriver::with_chip(Icm42688Bus(Async(spi)))
+    }
+
+    /// Gives the bus back.
+    pub fn destroy(self) -> SPI {
+        self.into_chip().0.0
+    }
+}
+
 /// The registers the shared driver uses.
 const MAP: Map = Map {
     who_am_i: WHO_AM_I,
@@ -467,19 +486,22 @@ const MAP: Map = Map {
 #[derive(Debug)]
 pub struct Icm42688Bus<SPI>(SPI);
 
-impl<SPI: SpiDevice> Chip for Icm42688Bus<SPI> {
+impl<SPI: SpiIo> Chip for Icm42688Bus<SPI> {
     type BusError = SPI::Error;
     type Config = Icm42688Config;
     const MAP: Map = MAP;
 
-    fn write(&mut self, reg: u8, value: u8) -> Result<(), SPI::Error> {
-        self.0.write(&[reg, value])
+    async fn write(&mut self, reg: u8, value: u8) -> Result<(), SPI::Error> {
+        self.0
+            .transaction(&mut [Operation::Write(&[reg, value])])
+            .await
     }
 
-    fn read(&mut self, reg: u8, buf: &mut [u8]) -> Result<(), SPI::Error> {
+    async fn read(&mut self, reg: u8, buf: &mut [u8]) -> Result<(), SPI::Error> {
         let address = [reg | SPI_READ];
         self.0
             .transaction(&mut [Operation::Write(&address), Operation::Read(buf)])
+            .await
     }
 
     /// Ranges and rates, then gyro and accelerometer on in low-noise mode.

@@ -17,21 +17,31 @@
 //! chip on its bus ([`Mpu6050Bus`], [`Icm42688Bus`]), whose registers, write sequences and
 //! packet layout are all that differs. `init`, `recover`, `enable_fifo` and the FIFO routine
 //! (overflow, resync after a failed read, chip-reset detection) are written once.
+//!
+//! They are written once for async firmware too (embassy, RTIC 2): [`Mpu6050Async`] and
+//! [`Icm42688Async`] are the [`AsyncDriver`] over an `embedded-hal-async` bus. The chip logic
+//! is `async` code over the chip's transfers; the blocking readers run it over their blocking
+//! bus, where every future is ready at its first poll. Both readers make the same transfers and
+//! give the same samples and counts.
 
 mod board;
 mod chip;
 mod driver;
 mod fifo;
 mod icm42688;
+mod io;
 mod mpu6050;
 mod replay;
 
 use core::fmt;
 
 pub use board::{CycleClock, FifoLoop, Pass, Recover};
-pub use driver::Driver;
-pub use icm42688::{Icm42688, Icm42688Bus, Icm42688Config, IcmAccelRange, IcmGyroRange, Odr};
-pub use mpu6050::{AccelRange, Dlpf, GyroRange, Mpu6050, Mpu6050Bus, Mpu6050Config};
+pub use driver::{AsyncDriver, Driver};
+pub use icm42688::{
+    Icm42688, Icm42688Async, Icm42688Bus, Icm42688Config, IcmAccelRange, IcmGyroRange, Odr,
+};
+pub use io::Async;
+pub use mpu6050::{AccelRange, Dlpf, GyroRange, Mpu6050, Mpu6050Async, Mpu6050Bus, Mpu6050Config};
 pub use replay::Replay;
 
 /// One six-axis reading in raw counts, in the sensor's axes.

@@ -10,9 +10,11 @@
 //! sensitivity) and 6.2 (accelerometer sensitivity).
 
 use embedded_hal::i2c::I2c;
+use embedded_hal_async::i2c::I2c as AsyncI2c;
 
 use super::chip::{Check, Chip, Map, Packet, Write};
-use super::driver::Driver;
+use super::driver::{AsyncDriver, Driver};
+use super::io::{Async, I2cIo};
 use super::{RawSample, Scale, Thermometer, be_i16, be_i16x3};
 
 /// Register 25, SMPLRT_DIV: sample rate = gyro output rate / (1 + SMPLRT_DIV).
@@ -360,6 +362,49 @@ impl<I2C: I2c> Mpu6050<I2C> {
     }
 }
 
+/// An MPU-6050 on an async I2C bus (`embedded-hal-async`): the [`AsyncDriver`] of an
+/// [`Mpu6050Bus`], the async twin of [`Mpu6050`]: the same registers, checks and counts,
+/// awaited.
+///
+/// ```
+/// # use embedded_hal_async::i2c::{ErrorType, I2c, Operation};
+/// # struct Bus;
+/// # impl ErrorType for Bus { type Error = core::convert::Infallible; }
+/// # impl I2c for Bus {
+/// #     async fn transaction(&mut self, _: u8, ops: &mut [Operation<'_>]) -> Result<(), Self::Error> {
+/// #         for op in ops { if let Operation::Read(b) = op { b.fill(0); b[0] = 0x68; } }
+/// #         Ok(())
+/// #     }
+/// # }
+/// # struct Delay;
+/// # impl embedded_hal_async::delay::DelayNs for Delay { async fn delay_ns(&mut self, _: u32) {} }
+/// use imu_ar::sensor::{Mpu6050Async, Mpu6050Config};
+///
+/// async fn first_sample() -> Result<(), imu_ar::sensor::Error<core::convert::Infallible>> {
+///     let mut imu = Mpu6050Async::new(Bus, 0x68);
+///     imu.init(&mut Delay, Mpu6050Config::default()).await?;
+///     let sample = imu.read().await?;
+///     let _gyro = imu.scale().gyro(sample.gyro, imu_ar::sensor::GyroUnit::DegPerSec);
+///     Ok(())
+/// }
+/// ```
+pub type Mpu6050Async<I2C> = AsyncDriver<Mpu6050Bus<Async<I2C>>>;
+
+impl<I2C: AsyncI2c> Mpu6050Async<I2C> {
+    /// A reader at `address` (0x68, or 0x69 with AD0 high); no bus traffic until `init`.
+    pub fn new(i2c: I2C, address: u8) -> Self {
+        AsyncDriver::with_chip(Mpu6050Bus {
+            i2c: Async(i2c),
+            address,
+        })
+    }
+
+    /// Gives the bus back.
+    pub fn destroy(self) -> I2C {
+        self.into_chip().i2c.0
+    }
+}
+
 /// The registers the shared driver uses.
 const MAP: Map = Map {
     who_am_i: WHO_AM_I,
@@ -391,17 +436,17 @@ pub struct Mpu6050Bus<I2C> {
     address: u8,
 }
 
-impl<I2C: I2c> Chip for Mpu6050Bus<I2C> {
+impl<I2C: I2cIo> Chip for Mpu6050Bus<I2C> {
     type BusError = I2C::Error;
     type Config = Mpu6050Config;
     const MAP: Map = MAP;
 
-    fn write(&mut self, reg: u8, value: u8) -> Result<(), I2C::Error> {
-        self.i2c.write(self.address, &[reg, value])
+    async fn write(&mut self, reg: u8, value: u8) -> Result<(), I2C::Error> {
+        self.i2c.write(self.address, &[reg, value]).await
     }
 
-    fn read(&mut self, reg: u8, buf: &mut [u8]) -> Result<(), I2C::Error> {
-        self.i2c.write_read(self.address, &[reg], buf)
+    async fn read(&mut self, reg: u8, buf: &mut [u8]) -> Result<(), I2C::Error> {
+        self.i2c.write_read(self.address, &[reg], buf).await
     }
 
     /// Awake on the X-gyro PLL clock, then rate, filter and ranges.

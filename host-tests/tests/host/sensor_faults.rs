@@ -13,10 +13,12 @@ use crate::sim;
 use std::cell::RefCell;
 use std::rc::Rc;
 
+use embedded_hal::{i2c, spi};
 use imu_ar::sensor::{
-    Dlpf, Error, Icm42688, Icm42688Config, ImuReader, Mpu6050, Mpu6050Config, Odr, RawSample,
-    Replay, Scale,
+    Dlpf, Error, Icm42688, Icm42688Async, Icm42688Config, ImuReader, Mpu6050, Mpu6050Async,
+    Mpu6050Config, Odr, RawSample, Replay, Scale,
 };
+use sim::asynch::{AsyncBus, AsyncNoDelay, Awaited, block_on};
 use sim::hooks::{Action, HookedI2c, HookedSpi, Hooks};
 use sim::icm42688::{self as icm, SimSpi};
 use sim::mpu6050::{self as mpu, SimI2c};
@@ -50,6 +52,54 @@ fn mpu_with(seed: u64, config: Mpu6050Config) -> (Rc<RefCell<Sim>>, Hooks, Mpu60
     (sim, hooks, imu)
 }
 
+/// A session of the blocking and of the async reader (its bus suspending at every transfer).
+type Both<E> = Vec<(Rc<RefCell<Sim>>, Hooks, Box<dyn ImuReader<BusError = E>>)>;
+
+/// [`mpu`] with the blocking reader, then the same session with the async one.
+fn mpu_both(seed: u64) -> Both<i2c::ErrorKind> {
+    let (sim, hooks, imu) = mpu(seed);
+    let blocking: Box<dyn ImuReader<BusError = _>> = Box::new(imu);
+    let sim2 = Sim::new(Model::Mpu6050, seed);
+    let hooks2 = Hooks::default();
+    let bus = HookedI2c {
+        sim: sim2.clone(),
+        inner: SimI2c(sim2.clone()),
+        hooks: hooks2.clone(),
+    };
+    let mut imu = Awaited(Mpu6050Async::new(AsyncBus(bus), 0x68));
+    block_on(imu.0.init(&mut AsyncNoDelay, mpu_config())).unwrap();
+    block_on(imu.0.enable_fifo()).unwrap();
+    vec![(sim, hooks, blocking), (sim2, hooks2, Box::new(imu))]
+}
+
+/// [`icm`] with the blocking reader, then the same session with the async one.
+fn icm_both(seed: u64) -> Both<spi::ErrorKind> {
+    let (sim, hooks, imu) = icm(seed);
+    let blocking: Box<dyn ImuReader<BusError = _>> = Box::new(imu);
+    let sim2 = Sim::new(Model::Icm42688, seed);
+    let hooks2 = Hooks::default();
+    let bus = HookedSpi {
+        sim: sim2.clone(),
+        inner: SimSpi(sim2.clone()),
+        hooks: hooks2.clone(),
+    };
+    let mut imu = Awaited(Icm42688Async::new(AsyncBus(bus)));
+    block_on(imu.0.init(&mut AsyncNoDelay, icm_config())).unwrap();
+    block_on(imu.0.enable_fifo()).unwrap();
+    sim2.borrow_mut().tick(u64::from(icm::GYRO_STARTUP));
+    let mut out = [RawSample::default(); 160];
+    assert_eq!(imu.read_fifo(&mut out), Ok(0));
+    vec![(sim, hooks, blocking), (sim2, hooks2, Box::new(imu))]
+}
+
+/// 1 kHz.
+fn icm_config() -> Icm42688Config {
+    Icm42688Config {
+        odr: Odr::Hz1000,
+        ..Icm42688Config::default()
+    }
+}
+
 /// An ICM-42688-P at 1 kHz with its FIFO on and the gyro start-up behind it.
 fn icm(seed: u64) -> (Rc<RefCell<Sim>>, Hooks, Icm42688<HookedSpi>) {
     let sim = Sim::new(Model::Icm42688, seed);
@@ -60,11 +110,7 @@ fn icm(seed: u64) -> (Rc<RefCell<Sim>>, Hooks, Icm42688<HookedSpi>) {
         hooks: hooks.clone(),
     };
     let mut imu = Icm42688::new(bus);
-    let config = Icm42688Config {
-        odr: Odr::Hz1000,
-        ..Icm42688Config::default()
-    };
-    imu.init(&mut NoDelay, config).unwrap();
+    imu.init(&mut NoDelay, icm_config()).unwrap();
     imu.enable_fifo().unwrap();
     sim.borrow_mut().tick(u64::from(icm::GYRO_STARTUP));
     let mut out = [RawSample::default(); 160];
@@ -515,24 +561,25 @@ fn mpu_enable_fifo_before_init_is_an_error() {
 /// counted.
 #[test]
 fn mpu_overflow_during_a_near_full_read_delivers_no_misaligned_sample() {
-    let (sim, hooks, mut imu) = mpu(11);
-    let mut out = [RawSample::default(); 128];
-    sim.borrow_mut().tick(85);
-    hooks.add(Kind::Read(mpu::FIFO_R_W), 0, Action::TickBefore(1));
-    let r = imu.read_fifo(&mut out);
-    if let Ok(k) = r {
-        let garbage = out[..k].iter().filter(|s| decode(s).is_none()).count();
-        assert_eq!(garbage, 0, "{garbage} of {k} samples delivered misaligned");
+    for (sim, hooks, mut imu) in mpu_both(11) {
+        let mut out = [RawSample::default(); 128];
+        sim.borrow_mut().tick(85);
+        hooks.add(Kind::Read(mpu::FIFO_R_W), 0, Action::TickBefore(1));
+        let r = imu.read_fifo(&mut out);
+        if let Ok(k) = r {
+            let garbage = out[..k].iter().filter(|s| decode(s).is_none()).count();
+            assert_eq!(garbage, 0, "{garbage} of {k} samples delivered misaligned");
+        }
+        assert!(
+            matches!(r, Err(Error::FifoOverflow { .. })),
+            "{r:?}: the overflow during the read is reported"
+        );
+        // The next calls deliver aligned samples again.
+        sim.borrow_mut().tick(20);
+        let k = imu.read_fifo(&mut out).unwrap();
+        assert_eq!(k, 20);
+        assert!(out[..k].iter().all(|s| decode(s).is_some()));
     }
-    assert!(
-        matches!(r, Err(Error::FifoOverflow { .. })),
-        "{r:?}: the overflow during the read is reported"
-    );
-    // The next calls deliver aligned samples again.
-    sim.borrow_mut().tick(20);
-    let k = imu.read_fifo(&mut out).unwrap();
-    assert_eq!(k, 20);
-    assert!(out[..k].iter().all(|s| decode(s).is_some()));
 }
 
 /// Both chips: 10 packets in the FIFO, a sample arrives just before the FIFO_R_W transfer,
@@ -548,22 +595,23 @@ fn resync_after_a_sample_arrived_before_the_failed_read_counts_it_as_unsure() {
     // `clock_out` and fails; the count after it is 132 - clock_out, taken as clock_out - 12
     // bytes out (nothing entered): the packets the 96 leave room for beyond those are unsure.
     for (clock_out, unsure) in [(usize::MAX, 1), (60, 4), (0, 8)] {
-        let (sim, hooks, mut imu) = mpu(12);
-        let mut out = [RawSample::default(); 128];
-        sim.borrow_mut().tick(10);
-        hooks.add(Kind::Read(mpu::FIFO_R_W), 0, Action::TickBefore(1));
-        sim.borrow_mut()
-            .fail(Kind::Read(mpu::FIFO_R_W), 0, clock_out);
-        let r = imu.read_fifo(&mut out);
-        assert!(matches!(r, Err(Error::FifoResync { .. })), "{r:?}");
-        let s = imu.fifo_stats();
-        let sim = sim.borrow();
-        let dropped = sim.produced - sim.fifo_packets();
-        assert!(
-            s.discarded <= dropped && dropped <= s.discarded + s.unsure,
-            "clock-out {clock_out}: {dropped} dropped, {s:?}"
-        );
-        assert_eq!(s.unsure, unsure, "clock-out {clock_out}: {s:?}");
+        for (sim, hooks, mut imu) in mpu_both(12) {
+            let mut out = [RawSample::default(); 128];
+            sim.borrow_mut().tick(10);
+            hooks.add(Kind::Read(mpu::FIFO_R_W), 0, Action::TickBefore(1));
+            sim.borrow_mut()
+                .fail(Kind::Read(mpu::FIFO_R_W), 0, clock_out);
+            let r = imu.read_fifo(&mut out);
+            assert!(matches!(r, Err(Error::FifoResync { .. })), "{r:?}");
+            let s = imu.fifo_stats();
+            let sim = sim.borrow();
+            let dropped = sim.produced - sim.fifo_packets();
+            assert!(
+                s.discarded <= dropped && dropped <= s.discarded + s.unsure,
+                "clock-out {clock_out}: {dropped} dropped, {s:?}"
+            );
+            assert_eq!(s.unsure, unsure, "clock-out {clock_out}: {s:?}");
+        }
     }
 }
 
@@ -577,43 +625,44 @@ fn resync_after_a_sample_arrived_before_the_failed_read_counts_it_as_unsure() {
 #[test]
 fn icm_byte_slip_is_resynchronised() {
     for seed in 0..16 {
-        let (sim, hooks, mut imu) = icm(100 + seed);
-        let mut out = [RawSample::default(); 160];
-        let before = imu.fifo_stats();
-        let produced = sim.borrow().produced;
-        sim.borrow_mut().tick(12);
-        hooks.add(Kind::Read(icm::FIFO_DATA), 0, Action::Slip);
-        let mut delivered = 0u64;
-        let mut resynced = false;
-        for _ in 0..5 {
-            match imu.read_fifo(&mut out) {
-                Ok(k) => {
-                    let garbage = out[..k].iter().filter(|s| decode(s).is_none()).count();
-                    assert_eq!(garbage, 0, "seed {seed}: misaligned samples delivered");
-                    delivered += k as u64;
+        for (sim, hooks, mut imu) in icm_both(100 + seed) {
+            let mut out = [RawSample::default(); 160];
+            let before = imu.fifo_stats();
+            let produced = sim.borrow().produced;
+            sim.borrow_mut().tick(12);
+            hooks.add(Kind::Read(icm::FIFO_DATA), 0, Action::Slip);
+            let mut delivered = 0u64;
+            let mut resynced = false;
+            for _ in 0..5 {
+                match imu.read_fifo(&mut out) {
+                    Ok(k) => {
+                        let garbage = out[..k].iter().filter(|s| decode(s).is_none()).count();
+                        assert_eq!(garbage, 0, "seed {seed}: misaligned samples delivered");
+                        delivered += k as u64;
+                    }
+                    Err(Error::FifoResync { .. }) => resynced = true,
+                    Err(e) => panic!("seed {seed}: {e:?}"),
                 }
-                Err(Error::FifoResync { .. }) => resynced = true,
-                Err(e) => panic!("seed {seed}: {e:?}"),
+                sim.borrow_mut().tick(10);
             }
-            sim.borrow_mut().tick(10);
+            assert!(resynced, "seed {seed}: the slip was never resynchronised");
+            let k = imu.read_fifo(&mut out).unwrap();
+            assert!(k >= 10, "seed {seed}: samples do not flow again ({k})");
+            delivered += k as u64;
+            let s = imu.fifo_stats();
+            let sim = sim.borrow();
+            let counted = delivered
+                + (s.discarded - before.discarded)
+                + (s.malformed - before.malformed)
+                + (s.invalid - before.invalid)
+                + sim.fifo_packets();
+            // The slipped byte leaves a partial packet: the counts reckon whole packets.
+            let written = sim.produced - produced;
+            assert!(
+                counted <= written && written <= counted + (s.unsure - before.unsure) + 1,
+                "seed {seed}: wrote {written}, accounted {counted}: {s:?}"
+            );
         }
-        assert!(resynced, "seed {seed}: the slip was never resynchronised");
-        let k = imu.read_fifo(&mut out).unwrap();
-        assert!(k >= 10, "seed {seed}: samples do not flow again ({k})");
-        delivered += k as u64;
-        let s = imu.fifo_stats();
-        let sim = sim.borrow();
-        let counted = delivered
-            + (s.discarded - before.discarded)
-            + (s.malformed - before.malformed)
-            + (s.invalid - before.invalid)
-            + sim.fifo_packets();
-        // The slipped byte leaves a partial packet: the counts reckon whole packets.
-        let written = sim.produced - produced;
-        assert!(
-            counted <= written && written <= counted + (s.unsure - before.unsure) + 1,
-            "seed {seed}: wrote {written}, accounted {counted}: {s:?}"
-        );
     }
 }
 
@@ -628,13 +677,42 @@ fn icm_byte_slip_is_resynchronised() {
 /// counted.
 #[test]
 fn board_loop_counts_a_two_minute_unplug() {
+    use imu_ar::sensor::FifoLoop;
+    let sim = Sim::new(Model::Mpu6050, 21);
+    let config = Mpu6050Config::default(); // 100 Hz
+    let mut blocking = Mpu6050::new(SimI2c(sim.clone()), 0x68);
+    blocking.init(&mut NoDelay, config).unwrap();
+    blocking.enable_fifo().unwrap();
+    two_minute_unplug(&sim, |board, counter, out| {
+        let pass = board.pass(|| counter, &mut blocking, &mut NoDelay, out);
+        (pass, blocking.fifo_stats())
+    });
+    // The async reader and FifoLoop::pass_async on the same session.
+    let sim = Sim::new(Model::Mpu6050, 21);
+    let mut reader = Mpu6050Async::new(AsyncBus(SimI2c(sim.clone())), 0x68);
+    block_on(reader.init(&mut AsyncNoDelay, config)).unwrap();
+    block_on(reader.enable_fifo()).unwrap();
+    two_minute_unplug(&sim, |board: &mut FifoLoop, counter, out| {
+        let pass = block_on(board.pass_async(|| counter, &mut reader, &mut AsyncNoDelay, out));
+        (pass, reader.fifo_stats())
+    });
+}
+
+/// [`board_loop_counts_a_two_minute_unplug`] with the pass `step` (the loop, the cycle
+/// counter, the buffer: what the pass did and the reader's counts after it).
+fn two_minute_unplug(
+    sim: &Rc<RefCell<Sim>>,
+    mut step: impl FnMut(
+        &mut imu_ar::sensor::FifoLoop,
+        u32,
+        &mut [RawSample],
+    ) -> (
+        imu_ar::sensor::Pass<i2c::ErrorKind>,
+        imu_ar::sensor::FifoStats,
+    ),
+) {
     use imu_ar::sensor::{CycleClock, FifoLoop, Pass};
     const HZ: u64 = 84_000_000;
-    let sim = Sim::new(Model::Mpu6050, 21);
-    let mut imu = Mpu6050::new(SimI2c(sim.clone()), 0x68);
-    let config = Mpu6050Config::default(); // 100 Hz
-    imu.init(&mut NoDelay, config).unwrap();
-    imu.enable_fifo().unwrap();
     // Cycles, wrapping at 32 bits; time in microseconds kept exactly beside it.
     let mut t_us: u64 = 5_000_000;
     let counter = |t_us: u64| ((t_us * (HZ / 1_000_000)) % (1 << 32)) as u32;
@@ -642,6 +720,7 @@ fn board_loop_counts_a_two_minute_unplug() {
     let mut out = [RawSample::default(); 32];
     let (mut delivered, mut recovered) = (0u64, None);
     let (unplug, replug) = (60_000_000u64, 180_000_000u64);
+    let mut stats = imu_ar::sensor::FifoStats::default();
     // The chip's sample clock: one sample per 10 ms while powered.
     let mut chip_us = t_us;
     while t_us < 300_000_000 {
@@ -661,7 +740,9 @@ fn board_loop_counts_a_two_minute_unplug() {
         } else {
             chip_us = t_us;
         }
-        match board.pass(|| counter(t_us), &mut imu, &mut NoDelay, &mut out) {
+        let (pass, now) = step(&mut board, counter(t_us), &mut out);
+        stats = now;
+        match pass {
             Pass::Samples(n) => {
                 assert!(out[..n].iter().all(|s| decode(s).is_some()));
                 delivered += n as u64;
@@ -677,7 +758,7 @@ fn board_loop_counts_a_two_minute_unplug() {
         (120_000_000..=120_200_000).contains(&outage),
         "recover was passed {outage} us"
     );
-    let s = imu.fifo_stats();
+    let s = stats;
     assert_eq!(s.lost, (outage + 5_000) / 10_000, "{s:?}");
     // The chip wrote only while powered: all of it delivered or still in the FIFO.
     let sim = sim.borrow();

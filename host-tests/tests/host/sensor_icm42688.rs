@@ -5,6 +5,8 @@
 
 use crate::common;
 use crate::sim;
+use crate::sim::asynch::{AsyncBus, AsyncNoDelay, Awaited, block_on};
+use crate::sim::run::fault_run;
 
 use std::cell::RefCell;
 use std::rc::Rc;
@@ -14,8 +16,8 @@ use embedded_hal::spi::{ErrorType, Operation, SpiDevice};
 use embedded_hal_mock::eh1::delay::NoopDelay;
 use embedded_hal_mock::eh1::spi::{Mock as SpiMock, Transaction as Spi};
 use imu_ar::sensor::{
-    AccelUnit, Error, GyroUnit, Icm42688, Icm42688Config, IcmAccelRange, IcmGyroRange, ImuReader,
-    Odr, RawSample, Thermometer,
+    AccelUnit, Error, GyroUnit, Icm42688, Icm42688Async, Icm42688Config, IcmAccelRange,
+    IcmGyroRange, ImuReader, Odr, RawSample, Thermometer,
 };
 use sim::icm42688::{self as icm, SimSpi};
 use sim::{Kind, Model, NoDelay, Sim, decode};
@@ -558,4 +560,31 @@ fn random_bus_faults_lose_nothing_uncounted() {
     let recover = |imu: &mut Icm42688<SimSpi>, us| imu.recover(&mut NoDelay, us).map(|_| ());
     let figures = common::random_bus_faults(&sim, &mut imu, recover, 12, "ICM-42688-P");
     assert!(figures.stats.invalid > 0);
+}
+
+/// The async reader ([`Icm42688Async`]) on the same session as the blocking one, faults
+/// included, its bus suspending at every transfer: the same transfers, faults, samples and
+/// counts, figure for figure.
+#[test]
+fn async_reader_agrees_with_the_blocking_one_under_random_faults() {
+    let (sim, mut imu) = reader(2024);
+    let recover = |imu: &mut Icm42688<SimSpi>, us| imu.recover(&mut NoDelay, us).map(|_| ());
+    let blocking = fault_run(&sim, &mut imu, recover, 12, 0.01, 100_000);
+
+    let sim = Sim::new(Model::Icm42688, 2024);
+    let mut imu = Awaited(Icm42688Async::new(AsyncBus(SimSpi(sim.clone()))));
+    block_on(imu.0.init(&mut AsyncNoDelay, config())).unwrap();
+    block_on(imu.0.enable_fifo()).unwrap();
+    sim.borrow_mut().tick(u64::from(icm::GYRO_STARTUP));
+    let mut out = [RawSample::default(); 160];
+    assert_eq!(imu.read_fifo(&mut out), Ok(0));
+    let recover = |imu: &mut Awaited<Icm42688Async<AsyncBus<SimSpi>>>, us| {
+        block_on(imu.0.recover(&mut AsyncNoDelay, us)).map(|_| ())
+    };
+    let awaited = fault_run(&sim, &mut imu, recover, 12, 0.01, 100_000);
+    assert!(
+        awaited.delivered >= 100_000 && awaited.faults > 1000,
+        "{awaited:#?}"
+    );
+    assert_eq!(format!("{blocking:?}"), format!("{awaited:?}"));
 }

@@ -5,6 +5,8 @@
 
 use crate::common;
 use crate::sim;
+use crate::sim::asynch::{AsyncBus, AsyncNoDelay, Awaited, block_on};
+use crate::sim::run::fault_run;
 
 use std::cell::RefCell;
 use std::rc::Rc;
@@ -14,8 +16,8 @@ use embedded_hal::i2c::ErrorKind;
 use embedded_hal_mock::eh1::delay::NoopDelay;
 use embedded_hal_mock::eh1::i2c::{Mock as I2cMock, Transaction as I2c};
 use imu_ar::sensor::{
-    AccelRange, AccelUnit, Dlpf, Error, GyroRange, GyroUnit, ImuReader, Mpu6050, Mpu6050Config,
-    RawSample, Thermometer,
+    AccelRange, AccelUnit, Dlpf, Error, GyroRange, GyroUnit, ImuReader, Mpu6050, Mpu6050Async,
+    Mpu6050Config, RawSample, Thermometer,
 };
 use sim::mpu6050::{self as mpu, SimI2c};
 use sim::{Kind, Model, NoDelay, Sim};
@@ -545,4 +547,28 @@ fn random_bus_faults_lose_nothing_uncounted() {
     let recover = |imu: &mut Mpu6050<SimI2c>, us| imu.recover(&mut NoDelay, us).map(|_| ());
     common::random_bus_faults(&sim, &mut imu, recover, 11, "MPU-6050");
     assert_eq!(sim.borrow().resets_with_channels_on, 0);
+}
+
+/// The async reader ([`Mpu6050Async`]) on the same session as the blocking one, faults
+/// included, its bus suspending at every transfer: the same transfers, faults, samples and
+/// counts, figure for figure.
+#[test]
+fn async_reader_agrees_with_the_blocking_one_under_random_faults() {
+    let (sim, mut imu) = reader(2024);
+    let recover = |imu: &mut Mpu6050<SimI2c>, us| imu.recover(&mut NoDelay, us).map(|_| ());
+    let blocking = fault_run(&sim, &mut imu, recover, 11, 0.01, 100_000);
+
+    let sim = Sim::new(Model::Mpu6050, 2024);
+    let mut imu = Awaited(Mpu6050Async::new(AsyncBus(SimI2c(sim.clone())), 0x68));
+    block_on(imu.0.init(&mut AsyncNoDelay, config())).unwrap();
+    block_on(imu.0.enable_fifo()).unwrap();
+    let recover = |imu: &mut Awaited<Mpu6050Async<AsyncBus<SimI2c>>>, us| {
+        block_on(imu.0.recover(&mut AsyncNoDelay, us)).map(|_| ())
+    };
+    let awaited = fault_run(&sim, &mut imu, recover, 11, 0.01, 100_000);
+    assert!(
+        awaited.delivered >= 100_000 && awaited.faults > 1000,
+        "{awaited:#?}"
+    );
+    assert_eq!(format!("{blocking:?}"), format!("{awaited:?}"));
 }

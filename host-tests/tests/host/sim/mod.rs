@@ -19,6 +19,7 @@
 
 #![allow(dead_code)]
 
+pub mod asynch;
 pub mod hooks;
 pub mod icm42688;
 pub mod mpu6050;
