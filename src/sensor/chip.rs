@@ -69,6 +69,10 @@ pub struct Map {
     pub configured: Check,
     /// The formula of the raw temperature of the chip's samples.
     pub thermometer: Thermometer,
+    /// The chip writes whole packets into its FIFO, so its byte count is a whole number of
+    /// packets: a remainder means a byte lost or added on the wire (an SPI slip), and the
+    /// packets are misaligned.
+    pub whole_packets: bool,
 }
 
 /// What a FIFO packet turned out to be.

@@ -33,6 +33,10 @@ pub(crate) struct PendingReset {
     overflow: bool,
     /// The reset is for a failed data read.
     resync: bool,
+    /// The INT_STATUS read that closes a FIFO read failed: an overflow during the read may
+    /// have set its flag, and the failed read may have cleared it. The reset counts an
+    /// overflow when the bytes it drops reach the FIFO's size (the FIFO may have filled up).
+    flag_unknown: bool,
     /// Bytes of the dropped packets already taken out of the FIFO: read before a failed
     /// transfer, or clocked out by it.
     consumed: u32,
@@ -191,7 +195,7 @@ pub(crate) async fn enable<C: Chip>(
     reset(chip, state).await?;
     state.running = true;
     if let Some(p) = state.pending.take() {
-        count_reset(&mut state.stats, p, packet::<C>());
+        count_reset::<C>(&mut state.stats, p);
     }
     Ok(())
 }
@@ -229,6 +233,11 @@ pub(crate) async fn read_fifo<C: Chip>(
     }
     if state.pending.is_some() {
         return finish_reset(chip, state).await;
+    }
+    if C::MAP.whole_packets && usize::from(readable) % packet != 0 {
+        // A chip that writes whole packets holds part of one: a byte was lost or added on the
+        // wire (an SPI slip), and every packet after it is misaligned.
+        return drop_call(chip, state, 0, |p| p.resync = true).await;
     }
     let available = usize::from(readable) / packet;
     if available == 0 {
@@ -280,8 +289,27 @@ pub(crate) async fn read_fifo<C: Chip>(
         return drop_call(chip, state, taken, |p| {
             p.overflow |= flag.is_ok();
             p.resync |= flag.is_err();
+            p.flag_unknown |= flag.is_err();
         })
         .await;
+    }
+    // A chip that reset itself during the read left its FIFO off, and the bytes read after
+    // the reset are no samples (an empty FIFO repeats a byte): its FIFO mode says. The call's
+    // samples are not delivered; the recovery's outage counts them.
+    for &check in C::MAP.fifo_on {
+        match chip.check(check).await {
+            Ok(true) => {}
+            Ok(false) => {
+                state.reset_seen = true;
+                return Err(Error::SensorReset);
+            }
+            Err(_) => return drop_call(chip, state, taken, |p| p.resync = true).await,
+        }
+    }
+    // A byte slipped during the read misaligned the packets after it: the FIFO then holds part
+    // of a packet.
+    if C::MAP.whole_packets && !matches!(count(chip).await, Ok(c) if usize::from(c) % packet == 0) {
+        return drop_call(chip, state, taken, |p| p.resync = true).await;
     }
     batch.count(&mut state.stats);
     Ok(batch.delivered)
@@ -377,6 +405,11 @@ async fn reset<C: Chip>(chip: &mut C, state: &mut FifoState) -> Result<(), Error
     chip.write_all(C::MAP.fifo_stop).await?;
     let held = count(chip).await?;
     observe::<C>(state, held);
+    if held >= C::MAP.fifo_bytes {
+        // A full FIFO has overwritten its oldest bytes: an overflow, whether or not its flag
+        // was read (a read of INT_STATUS that failed may have cleared it).
+        state.mark_overflow();
+    }
     if held == 0 && !chip.check(C::MAP.configured).await? {
         // A chip that reset itself: starting its FIFO would hide the reset (the FIFO would
         // look configured, and stay empty).
@@ -395,20 +428,21 @@ async fn reset<C: Chip>(chip: &mut C, state: &mut FifoState) -> Result<(), Error
 }
 
 /// Counts a reset that has been carried out: its bytes as discarded, its cause. Returns the
-/// complete samples discarded.
-fn count_reset(stats: &mut FifoStats, p: PendingReset, packet: usize) -> u16 {
+/// complete samples discarded, and whether the cause is an overflow.
+fn count_reset<C: Chip>(stats: &mut FifoStats, p: PendingReset) -> (u16, bool) {
     let bytes = p.consumed.saturating_add(u32::from(p.held));
-    let discarded = bytes / u32::try_from(packet.max(1)).unwrap_or(1);
+    let discarded = bytes / u32::try_from(packet::<C>()).unwrap_or(1);
+    let overflow = p.overflow || (p.flag_unknown && bytes >= u32::from(C::MAP.fifo_bytes));
     stats.discarded = stats.discarded.saturating_add(u64::from(discarded));
     stats.discarded_bytes = stats.discarded_bytes.saturating_add(u64::from(bytes));
     stats.unsure = stats.unsure.saturating_add(u64::from(p.unsure));
     stats.malformed = stats.malformed.saturating_add(p.malformed);
-    if p.overflow {
+    if overflow {
         stats.overflows = stats.overflows.saturating_add(1);
     } else if p.resync {
         stats.resyncs = stats.resyncs.saturating_add(1);
     }
-    u16::try_from(discarded).unwrap_or(u16::MAX)
+    (u16::try_from(discarded).unwrap_or(u16::MAX), overflow)
 }
 
 /// Carries out the pending reset and counts it: [`Error::FifoOverflow`] or
@@ -421,8 +455,8 @@ async fn finish_reset<C: Chip>(
     let Some(p) = state.pending.take() else {
         return Ok(0);
     };
-    let discarded = count_reset(&mut state.stats, p, packet::<C>());
-    if p.overflow {
+    let (discarded, overflow) = count_reset::<C>(&mut state.stats, p);
+    if overflow {
         Err(Error::FifoOverflow { discarded })
     } else {
         Err(Error::FifoResync { discarded })

@@ -480,6 +480,7 @@ const MAP: Map = Map {
     fifo_on: &[STREAMING, CHANNELS_ON],
     configured: SENSORS_ON,
     thermometer: Thermometer::ICM42688,
+    whole_packets: true,
 };
 
 /// The ICM-42688-P on an SPI device: the chip that an [`Icm42688`] drives.

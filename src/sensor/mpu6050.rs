@@ -427,6 +427,7 @@ const MAP: Map = Map {
     fifo_on: &[FIFO_ON],
     configured: AWAKE_ON_PLL,
     thermometer: Thermometer::MPU6050,
+    whole_packets: false,
 };
 
 /// The MPU-6050 at its address on an I2C bus: the chip that an [`Mpu6050`] drives.

@@ -964,3 +964,108 @@ fn board_loop_counts_a_malformed_packet_of_a_failed_call_once() {
     let accounted = s.samples + s.discarded + s.malformed + s.lost + sim.fifo_packets();
     assert_eq!(accounted, sim.ticks - t0, "{p2:?}: {s:?}");
 }
+
+/// ICM-42688-P: a byte slip before a packet whose timestamp's low byte looks like a header
+/// (0x60 to 0x6F: accelerometer and gyro, no 20-byte flag) was never found: the next call's
+/// one shifted packet passed the header test and was delivered, garbage. The chip writes whole
+/// packets, so after a slip its FIFO holds part of one: the count says, at the end of the
+/// slipped read and at the start of every call.
+/// Expected: for every timestamp byte, no misaligned sample is delivered, the slip is
+/// resynchronised and samples flow again; both readers.
+#[test]
+fn icm_slip_before_a_header_like_byte_delivers_nothing_misaligned() {
+    for before in 0..64u64 {
+        for (sim, hooks, mut imu) in icm_both(500 + before) {
+            let mut out = [RawSample::default(); 160];
+            // Drain, then the slipped read of one to three packets; then one more packet.
+            sim.borrow_mut().tick(before);
+            let _ = imu.read_fifo(&mut out);
+            let produced = sim.borrow().produced;
+            // The slipped packet's timestamp low byte: 0x60 + (before % 16) for before < 64,
+            // by aligning the producer's count.
+            let next = (produced & !0xFF) + 0x160 + (before % 16);
+            let wait = next - produced;
+            sim.borrow_mut().tick(wait);
+            let _ = imu.read_fifo(&mut out);
+            sim.borrow_mut().tick(1 + before % 3);
+            hooks.add(Kind::Read(icm::FIFO_DATA), 0, Action::Slip);
+            let mut resynced = false;
+            for k in 0..4 {
+                match imu.read_fifo(&mut out) {
+                    Ok(n) => {
+                        let garbage = out[..n].iter().filter(|s| decode(s).is_none()).count();
+                        assert_eq!(garbage, 0, "before {before}, call {k}: garbage delivered");
+                    }
+                    Err(Error::FifoResync { .. }) => resynced = true,
+                    Err(e) => panic!("before {before}: {e:?}"),
+                }
+                sim.borrow_mut().tick(1);
+            }
+            assert!(resynced, "before {before}: the slip was not found");
+            sim.borrow_mut().tick(5);
+            let n = imu.read_fifo(&mut out).unwrap();
+            assert!(n >= 5 && out[..n].iter().all(|s| decode(s).is_some()));
+        }
+    }
+}
+
+/// MPU-6050: the chip resets itself (a supply glitch) between the reader's FIFO_COUNT reads
+/// and its FIFO_R_W read. The reset FIFO is off and empty, and its reads repeat a byte: the
+/// reader delivered those bytes as samples (all zeros).
+/// Expected: nothing delivered, `Error::SensorReset`; `recover` brings samples back; both
+/// readers.
+#[test]
+fn mpu_chip_reset_during_a_read_delivers_nothing() {
+    for (sim, hooks, mut imu) in mpu_both(31) {
+        let mut out = [RawSample::default(); 64];
+        sim.borrow_mut().tick(10);
+        hooks.add(Kind::Read(mpu::FIFO_R_W), 0, Action::GlitchBefore);
+        let r = imu.read_fifo(&mut out);
+        assert_eq!(r, Err(Error::SensorReset), "{r:?}");
+        assert_eq!(imu.fifo_stats().samples, 0);
+        assert_eq!(imu.fifo_stats().discarded, 0);
+    }
+    // Recovered (the blocking reader, as the board loop does).
+    let (sim, hooks, mut imu) = mpu(31);
+    let mut out = [RawSample::default(); 64];
+    sim.borrow_mut().tick(10);
+    hooks.add(Kind::Read(mpu::FIFO_R_W), 0, Action::GlitchBefore);
+    assert_eq!(imu.read_fifo(&mut out), Err(Error::SensorReset));
+    imu.recover(&mut NoDelay, 10_000).unwrap();
+    sim.borrow_mut().tick(5);
+    let n = imu.read_fifo(&mut out).unwrap();
+    assert_eq!(n, 5);
+    assert!(out[..n].iter().all(|s| decode(s).is_some()));
+    assert_eq!(imu.fifo_stats().resets, 1);
+}
+
+/// Both chips: the FIFO overflows during the data read, and the INT_STATUS read that closes
+/// the read fails after clearing the flag. The call's packets were dropped and the FIFO reset,
+/// but counted as a resync: the overflow was lost.
+/// Expected: a FIFO found full by the reset is an overflow, flag or not: `overflows` 1.
+#[test]
+fn failed_closing_int_status_read_still_counts_the_overflow() {
+    for (sim, hooks, mut imu) in mpu_both(41) {
+        let mut out = [RawSample::default(); 128];
+        sim.borrow_mut().tick(80);
+        hooks.add(Kind::Read(mpu::FIFO_R_W), 0, Action::TickBefore(10));
+        // The opening INT_STATUS read, then the closing one, which fails once applied.
+        sim.borrow_mut()
+            .fail_applied(Kind::Read(mpu::INT_STATUS), 1);
+        let r = imu.read_fifo(&mut out);
+        assert!(matches!(r, Err(Error::FifoOverflow { .. })), "{r:?}");
+        let s = imu.fifo_stats();
+        assert_eq!((s.overflows, s.resyncs), (1, 0), "{s:?}");
+    }
+    for (sim, hooks, mut imu) in icm_both(41) {
+        let mut out = [RawSample::default(); 160];
+        sim.borrow_mut().tick(120);
+        hooks.add(Kind::Read(icm::FIFO_DATA), 0, Action::TickBefore(10));
+        sim.borrow_mut()
+            .fail_applied(Kind::Read(icm::INT_STATUS), 1);
+        let r = imu.read_fifo(&mut out);
+        assert!(matches!(r, Err(Error::FifoOverflow { .. })), "{r:?}");
+        let s = imu.fifo_stats();
+        assert_eq!((s.overflows, s.resyncs), (1, 0), "{s:?}");
+    }
+}

@@ -81,6 +81,18 @@ fn icm_fifo_reset(held: u16) -> Vec<Spi<u8>> {
     v
 }
 
+/// What closes a FIFO read that found nothing wrong: INT_STATUS without the overflow flag, the
+/// FIFO still in stream mode with its channels on, and a count of `left` bytes, whole packets.
+fn icm_read_closed(left: u16) -> Vec<Spi<u8>> {
+    [
+        spi_read(0x2D, vec![0x00]),                  // INT_STATUS after the read
+        spi_read(0x16, vec![0x40]),                  // FIFO_CONFIG: stream mode
+        spi_read(0x5F, vec![0x07]),                  // FIFO_CONFIG1: packet 3
+        spi_read(0x2E, left.to_be_bytes().to_vec()), // FIFO_COUNT
+    ]
+    .concat()
+}
+
 /// A reader on a mock expecting `expect`, initialised with `icm_config()` and its FIFO on:
 /// `expect` begins with `icm_init()` and `icm_fifo_enable()`.
 fn icm_with_fifo(expect: &[Spi<u8>]) -> Icm42688<SpiMock<u8>> {
@@ -209,25 +221,26 @@ fn icm42688_wrong_device_is_a_typed_error() {
 /// A header that is not one (a wrong layout, or the "FIFO empty" marker inside the counted
 /// bytes) most likely means misaligned packets: the call's packets are dropped (the malformed
 /// ones counted as such, the rest as discarded) and the FIFO is flushed, which realigns it.
+/// The chip writes whole packets, so a count with part of one (a byte slipped on the wire)
+/// is misaligned too.
 #[test]
 fn icm42688_fifo_packets_malformed_empty_and_partial() {
     let mut expect = icm_init();
     expect.extend(icm_fifo_enable());
     expect.extend(spi_read(0x2D, vec![0x08])); // INT_STATUS: data ready
-    expect.extend(spi_read(0x2E, vec![0, 2 * 16 + 7])); // 2 packets and 7 stray bytes
-    expect.extend(spi_read(0x2E, vec![0, 2 * 16 + 7])); // the count confirmed
+    expect.extend(spi_read(0x2E, vec![0, 2 * 16])); // 2 packets
+    expect.extend(spi_read(0x2E, vec![0, 2 * 16])); // the count confirmed
     let data = [
         icm_packet(0x68, [1, 2, 3], [4, 5, 6], 10),
         icm_packet(0x6A, [-1, -2, -3], [-4, -5, -6], -5),
     ]
     .concat();
     expect.extend(spi_read(0x30, data));
-    expect.extend(spi_read(0x2D, vec![0x00])); // INT_STATUS after the read
-    // The partial packet stays for the next call; the next packet is gyro only: malformed
-    // for this layout.
+    expect.extend(icm_read_closed(0));
+    // The next call's second packet is gyro only: malformed for this layout.
     expect.extend(spi_read(0x2D, vec![0x00]));
-    expect.extend(spi_read(0x2E, vec![0, 3 * 16 + 7]));
-    expect.extend(spi_read(0x2E, vec![0, 3 * 16 + 7])); // the count confirmed
+    expect.extend(spi_read(0x2E, vec![0, 3 * 16]));
+    expect.extend(spi_read(0x2E, vec![0, 3 * 16])); // the count confirmed
     let data = [
         icm_packet(0x68, [7; 3], [7; 3], 0),
         icm_packet(0x28, [0; 3], [7, 8, 9], 0),
@@ -235,7 +248,7 @@ fn icm42688_fifo_packets_malformed_empty_and_partial() {
     ]
     .concat();
     expect.extend(spi_read(0x30, data));
-    expect.extend(icm_fifo_reset(7));
+    expect.extend(icm_fifo_reset(0));
     // An empty-FIFO header inside the counted bytes is a damaged header too.
     expect.extend(spi_read(0x2D, vec![0x00]));
     expect.extend(spi_read(0x2E, vec![0, 32]));
@@ -249,6 +262,11 @@ fn icm42688_fifo_packets_malformed_empty_and_partial() {
         .concat(),
     ));
     expect.extend(icm_fifo_reset(0));
+    // A packet and 7 bytes: misaligned, nothing read; the flush drops the packet.
+    expect.extend(spi_read(0x2D, vec![0x00]));
+    expect.extend(spi_read(0x2E, vec![0, 16 + 7]));
+    expect.extend(spi_read(0x2E, vec![0, 16 + 7])); // the count confirmed
+    expect.extend(icm_fifo_reset(16 + 7));
     let mut imu = Icm42688::new(SpiMock::new(&expect));
     let mut out = [RawSample::default(); 8];
     assert_eq!(imu.read_fifo(&mut out), Err(Error::FifoDisabled));
@@ -269,10 +287,14 @@ fn icm42688_fifo_packets_malformed_empty_and_partial() {
     );
     let celsius = imu.die_temperature(&out[0]).unwrap();
     assert!((celsius - (10.0 / 2.07 + 25.0)).abs() < 1e-4, "{celsius}");
-    // 2 good packets and the 7 stray bytes dropped with the malformed one: 2 discarded.
+    // 2 good packets dropped with the malformed one: 2 discarded.
     assert_eq!(
         imu.read_fifo(&mut out),
         Err(Error::FifoResync { discarded: 2 })
+    );
+    assert_eq!(
+        imu.read_fifo(&mut out),
+        Err(Error::FifoResync { discarded: 1 })
     );
     assert_eq!(
         imu.read_fifo(&mut out),
@@ -286,7 +308,7 @@ fn icm42688_fifo_packets_malformed_empty_and_partial() {
             stats.discarded,
             stats.resyncs
         ),
-        (2, 2, 3, 2)
+        (2, 2, 4, 3)
     );
     imu.destroy().done();
 }
@@ -303,7 +325,7 @@ fn icm42688_fifo_overflow_is_counted_and_recovered() {
     expect.extend(spi_read(0x2E, vec![0, 16]));
     expect.extend(spi_read(0x2E, vec![0, 16])); // the count confirmed
     expect.extend(spi_read(0x30, icm_packet(0x68, [1; 3], [2; 3], 0)));
-    expect.extend(spi_read(0x2D, vec![0x00])); // INT_STATUS after the read
+    expect.extend(icm_read_closed(0));
     let mut imu = icm_with_fifo(&expect);
     common::overflow_then_one_sample(&mut imu, 128);
     imu.destroy().done();
@@ -319,7 +341,7 @@ fn icm42688_resetting_itself_is_detected_recovered_and_counted() {
     expect.extend(spi_read(0x2E, vec![0, 16]));
     expect.extend(spi_read(0x2E, vec![0, 16])); // the count confirmed
     expect.extend(spi_read(0x30, icm_packet(0x68, [1; 3], [2; 3], 0)));
-    expect.extend(spi_read(0x2D, vec![0x00])); // INT_STATUS after the read
+    expect.extend(icm_read_closed(0));
     expect.extend(spi_read(0x2D, vec![0x00]));
     expect.extend(spi_read(0x2E, vec![0, 0]));
     expect.extend(spi_read(0x16, vec![0x00])); // FIFO_CONFIG after a reset: bypass
@@ -417,7 +439,7 @@ fn icm42688_invalid_marker_is_skipped_and_counted() {
     ]
     .concat();
     expect.extend(spi_read(0x30, data));
-    expect.extend(spi_read(0x2D, vec![0x00])); // INT_STATUS after the read
+    expect.extend(icm_read_closed(0));
     let mut burst = Vec::new();
     for v in [1325i16, 0, 0, 0, i16::MIN, i16::MIN, i16::MIN] {
         burst.extend(v.to_be_bytes());

@@ -223,12 +223,14 @@ fn mpu6050_fifo_whole_packets_chunks_and_partial_packets() {
     expect.push(I2c::write_read(ADDR, vec![0x74], packets[..8].concat()));
     expect.push(I2c::write_read(ADDR, vec![0x74], packets[8..].concat()));
     expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x00])); // INT_STATUS after the read
+    expect.push(I2c::write_read(ADDR, vec![0x6A], vec![0x40, 0x01])); // the FIFO still on
     // The next call asks for fewer samples than there are.
     expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x00]));
     expect.push(I2c::write_read(ADDR, vec![0x72], vec![0, 41])); // 3 packets + 5 bytes
     expect.push(I2c::write_read(ADDR, vec![0x72], vec![0, 41]));
     expect.push(I2c::write_read(ADDR, vec![0x74], packets[..2].concat()));
     expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x00])); // INT_STATUS after the read
+    expect.push(I2c::write_read(ADDR, vec![0x6A], vec![0x40, 0x01])); // the FIFO still on
     let mut imu = Mpu6050::new(I2cMock::new(&expect), ADDR);
     let mut out = [RawSample::default(); 16];
     assert_eq!(imu.read_fifo(&mut out), Err(Error::FifoDisabled));
@@ -264,6 +266,7 @@ fn mpu6050_fifo_overflow_is_counted_and_recovered() {
         mpu_packet([1, 2, 3], [4, 5, 6]),
     ));
     expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x00])); // INT_STATUS after the read
+    expect.push(I2c::write_read(ADDR, vec![0x6A], vec![0x40, 0x01])); // the FIFO still on
     let mut imu = mpu_with_fifo(&expect);
     common::overflow_then_one_sample(&mut imu, 85);
     imu.destroy().done();
@@ -319,6 +322,7 @@ fn mpu6050_resetting_itself_is_detected_recovered_and_counted() {
     let packets = [mpu_packet([1; 3], [2; 3]), mpu_packet([3; 3], [4; 3])];
     expect.push(I2c::write_read(ADDR, vec![0x74], packets.concat()));
     expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x00])); // INT_STATUS after the read
+    expect.push(I2c::write_read(ADDR, vec![0x6A], vec![0x40, 0x01])); // the FIFO still on
     expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x00]));
     expect.push(I2c::write_read(ADDR, vec![0x72], vec![0, 0]));
     // USER_CTRL and PWR_MGMT_1 after a reset: FIFO off, asleep.
@@ -336,6 +340,7 @@ fn mpu6050_resetting_itself_is_detected_recovered_and_counted() {
         mpu_packet([5; 3], [6; 3]),
     ));
     expect.push(I2c::write_read(ADDR, vec![0x3A], vec![0x00])); // INT_STATUS after the read
+    expect.push(I2c::write_read(ADDR, vec![0x6A], vec![0x40, 0x01])); // the FIFO still on
     let mut imu = mpu_with_fifo(&expect);
     let mut out = [RawSample::default(); 4];
     assert_eq!(imu.read_fifo(&mut out), Ok(2));

@@ -18,6 +18,8 @@ use super::{Kind, Sim};
 pub enum Action {
     /// The chip writes `n` samples right before the transfer.
     TickBefore(u64),
+    /// The chip resets itself right before the transfer (a supply glitch).
+    GlitchBefore,
     /// The read returns these bytes at these offsets (after the chip's own answer).
     Overwrite(Vec<(usize, u8)>),
     /// The read takes one byte fewer out of the chip than it returns, and reports success (a
@@ -67,6 +69,9 @@ impl Hooks {
         let action = self.due(kind);
         if let Some(Action::TickBefore(n)) = &action {
             sim.borrow_mut().tick(*n);
+        }
+        if let Some(Action::GlitchBefore) = &action {
+            sim.borrow_mut().glitch();
         }
         match buf {
             Some(buf) if matches!(action, Some(Action::Slip)) && buf.len() > 1 => {
