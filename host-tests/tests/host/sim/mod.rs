@@ -117,6 +117,15 @@ pub struct Sim {
     rules: Vec<Rule>,
     /// Probability of a random fault at each transfer.
     pub rate: f64,
+    /// Probability that one to three samples arrive right before a transfer (samples keep
+    /// arriving while the reader works).
+    pub arrivals: f64,
+    /// Probability that a FIFO data read slips a byte: it takes one byte fewer out of the
+    /// FIFO than it returns, its last byte repeating the one before, and reports success (SPI
+    /// has no acknowledge).
+    pub slips: f64,
+    /// Slips made.
+    pub slipped: u64,
     /// Every read returns 0xFF (SDA stuck high).
     pub stuck_high: bool,
     /// The sensor is unplugged: every transfer fails and does nothing.
@@ -175,6 +184,9 @@ impl Sim {
             rng: ChaCha8Rng::seed_from_u64(seed),
             rules: Vec::new(),
             rate: 0.0,
+            arrivals: 0.0,
+            slips: 0.0,
+            slipped: 0,
             stuck_high: false,
             unplugged: false,
             who_am_i: model.chip().id,
@@ -390,6 +402,13 @@ impl Sim {
 
     /// One transfer: `Err(())` when it fails.
     fn transfer(&mut self, kind: Kind, buf: &mut [u8]) -> Result<(), ()> {
+        if self.arrivals > 0.0 && !self.unplugged {
+            let draw = self.rng.next_u64() as f64 / u64::MAX as f64;
+            if draw < self.arrivals {
+                let n = 1 + self.rng.next_u64() % 3;
+                self.tick(n);
+            }
+        }
         let fault = self.decide(kind, buf.len());
         match (kind, fault) {
             (Kind::Write(reg), None) => {
@@ -404,7 +423,17 @@ impl Sim {
             }
             (Kind::Read(reg), None) => {
                 let n = buf.len();
-                self.read(reg, buf, n);
+                let slip = self.slips > 0.0
+                    && n > 1
+                    && self.is_fifo_data(reg)
+                    && (self.rng.next_u64() as f64 / u64::MAX as f64) < self.slips;
+                if slip {
+                    self.slipped += 1;
+                    self.read(reg, &mut buf[..n - 1], n - 1);
+                    buf[n - 1] = buf[n - 2];
+                } else {
+                    self.read(reg, buf, n);
+                }
                 Ok(())
             }
             (Kind::Read(reg), Some(f)) => {

@@ -44,6 +44,10 @@ pub struct Figures {
 ///
 /// `ticks = delivered + discarded + invalid + malformed + lost + dropped by the chip while
 /// full + ticks with the FIFO's channels off outside an outage + left in the FIFO`.
+///
+/// With samples arriving during transfers (`Sim::arrivals`) or byte slips (`Sim::slips`) the
+/// sum is within its bounds instead: at most `unsure` below the ticks, at most one per slip
+/// above them.
 pub fn fault_run<R: ImuReader>(
     sim: &Rc<RefCell<Sim>>,
     reader: &mut R,
@@ -139,7 +143,10 @@ where
     }
 
     // The faults stop: one recovery, and samples flow again.
+    let arrived_or_slipped = sim.borrow().arrivals > 0.0 || sim.borrow().slips > 0.0;
     sim.borrow_mut().rate = 0.0;
+    sim.borrow_mut().arrivals = 0.0;
+    sim.borrow_mut().slips = 0.0;
     sim.borrow_mut().tick(5);
     assert!(
         try_recover(
@@ -159,6 +166,7 @@ where
     delivered += accept(&out[..k], &mut last_seq);
 
     let sim = sim.borrow();
+    let slipped = sim.slipped;
     let paused_outside = sim
         .paused
         .iter()
@@ -192,17 +200,28 @@ where
             "no fault at {kind:?}: {figures:#?}"
         );
     }
-    assert_eq!(
-        figures.ticks,
-        delivered
-            + stats.discarded
-            + stats.invalid
-            + stats.malformed
-            + stats.lost
-            + figures.dropped_by_chip
-            + paused_outside
-            + figures.left_in_fifo,
-        "every tick accounted for: {figures:#?}"
-    );
+    let counted = delivered
+        + stats.discarded
+        + stats.invalid
+        + stats.malformed
+        + stats.lost
+        + figures.dropped_by_chip
+        + paused_outside
+        + figures.left_in_fifo;
+    if arrived_or_slipped {
+        // Samples arriving while a failed transfer clocks out bytes look the same to the
+        // counts as a transfer that clocked out more (`FifoStats::unsure`); a slipped byte
+        // can make one sample count twice.
+        assert!(
+            counted <= figures.ticks + slipped && figures.ticks <= counted + stats.unsure,
+            "every tick accounted for within the bounds: {counted} counted, {slipped} slips, \
+             {figures:#?}"
+        );
+    } else {
+        assert_eq!(
+            figures.ticks, counted,
+            "every tick accounted for: {figures:#?}"
+        );
+    }
     figures
 }
