@@ -97,9 +97,24 @@ impl PendingReset {
     }
 }
 
+/// A FIFO read under way: its data transfers have begun. An async `read_fifo` whose future is
+/// dropped there (a timeout, a `select`) leaves it behind, and the next call settles it as a
+/// failed read ([`settle_cancelled`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct InCall {
+    /// Bytes in the FIFO at the count the call read by.
+    latest: u16,
+    /// Bytes read by its completed transfers.
+    taken: u16,
+    /// Bytes the transfer under way asks for (0 between transfers).
+    len: u16,
+}
+
 /// A reader's FIFO bookkeeping.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct FifoState {
+    /// A read whose data transfers began and that has not returned.
+    in_call: Option<InCall>,
     /// `init` has completed: the chip is configured.
     pub(crate) initialised: bool,
     /// The FIFO should be on: `enable_fifo` was called since the last `init`.
@@ -117,6 +132,7 @@ pub(crate) struct FifoState {
 impl FifoState {
     /// `init` begins: the chip is being reset, its FIFO is off and nobody asked for it.
     pub(crate) fn off(&mut self) {
+        self.in_call = None;
         self.initialised = false;
         self.wanted = false;
         self.running = false;
@@ -129,6 +145,8 @@ impl FifoState {
     /// its cause (an overflow, a failed read) is kept, and counted when the FIFO runs again.
     pub(crate) fn recovering(&mut self) {
         self.running = false;
+        // The samples of a read cancelled part-way are inside the outage.
+        self.in_call = None;
         self.pending = self.pending.map(|p| PendingReset {
             overflow: p.overflow,
             resync: p.resync,
@@ -178,6 +196,24 @@ fn observe<C: Chip>(state: &mut FifoState, count: u16) {
     }
 }
 
+/// A read left part-way by a dropped future: its packets were taken out of the FIFO (the
+/// completed transfers' bytes, and up to the whole of a transfer under way) and never
+/// delivered. Settled as a failed data read: a FIFO reset realigns the packets and counts them,
+/// the bytes of the transfer under way reckoned from the next count ([`PendingReset::observe`]).
+fn settle_cancelled(state: &mut FifoState) {
+    if let Some(c) = state.in_call.take() {
+        let pending = state.pending.get_or_insert_with(PendingReset::default);
+        pending.resync = true;
+        pending.consumed = pending.consumed.saturating_add(u32::from(c.taken));
+        if c.len > 0 {
+            pending.unresolved = Some(Unresolved {
+                left: c.latest.saturating_sub(c.taken),
+                len: c.len,
+            });
+        }
+    }
+}
+
 /// `enable_fifo` of every chip: the chip's first write, then a FIFO reset. A FIFO that an
 /// earlier attempt left running is emptied by it: its samples are counted as discarded, and a
 /// reset still pending (an overflow, a failed read) is counted as done.
@@ -188,6 +224,7 @@ pub(crate) async fn enable<C: Chip>(
     if !state.initialised {
         return Err(Error::NotInitialised);
     }
+    settle_cancelled(state);
     state.wanted = true;
     state.running = false;
     state.pending.get_or_insert_with(PendingReset::default);
@@ -202,6 +239,18 @@ pub(crate) async fn enable<C: Chip>(
 
 /// `ImuReader::read_fifo` of every chip; see the readers' documentation.
 pub(crate) async fn read_fifo<C: Chip>(
+    chip: &mut C,
+    state: &mut FifoState,
+    out: &mut [RawSample],
+) -> Result<usize, Error<C::BusError>> {
+    settle_cancelled(state);
+    let result = read_fifo_once(chip, state, out).await;
+    state.in_call = None;
+    result
+}
+
+/// [`read_fifo`] once an earlier call cancelled part-way is settled.
+async fn read_fifo_once<C: Chip>(
     chip: &mut C,
     state: &mut FifoState,
     out: &mut [RawSample],
@@ -256,7 +305,14 @@ pub(crate) async fn read_fifo<C: Chip>(
     while remaining > 0 && batch.delivered < out.len() {
         let n = remaining.min(CHUNK).min(out.len() - batch.delivered);
         let bytes = &mut buf[..n * packet];
+        let u16_of = |v: usize| u16::try_from(v).unwrap_or(u16::MAX);
+        state.in_call = Some(InCall {
+            latest,
+            taken: u16_of(taken),
+            len: u16_of(n * packet),
+        });
         if let Err(e) = chip.read(C::MAP.fifo_data, bytes).await {
+            state.in_call = None;
             resync(chip, state, latest, taken, n * packet).await;
             return match finish_reset(chip, state).await {
                 Err(Error::Bus(_)) => Err(Error::Bus(e)),
@@ -265,6 +321,11 @@ pub(crate) async fn read_fifo<C: Chip>(
         }
         taken += n * packet;
         remaining -= n;
+        state.in_call = Some(InCall {
+            latest,
+            taken: u16_of(taken),
+            len: 0,
+        });
         batch.parse::<C>(bytes, out);
         if batch.malformed > 0 {
             // A header that is not one (the "FIFO empty" marker inside the counted bytes
@@ -390,6 +451,8 @@ async fn drop_call<C: Chip>(
     bytes: usize,
     mark: impl FnOnce(&mut PendingReset),
 ) -> Result<usize, Error<C::BusError>> {
+    // The call's bytes are the pending reset's now, whatever becomes of this future.
+    state.in_call = None;
     let pending = state.pending.get_or_insert_with(PendingReset::default);
     mark(pending);
     pending.consumed = pending
