@@ -37,6 +37,24 @@ pub struct Skipped {
 }
 
 impl Skipped {
+    /// What was lost, in words, when anything was (`None` otherwise): "12 undecodable, 3 not
+    /// finite". Messages of another IMU (`other_frame_id`), left out by choice, are not.
+    pub fn summary(&self) -> Option<String> {
+        let parts: Vec<String> = [
+            (
+                self.undecodable,
+                "undecodable (a batch or message dropped whole)",
+            ),
+            (self.non_finite, "not finite"),
+            (self.unpaired, "without a partner of the other sensor"),
+        ]
+        .iter()
+        .filter(|(n, _)| *n > 0)
+        .map(|(n, what)| format!("{n} {what}"))
+        .collect();
+        (!parts.is_empty()).then(|| format!("messages skipped: {}", parts.join(", ")))
+    }
+
     /// The warning for a log cut short, when it is.
     pub fn cut_short_warning(&self) -> Option<&'static str> {
         (self.cut_short > 0).then_some(

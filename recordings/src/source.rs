@@ -367,12 +367,20 @@ fn autopilot_stream(
     let mut skipped = Skipped::default();
     if kind == Kind::DataFlash {
         let survey = dataflash::survey(path).map_err(|e| Fail(e.to_string()))?;
-        let source = fuller_dataflash(&survey, &picks);
-        let found: Vec<(u8, String)> = survey
-            .instances(source)
-            .iter()
-            .map(|s| (s.instance, s.instance.to_string()))
-            .collect();
+        // The instances of the IMU messages and of the batches of the picked sensor; of the two,
+        // the one with more samples of the instance chosen.
+        let batch = batch_kind(&picks);
+        let mut found: Vec<(u8, String)> = Vec::new();
+        for s in survey
+            .instances(dataflash::Kind::Imu)
+            .into_iter()
+            .chain(batch.map(|b| survey.instances(b)).unwrap_or_default())
+        {
+            if found.iter().all(|(i, _)| *i != s.instance) {
+                found.push((s.instance, s.instance.to_string()));
+            }
+        }
+        found.sort_by_key(|(i, _)| *i);
         if found.is_empty() && !survey.unreadable.is_empty() {
             return Err(with_file(
                 files,
@@ -382,12 +390,13 @@ fn autopilot_stream(
                 ),
             ));
         }
-        let what = match source {
-            dataflash::Kind::Imu => "IMU messages",
-            dataflash::Kind::BatchGyro => "ISB gyro batches",
-            dataflash::Kind::BatchAccel => "ISB accel batches",
+        let what = match batch {
+            None => "IMU messages",
+            Some(dataflash::Kind::BatchGyro) => "IMU messages or ISB gyro batches",
+            Some(_) => "IMU messages or ISB accel batches",
         };
         let instance = choose(files, request, what, &found)?;
+        let source = fuller_dataflash(&survey, batch, instance);
         let select = dataflash::Select {
             kind: source,
             instance: Some(instance),
@@ -408,32 +417,59 @@ fn autopilot_stream(
     stamped(files, request, &picks, (timing, backward), skipped)
 }
 
-/// What a DataFlash log's axes `picks` are read from: the batch sampler's batches (`ISBH`,
-/// `ISBD`) of the one sensor they are all of, when those hold more samples than the `IMU`
-/// messages (the batches at the sensor's rate, the `IMU` messages at the loop's); the `IMU`
-/// messages otherwise, and always for axes of both sensors, which batches take at times of
-/// their own. A dropped or undecodable batch counts as undecodable.
-fn fuller_dataflash(survey: &dataflash::Survey, picks: &[usize]) -> dataflash::Kind {
-    let samples = |k| -> u64 { survey.instances(k).iter().map(|s| s.samples).sum() };
-    let batch = if picks.iter().all(|&i| i < 3) {
-        dataflash::Kind::BatchGyro
+/// The batches that could hold a DataFlash log's axes `picks`: those of the one sensor they
+/// are all of; none for axes of both sensors, which batches take at times of their own.
+fn batch_kind(picks: &[usize]) -> Option<dataflash::Kind> {
+    if picks.iter().all(|&i| i < 3) {
+        Some(dataflash::Kind::BatchGyro)
     } else if picks.iter().all(|&i| i >= 3) {
-        dataflash::Kind::BatchAccel
+        Some(dataflash::Kind::BatchAccel)
     } else {
-        return dataflash::Kind::Imu;
-    };
-    if samples(batch) > samples(dataflash::Kind::Imu) {
-        batch
-    } else {
-        dataflash::Kind::Imu
+        None
     }
 }
 
-/// Of a ULog file's sensor topic and its FIFO topic, the one with more samples: the FIFO
-/// topic at the sensor's full rate where the logger wrote it (SDLOG_PROFILE's raw FIFO bits),
-/// the sensor topic otherwise.
-pub fn fuller(survey: &ulog::Survey, sensor: ulog::Topic, fifo: ulog::Topic) -> ulog::Topic {
-    let samples = |t| -> u64 { survey.instances(t).iter().map(|i| i.samples).sum() };
+/// What a DataFlash log's IMU `instance` is read from: its batches of the `batch` kind
+/// (`ISBH`, `ISBD`), when those hold more of its samples than its `IMU` messages (the batches
+/// at the sensor's rate, the `IMU` messages at the loop's); its `IMU` messages otherwise. A
+/// dropped or undecodable batch counts as undecodable.
+fn fuller_dataflash(
+    survey: &dataflash::Survey,
+    batch: Option<dataflash::Kind>,
+    instance: u8,
+) -> dataflash::Kind {
+    let samples = |k| -> u64 {
+        survey
+            .instances(k)
+            .iter()
+            .filter(|s| s.instance == instance)
+            .map(|s| s.samples)
+            .sum()
+    };
+    match batch {
+        Some(b) if samples(b) > samples(dataflash::Kind::Imu) => b,
+        _ => dataflash::Kind::Imu,
+    }
+}
+
+/// Of a ULog file's sensor topic and its FIFO topic, the one with more samples (of `instance`,
+/// or of all instances): the FIFO topic at the sensor's full rate where the logger wrote it
+/// (SDLOG_PROFILE's raw FIFO bits, which PX4 may log for some IMUs only), the sensor topic
+/// otherwise.
+pub fn fuller(
+    survey: &ulog::Survey,
+    sensor: ulog::Topic,
+    fifo: ulog::Topic,
+    instance: Option<u8>,
+) -> ulog::Topic {
+    let samples = |t| -> u64 {
+        survey
+            .instances(t)
+            .iter()
+            .filter(|i| instance.is_none_or(|n| i.instance == n))
+            .map(|i| i.samples)
+            .sum()
+    };
     if samples(fifo) > samples(sensor) {
         fifo
     } else {
@@ -469,24 +505,30 @@ fn ulog_stream(
         if !wanted {
             continue;
         }
-        let topic = fuller(&survey, sensor, fifo);
-        let found: Vec<(u8, String)> = survey
-            .instances(topic)
-            .iter()
-            .map(|t| {
+        // The instances of either topic; of the two, the one with more samples of the
+        // instance chosen.
+        let mut found: Vec<(u8, String)> = Vec::new();
+        for t in survey
+            .instances(sensor)
+            .into_iter()
+            .chain(survey.instances(fifo))
+        {
+            if found.iter().all(|(i, _)| *i != t.instance) {
                 let ids: Vec<String> = t.device_ids.iter().map(u32::to_string).collect();
-                (
+                found.push((
                     t.instance,
                     format!("{} (device_id {})", t.instance, ids.join(", ")),
-                )
-            })
-            .collect();
+                ));
+            }
+        }
+        found.sort_by_key(|(i, _)| *i);
         let instance = choose(
             files,
             request,
-            &format!("{} messages", topic.name()),
+            &format!("{} or {} messages", sensor.name(), fifo.name()),
             &found,
         )?;
+        let topic = fuller(&survey, sensor, fifo, Some(instance));
         selects.push(ulog::Select {
             topic,
             which: ulog::Which::Instance(instance),
@@ -571,6 +613,10 @@ fn ulog_stream(
         ((join(g), join(x)), paired, unpaired)
     });
     let (g, x) = (reports.0.map_err(fail)?, reports.1.map_err(fail)?);
+    // A sample that is not finite is not delivered, and leaves its partner without one: the
+    // row is counted once, as not finite, as a CSV row with a NaN is.
+    let non_finite = g.non_finite + x.non_finite;
+    let unpaired = unpaired.saturating_sub(non_finite);
     if unpaired.saturating_mul(100) > paired.saturating_add(unpaired) {
         return Err(with_file(
             files,
@@ -584,7 +630,7 @@ fn ulog_stream(
         ));
     }
     skipped.undecodable = g.undecodable + x.undecodable;
-    skipped.non_finite = g.non_finite + x.non_finite;
+    skipped.non_finite = non_finite;
     skipped.unpaired = unpaired;
     Ok(skipped)
 }

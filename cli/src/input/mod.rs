@@ -94,6 +94,9 @@ impl Input {
         if let Some(w) = read.skipped.cut_short_warning() {
             eprintln!("imu-ar: warning: {}", self.fail(w).0);
         }
+        if let Some(w) = read.skipped.summary() {
+            eprintln!("imu-ar: warning: {}", self.fail(w).0);
+        }
         if let (Some(Some(bracket)), Some(to)) = (read.unknown.first(), &self.unit) {
             return Err(self.fail(format!(
                 "--unit {to}: column '{}' is in [{bracket}], which is not a unit converted here \

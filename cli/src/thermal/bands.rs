@@ -3,9 +3,10 @@
 //! calibration is applied), and the worst band's model for the noise parameter files.
 //!
 //! The bands split the sensor's calibrated range into equal widths; samples below or above it
-//! join the first or the last band. A band's samples are taken in time order: a warm-up
-//! crosses each band once, so they are one stretch of the record (a log that heats and cools
-//! crosses it twice, and the two stretches are joined).
+//! join the first or the last band. A warm-up crosses each band once, in one stretch of the
+//! record; a log that heats and cools crosses it twice, and the stretches cannot be joined (the
+//! Allan variance of the joint would see the step between them as noise): the longest stretch
+//! of the band is fitted, and the band says how many there were.
 
 use serde::Serialize;
 
@@ -29,8 +30,12 @@ pub struct BandNoise {
     pub from_c: f64,
     /// Its upper edge, deg C.
     pub to_c: f64,
-    /// Samples in the band.
+    /// Samples fitted: those of the band's longest stretch.
     pub n: usize,
+    /// Samples in the band, in all its stretches.
+    pub in_band: usize,
+    /// The stretches of the record in the band (the times the temperature crossed it).
+    pub stretches: usize,
     /// `N`, u/sqrt(Hz), when a model was fitted.
     pub white_noise: Option<f64>,
     /// Its 95 % interval, where the model gives one (the upper end infinite, `null`, when
@@ -111,17 +116,31 @@ pub fn fit(
         let mut bands = Vec::with_capacity(count);
         let mut models: Vec<Option<AxisModel>> = Vec::with_capacity(count);
         for b in 0..count {
-            let kept: Vec<f64> = x
-                .iter()
-                .zip(sensor.celsius)
-                .zip(&which)
-                .filter(|(_, w)| **w == b)
-                .map(|((v, t), _)| v - fit.poly.at(*t))
+            // The runs of consecutive samples in the band, and the longest.
+            let (mut stretches, mut in_band, mut longest, mut start) = (0, 0, 0..0, None);
+            for i in 0..=which.len() {
+                match (which.get(i) == Some(&b), start) {
+                    (true, None) => start = Some(i),
+                    (false, Some(s)) => {
+                        stretches += 1;
+                        in_band += i - s;
+                        if i - s > longest.len() {
+                            longest = s..i;
+                        }
+                        start = None;
+                    }
+                    _ => {}
+                }
+            }
+            let kept: Vec<f64> = longest
+                .map(|i| x[i] - fit.poly.at(sensor.celsius[i]))
                 .collect();
             let mut band = BandNoise {
                 from_c: low + width * b as f64,
                 to_c: low + width * (b + 1) as f64,
                 n: kept.len(),
+                in_band,
+                stretches,
                 white_noise: None,
                 white_noise_95: None,
                 random_walk: None,

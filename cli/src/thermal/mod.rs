@@ -171,6 +171,10 @@ pub struct Thermal {
     /// have a root mean square of at most [`HELD_OUT_Z`] (the fit explains them to their
     /// noise).
     pub generalises: bool,
+    /// The accelerometer's samples read (`n` is the gyro's).
+    pub n_accel: usize,
+    /// Samples of the gyro and of the accelerometer left out, by cause.
+    pub dropped: [Dropped; 2],
     /// Per axis, the noise model in each temperature band (none with `--bands 0`).
     pub noise_bands: Vec<AxisBands>,
     /// Why there are no noise bands, when there are none.
@@ -224,9 +228,25 @@ struct Record {
     axes: [Vec<f64>; 3],
     /// rad/s or m/s^2.
     unit: &'static str,
-    /// The sample rate, Hz, when the record gives it.
-    rate: Option<f64>,
+    /// The sample rate, Hz, or why the record gives none.
+    rate: Result<f64, String>,
+    /// Samples left out, by cause.
+    dropped: Dropped,
 }
+
+/// Samples of one sensor left out of the calibration, by cause.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct Dropped {
+    /// A NaN or infinite value.
+    pub non_finite: u64,
+    /// No temperature (a FIFO sample without its sensor topic's, say).
+    pub without_temperature: u64,
+    /// A temperature outside -60 to 150 deg C: no die temperature in deg C.
+    pub implausible_temperature: u64,
+}
+
+/// The die temperatures a sample may have, deg C (MEMS IMUs work from -40 to 105).
+const PLAUSIBLE_C: core::ops::RangeInclusive<f64> = -60.0..=150.0;
 
 /// A warm-up record: the gyro and the accelerometer of one IMU.
 struct WarmUp {
@@ -356,6 +376,8 @@ pub fn run(args: &Args) -> Result<Thermal, Fail> {
         caltemp_c: caltemp,
         generalises: results.iter().all(|a| a.generalises),
         axes: results,
+        n_accel: warm.sensors[1].celsius.len(),
+        dropped: [warm.sensors[0].dropped, warm.sensors[1].dropped],
         noise_bands,
         noise_bands_note,
         files: Vec::new(),
@@ -405,16 +427,23 @@ pub fn run(args: &Args) -> Result<Thermal, Fail> {
     }
     if let Some(noise_formats) = noise_formats {
         let Some((axes, rate)) = worst else {
-            return Err(with_file(
-                &args.files,
-                format!(
-                    "--noise-format: {}",
-                    thermal
-                        .noise_bands_note
-                        .as_deref()
-                        .unwrap_or("an axis has no band model")
-                ),
-            ));
+            let why = thermal.noise_bands_note.clone().unwrap_or_else(|| {
+                let missing: Vec<String> = thermal
+                    .noise_bands
+                    .iter()
+                    .filter(|a| a.worst.is_none())
+                    .map(|a| {
+                        let reason = a
+                            .bands
+                            .iter()
+                            .find_map(|b| b.note.clone())
+                            .unwrap_or_default();
+                        format!("{} ({reason})", a.axis)
+                    })
+                    .collect();
+                format!("no band of {} has a noise model", missing.join(", "))
+            });
+            return Err(with_file(&args.files, format!("--noise-format: {why}")));
         };
         let origin: Vec<String> = thermal
             .noise_bands
@@ -488,17 +517,20 @@ fn noise_bands(
     if args.bands == 0 {
         return Ok((Vec::new(), None, Some("--bands 0".into())));
     }
-    let (Some(gyro_rate), Some(accel_rate)) = (warm.sensors[0].rate, warm.sensors[1].rate) else {
-        return Ok((
-            Vec::new(),
-            None,
-            Some(
-                "the record gives no sample rate: give --rate, or a time column, for the noise \
-                 bands"
-                    .into(),
+    let (gyro_rate, accel_rate) = match (&warm.sensors[0].rate, &warm.sensors[1].rate) {
+        (Ok(g), Ok(a)) => (*g, *a),
+        (Err(e), _) | (_, Err(e)) => return Ok((Vec::new(), None, Some(e.clone()))),
+    };
+    if args.noise_format.is_some() && (accel_rate / gyro_rate - 1.0).abs() > 0.01 {
+        return Err(with_file(
+            &args.files,
+            format!(
+                "--noise-format: the gyro is sampled at {gyro_rate:.6} Hz and the accelerometer \
+                 at {accel_rate:.6} Hz; the noise parameter files take one IMU rate (leave \
+                 --noise-format out: the bands are reported for each)"
             ),
         ));
-    };
+    }
     let mut all = Vec::with_capacity(6);
     let mut models = Vec::with_capacity(6);
     for (s, rate) in [gyro_rate, accel_rate].into_iter().enumerate() {
@@ -539,19 +571,75 @@ fn warn_cut_short(path: &Path, truncated: Option<u64>) {
     }
 }
 
-/// The sample rate of sample times `us` (µs): one over their median interval.
-fn rate_of(us: &[f64]) -> Option<f64> {
-    let mut d: Vec<f64> = us
-        .windows(2)
-        .map(|w| w[1] - w[0])
-        .filter(|d| *d > 0.0)
-        .collect();
-    if d.is_empty() {
-        return None;
+/// The sample rate of a log's sample times `us` (µs): one over their median interval; an
+/// error when more than 1 % of the intervals are not positive (times that stand still or go
+/// back: a FIFO message with dt 0, say), which no rate describes.
+fn rate_of(us: &[f64]) -> Result<f64, String> {
+    let mut d: Vec<f64> = us.windows(2).map(|w| w[1] - w[0]).collect();
+    let bad = d.iter().filter(|d| d.is_nan() || **d <= 0.0).count();
+    if d.is_empty() || bad * 100 > d.len() {
+        return Err(format!(
+            "the log's sample times do not move forward ({bad} of {} intervals zero, negative or \
+             not a number): no sample rate for the noise bands",
+            d.len()
+        ));
     }
+    d.retain(|d| *d > 0.0);
     let mid = d.len() / 2;
     let (_, median, _) = d.select_nth_unstable_by(mid, f64::total_cmp);
-    Some(1e6 / *median)
+    Ok(1e6 / *median)
+}
+
+/// Keeps a sample of `record` at `celsius` with the values `xyz` (and its time `us` in
+/// `times`), or counts why not.
+fn keep(record: &mut Record, times: &mut Vec<f64>, us: f64, celsius: Option<f64>, xyz: [f64; 3]) {
+    let Some(t) = celsius else {
+        record.dropped.without_temperature += 1;
+        return;
+    };
+    if !t.is_finite() || xyz.iter().any(|v| !v.is_finite()) {
+        record.dropped.non_finite += 1;
+        return;
+    }
+    if !PLAUSIBLE_C.contains(&t) {
+        record.dropped.implausible_temperature += 1;
+        return;
+    }
+    record.celsius.push(t);
+    for (axis, x) in record.axes.iter_mut().zip(xyz) {
+        axis.push(x);
+    }
+    times.push(us);
+}
+
+/// An error when most of a sensor's temperatures are no die temperatures in deg C (a record in
+/// kelvin or Fahrenheit), or when more than 1 % of its samples were given a temperature held
+/// from the nearest one logged (`held`).
+fn check_dropped(files: &[PathBuf], record: &Record, what: &str, held: u64) -> Result<(), Fail> {
+    let d = record.dropped;
+    let kept = record.celsius.len() as u64;
+    if d.implausible_temperature > kept {
+        return Err(with_file(
+            files,
+            format!(
+                "{what}: {} of {} temperatures are outside -60 to 150 deg C: no die temperatures \
+                 in deg C (kelvin or Fahrenheit?)",
+                d.implausible_temperature,
+                kept + d.implausible_temperature
+            ),
+        ));
+    }
+    if held.saturating_mul(100) > kept {
+        return Err(with_file(
+            files,
+            format!(
+                "{what}: {held} of {kept} samples lie outside the times of the temperatures \
+                 logged for them (more than 1 %), and would take a temperature held from the \
+                 nearest: the temperature topic stopped early, or started late"
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// The warm-up record of `args.files`: a CSV record, a PX4 ULog file or an ArduPilot
@@ -609,13 +697,19 @@ fn read_ulog(path: &Path, instance: Option<u8>) -> Result<WarmUp, Fail> {
     .into_iter()
     .enumerate()
     {
-        let topic = source::fuller(&survey, topic, fifo);
-        let instances = survey.instances(topic);
+        let mut instances: Vec<&ulog::TopicSurvey> = survey.instances(topic);
+        for t in survey.instances(fifo) {
+            if instances.iter().all(|s| s.instance != t.instance) {
+                instances.push(t);
+            }
+        }
+        instances.sort_by_key(|t| t.instance);
         if instances.is_empty() {
             return Err(fail(format!(
-                "no {} messages: a thermal calibration needs sensor_gyro and sensor_accel (PX4's \
-                 SDLOG_PROFILE thermal calibration bit logs them)",
-                topic.name()
+                "no {} or {} messages: a thermal calibration needs sensor_gyro and \
+                 sensor_accel (PX4's SDLOG_PROFILE thermal calibration bit logs them)",
+                topic.name(),
+                fifo.name()
             )));
         }
         let which = match instance {
@@ -637,37 +731,41 @@ fn read_ulog(path: &Path, instance: Option<u8>) -> Result<WarmUp, Fail> {
                 )));
             }
         };
+        // Of the sensor topic and its FIFO topic, the one with more samples of this IMU.
+        let topic = source::fuller(&survey, topic, fifo, Some(which));
         let mut record = Record {
             celsius: Vec::new(),
             axes: Default::default(),
             unit,
-            rate: None,
+            rate: Err(String::new()),
+            dropped: Dropped::default(),
         };
         let mut times = Vec::new();
-        let mut without = 0u64;
         chosen = which;
         let select = ulog::Select {
             topic,
             which: ulog::Which::Instance(which),
         };
         let mut devices: Vec<u32> = Vec::new();
-        ulog::read_surveyed(path, &survey, &select, &mut |sample| {
+        let report = ulog::read_surveyed(path, &survey, &select, &mut |sample| {
             if !devices.contains(&sample.device_id) {
                 devices.push(sample.device_id);
             }
             ids[s] = sample.device_id;
-            let Some(t) = sample.temperature else {
-                without += 1;
-                return;
-            };
-            record.celsius.push(t);
-            times.push(sample.time_us);
-            for (axis, x) in record.axes.iter_mut().zip(sample.xyz) {
-                axis.push(x);
-            }
+            keep(
+                &mut record,
+                &mut times,
+                sample.time_us,
+                sample.temperature,
+                sample.xyz,
+            );
         })
         .map_err(|e| Fail(e.to_string()))?;
+        // The reader leaves out the samples that are not finite; they are counted here.
+        record.dropped.non_finite += report.non_finite;
         record.rate = rate_of(&times);
+        let files = [path.to_path_buf()];
+        check_dropped(&files, &record, topic.name(), report.held_temperature)?;
         if devices.len() > 1 {
             let list: Vec<String> = devices.iter().map(u32::to_string).collect();
             return Err(fail(format!(
@@ -683,7 +781,7 @@ fn read_ulog(path: &Path, instance: Option<u8>) -> Result<WarmUp, Fail> {
                 "{} has no temperature ({} samples without one{}): a thermal calibration needs \
                  the sensor's temperature",
                 topic.name(),
-                without,
+                record.dropped.without_temperature,
                 if topic.is_fifo() {
                     ", and no sensor topic of that device to take it from"
                 } else {
@@ -764,42 +862,46 @@ fn read_dataflash(path: &Path, instance: Option<u8>) -> Result<WarmUp, Fail> {
         celsius: Vec::new(),
         axes: Default::default(),
         unit: "rad/s",
-        rate: None,
+        rate: Err(String::new()),
+        dropped: Dropped::default(),
     };
     let mut accel = Record {
         celsius: Vec::new(),
         axes: Default::default(),
         unit: "m/s^2",
-        rate: None,
+        rate: Err(String::new()),
+        dropped: Dropped::default(),
     };
-    let mut times = Vec::new();
+    let (mut times, mut accel_times) = (Vec::new(), Vec::new());
     let select = dataflash::Select {
         kind,
         instance: Some(chosen),
     };
-    dataflash::read_surveyed(path, &survey, &select, &mut |sample| {
-        let Some(t) = sample.temperature else {
-            return;
-        };
-        times.push(sample.time_us);
-        for (record, xyz) in [(&mut gyro, sample.gyro), (&mut accel, sample.accel)] {
-            if let Some(xyz) = xyz {
-                record.celsius.push(t);
-                for (axis, x) in record.axes.iter_mut().zip(xyz) {
-                    axis.push(x);
-                }
-            }
+    let report = dataflash::read_surveyed(path, &survey, &select, &mut |sample| {
+        let t = sample.temperature;
+        if let Some(xyz) = sample.gyro {
+            keep(&mut gyro, &mut times, sample.time_us, t, xyz);
+        }
+        if let Some(xyz) = sample.accel {
+            keep(&mut accel, &mut accel_times, sample.time_us, t, xyz);
         }
     })
     .map_err(|e| Fail(e.to_string()))?;
+    // The reader leaves out the messages that are not finite; they are counted here.
+    gyro.dropped.non_finite += report.non_finite;
+    accel.dropped.non_finite += report.non_finite;
     if gyro.celsius.is_empty() || accel.celsius.is_empty() {
         return Err(fail(format!(
-            "the IMU messages of instance {chosen} carry no temperature: a thermal \
-             calibration needs it"
+            "the IMU messages of instance {chosen} carry no usable temperature ({} without one, \
+             {} outside -60 to 150 deg C): a thermal calibration needs it",
+            gyro.dropped.without_temperature, gyro.dropped.implausible_temperature
         )));
     }
+    let files = [path.to_path_buf()];
+    check_dropped(&files, &gyro, "IMU gyro", report.held_temperature)?;
+    check_dropped(&files, &accel, "IMU accelerometer", report.held_temperature)?;
     gyro.rate = rate_of(&times);
-    accel.rate = gyro.rate;
+    accel.rate = rate_of(&accel_times);
     Ok(WarmUp {
         sensors: [gyro, accel],
         device_ids: None,
@@ -868,8 +970,12 @@ fn read_csv(args: &Args) -> Result<WarmUp, Fail> {
     let timing =
         crate::input::summary(read.timing, false).map_err(|e| with_file(&args.files, e))?;
     let rate = match (args.rate, &timing) {
-        (None, None) => None,
-        (r, t) => Some(resolve_rate(r, t.as_ref()).map_err(|e| with_file(&args.files, e.0))?),
+        (None, None) => Err(
+            "the record gives no sample rate (no time column whose unit is clear): give --rate \
+             for the noise bands"
+                .to_string(),
+        ),
+        (r, t) => Ok(resolve_rate(r, t.as_ref()).map_err(|e| with_file(&args.files, e.0))?),
     };
     let mut names = [""; 6];
     for (i, axis) in axes.iter_mut().enumerate() {
@@ -887,22 +993,24 @@ fn read_csv(args: &Args) -> Result<WarmUp, Fail> {
         }
         names[i] = unit.si().name;
     }
-    let [gx, gy, gz, ax, ay, az] = axes;
+    let record = |unit| Record {
+        celsius: Vec::new(),
+        axes: Default::default(),
+        unit,
+        rate: rate.clone(),
+        dropped: Dropped::default(),
+    };
+    let (mut gyro, mut accel) = (record(names[0]), record(names[3]));
+    let mut times = Vec::new();
+    for (k, &t) in celsius.iter().enumerate() {
+        let xyz = |from: usize| [axes[from][k], axes[from + 1][k], axes[from + 2][k]];
+        keep(&mut gyro, &mut times, 0.0, Some(t), xyz(0));
+        keep(&mut accel, &mut times, 0.0, Some(t), xyz(3));
+    }
+    check_dropped(&args.files, &gyro, "the gyro", 0)?;
+    check_dropped(&args.files, &accel, "the accelerometer", 0)?;
     Ok(WarmUp {
-        sensors: [
-            Record {
-                celsius: celsius.clone(),
-                axes: [gx, gy, gz],
-                unit: names[0],
-                rate,
-            },
-            Record {
-                celsius,
-                axes: [ax, ay, az],
-                unit: names[3],
-                rate,
-            },
-        ],
+        sensors: [gyro, accel],
         device_ids: None,
         instance: None,
     })
@@ -939,12 +1047,12 @@ fn summary(thermal: &Thermal) -> Vec<String> {
     ];
     for a in &thermal.axes {
         lines.push(format!(
-            "{} ({}): change {:.3e}, PX4 leaves {:.3e}, ArduPilot leaves {:.3e}, held out {:.3e}{}",
+            "{} ({}): change {:.3e}, PX4 leaves {}, ArduPilot leaves {}, held out {:.3e}{}",
             a.axis,
             a.unit,
             a.change,
-            a.px4_left,
-            a.ardupilot_left,
+            shown(a.px4_left),
+            shown(a.ardupilot_left),
             a.held_out,
             if a.generalises {
                 ""
@@ -1044,6 +1152,16 @@ impl Output for Thermal {
                 a.generalises
             );
         }
+        for (what, d) in ["gyro", "accelerometer"].iter().zip(&self.dropped) {
+            let total = d.non_finite + d.without_temperature + d.implausible_temperature;
+            if total > 0 {
+                s += &format!(
+                    "{what}: {total} samples left out ({} not finite, {} without a temperature, \
+                     {} outside -60 to 150 deg C)\n",
+                    d.non_finite, d.without_temperature, d.implausible_temperature
+                );
+            }
+        }
         if !self.noise_bands.is_empty() {
             s += "noise against temperature, the thermal bias taken out (* the worst band, largest N):\n";
             s += "axis band (deg C)      samples  N (u/sqrt(Hz))  K (u/s/sqrt(Hz))  B (u)\n";
@@ -1061,7 +1179,13 @@ impl Output for Thermal {
                     value(b.white_noise),
                     value(b.random_walk),
                     value(b.bias_instability),
-                    b.note.as_ref().map_or(String::new(), |n| format!(" ({n})"))
+                    match (&b.note, b.stretches) {
+                        (Some(n), _) => format!(" ({n})"),
+                        (None, k) if k > 1 => format!(
+                            " (the longest of the {k} stretches the record spent in the band)"
+                        ),
+                        _ => String::new(),
+                    }
                 );
             }
         }

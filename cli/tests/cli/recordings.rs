@@ -609,7 +609,7 @@ fn refusals_name_the_file_and_what_it_is() {
     );
     // Empty, binary and compressed files under --topic.
     let cases: [(&str, &[u8], &str); 4] = [
-        ("empty.bin", b"", "the file is empty"),
+        ("empty.dat", b"", "the file is empty"),
         ("x.h5", b"\x89HDF\r\n\x1a\n\0\0\0\0", "an HDF5 file"),
         ("blob", b"\x01\x02\x03\x04abc", "a binary file"),
         ("a.csv.xz", b"\xfd7zXZ\0\0\x04", "an xz-compressed file"),

@@ -505,7 +505,10 @@ fn a_dataflash_warm_up_is_calibrated_unless_already_corrected() {
     ]);
     assert_one_line_failure(&run);
     let e = String::from_utf8_lossy(&run.stderr);
-    assert!(e.contains("no IMU messages of that instance"), "{e}");
+    assert!(
+        e.contains("no IMU messages") && e.contains("of that instance"),
+        "{e}"
+    );
 }
 
 /// The same samples (f32, as the logs hold them, at 100 Hz) as an ArduPilot DataFlash log, a
@@ -948,4 +951,334 @@ fn stray_temperatures_overflows_units_quantised_values_and_instances() {
     let (px4, ap) = calibrated(&third, &[]);
     assert_eq!(px4["TC_G3_ID"], 2359336.0);
     assert_eq!(ap["INS4_TCAL_ENABLE"], 1.0);
+}
+
+/// What a second red-team pass on the autopilot logs found, each fixed:
+/// - a PX4 log with FIFO topics for IMU 0 only: IMU 1 could not be read (the FIFO topic was
+///   chosen by the samples of all IMUs, not of the one asked for);
+/// - the same for a DataFlash log's batches;
+/// - FIFO messages with dt 0 gave noise bands at a wrong rate, exit 0;
+/// - a log that heats and cools joined the two stretches of a band (a step taken for noise);
+/// - NaN and implausible temperatures were dropped silently; Kelvin accepted;
+/// - `--noise-format` with a gyro and an accelerometer at different rates failed with a message
+///   naming neither;
+/// - "PX4 leaves NaN" in the ArduPilot file's comments;
+/// - NaN gyro samples of a ULog file were refused as unpaired;
+/// - `noise` said nothing of samples it skipped.
+#[test]
+fn second_red_team_pass_on_logs() {
+    let rows = samples(6_000, 0.0);
+    let f = |a: f64| a as f32;
+    // D1: sensor topics of IMUs 0 and 1 at 100 Hz, FIFO topics of IMU 0 only, at 1 kHz.
+    let mut log = ULog::new(0);
+    for format in [GYRO_FIFO, ACCEL_FIFO, SENSOR_GYRO, SENSOR_ACCEL] {
+        log.format(format);
+    }
+    log.subscribe(0, 0, "sensor_gyro_fifo");
+    log.subscribe(0, 1, "sensor_accel_fifo");
+    for i in 0..2u8 {
+        log.subscribe(i, 2 + 2 * u16::from(i), "sensor_gyro");
+        log.subscribe(i, 3 + 2 * u16::from(i), "sensor_accel");
+    }
+    for (k, (celsius, a)) in rows.iter().enumerate() {
+        let t = 1_000_000 + 10_000 * k as u64;
+        for i in 0..2u16 {
+            let device = 100 + 2 * u32::from(i);
+            log.data(
+                2 + 2 * i,
+                &sensor(t, t, device, [f(a[0]), f(a[1]), f(a[2])], f(*celsius)),
+            );
+            log.data(
+                3 + 2 * i,
+                &sensor(t, t, device + 1, [f(a[3]), f(a[4]), f(a[5])], f(*celsius)),
+            );
+        }
+        let xyz: [[i16; 32]; 3] = std::array::from_fn(|j| {
+            std::array::from_fn(|i| ((k * 31 + i * 7 + j * 3) % 19) as i16 - 9)
+        });
+        log.data(0, &fifo(t, 100, 1000.0, 1e-4, 10, &xyz));
+        log.data(1, &fifo(t, 101, 1000.0, 1e-3, 10, &xyz));
+    }
+    let multi = temp_file("multi.ulg", log.bytes);
+    let m = path_str(&multi);
+    let j = json(&imu_ar(&[
+        "noise",
+        m,
+        "--column",
+        "gx",
+        "--instance",
+        "1",
+        "--json",
+    ]));
+    assert_eq!(j["n"], 6_000, "IMU 1's sensor topic");
+    let j = json(&imu_ar(&[
+        "noise",
+        m,
+        "--column",
+        "gx",
+        "--instance",
+        "0",
+        "--json",
+    ]));
+    assert_eq!(j["n"], 60_000, "IMU 0's FIFO topic");
+    let out = temp_path("multi");
+    let args = [
+        "thermal",
+        m,
+        "--out",
+        path_str(&out),
+        "--instance",
+        "1",
+        "--json",
+    ];
+    let j = json(&imu_ar(&args));
+    assert_eq!(
+        (j["n"].as_u64(), j["instance"].as_u64()),
+        (Some(6_000), Some(1))
+    );
+
+    // D2: batches of IMU 0 only; IMU 1 is read from its IMU messages.
+    let mut df = Df::new();
+    df.isbh(1_000_000, 0, 1, 0, 1000, 2048, 1_000_000, 1000.0);
+    for k in 0..64u64 {
+        df.isbd(1_000_000 + k, 0, k as u16, &[[1i16; 32]; 3]);
+    }
+    for (k, (celsius, a)) in rows.iter().enumerate() {
+        let t = 1_000_000 + 10_000 * k as u64;
+        for i in 0..2 {
+            df.imu(
+                t,
+                i,
+                [f(a[0]), f(a[1]), f(a[2])],
+                [f(a[3]), f(a[4]), f(a[5])],
+                f(*celsius),
+            );
+        }
+    }
+    let bin = temp_file("batch-inst.bin", df.bytes);
+    let b = path_str(&bin);
+    let j = json(&imu_ar(&[
+        "noise",
+        b,
+        "--column",
+        "gx",
+        "--instance",
+        "1",
+        "--json",
+    ]));
+    assert_eq!(j["n"], 6_000, "IMU 1's IMU messages");
+
+    // D3: FIFO messages whose dt is 0 give no rate: no noise bands, and says why.
+    let mut log = ULog::new(0);
+    for format in [GYRO_FIFO, ACCEL_FIFO, SENSOR_GYRO, SENSOR_ACCEL] {
+        log.format(format);
+    }
+    for (id, name) in [
+        "sensor_gyro_fifo",
+        "sensor_accel_fifo",
+        "sensor_gyro",
+        "sensor_accel",
+    ]
+    .iter()
+    .enumerate()
+    {
+        log.subscribe(0, id as u16, name);
+    }
+    for (k, block) in rows.chunks(10).enumerate() {
+        let t = 1_000_000 + 10_000 * k as u64;
+        for (s, scale) in [(0usize, 1e-4f32), (1, 1e-3)] {
+            let mut xyz = [[0i16; 32]; 3];
+            for (i, (_, a)) in block.iter().enumerate() {
+                for (j, axis) in xyz.iter_mut().enumerate() {
+                    axis[i] = (a[3 * s + j] / f64::from(scale)).round() as i16;
+                }
+            }
+            log.data(s as u16, &fifo(t, 7 + s as u32, 0.0, scale, 10, &xyz));
+        }
+        log.data(2, &sensor(t, t, 7, [0.0; 3], f(block[0].0)));
+        log.data(3, &sensor(t, t, 8, [0.0; 3], f(block[0].0)));
+    }
+    let dt0 = temp_file("dt0.ulg", log.bytes);
+    let out = temp_path("dt0");
+    let j = json(&imu_ar(&[
+        "thermal",
+        path_str(&dt0),
+        "--out",
+        path_str(&out),
+        "--json",
+    ]));
+    assert_eq!(j["noise_bands"].as_array().map(Vec::len), Some(0));
+    assert!(
+        j["noise_bands_note"]
+            .as_str()
+            .unwrap()
+            .contains("do not move forward"),
+        "{j}"
+    );
+
+    // D4, D5, D11: heat then cool, with an implausible temperature, as CSV.
+    let mut text = String::from(
+        "t [s],gx [rad/s],gy [rad/s],gz [rad/s],ax [m/s^2],ay [m/s^2],az [m/s^2],temperature\n",
+    );
+    let back: Vec<&(f64, [f64; 6])> = rows.iter().chain(rows.iter().rev()).collect();
+    for (k, (celsius, a)) in back.iter().enumerate() {
+        let t = match k {
+            200 => "1e30".to_string(),
+            _ => format!("{celsius:.3}"),
+        };
+        text += &format!(
+            "{:.2},{},{},{},{},{},{},{t}\n",
+            k as f64 / 100.0,
+            a[0],
+            a[1],
+            a[2],
+            a[3],
+            a[4],
+            a[5]
+        );
+    }
+    let csv = temp_file("heat-cool.csv", text);
+    let out = temp_path("heat-cool");
+    let args = [
+        "thermal",
+        path_str(&csv),
+        "--out",
+        path_str(&out),
+        "--device-id",
+        "1,2",
+    ];
+    let run = imu_ar(&[&args[..], &["--json"]].concat());
+    let j = json(&run);
+    // (The CSV reader refuses a cell that is not a number, with its line.)
+    assert_eq!(j["n"], 12_000 - 1);
+    assert_eq!(j["dropped"][0]["implausible_temperature"], 1);
+    // The bands below the peak are crossed twice: the longer stretch is fitted; the top one
+    // holds the turn, one stretch.
+    let bands = j["noise_bands"][0]["bands"].as_array().unwrap();
+    for b in &bands[..3] {
+        assert_eq!(b["stretches"], 2, "{b}");
+        assert!(b["n"].as_u64() < b["in_band"].as_u64(), "{b}");
+    }
+    assert_eq!(bands[3]["stretches"], 1);
+    // ArduPilot's file: no NaN where PX4's figure is missing.
+    let run = imu_ar(&[
+        "thermal",
+        path_str(&csv),
+        "--out",
+        path_str(&out),
+        "--format",
+        "ardupilot",
+    ]);
+    assert!(run.status.success());
+    let parm = std::fs::read_to_string(out.join("ardupilot_tcal.parm")).unwrap();
+    assert!(!parm.contains("NaN") && !parm.contains("inf"), "{parm}");
+    // Kelvin.
+    let kelvin: String = std::fs::read_to_string(&csv)
+        .unwrap()
+        .lines()
+        .enumerate()
+        .map(|(k, l)| match (k, l.rsplit_once(',')) {
+            (0, _) | (_, None) => format!("{l}\n"),
+            (_, Some((head, t))) => {
+                format!(
+                    "{head},{}\n",
+                    t.parse::<f64>()
+                        .map_or(t.to_string(), |c| format!("{:.3}", c + 273.15))
+                )
+            }
+        })
+        .collect();
+    let kelvin = temp_file("kelvin.csv", kelvin);
+    let run = imu_ar(&[
+        "thermal",
+        path_str(&kelvin),
+        "--out",
+        path_str(&out),
+        "--device-id",
+        "1,2",
+    ]);
+    assert_one_line_failure(&run);
+    assert!(
+        String::from_utf8_lossy(&run.stderr).contains("kelvin"),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+
+    // D6: gyro at 100 Hz, accelerometer at 50 Hz, with --noise-format: one clear line.
+    let mut log = ULog::new(0);
+    log.format(SENSOR_GYRO);
+    log.format(SENSOR_ACCEL);
+    log.subscribe(0, 0, "sensor_gyro");
+    log.subscribe(0, 1, "sensor_accel");
+    for (k, (celsius, a)) in samples(40_000, 0.0).iter().enumerate() {
+        let t = 1_000_000 + 10_000 * k as u64;
+        log.data(
+            0,
+            &sensor(t, t, 7, [f(a[0]), f(a[1]), f(a[2])], f(*celsius)),
+        );
+        if k % 2 == 0 {
+            log.data(
+                1,
+                &sensor(t, t, 8, [f(a[3]), f(a[4]), f(a[5])], f(*celsius)),
+            );
+        }
+    }
+    let rates = temp_file("rates.ulg", log.bytes);
+    let out = temp_path("rates");
+    let run = imu_ar(&[
+        "thermal",
+        path_str(&rates),
+        "--out",
+        path_str(&out),
+        "--noise-format",
+        "kalibr",
+    ]);
+    assert_one_line_failure(&run);
+    let e = String::from_utf8_lossy(&run.stderr);
+    assert!(e.contains("rates.ulg") && e.contains("one IMU rate"), "{e}");
+    assert!(!out.join("px4_thermal.params").exists(), "nothing written");
+
+    // D8, D9: NaN gyro samples in a ULog file are not finite, not unpaired; noise says so.
+    let mut log = ULog::new(0);
+    log.format(SENSOR_GYRO);
+    log.format(SENSOR_ACCEL);
+    log.subscribe(0, 0, "sensor_gyro");
+    log.subscribe(0, 1, "sensor_accel");
+    for (k, (celsius, a)) in rows.iter().enumerate() {
+        let t = 1_000_000 + 10_000 * k as u64;
+        let g = if k % 50 == 0 {
+            [f32::NAN; 3]
+        } else {
+            [f(a[0]), f(a[1]), f(a[2])]
+        };
+        log.data(0, &sensor(t, t, 7, g, f(*celsius)));
+        log.data(
+            1,
+            &sensor(t, t, 8, [f(a[3]), f(a[4]), f(a[5])], f(*celsius)),
+        );
+    }
+    let nan = temp_file("nan-gyro.ulg", log.bytes);
+    let out = temp_path("nan-gyro");
+    let j = json(&imu_ar(&[
+        "characterise",
+        path_str(&nan),
+        "--out",
+        path_str(&out),
+        "--json",
+    ]));
+    assert_eq!(
+        (
+            j["skipped"]["non_finite"].as_u64(),
+            j["skipped"]["unpaired"].as_u64()
+        ),
+        (Some(120), Some(0))
+    );
+    let run = imu_ar(&["noise", path_str(&nan), "--column", "gx"]);
+    assert!(run.status.success());
+    let e = String::from_utf8_lossy(&run.stderr);
+    assert!(e.contains("warning") && e.contains("120 not finite"), "{e}");
+}
+
+fn path_str(p: &Path) -> &str {
+    p.to_str().unwrap()
 }
