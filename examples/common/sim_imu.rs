@@ -254,9 +254,10 @@ impl SimImu {
     fn read_reg(&mut self, reg: u8) -> u8 {
         match reg {
             0x3A => {
-                // INT_STATUS: 100 ms pass (but for the check that closes a FIFO read), then
-                // report (and clear) an overflow.
-                if !core::mem::take(&mut self.after_data) {
+                // INT_STATUS: 100 ms pass (but for the check that closes a FIFO read, and the
+                // one inside a FIFO reset, with the FIFO off), then report (and clear) an
+                // overflow.
+                if !core::mem::take(&mut self.after_data) && self.fifo_enabled {
                     for _ in 0..BATCH {
                         self.step();
                     }

@@ -57,6 +57,9 @@ pub struct Map {
     pub fifo_prepare: &'static [Write],
     /// Takes the channels off the FIFO (and, where needed, the FIFO itself).
     pub fifo_stop: &'static [Write],
+    /// The channels are off: read back after `fifo_stop`, before the count that the reset
+    /// relies on to stay still.
+    pub stopped: Check,
     /// Empties the FIFO, its channels off.
     pub fifo_empty: &'static [Write],
     /// Starts the FIFO and its channels.
@@ -73,6 +76,10 @@ pub struct Map {
     /// packets: a remainder means a byte lost or added on the wire (an SPI slip), and the
     /// packets are misaligned.
     pub whole_packets: bool,
+    /// The configuration writes of `init` are read back (SPI, whose writes have no
+    /// acknowledge; an I2C chip acknowledges every byte, and one that resets between them is
+    /// found asleep).
+    pub verify_setup: bool,
 }
 
 /// What a FIFO packet turned out to be.

@@ -83,6 +83,13 @@ impl<C: Chip> Core<C> {
         for (reg, value) in C::setup(&config) {
             self.chip.write(reg, value).await?;
         }
+        if map.verify_setup {
+            for (reg, value) in C::setup(&config) {
+                if self.chip.read_u8(reg).await? != value {
+                    return Err(Error::WriteNotApplied { register: reg });
+                }
+            }
+        }
         if map.settle_ms > 0 {
             wait.ms(map.settle_ms).await;
         }

@@ -132,6 +132,9 @@ pub(crate) struct FifoState {
 impl FifoState {
     /// `init` begins: the chip is being reset, its FIFO is off and nobody asked for it.
     pub(crate) fn off(&mut self) {
+        // A new session: the counts start again (an overflow or a read still pending belongs
+        // to the session `init` ends, whose samples the chip reset drops).
+        self.stats = FifoStats::default();
         self.in_call = None;
         self.initialised = false;
         self.wanted = false;
@@ -160,7 +163,12 @@ impl FifoState {
     pub(crate) fn recovered(&mut self, outage_us: u64, hz: u32, div: u32) {
         let chip_reset = core::mem::take(&mut self.reset_seen);
         let den = 1_000_000u128 * u128::from(div.max(1));
-        let lost = (u128::from(outage_us) * u128::from(hz) + den / 2) / den;
+        // Without the FIFO nothing was to be read, and nothing is lost.
+        let lost = if self.wanted {
+            (u128::from(outage_us) * u128::from(hz) + den / 2) / den
+        } else {
+            0
+        };
         let stats = &mut self.stats;
         stats.resets = stats.resets.saturating_add(u64::from(chip_reset));
         stats.lost = stats
@@ -204,6 +212,9 @@ fn settle_cancelled(state: &mut FifoState) {
     if let Some(c) = state.in_call.take() {
         let pending = state.pending.get_or_insert_with(PendingReset::default);
         pending.resync = true;
+        // The read may have been dropped after its closing INT_STATUS read cleared an
+        // overflow flag it never acted on.
+        pending.flag_unknown = true;
         pending.consumed = pending.consumed.saturating_add(u32::from(c.taken));
         if c.len > 0 {
             pending.unresolved = Some(Unresolved {
@@ -276,8 +287,9 @@ async fn read_fifo_once<C: Chip>(
         readable = readable.min(latest);
     }
     observe::<C>(state, readable);
-    if latest >= C::MAP.fifo_bytes {
-        // A full FIFO overwrites its oldest bytes: its packets are no longer aligned.
+    if readable >= C::MAP.fifo_bytes {
+        // A full FIFO overwrites its oldest bytes: its packets are no longer aligned. (The
+        // confirmed count: one corrupted high on the wire is no overflow.)
         state.mark_overflow();
     }
     if state.pending.is_some() {
@@ -466,8 +478,23 @@ async fn drop_call<C: Chip>(
 /// repeated: after a failure the whole sequence is simply run again.
 async fn reset<C: Chip>(chip: &mut C, state: &mut FifoState) -> Result<(), Error<C::BusError>> {
     chip.write_all(C::MAP.fifo_stop).await?;
-    let held = count(chip).await?;
+    if !chip.check(C::MAP.stopped).await? {
+        // The channels are still on (a write corrupted on the wire): the count would not stay
+        // still, and a sample written before the flush would go uncounted.
+        return Err(Error::WriteNotApplied {
+            register: C::MAP.stopped.reg,
+        });
+    }
+    // The count, stable with the channels off, confirmed: one corrupted high on the wire would
+    // count samples never written.
+    let held = count(chip).await?.min(count(chip).await?);
     observe::<C>(state, held);
+    // A sample that arrived after the call's INT_STATUS read and before the channels went off
+    // may have raised the overflow flag again: read (and clear) it now, for this reset, which
+    // drops what it is about.
+    if chip.read_u8(C::MAP.int_status).await? & C::MAP.int_fifo_overflow != 0 {
+        state.mark_overflow();
+    }
     if held >= C::MAP.fifo_bytes {
         // A full FIFO has overwritten its oldest bytes: an overflow, whether or not its flag
         // was read (a read of INT_STATUS that failed may have cleared it).
@@ -479,14 +506,20 @@ async fn reset<C: Chip>(chip: &mut C, state: &mut FifoState) -> Result<(), Error
         state.reset_seen = true;
         return Err(Error::SensorReset);
     }
-    let emptied = chip.write_all(C::MAP.fifo_empty).await;
-    if emptied.is_ok()
-        && let Some(p) = state.pending.as_mut()
-    {
+    chip.write_all(C::MAP.fifo_empty).await?;
+    // A flush that reported success but did not take (a write corrupted on the wire) leaves
+    // the FIFO as it was: its bytes are not dropped yet, and are not counted as dropped.
+    let left = count(chip).await?;
+    if left != 0 {
+        observe::<C>(state, left);
+        return Err(Error::WriteNotApplied {
+            register: C::MAP.fifo_empty.first().map_or(0, |w| w.0),
+        });
+    }
+    if let Some(p) = state.pending.as_mut() {
         p.consumed = p.consumed.saturating_add(u32::from(p.held));
         p.held = 0;
     }
-    emptied?;
     chip.write_all(C::MAP.fifo_start).await
 }
 

@@ -370,20 +370,21 @@ impl Icm42688Config {
 ///
 /// ```
 /// # use embedded_hal::spi::{ErrorType, Operation, SpiDevice};
-/// # struct Bus;
+/// # // A register file: writes are kept and read back; WHO_AM_I answers 0x47.
+/// # struct Bus([u8; 128]);
 /// # impl ErrorType for Bus { type Error = core::convert::Infallible; }
 /// # impl SpiDevice for Bus {
 /// #     fn transaction(&mut self, ops: &mut [Operation<'_, u8>]) -> Result<(), Self::Error> {
 /// #         let mut reg = 0;
 /// #         for op in ops {
 /// #             match op {
-/// #                 Operation::Write(w) => reg = w[0],
+/// #                 Operation::Write(w) => {
+/// #                     reg = w[0];
+/// #                     if let [r, v] = w[..] { self.0[usize::from(r & 0x7F)] = v; }
+/// #                 }
 /// #                 Operation::Read(b) => {
 /// #                     b.fill(0);
-/// #                     if reg == 0xF5 { b[0] = 0x47; } // WHO_AM_I
-/// #                     if reg == 0x96 { b[0] = 0x40; } // FIFO_CONFIG: stream mode
-/// #                     if reg == 0xCE { b[0] = 0x0F; } // PWR_MGMT0: low noise
-/// #                     if reg == 0xDF { b[0] = 0x07; } // FIFO_CONFIG1: packet 3
+/// #                     b[0] = if reg == 0xF5 { 0x47 } else { self.0[usize::from(reg & 0x7F)] };
 /// #                 }
 /// #                 _ => {}
 /// #             }
@@ -396,7 +397,7 @@ impl Icm42688Config {
 /// use imu_ar::recursive::{Channel, Config, Estimator, Lattice};
 /// use imu_ar::sensor::{AccelUnit, GyroUnit, Icm42688, Icm42688Config, ImuReader, RawSample};
 ///
-/// let mut imu = Icm42688::new(Bus);
+/// let mut imu = Icm42688::new(Bus([0; 128]));
 /// assert_eq!(imu.init(&mut Delay, Icm42688Config::default())?, 0x47);
 /// imu.enable_fifo()?;
 /// let config = Config::new(0.999f32, 0.01).unwrap();
@@ -475,12 +476,17 @@ const MAP: Map = Map {
     fifo_bytes: FIFO_BYTES,
     fifo_prepare: FIFO_STREAM,
     fifo_stop: FIFO_STOP,
+    stopped: Check {
+        reg: FIFO_CONFIG1,
+        fields: &[(u8::MAX, 0)],
+    },
     fifo_empty: FIFO_FLUSHED,
     fifo_start: FIFO_START,
     fifo_on: &[STREAMING, CHANNELS_ON],
     configured: SENSORS_ON,
     thermometer: Thermometer::ICM42688,
     whole_packets: true,
+    verify_setup: true,
 };
 
 /// The ICM-42688-P on an SPI device: the chip that an [`Icm42688`] drives.

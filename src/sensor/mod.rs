@@ -320,6 +320,15 @@ pub enum Error<E> {
     /// No sample is available (a replay at its end, or data registers holding the chip's
     /// invalid-data marker).
     NoData,
+    /// A register write reported success but did not take: read back, the register (or the
+    /// FIFO count a flush should have cleared) says otherwise. SPI has no acknowledge, so a
+    /// write corrupted on the wire looks like this, as does a chip that reset itself between
+    /// two writes. Nothing was counted for the failed step; call again (`init` or `recover`
+    /// for a configuration write, `read_fifo` for a FIFO reset, which is then finished).
+    WriteNotApplied {
+        /// The register written.
+        register: u8,
+    },
 }
 
 impl<E> From<E> for Error<E> {
@@ -355,6 +364,10 @@ impl<E: fmt::Debug> fmt::Display for Error<E> {
             Self::NotInitialised => f.write_str("the reader is not initialised: call init"),
             Self::SensorReset => f.write_str("the sensor has reset itself: recover it"),
             Self::NoData => f.write_str("no sample available"),
+            Self::WriteNotApplied { register } => write!(
+                f,
+                "the write of register 0x{register:02x} did not take (read back): call again"
+            ),
         }
     }
 }

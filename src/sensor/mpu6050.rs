@@ -422,12 +422,17 @@ const MAP: Map = Map {
     fifo_bytes: FIFO_BYTES,
     fifo_prepare: OVERFLOW_FLAG_ON,
     fifo_stop: FIFO_STOP,
+    stopped: Check {
+        reg: FIFO_EN,
+        fields: &[(u8::MAX, 0)],
+    },
     fifo_empty: FIFO_EMPTY,
     fifo_start: FIFO_START,
     fifo_on: &[FIFO_ON],
     configured: AWAKE_ON_PLL,
     thermometer: Thermometer::MPU6050,
     whole_packets: false,
+    verify_setup: false,
 };
 
 /// The MPU-6050 at its address on an I2C bus: the chip that an [`Mpu6050`] drives.

@@ -57,6 +57,10 @@ fn icm_init() -> Vec<Spi<u8>> {
         spi_write(0x4F, 3 << 5 | 8), // GYRO_CONFIG0: +-250 deg/s, 100 Hz
         spi_write(0x50, 2 << 5 | 8), // ACCEL_CONFIG0: +-4 g, 100 Hz
         spi_write(0x4E, 0x0F),       // PWR_MGMT0: gyro and accel low noise
+        // The three read back (SPI writes have no acknowledge).
+        spi_read(0x4F, vec![3 << 5 | 8]),
+        spi_read(0x50, vec![2 << 5 | 8]),
+        spi_read(0x4E, vec![0x0F]),
     ]
     .concat()
 }
@@ -70,13 +74,17 @@ fn icm_fifo_enable() -> Vec<Spi<u8>> {
 fn icm_fifo_reset(held: u16) -> Vec<Spi<u8>> {
     let mut v = [
         spi_write(0x5F, 0x00),                       // FIFO_CONFIG1: no channels
+        spi_read(0x5F, vec![0x00]),                  // read back: off
         spi_read(0x2E, held.to_be_bytes().to_vec()), // FIFO_COUNT
+        spi_read(0x2E, held.to_be_bytes().to_vec()), // confirmed
+        spi_read(0x2D, vec![0x00]),                  // INT_STATUS: no flag raised since
     ]
     .concat();
     if held == 0 {
         v.extend(spi_read(0x4E, vec![0x0F])); // PWR_MGMT0: low noise
     }
     v.extend(spi_write(0x4B, 0x02)); // SIGNAL_PATH_RESET: FIFO_FLUSH
+    v.extend(spi_read(0x2E, vec![0, 0])); // FIFO_COUNT: flushed
     v.extend(spi_write(0x5F, 0x07)); // FIFO_CONFIG1: temp, gyro, accel (packet 3)
     v
 }
@@ -389,7 +397,7 @@ impl SpiDevice for FailingSpi {
 
 #[test]
 fn icm42688_bus_error_at_every_init_step_then_a_clean_init() {
-    let steps = 5;
+    let steps = 8;
     for fail_at in 0..steps {
         // The mock expects the transactions before the failing one, then a full init.
         let transactions: Vec<Vec<Spi<u8>>> = vec![
@@ -398,6 +406,9 @@ fn icm42688_bus_error_at_every_init_step_then_a_clean_init() {
             spi_write(0x4F, 3 << 5 | 8),
             spi_write(0x50, 2 << 5 | 8),
             spi_write(0x4E, 0x0F),
+            spi_read(0x4F, vec![3 << 5 | 8]),
+            spi_read(0x50, vec![2 << 5 | 8]),
+            spi_read(0x4E, vec![0x0F]),
         ];
         let mut expect: Vec<Spi<u8>> = transactions[..fail_at].concat();
         expect.extend(icm_init());

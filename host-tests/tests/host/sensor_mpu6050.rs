@@ -60,13 +60,17 @@ fn mpu_fifo_reset(held: u16) -> Vec<I2c> {
     let mut v = vec![
         I2c::write(ADDR, vec![0x23, 0x00]), // FIFO_EN: no channels
         I2c::write(ADDR, vec![0x6A, 0x00]), // USER_CTRL: FIFO off
+        I2c::write_read(ADDR, vec![0x23], vec![0x00]), // FIFO_EN read back: no channels
         I2c::write_read(ADDR, vec![0x72], held.to_be_bytes().to_vec()), // FIFO_COUNT
+        I2c::write_read(ADDR, vec![0x72], held.to_be_bytes().to_vec()), // confirmed
+        I2c::write_read(ADDR, vec![0x3A], vec![0x00]), // INT_STATUS: no flag raised since
     ];
     if held == 0 {
         v.push(I2c::write_read(ADDR, vec![0x6B], vec![0x01])); // PWR_MGMT_1: awake, PLL
     }
     v.extend([
         I2c::write(ADDR, vec![0x6A, 0x04]), // USER_CTRL: FIFO_RESET
+        I2c::write_read(ADDR, vec![0x72], vec![0, 0]), // FIFO_COUNT: emptied
         I2c::write(ADDR, vec![0x6A, 0x40]), // USER_CTRL: FIFO_EN
         I2c::write(ADDR, vec![0x23, 0x78]), // FIFO_EN: XG YG ZG ACCEL
     ]);
