@@ -153,14 +153,16 @@ impl<C: Chip> Driver<C> {
     }
 
     /// Probes WHO_AM_I, resets the chip (and waits for the reset to complete), writes
-    /// `config` and returns the WHO_AM_I value. The FIFO is off afterwards. `enable_fifo` and
-    /// `recover` need a successful `init` first.
+    /// `config` and returns the WHO_AM_I value (the ICM-42688-P's configuration writes read
+    /// back). The FIFO is off afterwards, and its counts ([`FifoStats`]) start from zero: a
+    /// new session. `enable_fifo` and `recover` need a successful `init` first.
     ///
     /// # Errors
     ///
     /// [`Error::UnsupportedDevice`] for a related chip that this reader rejects (the MPU-6500
     /// and MPU-9250, 0x70 and 0x71, for [`Mpu6050`](super::Mpu6050)),
-    /// [`Error::WrongDevice`] for any other WHO_AM_I, or [`Error::Bus`]; after a bus error
+    /// [`Error::WrongDevice`] for any other WHO_AM_I, [`Error::WriteNotApplied`] for a
+    /// configuration write read back otherwise, or [`Error::Bus`]; after either of the last two
     /// `init` can simply be called again.
     pub fn init(
         &mut self,
