@@ -290,6 +290,7 @@ fn choose(
     request: &Request,
     what: &str,
     instances: &[(u8, String)],
+    cut_at: Option<u64>,
 ) -> Result<u8, Fail> {
     match (request.instance, instances) {
         (Some(i), _) if instances.iter().any(|(j, _)| *j == i) => Ok(i),
@@ -298,7 +299,16 @@ fn choose(
             format!("--instance {i}: the log has no {what} of that instance"),
         )),
         (None, [(i, _)]) => Ok(*i),
-        (None, []) => Err(with_file(files, format!("the log has no {what}"))),
+        (None, []) => Err(with_file(
+            files,
+            match cut_at {
+                Some(at) => format!(
+                    "the log has no {what}: it ends inside a message at byte {at} (cut short, \
+                     as when the power goes) before any"
+                ),
+                None => format!("the log has no {what}"),
+            },
+        )),
         (None, many) => {
             let list: Vec<&str> = many.iter().map(|(_, w)| w.as_str()).collect();
             Err(with_file(
@@ -395,7 +405,7 @@ fn autopilot_stream(
             Some(dataflash::Kind::BatchGyro) => "IMU messages or ISB gyro batches",
             Some(_) => "IMU messages or ISB accel batches",
         };
-        let instance = choose(files, request, what, &found)?;
+        let instance = choose(files, request, what, &found, survey.truncated)?;
         let source = fuller_dataflash(&survey, batch, instance);
         let select = dataflash::Select {
             kind: source,
@@ -527,6 +537,7 @@ fn ulog_stream(
             request,
             &format!("{} or {} messages", sensor.name(), fifo.name()),
             &found,
+            survey.truncated,
         )?;
         let topic = fuller(&survey, sensor, fifo, Some(instance));
         selects.push(ulog::Select {

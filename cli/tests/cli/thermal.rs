@@ -373,6 +373,19 @@ fn bad_autopilot_logs_are_named_in_one_line() {
     assert_eq!(json(&run)["n"], 3_999);
     let e = String::from_utf8_lossy(&run.stderr);
     assert!(e.contains("warning") && e.contains("cut short"), "{e}");
+    // Cut inside the first IMU message: no IMU messages, and why.
+    let mut df = Df::new();
+    let formats = df.bytes.len();
+    df.imu(1_000_000, 0, [0.0; 3], [0.0; 3], 30.0);
+    df.bytes.truncate(formats + 10);
+    let file = temp_file("cut-first.bin", df.bytes);
+    let run = imu_ar(&["noise", file.to_str().unwrap(), "--column", "gx"]);
+    assert_one_line_failure(&run);
+    let e = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        e.contains("no IMU messages") && e.contains("cut short"),
+        "{e}"
+    );
 }
 
 /// A PX4 ULog warm-up: sensor_gyro and sensor_accel of the IMUs `instances` at 100 Hz
