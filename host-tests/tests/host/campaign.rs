@@ -18,14 +18,14 @@ fn the_identified_fit_finds_the_truth_of_the_campaign() {
     println!("{}", campaign::table(&records));
     let s = campaign::summary(&records, true);
     assert_eq!(s.records, 192);
-    // K where the random walk dominates the last 1.5 decades. The aim is within 30 % on 90 %,
-    // never missing; measured, 84 of 96 (88 %) and missing on 1: the misses are 1 h records
-    // whose Gauss-Markov term (30 s, its random-walk equivalent above the true K) the
-    // criterion leaves out, or where a spurious 20-40 s term takes the walk's rise. Held here
-    // where it stands, so that it gets no worse.
+    // K where the random walk dominates the last 1.5 decades: within 30 % on at least 90 %,
+    // never missing. Measured: seeds 0..12, 87 of 96 (91 %); seeds 12..24, 88 of 96 (92 %);
+    // missing on none. The misses are 1 h records whose 30 s Gauss-Markov term (its
+    // random-walk equivalent above the true K) the criterion leaves out, so that K carries its
+    // rise, or where a spurious 20-40 s term takes part of the walk's.
     assert!(s.walk_records >= 48, "{s:?}");
-    assert!(100 * s.k_within_30pc >= 87 * s.walk_records, "{s:?}");
-    assert!(s.k_missing <= 1, "{s:?}");
+    assert!(10 * s.k_within_30pc >= 9 * s.walk_records, "{s:?}");
+    assert_eq!(s.k_missing, 0, "{s:?}");
     // N within 3 % on every record; the Allan check at every octave on 95 %.
     assert_eq!(s.n_within_3pc, s.records, "{s:?}");
     assert!(100 * s.check_holds >= 95 * s.records, "{s:?}");
@@ -47,8 +47,8 @@ fn the_identified_fit_finds_the_truth_of_the_campaign() {
         "{s:?}"
     );
     // The 95 % intervals of N and K contain the truth in 85 to 99 % of the records. Measured
-    // on seeds 0..12: N 184 of 192 (96 %), K 131 of 144 (91 %); on seeds 12..24: N 183 of 192
-    // (95 %), K 136 of 144 (94 %).
+    // on seeds 0..12: N 184 of 192 (96 %), K 133 of 144 (92 %); on seeds 12..24: N 182 of 192
+    // (95 %), K 135 of 144 (94 %).
     for (covered, of) in [(s.n_covered, s.n_intervals), (s.k_covered, s.k_intervals)] {
         assert!(of > 0);
         let rate = covered as f64 / of as f64;
@@ -120,4 +120,17 @@ fn a_damped_line_is_found_once_within_two_percent() {
     }
     // The 95 % interval of the frequency holds the line's on (nearly) every record.
     assert!(covered >= 5, "{covered} of 6");
+}
+
+/// A white + random-walk record (400 Hz, 1 h, seed 19) whose last octave dips: the forward
+/// steps took a 655 s term, and the walk that should replace it was solved first under the
+/// term's weights, which put it at zero, so that the walk "failed" the check and the term, then
+/// the curve fit, stood without a `K`. Judged by its own weights, the walk is found.
+#[test]
+fn a_walk_that_replaces_a_long_term_is_judged_by_its_own_weights() {
+    let r = campaign::record(0, 400.0, 3600.0, 19);
+    assert!(r.walk_dominates);
+    let k = r.identified.k / CASES[0].random_walk;
+    assert!((0.7..=1.3).contains(&k), "K / K_true = {k}: {r:?}");
+    assert!(r.identified.check_holds && !r.identified.curve_fit, "{r:?}");
 }
