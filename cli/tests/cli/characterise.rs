@@ -294,10 +294,14 @@ fn the_kalibr_file_carries_the_models_overbound_in_si() {
     assert!((yaml_value(&text, "update_rate") - 200.0).abs() < 0.2);
 }
 
+/// Six seeds of white + random walk, one hour at 100 Hz, `--horizon 600`: in the median over
+/// the seeds, `K_H / K_true` is at most 2 and `N_H / N_true` at most 1.2, for the gyro and the
+/// accelerometer, and every seed's overbound holds at every octave up to the horizon.
+/// `cargo test -p imu-ar-cli --test cli -- characterise::a_white --nocapture` prints the ratios.
 #[test]
 fn a_white_and_random_walk_record_exports_close_to_its_truth() {
-    // One hour at 100 Hz; the random walk crosses the white noise at sqrt(3) N / K = 43 s and
-    // rules the last 1.5 decades of the octaves the record resolves (to about 1300 s).
+    // The random walk crosses the white noise at sqrt(3) N / K = 43 s and rules the last 1.5
+    // decades of the octaves the record resolves (to about 1300 s).
     let (gyro, accel) = ((1e-3, 4e-5), (2e-2, 8e-4));
     let noise = Noise {
         white: [gyro.0, gyro.0, gyro.0, accel.0, accel.0, accel.0],
@@ -305,34 +309,53 @@ fn a_white_and_random_walk_record_exports_close_to_its_truth() {
         gm_sigma: [0.0; 6],
         gm_t: 1.0,
     };
-    let dir = temp_dir("white-rw");
-    let file = dir.join("data.csv");
-    write_euroc(&file, &noise_frames_of(&noise, 360_000, 100.0, 12));
-    let out = dir.join("out");
     let horizon = 600.0;
-    let model = characterise(
-        &[path(&file)],
-        &out,
-        &["--format", "kalibr", "--horizon", "600"],
-    );
-    let text = std::fs::read_to_string(out.join("imu.yaml")).unwrap();
-    assert!(
-        text.contains("to H = 6.0000e2 s, the horizon asked for (log N_H/N"),
-        "{text}"
-    );
-    for ((n_key, k_key, axes), (n_true, k_true)) in KALIBR_KEYS.into_iter().zip([gyro, accel]) {
-        let (n, k) = (yaml_value(&text, n_key), yaml_value(&text, k_key));
-        assert!(n / n_true <= 1.2, "{n_key}: N_H / N = {}", n / n_true);
-        assert!(k / k_true <= 2.0, "{k_key}: K_H / K = {}", k / k_true);
-        for i in axes {
-            let rows = model_octaves(&model, i, horizon);
-            assert!(rows.len() >= 9, "axis {i}: {} octaves", rows.len());
-            let below = uncovered(n, k, &rows);
-            assert!(
-                below.is_empty(),
-                "axis {i}: ({n}, {k}) below the model at {below:?}"
-            );
+    let mut ratios = [const { Vec::new() }; 2];
+    for seed in 12..18 {
+        let dir = temp_dir(&format!("white-rw-{seed}"));
+        let file = dir.join("data.csv");
+        write_euroc(&file, &noise_frames_of(&noise, 360_000, 100.0, seed));
+        let out = dir.join("out");
+        let model = characterise(
+            &[path(&file)],
+            &out,
+            &["--format", "kalibr", "--horizon", "600"],
+        );
+        let text = std::fs::read_to_string(out.join("imu.yaml")).unwrap();
+        assert!(
+            text.contains("to H = 6.0000e2 s, the horizon asked for (log N_H/N"),
+            "{text}"
+        );
+        let sensors = KALIBR_KEYS.into_iter().zip([gyro, accel]);
+        for (s, ((n_key, k_key, axes), (n_true, k_true))) in sensors.enumerate() {
+            let (n, k) = (yaml_value(&text, n_key), yaml_value(&text, k_key));
+            ratios[s].push((n / n_true, k / k_true));
+            for i in axes {
+                let rows = model_octaves(&model, i, horizon);
+                assert!(
+                    rows.len() >= 9,
+                    "seed {seed} axis {i}: {} octaves",
+                    rows.len()
+                );
+                let below = uncovered(n, k, &rows);
+                assert!(
+                    below.is_empty(),
+                    "seed {seed} axis {i}: ({n}, {k}) below the model at {below:?}"
+                );
+            }
         }
+    }
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        (v[v.len() / 2 - 1] + v[v.len() / 2]) / 2.0
+    };
+    for (name, r) in ["gyro", "accelerometer"].into_iter().zip(ratios) {
+        println!("{name}: (N_H / N, K_H / K) by seed {r:.3?}");
+        let n = median(r.iter().map(|p| p.0).collect());
+        let k = median(r.iter().map(|p| p.1).collect());
+        println!("{name}: median N_H / N {n:.3}, K_H / K {k:.3}");
+        assert!(n <= 1.2, "{name}: median N_H / N = {n}");
+        assert!(k <= 2.0, "{name}: median K_H / K = {k}");
     }
 }
 
