@@ -297,11 +297,14 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
         Ok((model, limited))
     }
 
-    /// The fit of `set` (its zero terms left out, the set returned without them), refined by
-    /// its own weights; where that reweighting talks a term the data need down to zero, so
+    /// The fit of `set` (its zero terms left out, the set returned without them), from the
+    /// data's own weights (another model's would judge the set by where that model bends:
+    /// one that levels off predicts small variances at the last octaves, where a single low
+    /// estimate then puts a rising term at zero), refined by its own weights; where that reweighting talks a term the data need down to zero, so
     /// that the refined fit fails the whole-curve check that the set's own fit passes, the
     /// set's own fit.
     fn settle(&mut self, set: Set) -> Result<(Set, Full<P>), NoiseError> {
+        self.reweight::<MAX>(None);
         let (x, _) = self.nnls(set.columns())?;
         let set = Self::compact(&set, &x);
         let (x, _) = self.nnls(set.columns())?;
@@ -332,12 +335,8 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
                     };
                     // Unless the record contradicts the walk: the term explains every octave
                     // and the walk does not (a rise that levels off, as a long term's does).
-                    // Each settled from the data's own weights: under the term's, which
-                    // predict a small variance where the term levels off, the walk's first
-                    // solve would put it at zero before its own weights could judge it.
-                    self.reweight::<MAX>(None);
+                    // Each settled from the data's own weights (`settle`).
                     let (_, term) = self.settle(set)?;
-                    self.reweight::<MAX>(None);
                     let (_, walked) = self.settle(walk)?;
                     if term.check_whole(self.octaves)?.holds()
                         && !walked.check_whole(self.octaves)?.holds()

@@ -639,8 +639,19 @@ impl Output for NoiseResult {
             unit(self.quantization, &format!("{} s", u.name))
         );
         s += &format!("random_walk {}", json(&self.random_walk));
-        if let Some(k) = self.random_walk {
-            s += &format!(" {}/s{}", u.psd_root(), u.rrw(k));
+        match (self.random_walk, &self.intervals) {
+            (Some(k), _) => s += &format!(" {}/s{}", u.psd_root(), u.rrw(k)),
+            // Not identified: the bound the record sets is the walk a filter can take.
+            (None, Some(i)) if i.random_walk.high > 0.0 => {
+                s += &format!(
+                    ": the record shows no walk; at most {} {}/s{} (95 %), the value the \
+                     parameter files carry",
+                    json(&i.random_walk.high),
+                    u.psd_root(),
+                    u.rrw(i.random_walk.high)
+                )
+            }
+            (None, _) => {}
         }
         s += "\n";
         s += &format!(

@@ -460,3 +460,37 @@ fn a_trend_gets_no_ar_part_and_out_of_range_magnitudes_are_named() {
         "underflows f64",
     );
 }
+
+#[test]
+fn a_record_without_a_walk_names_the_bound_the_files_carry() {
+    let file = scaled_white("noise-no-walk.csv", 1.0);
+    let v = noise(
+        std::slice::from_ref(&file),
+        "x",
+        "100",
+        &["--ar-order", "0"],
+    );
+    assert!(v["random_walk"].is_null(), "{v}");
+    let high = f(&v["intervals"]["random_walk"]["high"]);
+    assert!(high > 0.0, "{v}");
+    let text = stdout(&imu_ar(&[
+        "noise",
+        file.to_str().unwrap(),
+        "--column",
+        "x",
+        "--rate",
+        "100",
+        "--ar-order",
+        "0",
+    ]));
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("random_walk "))
+        .unwrap_or_else(|| panic!("{text}"));
+    let said = line
+        .split_once("the record shows no walk; at most ")
+        .and_then(|(_, rest)| rest.split(' ').next())
+        .and_then(|n| n.parse::<f64>().ok())
+        .unwrap_or_else(|| panic!("{line}"));
+    assert_eq!(said, high, "{line}");
+}
