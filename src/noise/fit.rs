@@ -213,13 +213,18 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
     /// ([`super::Estimator::octave_correlation`]), so that the weighted misfit `chi^2` is that
     /// of independent rows of unit variance:
     ///
-    /// 1. It starts from white noise (and the AR part, if given).
+    /// 1. It starts from white noise (and the AR part, if given and of short memory: its
+    ///    Allan variance within 10 % of its white equivalent at the longest correlation time
+    ///    the record tells, `tau_max / RECORD_OCTAVES`; an AR part still colouring the
+    ///    octaves there, such as one whose root near 1 took a random walk or a slow drift,
+    ///    would hand its white equivalent, up to a hundred times the data's level, to `N`,
+    ///    and the walk it took to no term: the fit goes without it).
     /// 2. It adds, one at a time, the candidate (quantisation, random walk, ramp, a
     ///    Gauss-Markov term at a grid correlation time from `dt` to [`RECORD_OCTAVES`]
     ///    times less than the longest `tau`, an
-    ///    oscillator) that lowers `chi^2 + ln(L) k` most, `k` its parameters (1; 2 for a
-    ///    Gauss-Markov term; 3 for an oscillator) and `L` the octaves (BIC), as long as one
-    ///    lowers it. The new term's correlation time (an oscillator's frequency and decay
+    ///    oscillator) that lowers `chi^2 + 2 ln(ln L) k` most, `k` its parameters (1; 2 for
+    ///    a Gauss-Markov term; 3 for an oscillator) and `L` the octaves (Hannan-Quinn), as
+    ///    long as one lowers it. The new term's correlation time (an oscillator's frequency and decay
     ///    time) is refined by golden-section search between its grid neighbours.
     /// 3. When a candidate would pass but the budget has no state left for it,
     ///    [`Identified::budget_limited`] says so.
@@ -275,6 +280,7 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
             ),
             None => None,
         };
+        let ar = ar.filter(|ar| short_memory(ar, &scaled));
         let (mut model, budget_limited) = Self::fit_unit(&scaled, ar.as_ref(), config)?;
         // Identified terms that fail the whole-curve check at octaves where the curve fit
         // passes it: the data hold more than the criterion found terms for, and the curve fit
@@ -309,7 +315,7 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
         })
     }
 
-    /// [`NoiseModel::fit`] in the scaled units.
+    /// [`NoiseModel::fit`] in the scaled units (the AR part one of short memory).
     fn fit_unit<const L: usize>(
         octaves: &Octaves<L>,
         ar: Option<&ArModel<f64, P>>,
@@ -698,4 +704,28 @@ pub struct Identified<const P: usize, const G: usize> {
     /// ([`NoiseModel::check_whole`]) at more octaves than the curve fit. Its parameters then
     /// describe the curve, and may not be the sensor's.
     pub curve_fit: bool,
+}
+
+/// Whether the AR part `ar` is short-term colouring over `octaves`: its Allan variance times
+/// `tau` within 10 % of its white equivalent `sigma^2 dt / (1 - sum a)^2` at the octave of the
+/// longest correlation time the record tells (`tau_max / RECORD_OCTAVES`, the first octave
+/// for a record shorter than that). One that is not stationary is left to the fit to refuse.
+fn short_memory<const P: usize, const L: usize>(
+    ar: &ArModel<f64, P>,
+    octaves: &Octaves<L>,
+) -> bool {
+    let len = octaves.avar().len().min(L);
+    let mut curve = [0.0; L];
+    if component::ar_octaves(ar, &mut curve[..len]).is_err() {
+        return true;
+    }
+    let reach = octaves.tau(len.saturating_sub(1)) / RECORD_OCTAVES;
+    let j = (0..len)
+        .rev()
+        .find(|j| octaves.tau(*j) <= reach * (1.0 + 1e-9))
+        .unwrap_or(0);
+    let gain = 1.0 - ar.a().iter().sum::<f64>();
+    let white = ar.noise_variance() * octaves.dt() / (gain * gain);
+    let ratio = curve.get(j).copied().unwrap_or(0.0) * octaves.tau(j) / white;
+    (0.9..=1.1).contains(&ratio)
 }

@@ -670,7 +670,30 @@ fn bias_instability<const P: usize, const G: usize, const L: usize>(
 /// `chi^2_nu / nu` at its 2.5 % quantile: Wilson-Hilferty, and below a few degrees of freedom,
 /// where that reaches 0, the lower tail `P(chi^2 < x) ~ (x/2)^(nu/2) / Gamma(nu/2 + 1)`.
 fn chi2_lower_over_nu(nu: f64) -> f64 {
-    let tail = 2.0 * libm::pow(0.025 * libm::tgamma(nu / 2.0 + 1.0), 2.0 / nu) / nu;
+    // In logarithms: Gamma(nu/2 + 1) overflows f64 beyond 340 degrees of freedom, and the tail
+    // then read infinite, which put the interval's upper end at 0.
+    let ln_tail = (libm::log(0.025) + libm::lgamma(nu / 2.0 + 1.0)) * 2.0 / nu;
+    let tail = 2.0 * libm::exp(ln_tail) / nu;
     let q = chi2_over_nu(nu, -Z95).max(tail);
     if q > 0.0 { q } else { f64::MIN_POSITIVE }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_lower_quantile_holds_at_every_degree_of_freedom() {
+        // Beyond 340 degrees of freedom Gamma(nu/2 + 1) overflows f64: the quantile read
+        // infinite, and B's interval had its upper end at 0, below its value.
+        let mut previous = 0.0;
+        for nu in [0.5, 1.0, 2.0, 4.0, 10.0, 100.0, 340.0, 400.0, 1e4, 1e6, 1e9] {
+            let q = chi2_lower_over_nu(nu);
+            assert!(q.is_finite() && q > 0.0 && q < 1.0, "nu {nu}: {q}");
+            assert!(q > previous, "nu {nu}: {q} after {previous}");
+            previous = q;
+        }
+        // The 2.5 % quantile of chi^2_400 / 400 is 0.8667.
+        assert!((chi2_lower_over_nu(400.0) / 0.8667 - 1.0).abs() < 2e-3);
+    }
 }

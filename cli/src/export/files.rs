@@ -165,14 +165,18 @@ struct Bounded {
 }
 
 /// The smallest overbound from `(n, k)` of the model of `axes` at every octave in `[1 s, h]`.
-/// A zero `n` or `k` is replaced by its floor: for `K`, [`bound::k_floor`] at the longest octave
-/// in range; for `N`, [`bound::n_floor`] at the shortest (or, when the model has neither,
-/// [`bound::FLOOR_RISE`] of its Allan deviation there, as white noise).
+/// A zero `n` or `k` is replaced by its floor: for `K`, the largest upper end of the 95 %
+/// intervals of the axes without a random walk, or without one [`bound::k_floor`] at the
+/// longest octave in range; for `N`, [`bound::n_floor`] at the shortest (or, when the model
+/// has neither, [`bound::FLOOR_RISE`] of its Allan deviation there, as white noise). A `k`
+/// below such an upper end is raised to it: the file never carries less random walk than an
+/// axis's record allows.
 fn bounded(n: f64, k: f64, axes: &[(usize, &AxisModel)], h: f64) -> Result<Bounded, Fail> {
-    // A model without K: the upper end of K's 95 % interval, the largest random walk the data
-    // leave room for, of the axes.
+    // An axis without K: the upper end of its K's 95 % interval, the largest random walk its
+    // data leave room for; the largest of the axes without K.
     let k_high = axes
         .iter()
+        .filter(|(_, a)| a.random_walk <= 0.0)
         .filter_map(|(_, a)| a.random_walk_interval.map(|i| i.1))
         .filter(|v| v.is_finite() && *v > 0.0)
         .max_by(f64::total_cmp);
@@ -212,7 +216,16 @@ fn bounded(n: f64, k: f64, axes: &[(usize, &AxisModel)], h: f64) -> Result<Bound
         ));
         floor
     };
-    let k_ref = if k > 0.0 {
+    let k_ref = if let Some(high) = k_high.filter(|high| k > 0.0 && *high > k) {
+        floors.push(format!(
+            "An axis without a random walk leaves room for more than the largest fitted K ({}): \
+             K is taken as {} (never below what an axis's record allows), the upper end of \
+             that axis's 95 % interval.",
+            short(k),
+            short(high)
+        ));
+        high
+    } else if k > 0.0 {
         k
     } else if let Some(high) = k_high {
         floors.push(format!(

@@ -757,3 +757,33 @@ fn uptime_clocks_rounded_stamps_and_unknown_units() {
     );
     assert_eq!(std::fs::read_dir(&out).unwrap().count(), 1);
 }
+
+/// One gyro axis shows a walk; another, a hundred times noisier, shows none and leaves room for
+/// a larger one. The Kalibr file's gyro random walk is the larger: the file never carries less
+/// than an axis's record allows (before, the fitted walk of the first axis alone).
+#[test]
+fn an_axis_without_a_walk_lends_the_file_its_bound() {
+    let noise = Noise {
+        white: [1e-3, 5e-2, 1e-3, 2e-2, 2e-2, 2e-2],
+        walk: [4e-5, 0.0, 4e-5, 8e-4, 8e-4, 8e-4],
+        gm_sigma: [0.0; 6],
+        gm_t: 1.0,
+    };
+    let dir = temp_dir("axis-without-walk");
+    let file = dir.join("data.csv");
+    write_euroc(&file, &noise_frames_of(&noise, 360_000, 100.0, 5));
+    let out = dir.join("out");
+    let model = characterise(&[path(&file)], &out, &["--format", "kalibr"]);
+    let gy = &model["axes"][1]["model"];
+    assert!(gy["random_walk"].is_null(), "{gy}");
+    let bound = gy["intervals"]["random_walk"]["high"].as_f64().unwrap();
+    let fitted = model["axes"][0]["model"]["random_walk"].as_f64().unwrap();
+    assert!(bound > fitted, "gy's bound {bound}, gx's K {fitted}");
+    let text = std::fs::read_to_string(out.join("imu.yaml")).unwrap();
+    let k = yaml_value(&text, "gyroscope_random_walk");
+    assert!(k >= bound, "{k} < gy's bound {bound}: {text}");
+    assert!(
+        text.contains("An axis without a random walk leaves room for more"),
+        "{text}"
+    );
+}

@@ -494,3 +494,44 @@ fn a_record_without_a_walk_names_the_bound_the_files_carry() {
         .unwrap_or_else(|| panic!("{line}"));
     assert_eq!(said, high, "{line}");
 }
+
+/// A random walk that dominates from the first octaves: BIC's AR part of the samples has a root
+/// near 1 there. It is no short-term colouring, and the fit goes without it: before, its white
+/// equivalent became `N` (up to five times the truth) and it took the walk, so that `K` went
+/// missing.
+#[test]
+fn a_walk_that_dominates_is_not_taken_by_the_ar_part() {
+    let truth = Composite {
+        dt: 0.01,
+        white: 1e-5,
+        quantization: 0.0,
+        gm: vec![],
+        random_walk: 5e-4,
+    };
+    for seed in 0..4 {
+        let x = truth.simulate(60_000, 1000 + seed);
+        let file = column_file(
+            &format!("noise-walk-dominates-{seed}.csv"),
+            x.iter().map(|v| v.to_string()),
+        );
+        let v = noise(&[file], "x", "100", &[]);
+        let n = f(&v["white_noise"]);
+        let k = f(&v["random_walk"]);
+        assert!(
+            (n / truth.white - 1.0).abs() < 0.03,
+            "seed {seed}: N {n}: {v}"
+        );
+        assert!(
+            (k / truth.random_walk - 1.0).abs() < 0.3,
+            "seed {seed}: K {k}: {v}"
+        );
+        let i = &v["intervals"];
+        assert!(f(&i["white_noise"]["low"]) <= truth.white, "{i}");
+        assert!(truth.white <= f(&i["white_noise"]["high"]), "{i}");
+        for key in ["white_noise", "random_walk", "bias_instability"] {
+            let b = &i[key];
+            let inside = f(&b["low"]) <= f(&b["value"]) && f(&b["value"]) <= f(&b["high"]);
+            assert!(inside, "seed {seed}: {key} {b}");
+        }
+    }
+}
