@@ -414,7 +414,7 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
     }
 
     /// The model with every variance times `2^exponent`.
-    fn scaled(mut self, exponent: i32) -> Result<Self, NoiseError> {
+    pub(super) fn scaled(mut self, exponent: i32) -> Result<Self, NoiseError> {
         let root = |v: f64| libm::sqrt(libm::scalbn(v * v, exponent));
         self.quantization = root(self.quantization);
         self.white = root(self.white);

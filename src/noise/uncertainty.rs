@@ -100,6 +100,37 @@ impl<const G: usize, const L: usize> Uncertainty<G, L> {
     }
 }
 
+impl<const G: usize, const L: usize> Uncertainty<G, L> {
+    /// The intervals of the model with every variance times `2^exponent`: the coefficients,
+    /// `sigma`s, `B` and the band times `2^(exponent / 2)`; times and frequencies as they are.
+    fn scaled(mut self, exponent: i32) -> Self {
+        let root = |v: f64| libm::sqrt(libm::scalbn(v * v, exponent));
+        let interval = |i: &mut Interval| {
+            i.low = root(i.low);
+            i.high = root(i.high);
+        };
+        for i in [
+            &mut self.white_noise,
+            &mut self.quantization,
+            &mut self.random_walk,
+            &mut self.ramp,
+            &mut self.bias_instability,
+        ] {
+            interval(i);
+        }
+        for t in self.gm.iter_mut() {
+            interval(&mut t.sigma);
+        }
+        for o in self.osc.iter_mut() {
+            interval(&mut o.sigma);
+        }
+        for b in self.band.iter_mut() {
+            interval(b);
+        }
+        self
+    }
+}
+
 /// One parameter of the covariance.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 enum Parameter {
@@ -177,6 +208,25 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
     /// [`NoiseError::Capacity`] for more than [`MAX_PARAMETERS`] parameters;
     /// [`NoiseError::Ar`] when the AR part is not stationary.
     pub fn uncertainty<const L: usize>(
+        &self,
+        octaves: &Octaves<L>,
+    ) -> Result<Uncertainty<G, L>, NoiseError> {
+        // In units where the largest Allan variance is about 1, as the fit works (a power of two
+        // away, so that the scaling is exact): the information holds variances squared, which
+        // leave f64 for Allan deviations past 1e77 or below 1e-77.
+        let largest = octaves.avar().iter().copied().fold(0.0, f64::max);
+        let exponent = if largest.is_normal() {
+            libm::ilogb(largest)
+        } else {
+            0
+        };
+        let model = self.scaled(exponent.saturating_neg())?;
+        let unit = model.uncertainty_unit(&octaves.scaled(exponent.saturating_neg()))?;
+        Ok(unit.scaled(exponent))
+    }
+
+    /// [`NoiseModel::uncertainty`] in the units of `octaves`.
+    fn uncertainty_unit<const L: usize>(
         &self,
         octaves: &Octaves<L>,
     ) -> Result<Uncertainty<G, L>, NoiseError> {

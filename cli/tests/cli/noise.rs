@@ -363,6 +363,16 @@ fn fits_any_magnitude_alike() {
         let v = noise(&[file], "x", "100", &["--ar-order", "0"]);
         let ratio = f(&v["white_noise"]) / scale / f(&one["white_noise"]);
         assert!((ratio - 1.0).abs() < 1e-6, "scale {scale:e}: {v}");
+        // The intervals too (before, past 1e82 their upper ends were null, and below 1e-74
+        // they had no width).
+        let intervals = v["intervals"].as_object().unwrap();
+        for (key, b) in intervals.iter().filter(|(_, b)| b.get("high").is_some()) {
+            for end in ["low", "high"] {
+                let (got, want) = (f(&b[end]), f(&one["intervals"][key][end]) * scale);
+                let close = got == want || (got / want - 1.0).abs() < 1e-6;
+                assert!(close, "scale {scale:e}: {key} {end} {got:e}, want {want:e}");
+            }
+        }
         assert_eq!(
             v["explained_up_to_s"], one["explained_up_to_s"],
             "scale {scale:e}"
