@@ -143,8 +143,10 @@ pub enum Step {
 /// The most buckets held: past them, every bucket's width doubles (one significant bit less).
 const DISTINCT: usize = 1 << 16;
 
-/// Intervals taken before they are sorted into the histogram, all at once.
-const PENDING: usize = 1 << 15;
+/// Intervals taken before they are sorted into the histogram, all at once (1 MB): each merge
+/// copies every bucket, so the fewer merges the better, while the sort's cost per interval
+/// grows only with the logarithm of their number.
+const PENDING: usize = 1 << 17;
 
 /// `buckets` (in the order of their keys) at `bits` significant bits, neighbours merged.
 fn coarser(buckets: &[Bucket], bits: u32) -> Vec<Bucket> {
@@ -160,10 +162,10 @@ fn coarser(buckets: &[Bucket], bits: u32) -> Vec<Bucket> {
 }
 
 /// `buckets` (in the order of their keys) with the intervals `more` (emptied) in, at `bits`
-/// significant bits.
-fn merged(buckets: &[Bucket], more: &mut Vec<i64>, bits: u32) -> Vec<Bucket> {
+/// significant bits, into `out` (emptied first).
+fn merge_into(buckets: &[Bucket], more: &mut Vec<i64>, bits: u32, out: &mut Vec<Bucket>) {
     more.sort_unstable();
-    let mut out: Vec<Bucket> = Vec::with_capacity(buckets.len() + 64);
+    out.clear();
     let add = |out: &mut Vec<Bucket>, b: &Bucket| match out.last_mut() {
         Some(last) if last.key == b.key => last.merge(b),
         _ => out.push(*b),
@@ -174,7 +176,7 @@ fn merged(buckets: &[Bucket], more: &mut Vec<i64>, bits: u32) -> Vec<Bucket> {
         while let Some(&o) = old.peek()
             && o.key <= key
         {
-            add(&mut out, o);
+            add(out, o);
             old.next();
         }
         match out.last_mut() {
@@ -182,7 +184,13 @@ fn merged(buckets: &[Bucket], more: &mut Vec<i64>, bits: u32) -> Vec<Bucket> {
             _ => out.push(Bucket::of(iv, bits)),
         }
     }
-    old.for_each(|o| add(&mut out, o));
+    old.for_each(|o| add(out, o));
+}
+
+/// [`merge_into`] a new vector.
+fn merged(buckets: &[Bucket], more: &mut Vec<i64>, bits: u32) -> Vec<Bucket> {
+    let mut out = Vec::with_capacity(buckets.len() + 64);
+    merge_into(buckets, more, bits, &mut out);
     out
 }
 
@@ -273,6 +281,8 @@ pub struct Timing {
     dropped: u64,
     /// The histogram, in the order of the intervals.
     buckets: Vec<Bucket>,
+    /// The histogram before the last merge: its allocation, for the next.
+    spare: Vec<Bucket>,
     /// Intervals not yet in the histogram, sorted in all at once (a fraction of a table
     /// lookup per interval).
     pending: Vec<i64>,
@@ -302,7 +312,8 @@ impl Timing {
         }
         self.pending.push(t.saturating_sub(self.last));
         if self.pending.len() >= PENDING {
-            self.buckets = merged(&self.buckets, &mut self.pending, self.bits);
+            merge_into(&self.buckets, &mut self.pending, self.bits, &mut self.spare);
+            std::mem::swap(&mut self.buckets, &mut self.spare);
             while self.buckets.len() > DISTINCT && self.bits > 1 {
                 self.bits -= 1;
                 self.buckets = coarser(&self.buckets, self.bits);
