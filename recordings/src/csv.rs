@@ -460,7 +460,7 @@ impl<'a> Source<'a> {
 
 /// Passes the cells that `select` picks of each row of one CSV source (named `path` in errors,
 /// with its header if that is a comment line) to `each`; `locate` gives the line of a byte
-/// offset, for errors.
+/// offset, for errors. Read [`READ_BUFFER`] bytes at a time.
 fn read_source(
     path: &Path,
     (source, comment_header): (Source, Option<Vec<String>>),
@@ -474,9 +474,13 @@ fn read_source(
         select,
         each,
         locate,
-        (1 << 20, false),
+        (READ_BUFFER, false),
     )
 }
+
+/// Bytes read at a time, and so the text of a batch of records: small enough that a batch's
+/// text and fields are still in the cache when the rows are checked and parsed.
+const READ_BUFFER: usize = 1 << 18;
 
 /// [`read_source`] with a buffer of `buffer` bytes to start with (lines longer than it
 /// enlarge it), scanned on a thread of its own also when the source is short (`force_thread`).

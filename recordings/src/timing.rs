@@ -80,7 +80,7 @@ impl TimeUnit {
             Self::Nanoseconds | Self::HeaderStamps => 1,
         };
         let out_of_range = || format!("timestamp '{cell}' {} is out of range", self.name());
-        if let Ok(v) = cell.parse::<i64>() {
+        if let Some(v) = integer(cell) {
             return v.checked_mul(scale).ok_or_else(out_of_range);
         }
         if let Some(ns) = decimal_ns(cell, scale) {
@@ -97,6 +97,60 @@ impl TimeUnit {
             _ => Err(format!("timestamp '{cell}' is not a number")),
         }
     }
+}
+
+/// `cell` as `str::parse::<i64>` reads it (the same values, the same refusals), eight digits
+/// at a time: a stamp in ns has 19, one by one a chain of 19 multiplications. Longer runs of
+/// digits (leading zeros) are the standard library's.
+fn integer(cell: &str) -> Option<i64> {
+    let (negative, digits) = match cell.as_bytes() {
+        [b'-', rest @ ..] => (true, rest),
+        [b'+', rest @ ..] => (false, rest),
+        all => (false, all),
+    };
+    if digits.is_empty() || digits.len() > 19 {
+        return cell.parse().ok();
+    }
+    // Below 10^19 < 2^64: no overflow.
+    let mut v = 0u64;
+    let mut rest = digits;
+    while let Some((eight, tail)) = rest.split_first_chunk::<8>() {
+        v = v * 100_000_000 + eight_digits(u64::from_le_bytes(*eight))?;
+        rest = tail;
+    }
+    for &b in rest {
+        let d = b.wrapping_sub(b'0');
+        if d > 9 {
+            return None;
+        }
+        v = v * 10 + u64::from(d);
+    }
+    if negative {
+        // Down to -2^63.
+        (v <= 1 << 63).then(|| 0i64.wrapping_sub_unsigned(v))
+    } else {
+        i64::try_from(v).ok()
+    }
+}
+
+/// The number that eight ASCII digits (little-endian, the first digit in the lowest byte) spell,
+/// or `None` when a byte is no digit.
+fn eight_digits(word: u64) -> Option<u64> {
+    // Every byte's high nibble 3, and still 3 with 6 added: 0x30 to 0x39. (A carry out of a
+    // byte comes only from one of 0xfa and up, which fails already.)
+    let high = 0xf0f0_f0f0_f0f0_f0f0u64;
+    if (word & high) | ((word.wrapping_add(0x0606_0606_0606_0606) & high) >> 4)
+        != 0x3333_3333_3333_3333
+    {
+        return None;
+    }
+    let v = word - 0x3030_3030_3030_3030;
+    // Pairs, then fours, then all eight.
+    let v = (v * 10) + (v >> 8);
+    let v = (((v & 0x0000_00ff_0000_00ff).wrapping_mul(0x000f_4240_0000_0064))
+        .wrapping_add(((v >> 16) & 0x0000_00ff_0000_00ff).wrapping_mul(0x0000_2710_0000_0001)))
+        >> 32;
+    Some(v & 0xffff_ffff)
 }
 
 /// A plain decimal `[+-]digits.digits` (no exponent) times `scale` (a power of ten up to 10^9),
@@ -143,8 +197,10 @@ pub enum Step {
 /// The most buckets held: past them, every bucket's width doubles (one significant bit less).
 const DISTINCT: usize = 1 << 16;
 
-/// Intervals taken before they are sorted into the histogram, all at once.
-const PENDING: usize = 1 << 15;
+/// Intervals taken before they are sorted into the histogram, all at once (1 MB): each merge
+/// copies every bucket, so the fewer merges the better, while the sort's cost per interval
+/// grows only with the logarithm of their number.
+const PENDING: usize = 1 << 17;
 
 /// `buckets` (in the order of their keys) at `bits` significant bits, neighbours merged.
 fn coarser(buckets: &[Bucket], bits: u32) -> Vec<Bucket> {
@@ -160,10 +216,10 @@ fn coarser(buckets: &[Bucket], bits: u32) -> Vec<Bucket> {
 }
 
 /// `buckets` (in the order of their keys) with the intervals `more` (emptied) in, at `bits`
-/// significant bits.
-fn merged(buckets: &[Bucket], more: &mut Vec<i64>, bits: u32) -> Vec<Bucket> {
+/// significant bits, into `out` (emptied first).
+fn merge_into(buckets: &[Bucket], more: &mut Vec<i64>, bits: u32, out: &mut Vec<Bucket>) {
     more.sort_unstable();
-    let mut out: Vec<Bucket> = Vec::with_capacity(buckets.len() + 64);
+    out.clear();
     let add = |out: &mut Vec<Bucket>, b: &Bucket| match out.last_mut() {
         Some(last) if last.key == b.key => last.merge(b),
         _ => out.push(*b),
@@ -174,7 +230,7 @@ fn merged(buckets: &[Bucket], more: &mut Vec<i64>, bits: u32) -> Vec<Bucket> {
         while let Some(&o) = old.peek()
             && o.key <= key
         {
-            add(&mut out, o);
+            add(out, o);
             old.next();
         }
         match out.last_mut() {
@@ -182,7 +238,13 @@ fn merged(buckets: &[Bucket], more: &mut Vec<i64>, bits: u32) -> Vec<Bucket> {
             _ => out.push(Bucket::of(iv, bits)),
         }
     }
-    old.for_each(|o| add(&mut out, o));
+    old.for_each(|o| add(out, o));
+}
+
+/// [`merge_into`] a new vector.
+fn merged(buckets: &[Bucket], more: &mut Vec<i64>, bits: u32) -> Vec<Bucket> {
+    let mut out = Vec::with_capacity(buckets.len() + 64);
+    merge_into(buckets, more, bits, &mut out);
     out
 }
 
@@ -273,6 +335,8 @@ pub struct Timing {
     dropped: u64,
     /// The histogram, in the order of the intervals.
     buckets: Vec<Bucket>,
+    /// The histogram before the last merge: its allocation, for the next.
+    spare: Vec<Bucket>,
     /// Intervals not yet in the histogram, sorted in all at once (a fraction of a table
     /// lookup per interval).
     pending: Vec<i64>,
@@ -302,7 +366,8 @@ impl Timing {
         }
         self.pending.push(t.saturating_sub(self.last));
         if self.pending.len() >= PENDING {
-            self.buckets = merged(&self.buckets, &mut self.pending, self.bits);
+            merge_into(&self.buckets, &mut self.pending, self.bits, &mut self.spare);
+            std::mem::swap(&mut self.buckets, &mut self.spare);
             while self.buckets.len() > DISTINCT && self.bits > 1 {
                 self.bits -= 1;
                 self.buckets = coarser(&self.buckets, self.bits);
@@ -639,6 +704,63 @@ mod tests {
         assert_eq!(summary.rate_hz, 400.0);
         assert_eq!(summary.median_interval_s, 2.5e-3);
         assert_eq!(summary.jitter_rms, 0.0);
+    }
+
+    /// Integers read eight digits at a time as the standard library reads them: the same
+    /// values, or both refuse. Random texts of digits, signs and other bytes, of 0 to 24
+    /// characters (runs of 19 digits the most), and the ends of the range.
+    #[test]
+    fn integers_read_as_the_standard_library_reads_them() {
+        const CHARS: &[u8] = b"0123456789012345678901234567890123456789+-/:. e\x00\xff";
+        let mut next = crate::xorshift(0x0bad_5eed_1234_5678);
+        let mut text = Vec::new();
+        for case in 0..1_000_000 {
+            text.clear();
+            let len = match next() % 4 {
+                0 => 19,
+                1 => 18 + next() % 3,
+                _ => next() % 25,
+            };
+            let odd = next().is_multiple_of(3);
+            for _ in 0..len {
+                let pick = if odd { CHARS.len() } else { 10 };
+                text.push(CHARS[(next() % pick as u64) as usize]);
+            }
+            if next().is_multiple_of(4) {
+                text.insert(0, [b'-', b'+'][(next() % 2) as usize]);
+            }
+            let Ok(text) = std::str::from_utf8(&text) else {
+                continue;
+            };
+            assert_eq!(
+                integer(text),
+                text.parse::<i64>().ok(),
+                "case {case}: {text:?}"
+            );
+        }
+        for text in [
+            "9223372036854775807",
+            "9223372036854775808",
+            "-9223372036854775808",
+            "-9223372036854775809",
+            "+9223372036854775807",
+            "9999999999999999999",
+            "-9999999999999999999",
+            "00000000000000000000001",
+            "-0",
+            "+0",
+            "-",
+            "+",
+            "",
+            " 1",
+            "1 ",
+            "1699999999999985352",
+            "12345678",
+            "1234567:",
+            "/2345678",
+        ] {
+            assert_eq!(integer(text), text.parse::<i64>().ok(), "{text:?}");
+        }
     }
 
     #[test]
