@@ -239,6 +239,9 @@ fn merge_into(buckets: &[Bucket], more: &mut Vec<i64>, bits: u32, out: &mut Vec<
         }
     }
     old.for_each(|o| add(out, o));
+    // The histogram is read in the order of its keys (its median, its runs): a merge of
+    // unsorted intervals would leave equal keys apart and still sum to the same rate.
+    debug_assert!(out.windows(2).all(|w| w[0].key < w[1].key));
 }
 
 /// [`merge_into`] a new vector.
