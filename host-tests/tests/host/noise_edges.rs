@@ -170,7 +170,9 @@ fn exact_white_and_walk_curves_always_fit() {
 #[test]
 fn a_capacity_too_small_for_the_columns_is_a_typed_error() {
     // L = 2 holds four columns: quantisation, white, random walk, ramp and an AR part are five.
-    let ar = ArModel::new([0.5], 1.0, 0.0, 0.01).unwrap();
+    // The AR part is short-term colouring at the first octave (its Allan variance times `tau`
+    // 0.96 of its white equivalent), so that the fit takes it.
+    let ar = ArModel::new([0.02], 1.0, 0.0, 0.01).unwrap();
     let octaves = Octaves::<2>::new(0.01, &[1e-2, 5e-3], Estimator::Overlapping { n: 4 }).unwrap();
     let config = FitConfig::new(0).with_ramp(true);
     let got = NoiseModel::<1, 1>::fit(&octaves, Some(&ar), &config);
