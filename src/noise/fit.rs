@@ -707,7 +707,7 @@ pub struct Identified<const P: usize, const G: usize> {
 }
 
 /// Whether the AR part `ar` is short-term colouring over `octaves`: its Allan variance times
-/// `tau` within 10 % of its white equivalent `sigma^2 dt / (1 - sum a)^2` at the octave of the
+/// `tau` within 10 % of its white equivalent (`ar_white_equivalent`) at the octave of the
 /// longest correlation time the record tells (`tau_max / RECORD_OCTAVES`, the first octave
 /// for a record shorter than that). One that is not stationary is left to the fit to refuse.
 fn short_memory<const P: usize, const L: usize>(
@@ -724,8 +724,7 @@ fn short_memory<const P: usize, const L: usize>(
         .rev()
         .find(|j| octaves.tau(*j) <= reach * (1.0 + 1e-9))
         .unwrap_or(0);
-    let gain = 1.0 - ar.a().iter().sum::<f64>();
-    let white = ar.noise_variance() * octaves.dt() / (gain * gain);
+    let white = super::model::ar_white_equivalent(ar, octaves.dt());
     let ratio = curve.get(j).copied().unwrap_or(0.0) * octaves.tau(j) / white;
     (0.9..=1.1).contains(&ratio)
 }

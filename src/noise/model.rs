@@ -427,10 +427,9 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
     }
 
     pub(super) fn ar_white_psd(&self) -> f64 {
-        self.ar.as_ref().map_or(0.0, |ar| {
-            let gain = 1.0 - ar.a().iter().sum::<f64>();
-            ar.noise_variance() * self.dt / (gain * gain)
-        })
+        self.ar
+            .as_ref()
+            .map_or(0.0, |ar| ar_white_equivalent(ar, self.dt))
     }
 
     /// The model's Allan variance at `tau = 2^j dt` for `j < out.len()`, in u^2.
@@ -703,6 +702,13 @@ pub(super) fn family_z(rows: usize) -> f64 {
         }
     }
     (lo + hi) / 2.0
+}
+
+/// The white equivalent of the AR part `ar` sampled every `dt`: `sigma^2 dt / (1 - sum a)^2`,
+/// u^2/Hz, the level its Allan variance times `tau` reaches past its memory.
+pub(super) fn ar_white_equivalent<const P: usize>(ar: &ArModel<f64, P>, dt: f64) -> f64 {
+    let gain = 1.0 - ar.a().iter().sum::<f64>();
+    ar.noise_variance() * dt / (gain * gain)
 }
 
 #[cfg(test)]

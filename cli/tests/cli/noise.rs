@@ -2,6 +2,7 @@
 //! hand-off to a filter, its keys, its plot and its refusals.
 
 use std::path::{Path, PathBuf};
+use std::process::Output;
 
 use imu_ar_host::composite::Composite;
 use imu_ar_host::fixtures::{AXES, real_records};
@@ -13,11 +14,18 @@ use common::{column_file, imu_ar, json, misused, stdout, temp_file};
 
 /// `imu-ar noise FILES --column C --rate HZ --json EXTRA..`, parsed.
 fn noise(files: &[PathBuf], column: &str, rate: &str, extra: &[&str]) -> Value {
+    let mut with_json = vec!["--json"];
+    with_json.extend_from_slice(extra);
+    json(&noise_run(files, column, rate, &with_json))
+}
+
+/// `imu-ar noise FILES --column C --rate HZ EXTRA..`.
+fn noise_run(files: &[PathBuf], column: &str, rate: &str, extra: &[&str]) -> Output {
     let mut args: Vec<&str> = vec!["noise"];
     args.extend(files.iter().map(|f| f.to_str().unwrap()));
-    args.extend(["--column", column, "--rate", rate, "--json"]);
+    args.extend(["--column", column, "--rate", rate]);
     args.extend_from_slice(extra);
-    json(&imu_ar(&args))
+    imu_ar(&args)
 }
 
 fn f(v: &Value) -> f64 {
@@ -483,16 +491,8 @@ fn a_record_without_a_walk_names_the_bound_the_files_carry() {
     assert!(v["random_walk"].is_null(), "{v}");
     let high = f(&v["intervals"]["random_walk"]["high"]);
     assert!(high > 0.0, "{v}");
-    let text = stdout(&imu_ar(&[
-        "noise",
-        file.to_str().unwrap(),
-        "--column",
-        "x",
-        "--rate",
-        "100",
-        "--ar-order",
-        "0",
-    ]));
+    let files = std::slice::from_ref(&file);
+    let text = stdout(&noise_run(files, "x", "100", &["--ar-order", "0"]));
     let line = text
         .lines()
         .find(|l| l.starts_with("random_walk "))
