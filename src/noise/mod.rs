@@ -42,7 +42,7 @@ pub use model::{
     QuantizationStates,
 };
 pub use nnls::NnlsError;
-pub use octaves::{Estimator, NoiseType, Octaves};
+pub use octaves::{DRIFT_OCTAVES, Estimator, NoiseType, Octaves, PARTS};
 pub use parts::Coefficients;
 pub use uncertainty::{
     Interval, MAX_PARAMETERS, OscillatorUncertainty, TermUncertainty, Uncertainty,

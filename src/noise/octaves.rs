@@ -142,6 +142,16 @@ fn overlapping_edf(big: f64, m: f64, noise: NoiseType) -> f64 {
     }
 }
 
+/// Parts a record is cut into to see whether its short-term level moves
+/// ([`Octaves::with_parts`]).
+pub const PARTS: usize = 8;
+
+/// The first octaves whose level is compared between the parts of a record.
+pub const DRIFT_OCTAVES: usize = 8;
+
+/// The fewest clusters of `2^j` samples a part needs for its octave `j` to be compared.
+const PART_CLUSTERS: u64 = 64;
+
 /// Allan variances at `tau = 2^j dt`, `j = 0..len`, with the estimator that measured them.
 ///
 /// `L` is the capacity in octaves.
@@ -154,6 +164,10 @@ pub struct Octaves<const L: usize> {
     differences: Option<[f64; L]>,
     len: usize,
     estimator: Estimator,
+    /// The relative variance the movement of the level between parts of the record adds to
+    /// the Allan variance of each of the first octaves ([`Octaves::with_parts`]); 0 where it is
+    /// not measured or not significant.
+    drift: [f64; DRIFT_OCTAVES],
 }
 
 impl<const L: usize> Octaves<L> {
@@ -182,6 +196,7 @@ impl<const L: usize> Octaves<L> {
             estimator: Estimator::NonOverlapping {
                 n: stream.samples(),
             },
+            drift: [0.0; DRIFT_OCTAVES],
         })
     }
 
@@ -213,13 +228,101 @@ impl<const L: usize> Octaves<L> {
             *slot = v.to_f64();
             len = len.saturating_add(1);
         }
-        Ok(Self {
+        let whole = Self {
             dt,
             avar,
             differences: None,
             len,
             estimator: Estimator::Overlapping { n: x.len() as u64 },
-        })
+            drift: [0.0; DRIFT_OCTAVES],
+        };
+        // The same estimator over each of PARTS consecutive parts, at the first octaves.
+        let part = x.len() / PARTS;
+        let mut parts = [(0u64, [0.0; DRIFT_OCTAVES]); PARTS];
+        for (k, (samples, avar)) in indexed(parts.iter_mut()) {
+            let Some(slice) =
+                x.get(k.saturating_mul(part)..k.saturating_add(1).saturating_mul(part))
+            else {
+                return Ok(whole);
+            };
+            *samples = part as u64;
+            for (j, slot) in indexed(avar.iter_mut()) {
+                let m = 1usize << j;
+                if (part as u64) < PART_CLUSTERS.saturating_mul(m as u64) {
+                    break;
+                }
+                let Ok(v) = overlapping_avar(slice, m) else {
+                    break;
+                };
+                *slot = v.to_f64();
+            }
+        }
+        let rows = parts.each_ref().map(|(n, a)| (*n, &a[..]));
+        Ok(whole.with_parts(&rows))
+    }
+
+    /// The octaves with what consecutive parts of the same record say of its stationarity:
+    /// `parts[k]` holds part `k`'s samples and its Allan variances at the first octaves, as
+    /// the whole record's were measured (0 or missing where the part is too short).
+    ///
+    /// At each of the first [`DRIFT_OCTAVES`] octaves where every part has at least 64
+    /// clusters, the parts' spread is tested against their sampling spread (Cochran's `Q`,
+    /// `(k - 1) s^2 / (2 / nu)` against `chi^2_(k-1)`, at 1 % over the octaves together). Where
+    /// the level moves more than sampling explains, the excess between-part variance over
+    /// `k` is what that movement adds to the whole record's estimate (the random-effects
+    /// model of meta-analysis, DerSimonian and Laird 1986): [`NoiseModel::uncertainty`] adds
+    /// it to `N`'s. Fewer than four parts change nothing.
+    ///
+    /// [`NoiseModel::uncertainty`]: super::NoiseModel::uncertainty
+    #[must_use]
+    pub fn with_parts(mut self, parts: &[(u64, &[f64])]) -> Self {
+        self.drift = [0.0; DRIFT_OCTAVES];
+        let k = parts.len();
+        if k < 4 {
+            return self;
+        }
+        let kf = k as f64;
+        // Bonferroni over the octaves: chi^2_(k-1) at 1 - 0.01 / DRIFT_OCTAVES (z = 3.023).
+        let critical = (kf - 1.0) * chi2_quantile_over_nu(kf - 1.0, 3.023);
+        for (j, slot) in indexed(self.drift.iter_mut()) {
+            let m = 1u64 << j;
+            let mut sum = 0.0;
+            let mut within = 0.0;
+            let mut usable = true;
+            for (n, avar) in parts {
+                let a = avar.get(j).copied().unwrap_or(0.0);
+                usable &= *n >= PART_CLUSTERS.saturating_mul(m) && a.is_finite() && a > 0.0;
+                sum += a;
+                within += 2.0
+                    / Estimator::Overlapping { n: *n }
+                        .edf(m, NoiseType::WhiteFrequency)
+                        .max(1.0);
+            }
+            if !(usable && sum > 0.0 && sum.is_finite()) {
+                break;
+            }
+            let mean = sum / kf;
+            within /= kf;
+            let spread = parts
+                .iter()
+                .map(|(_, a)| {
+                    let r = a.get(j).copied().unwrap_or(0.0) / mean - 1.0;
+                    r * r
+                })
+                .sum::<f64>()
+                / (kf - 1.0);
+            if (kf - 1.0) * spread / within > critical {
+                *slot = (spread - within) / kf;
+            }
+        }
+        self
+    }
+
+    /// The relative variance the movement of the record's level between its parts adds to
+    /// its Allan variance at octave `j` ([`Octaves::with_parts`]); 0 where it is not
+    /// significant or not measured.
+    pub fn drift(&self, j: usize) -> f64 {
+        self.drift.get(j).copied().unwrap_or(0.0)
     }
 
     /// Octaves given directly: `avar[j]` at `tau = 2^j dt`, measured by `estimator`.
@@ -251,6 +354,7 @@ impl<const L: usize> Octaves<L> {
             differences: None,
             len: avar.len(),
             estimator,
+            drift: [0.0; DRIFT_OCTAVES],
         })
     }
 
@@ -292,6 +396,13 @@ impl<const L: usize> Octaves<L> {
     pub fn tau(&self, j: usize) -> f64 {
         self.dt * (1u64 << j.min(63)) as f64
     }
+}
+
+/// `chi^2_nu / nu` at `z` standard normal deviations (Wilson-Hilferty), at least 0.
+pub(super) fn chi2_quantile_over_nu(nu: f64, z: f64) -> f64 {
+    let c = 2.0 / (9.0 * nu);
+    let b = 1.0 - c + z * libm::sqrt(c);
+    if b > 0.0 { b * b * b } else { 0.0 }
 }
 
 fn check_dt(dt: f64) -> Result<(), NoiseError> {

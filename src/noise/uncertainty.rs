@@ -4,6 +4,7 @@
 use super::component;
 use super::fit::{Column, Problem, RECORD_OCTAVES};
 use super::model::NoiseModel;
+use super::octaves::{DRIFT_OCTAVES, chi2_quantile_over_nu};
 use super::{NoiseError, NoiseType, Octaves, indexed};
 
 /// The most parameters whose covariance is computed: white noise, quantisation, random walk,
@@ -198,7 +199,9 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
     ///   the whole curve, and at least `1.96 s`, `s` from the information with that term added
     ///   at 0: the room the record leaves for it;
     /// - correlation times, frequencies and decay times are log-normal;
-    /// - `B` is read from the data, with the degrees of freedom of its octave.
+    /// - `B` is read from the data, with the degrees of freedom of its octave;
+    /// - where the record's parts show its short-term level moving more than sampling explains
+    ///   ([`Octaves::with_parts`]), `N^2`'s variance gains that movement's.
     ///
     /// Checked by simulation over the campaign of `host-tests` (`campaign`): the intervals of
     /// `N` and `K` contain the truth in 85 to 99 % of the records.
@@ -260,9 +263,18 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
             (Some(w), None) => main.get(w, w),
             _ => f64::INFINITY,
         };
+        // Where the record's short-term level moves between its parts more than sampling
+        // explains, N^2 varies with it: the largest such variance of the octaves where white
+        // noise makes at least half the model's Allan variance.
+        let n2 = self.white * self.white + n_ar2;
+        let mut curve = [0.0; L];
+        self.avar_octaves(&mut curve[..rows])?;
+        let drift = indexed(curve.iter().take(rows.min(DRIFT_OCTAVES)))
+            .filter(|(j, a)| n2 / octaves.tau(*j) >= 0.5 * **a)
+            .fold(0.0f64, |d, (j, _)| d.max(octaves.drift(j)));
         let white_noise = root(variance_interval(
-            self.white * self.white + n_ar2,
-            libm::sqrt(n2_variance.max(0.0)),
+            n2,
+            libm::sqrt(n2_variance.max(0.0) + n2 * n2 * drift),
         ));
         // The random walk's rise may be shared with a Gauss-Markov term as long as the record
         // tells (`tau_max / RECORD_OCTAVES`: a longer one the identification takes as the walk
@@ -332,8 +344,6 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
 
         // The model's Allan variance at each octave, and its standard deviation from the
         // parameters' covariance.
-        let mut curve = [0.0; L];
-        self.avar_octaves(&mut curve[..rows])?;
         let mut band = [Interval::default(); L];
         for (j, (slot, a)) in indexed(band.iter_mut().zip(&curve).take(rows)) {
             let mut g = [0.0; MAX_PARAMETERS];
@@ -672,16 +682,9 @@ fn variance_interval(v: f64, s: f64) -> Interval {
     }
     let nu = 2.0 * (v / s) * (v / s);
     Interval {
-        low: v / chi2_over_nu(nu, Z95),
-        high: v / chi2_over_nu(nu, -Z95).max(f64::MIN_POSITIVE),
+        low: v / chi2_quantile_over_nu(nu, Z95),
+        high: v / chi2_quantile_over_nu(nu, -Z95).max(f64::MIN_POSITIVE),
     }
-}
-
-/// `chi^2_nu / nu` at `z` standard normal deviations (Wilson-Hilferty), at least 0.
-fn chi2_over_nu(nu: f64, z: f64) -> f64 {
-    let c = 2.0 / (9.0 * nu);
-    let b = 1.0 - c + z * libm::sqrt(c);
-    if b > 0.0 { b * b * b } else { 0.0 }
 }
 
 /// The square roots of a variance's interval.
@@ -712,7 +715,7 @@ fn bias_instability<const P: usize, const G: usize, const L: usize>(
     let nu = octaves.edf(j, kind);
     let b = |q: f64| libm::sqrt(*a / q) / 0.664;
     Interval {
-        low: b(chi2_over_nu(nu, Z95)),
+        low: b(chi2_quantile_over_nu(nu, Z95)),
         high: b(chi2_lower_over_nu(nu)),
     }
 }
@@ -724,7 +727,7 @@ fn chi2_lower_over_nu(nu: f64) -> f64 {
     // then read infinite, which put the interval's upper end at 0.
     let ln_tail = (libm::log(0.025) + libm::lgamma(nu / 2.0 + 1.0)) * 2.0 / nu;
     let tail = 2.0 * libm::exp(ln_tail) / nu;
-    let q = chi2_over_nu(nu, -Z95).max(tail);
+    let q = chi2_quantile_over_nu(nu, -Z95).max(tail);
     if q > 0.0 { q } else { f64::MIN_POSITIVE }
 }
 

@@ -9,7 +9,7 @@
 //! are then still 4096 terms in every window of `m` samples, so the estimate keeps the
 //! overlapping estimator's degrees of freedom to within a fraction of a percent.
 
-use imu_ar::noise::{Estimator, NoiseError, Octaves};
+use imu_ar::noise::{DRIFT_OCTAVES, Estimator, NoiseError, Octaves, PARTS};
 
 /// Octaves computed from every phase point: `m` up to `2^EXACT`.
 const EXACT: usize = 12;
@@ -23,6 +23,21 @@ pub const LAGS: usize = 8;
 
 /// Phase points of level 0 kept: two windows of the longest octave it serves.
 const KEEP: usize = 2 << EXACT;
+
+/// Samples between marks at first; doubled whenever the marks reach [`MARKS`].
+const BLOCK: u64 = 1 << 10;
+
+/// The most marks kept.
+const MARKS: usize = 1 << 10;
+
+/// The sums of the first octaves after some number of samples: the record's parts are the
+/// differences between marks ([`Octaves::with_parts`]).
+#[derive(Clone, Copy, Default)]
+struct Mark {
+    n: u64,
+    sums: [f64; DRIFT_OCTAVES],
+    counts: [u64; DRIFT_OCTAVES],
+}
 
 /// Phase points every `2^level` samples (`level` from 1), in a ring.
 struct Level {
@@ -105,6 +120,9 @@ pub struct AxisStream<const L: usize> {
     ys: Vec<f64>,
     sum: f64,
     constant: bool,
+    /// Marks every `block` samples, the first at 0.
+    marks: Vec<Mark>,
+    block: u64,
 }
 
 impl<const L: usize> Default for AxisStream<L> {
@@ -131,6 +149,8 @@ impl<const L: usize> AxisStream<L> {
             ys: Vec::new(),
             sum: 0.0,
             constant: true,
+            marks: vec![Mark::default()],
+            block: BLOCK,
         }
     }
 
@@ -151,7 +171,43 @@ impl<const L: usize> AxisStream<L> {
 
     /// Takes the next (finite) samples, as [`AxisStream::push`] one by one would (to rounding:
     /// sums run in another order), in a fraction of its time for long runs.
-    pub fn extend(&mut self, xs: &[f64]) {
+    pub fn extend(&mut self, mut xs: &[f64]) {
+        while !xs.is_empty() {
+            let room = (self.block - self.n % self.block) as usize;
+            let (now, rest) = xs.split_at(room.min(xs.len()));
+            self.extend_within_block(now);
+            if self.n.is_multiple_of(self.block) {
+                self.mark();
+            }
+            xs = rest;
+        }
+    }
+
+    /// Marks the sums of the first octaves, halving the marks (every other kept) and doubling
+    /// the block when they are full.
+    fn mark(&mut self) {
+        let mut mark = Mark {
+            n: self.n,
+            ..Mark::default()
+        };
+        mark.sums
+            .iter_mut()
+            .zip(&self.sums)
+            .for_each(|(m, s)| *m = *s);
+        mark.counts
+            .iter_mut()
+            .zip(&self.counts)
+            .for_each(|(m, c)| *m = *c);
+        self.marks.push(mark);
+        if self.marks.len() > MARKS {
+            let kept: Vec<Mark> = self.marks.iter().step_by(2).copied().collect();
+            self.marks = kept;
+            self.block *= 2;
+        }
+    }
+
+    /// [`AxisStream::extend`] for samples that do not cross a block's end.
+    fn extend_within_block(&mut self, xs: &[f64]) {
         let Some(&x0) = xs.first() else {
             return;
         };
@@ -252,7 +308,29 @@ impl<const L: usize> AxisStream<L> {
             }
             len = j + 1;
         }
-        Octaves::new(dt, &avar[..len], Estimator::Overlapping { n: self.n })
+        let octaves = Octaves::new(dt, &avar[..len], Estimator::Overlapping { n: self.n })?;
+        // PARTS parts of whole blocks, as equal as the marks allow.
+        let blocks = self.marks.len() - 1;
+        if blocks < PARTS {
+            return Ok(octaves);
+        }
+        let mut parts = [(0u64, [0.0; DRIFT_OCTAVES]); PARTS];
+        for (k, (n, avar)) in parts.iter_mut().enumerate() {
+            let (a, b) = (
+                &self.marks[k * blocks / PARTS],
+                &self.marks[(k + 1) * blocks / PARTS],
+            );
+            *n = b.n - a.n;
+            for (j, v) in avar.iter_mut().enumerate() {
+                let count = b.counts[j] - a.counts[j];
+                if count > 0 {
+                    let mf = (1u64 << j) as f64;
+                    *v = scale * (b.sums[j] - a.sums[j]) / (2.0 * mf * mf * count as f64);
+                }
+            }
+        }
+        let rows = parts.each_ref().map(|(n, a)| (*n, &a[..]));
+        Ok(octaves.with_parts(&rows))
     }
 
     /// The mean of the samples.
@@ -343,6 +421,45 @@ mod tests {
         }
     }
 
+    /// Gaussian noise of standard deviation `level(i)` at sample `i` (Box-Muller over a
+    /// 64-bit linear congruential generator).
+    fn noise(n: usize, level: impl Fn(usize) -> f64) -> Vec<f64> {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut uniform = || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            ((state >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+        };
+        (0..n)
+            .map(|i| {
+                let (u, v) = (uniform(), uniform());
+                level(i) * (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn parts_see_a_moving_level_as_the_library_does() {
+        // 1.2 M samples: the marks are thinned once (every 2048 samples).
+        let n = 1_200_000;
+        for (step, moves) in [(1.0, false), (1.1, true)] {
+            let x = noise(n, |i| if i < n / 2 { 1.0 } else { step });
+            let mut s = AxisStream::<20>::new();
+            s.extend(&x);
+            assert_eq!(s.block, 2 * BLOCK);
+            let o = s.octaves(0.01, 1.0).unwrap();
+            let want = Octaves::<20>::overlapping(&x, 0.01).unwrap();
+            for j in 0..DRIFT_OCTAVES {
+                let (a, b) = (o.drift(j), want.drift(j));
+                assert_eq!(a > 0.0, moves, "step {step} octave {j}: {a}");
+                assert_eq!(b > 0.0, moves, "step {step} octave {j}: {b}");
+                // Parts of whole blocks against exact eighths.
+                assert!((a - b).abs() <= 0.05 * b, "octave {j}: {a} vs {b}");
+            }
+        }
+    }
+
     #[test]
     fn extending_in_pieces_equals_pushing_one_by_one() {
         let x = record(70_000);
@@ -360,6 +477,13 @@ mod tests {
         }
         assert_eq!(pieces.samples(), one.samples());
         assert_eq!(pieces.counts, one.counts);
+        assert_eq!(pieces.marks.len(), one.marks.len());
+        for (a, b) in pieces.marks.iter().zip(&one.marks) {
+            assert_eq!((a.n, a.counts), (b.n, b.counts));
+            for (p, q) in a.sums.iter().zip(&b.sums) {
+                assert!((p - q).abs() <= 1e-12 * q, "mark at {}: {p} vs {q}", a.n);
+            }
+        }
         // Octaves 0 to 15 hold second differences (70,000 samples hold two windows of 2^15).
         assert!(pieces.counts[15] > 0 && pieces.counts[16] == 0);
         for j in 0..18 {

@@ -18,6 +18,7 @@ mod gate;
 mod levinson;
 mod model;
 mod noise;
+mod noise_drift;
 mod noise_edges;
 mod noise_kalman;
 mod online_hostile;
