@@ -13,7 +13,8 @@ use imu_ar::ArModel;
 use imu_ar::batch::criteria::Criterion;
 use imu_ar::batch::{BatchConfig, burg};
 use imu_ar::noise::{
-    Check, FitConfig, Ieee952, Interval, KalmanForm, NoiseError, NoiseModel, Octaves, Uncertainty,
+    Check, DRIFT_OCTAVES, FitConfig, Ieee952, Interval, KalmanForm, NoiseError, NoiseModel,
+    Octaves, PARTS, Uncertainty,
 };
 use serde::Serialize;
 
@@ -200,6 +201,34 @@ pub struct Intervals {
     pub bias_instability: Bounds,
     /// The Gauss-Markov terms, in the order of `gauss_markov`.
     pub gauss_markov: Vec<TermBounds>,
+    /// Where the record's eighths show its short-term level moving more than sampling explains
+    /// (`Octaves::drift`): the largest such movement, which `white_noise`'s interval counts.
+    pub level_drift: Option<LevelDrift>,
+}
+
+/// How much the record's short-term level moves between its eighths.
+#[derive(Serialize)]
+pub struct LevelDrift {
+    /// The averaging time where it moves most, s.
+    pub tau_s: f64,
+    /// The standard deviation of the eighths' Allan deviation beyond their sampling spread,
+    /// relative.
+    pub spread: f64,
+}
+
+impl LevelDrift {
+    fn of<const L: usize>(octaves: &Octaves<L>) -> Option<Self> {
+        (0..DRIFT_OCTAVES)
+            .map(|j| (j, octaves.drift(j)))
+            .filter(|(_, d)| *d > 0.0)
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(j, d)| Self {
+                tau_s: octaves.tau(j),
+                // The eighths' relative variance of their Allan variance is PARTS times the
+                // drift; the deviation's is a quarter of that.
+                spread: (PARTS as f64 * d).sqrt() / 2.0,
+            })
+    }
 }
 
 impl Intervals {
@@ -207,6 +236,7 @@ impl Intervals {
         model: &NoiseModel<P, MAX_GM_STATES>,
         u: &Uncertainty<MAX_GM_STATES, OCTAVES>,
         b: f64,
+        octaves: &Octaves<OCTAVES>,
     ) -> Self {
         let mut gauss_markov: Vec<TermBounds> = model
             .gauss_markov()
@@ -236,6 +266,7 @@ impl Intervals {
             rate_ramp: Bounds::of(model.ramp(), u.ramp),
             bias_instability: Bounds::of(b, u.bias_instability),
             gauss_markov,
+            level_drift: LevelDrift::of(octaves),
         }
     }
 }
@@ -469,7 +500,7 @@ impl Fitting {
         result.curve_fit = fit.curve_fit;
         result.intervals = uncertainty
             .as_ref()
-            .map(|u| Intervals::of(&model, u, result.bias_instability.value));
+            .map(|u| Intervals::of(&model, u, result.bias_instability.value, octaves));
         let default = self.caption(&model);
         // The 95 % band of the model's Allan deviation, from its parameters' intervals.
         let band: Vec<(f64, f64)> = uncertainty.as_ref().map_or(Vec::new(), |u| {
@@ -691,6 +722,14 @@ impl Output for NoiseResult {
             s += "95 % intervals (from the Allan variances' sampling distribution; a term the \
                   model lacks from 0):\n";
             s += &format!("  white_noise {}\n", i.white_noise.text());
+            if let Some(d) = &i.level_drift {
+                s += &format!(
+                    "    the record's short-term level moves: its eighths' Allan deviation \
+                     spreads {:.1} % beyond their sampling at {} s, which this interval counts\n",
+                    100.0 * d.spread,
+                    d.tau_s
+                );
+            }
             s += &format!("  quantization {}\n", i.quantization.text());
             s += &format!("  random_walk {}\n", i.random_walk.text());
             s += &format!("  rate_ramp {}\n", i.rate_ramp.text());

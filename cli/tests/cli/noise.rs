@@ -545,3 +545,41 @@ fn a_walk_that_dominates_is_not_taken_by_the_ar_part() {
         }
     }
 }
+
+/// Uniform noise whose level steps up 10 % halfway: the record's eighths show it, the text and
+/// the JSON name it, and `N`'s interval counts it; the same noise without the step shows none.
+#[test]
+fn a_level_that_moves_is_named_and_counted() {
+    let n = 1usize << 16;
+    let stepped = |name: &str, step: f64| {
+        let mut seed = 91u64;
+        let values = (0..n).map(move |i| {
+            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+            let u = (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+            format!("{:e}", u * if i < n / 2 { 1.0 } else { step })
+        });
+        column_file(name, values)
+    };
+    let args = ["--ar-order", "0"];
+    let still = noise(&[stepped("noise-level-still.csv", 1.0)], "x", "100", &args);
+    assert!(still["intervals"]["level_drift"].is_null(), "{still}");
+    let file = stepped("noise-level-moves.csv", 1.1);
+    let moves = noise(std::slice::from_ref(&file), "x", "100", &args);
+    let drift = &moves["intervals"]["level_drift"];
+    // Eighths at 1.0 and 1.1 in the deviation: a spread of about 5 %.
+    let spread = f(&drift["spread"]);
+    assert!((0.03..0.07).contains(&spread), "{moves}");
+    let width = |v: &Value| {
+        let i = &v["intervals"]["white_noise"];
+        f(&i["high"]) / f(&i["low"])
+    };
+    assert!(
+        width(&moves) > 2.0 * width(&still) - 1.0,
+        "{moves}\n{still}"
+    );
+    let text = stdout(&noise_run(&[file], "x", "100", &args));
+    assert!(
+        text.contains("the record's short-term level moves"),
+        "{text}"
+    );
+}
