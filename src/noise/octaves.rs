@@ -236,21 +236,23 @@ impl<const L: usize> Octaves<L> {
             estimator: Estimator::Overlapping { n: x.len() as u64 },
             drift: [0.0; DRIFT_OCTAVES],
         };
-        // The same estimator over each of PARTS consecutive parts, at the first octaves.
+        // The same estimator over each of PARTS consecutive parts, at the first octaves: part
+        // k's second differences are those that end in it (as a stream sums them), so that
+        // the parts share the whole record's differences.
         let part = x.len() / PARTS;
         let mut parts = [(0u64, [0.0; DRIFT_OCTAVES]); PARTS];
         for (k, (samples, avar)) in indexed(parts.iter_mut()) {
-            let Some(slice) =
-                x.get(k.saturating_mul(part)..k.saturating_add(1).saturating_mul(part))
-            else {
-                return Ok(whole);
-            };
             *samples = part as u64;
+            let end = k.saturating_add(1).saturating_mul(part);
             for (j, slot) in indexed(avar.iter_mut()) {
                 let m = 1usize << j;
                 if (part as u64) < PART_CLUSTERS.saturating_mul(m as u64) {
                     break;
                 }
+                let start = k.saturating_mul(part).saturating_sub(2 * m);
+                let Some(slice) = x.get(start..end) else {
+                    return Ok(whole);
+                };
                 let Ok(v) = overlapping_avar(slice, m) else {
                     break;
                 };
@@ -263,11 +265,12 @@ impl<const L: usize> Octaves<L> {
 
     /// The octaves with what consecutive parts of the same record say of its stationarity:
     /// `parts[k]` holds part `k`'s samples and its Allan variances at the first octaves, as
-    /// the whole record's were measured (0 or missing where the part is too short).
+    /// the whole record's were measured (what it holds at octaves its samples are too few for
+    /// is not read).
     ///
     /// At each of the first [`DRIFT_OCTAVES`] octaves where every part has at least 64
     /// clusters, the parts' spread is tested against their sampling spread (Cochran's `Q`,
-    /// `(k - 1) s^2 / (2 / nu)` against `chi^2_(k-1)`, at 1 % over the octaves together). Where
+    /// `(k - 1) s^2 / (2 / nu)` against `chi^2_(k-1)`, at 5 % over the octaves together). Where
     /// the level moves more than sampling explains, the excess between-part variance over
     /// `k` is what that movement adds to the whole record's estimate (the random-effects
     /// model of meta-analysis, DerSimonian and Laird 1986): [`NoiseModel::uncertainty`] adds
@@ -282,17 +285,19 @@ impl<const L: usize> Octaves<L> {
             return self;
         }
         let kf = k as f64;
-        // Bonferroni over the octaves: chi^2_(k-1) at 1 - 0.01 / DRIFT_OCTAVES (z = 3.023).
-        let critical = (kf - 1.0) * chi2_quantile_over_nu(kf - 1.0, 3.023);
+        // Bonferroni over the octaves: chi^2_(k-1) at 1 - 0.05 / DRIFT_OCTAVES (z = 2.498).
+        let critical = (kf - 1.0) * chi2_quantile_over_nu(kf - 1.0, 2.498);
         for (j, slot) in indexed(self.drift.iter_mut()) {
             let m = 1u64 << j;
+            // The parts' mean, summed in shares so that it cannot overflow.
             let mut sum = 0.0;
             let mut within = 0.0;
             let mut usable = true;
             for (n, avar) in parts {
-                let a = avar.get(j).copied().unwrap_or(0.0);
-                usable &= *n >= PART_CLUSTERS.saturating_mul(m) && a.is_finite() && a > 0.0;
-                sum += a;
+                let a = avar.get(j).copied().unwrap_or(f64::NAN);
+                // A part of zero variance (a stuck sensor) is the level's largest move.
+                usable &= *n >= PART_CLUSTERS.saturating_mul(m) && a.is_finite() && a >= 0.0;
+                sum += a / kf;
                 within += 2.0
                     / Estimator::Overlapping { n: *n }
                         .edf(m, NoiseType::WhiteFrequency)
@@ -301,7 +306,7 @@ impl<const L: usize> Octaves<L> {
             if !(usable && sum > 0.0 && sum.is_finite()) {
                 break;
             }
-            let mean = sum / kf;
+            let mean = sum;
             within /= kf;
             let spread = parts
                 .iter()
