@@ -146,8 +146,10 @@ fn overlapping_edf(big: f64, m: f64, noise: NoiseType) -> f64 {
 /// ([`Octaves::with_parts`]).
 pub const PARTS: usize = 8;
 
-/// The first octaves whose level is compared between the parts of a record.
-pub const DRIFT_OCTAVES: usize = 8;
+/// The first octaves whose level is compared between the parts of a record: `tau` up to
+/// eight samples, where a change of the white level shows in full and a slow change of the
+/// mean (a warm-up, a ramp: Allan variance growing as `tau^2`) does not.
+pub const DRIFT_OCTAVES: usize = 4;
 
 /// The fewest clusters of `2^j` samples a part needs for its octave `j` to be compared.
 const PART_CLUSTERS: u64 = 64;
@@ -285,8 +287,8 @@ impl<const L: usize> Octaves<L> {
             return self;
         }
         let kf = k as f64;
-        // Bonferroni over the octaves: chi^2_(k-1) at 1 - 0.05 / DRIFT_OCTAVES (z = 2.498).
-        let critical = (kf - 1.0) * chi2_quantile_over_nu(kf - 1.0, 2.498);
+        // Bonferroni over the octaves: chi^2_(k-1) at 1 - 0.05 / DRIFT_OCTAVES (z = 2.241).
+        let critical = (kf - 1.0) * chi2_quantile_over_nu(kf - 1.0, 2.241);
         for (j, slot) in indexed(self.drift.iter_mut()) {
             let m = 1u64 << j;
             // The parts' mean, summed in shares so that it cannot overflow.

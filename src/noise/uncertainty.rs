@@ -264,14 +264,11 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
             _ => f64::INFINITY,
         };
         // Where the record's short-term level moves between its parts more than sampling
-        // explains, N^2 varies with it: the largest such variance of the octaves where white
-        // noise makes at least half the model's Allan variance.
+        // explains, N^2 varies with it.
         let n2 = self.white * self.white + n_ar2;
         let mut curve = [0.0; L];
         self.avar_octaves(&mut curve[..rows])?;
-        let drift = indexed(curve.iter().take(rows.min(DRIFT_OCTAVES)))
-            .filter(|(j, a)| n2 / octaves.tau(*j) >= 0.5 * **a)
-            .fold(0.0f64, |d, (j, _)| d.max(octaves.drift(j)));
+        let drift = self.level_drift_unit(octaves)?.map_or(0.0, |(_, d)| d);
         let white_noise = root(variance_interval(
             n2,
             libm::sqrt(n2_variance.max(0.0) + n2 * n2 * drift),
@@ -376,6 +373,44 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
             band,
             band_len: rows,
         })
+    }
+
+    /// The movement of the record's short-term level that [`NoiseModel::uncertainty`] counts
+    /// in `N`'s interval: the largest [`Octaves::drift`] of the octaves where white noise
+    /// (with the AR part's white equivalent) makes at least half this model's Allan variance,
+    /// with its octave; `None` where there is none.
+    ///
+    /// # Errors
+    ///
+    /// [`NoiseError::Ar`] when the AR part is not stationary.
+    pub fn level_drift<const L: usize>(
+        &self,
+        octaves: &Octaves<L>,
+    ) -> Result<Option<(usize, f64)>, NoiseError> {
+        // In units where the largest Allan variance is about 1, as `uncertainty` works.
+        let largest = octaves.avar().iter().copied().fold(0.0, f64::max);
+        let exponent = if largest.is_normal() {
+            libm::ilogb(largest)
+        } else {
+            0
+        };
+        self.scaled(exponent.saturating_neg())?
+            .level_drift_unit(&octaves.scaled(exponent.saturating_neg()))
+    }
+
+    /// [`NoiseModel::level_drift`] in the units of `octaves`.
+    fn level_drift_unit<const L: usize>(
+        &self,
+        octaves: &Octaves<L>,
+    ) -> Result<Option<(usize, f64)>, NoiseError> {
+        let rows = octaves.avar().len().min(L).min(DRIFT_OCTAVES);
+        let mut curve = [0.0; DRIFT_OCTAVES];
+        self.avar_octaves(&mut curve[..rows])?;
+        let n2 = self.white * self.white + self.ar_white_psd();
+        Ok(indexed(curve.iter().take(rows))
+            .filter(|(j, a)| n2 / octaves.tau(*j) >= 0.5 * **a && octaves.drift(*j) > 0.0)
+            .map(|(j, _)| (j, octaves.drift(j)))
+            .max_by(|a, b| a.1.total_cmp(&b.1)))
     }
 
     /// The standard deviation of `ln T` of each Gauss-Markov term, with `problem` weighted by

@@ -13,8 +13,8 @@ use imu_ar::ArModel;
 use imu_ar::batch::criteria::Criterion;
 use imu_ar::batch::{BatchConfig, burg};
 use imu_ar::noise::{
-    Check, DRIFT_OCTAVES, FitConfig, Ieee952, Interval, KalmanForm, NoiseError, NoiseModel,
-    Octaves, PARTS, Uncertainty,
+    Check, FitConfig, Ieee952, Interval, KalmanForm, NoiseError, NoiseModel, Octaves, PARTS,
+    Uncertainty,
 };
 use serde::Serialize;
 
@@ -217,17 +217,17 @@ pub struct LevelDrift {
 }
 
 impl LevelDrift {
-    fn of<const L: usize>(octaves: &Octaves<L>) -> Option<Self> {
-        (0..DRIFT_OCTAVES)
-            .map(|j| (j, octaves.drift(j)))
-            .filter(|(_, d)| *d > 0.0)
-            .max_by(|a, b| a.1.total_cmp(&b.1))
-            .map(|(j, d)| Self {
-                tau_s: octaves.tau(j),
-                // The eighths' relative variance of their Allan variance is PARTS times the
-                // drift; the deviation's is a quarter of that.
-                spread: (PARTS as f64 * d).sqrt() / 2.0,
-            })
+    fn of<const P: usize>(
+        model: &NoiseModel<P, MAX_GM_STATES>,
+        octaves: &Octaves<OCTAVES>,
+    ) -> Option<Self> {
+        let (j, d) = model.level_drift(octaves).ok().flatten()?;
+        Some(Self {
+            tau_s: octaves.tau(j),
+            // The eighths' relative variance of their Allan variance is PARTS times the
+            // drift; the deviation's is a quarter of that.
+            spread: (PARTS as f64 * d).sqrt() / 2.0,
+        })
     }
 }
 
@@ -266,7 +266,7 @@ impl Intervals {
             rate_ramp: Bounds::of(model.ramp(), u.ramp),
             bias_instability: Bounds::of(b, u.bias_instability),
             gauss_markov,
-            level_drift: LevelDrift::of(octaves),
+            level_drift: LevelDrift::of(model, octaves),
         }
     }
 }

@@ -135,3 +135,26 @@ fn parts_near_the_largest_double_move_as_small_ones_do() {
         assert!((a - b).abs() <= 1e-12 * b, "{big:?} vs {small:?}");
     }
 }
+
+#[test]
+fn a_warm_up_of_the_mean_is_no_move_of_the_level() {
+    // The mean settles by 100 standard deviations of the noise with a 100 s time constant: a
+    // rate ramp to the Allan variance (growing as tau^2) in the first eighth, which the test
+    // at tau of a second took for a move of the white level (N's interval -22 %, +40 % on a
+    // record whose white level never moved).
+    let flagged = (0..RECORDS)
+        .filter(|&seed| {
+            let mut x = white(1.0, N, seed);
+            for (i, v) in x.iter_mut().enumerate() {
+                *v += 100.0 * (-(i as f64) * DT / 100.0).exp();
+            }
+            let octaves = Octaves::<16>::overlapping(&x, DT).unwrap();
+            (0..DRIFT_OCTAVES).any(|j| octaves.drift(j) > 0.0)
+        })
+        .count();
+    println!("warmed-up records flagged: {flagged} of {RECORDS}");
+    // As often as stationary records are.
+    let expected = 0.05 * RECORDS as f64;
+    let bound = expected + 3.0 * (expected * 0.95).sqrt();
+    assert!(flagged as f64 <= bound, "{flagged} of {RECORDS} flagged");
+}
