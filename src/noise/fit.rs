@@ -235,9 +235,12 @@ impl<const P: usize, const G: usize> NoiseModel<P, G> {
     ///    `tau` (`N^2 = 2 sigma^2 T`).
     /// 5. Last, every correlation time is refined again and the weights refined as in
     ///    [`NoiseModel::fit`].
-    /// 6. Where the identified model fails the whole-curve check ([`NoiseModel::check_whole`])
-    ///    and the curve fit fails it at fewer octaves, the curve fit stands
-    ///    ([`Identified::curve_fit`]).
+    /// 6. Where the identified model has no random walk and fails the whole-curve check
+    ///    ([`NoiseModel::check_whole`]), the walk added, or in place of one of its Gauss-Markov
+    ///    terms, stands if it passes (the best of those by the criterion): a term fitted to
+    ///    chance lows at the last octaves levels off where the record still rises.
+    /// 7. Where the identified model still fails the check and the curve fit fails it at fewer
+    ///    octaves, the curve fit stands ([`Identified::curve_fit`]).
     ///
     /// # Errors
     ///

@@ -272,6 +272,36 @@ impl<const P: usize, const L: usize> Problem<'_, P, L> {
             }
             (set, model) = (smaller, without);
         }
+        // A set without the random walk that fails the whole-curve check: a term fitted to
+        // the last octaves' chance lows levels off where the record still rises. The walk,
+        // added or in a Gauss-Markov term's place, stands where it passes (the best of those
+        // that pass by the criterion), before the curve fit is asked.
+        if columns.contains(&Column::RandomWalk)
+            && !set.contains(Column::RandomWalk)
+            && !model.check_whole(self.octaves)?.holds()
+        {
+            let mut best: Option<(f64, Set, Full<P>)> = None;
+            for i in 0..=set.len {
+                let candidate = match set.columns().get(i) {
+                    None => set.with(Column::RandomWalk),
+                    Some(Column::GaussMarkov(_)) => set.without(i).with(Column::RandomWalk),
+                    Some(_) => continue,
+                };
+                let (settled, fitted) = self.settle(candidate)?;
+                if !settled.contains(Column::RandomWalk)
+                    || !fitted.check_whole(self.octaves)?.holds()
+                {
+                    continue;
+                }
+                let (ic, _) = self.criterion(&settled)?;
+                if best.as_ref().is_none_or(|b| ic < b.0) {
+                    best = Some((ic, settled, fitted));
+                }
+            }
+            if let Some((_, settled, fitted)) = best {
+                (set, model) = (settled, fitted);
+            }
+        }
         // A random walk less than one standard deviation above zero, without which the model
         // still passes the Allan check at every octave, is not identified.
         self.reweight(Some(&model));

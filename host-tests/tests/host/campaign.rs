@@ -134,3 +134,32 @@ fn a_walk_that_replaces_a_long_term_is_judged_by_its_own_weights() {
     assert!((0.7..=1.3).contains(&k), "K / K_true = {k}: {r:?}");
     assert!(r.identified.check_holds && !r.identified.curve_fit, "{r:?}");
 }
+
+/// White + random-walk records at 10 Hz for 4 h, 24 seeds: the last octaves (3277 and 6554 s)
+/// hold one or two degrees of freedom, and a chance low there made a Gauss-Markov term fit
+/// better than the walk; that term levels off where the record still rises, so the identified
+/// set failed the whole-curve check and the curve fit stood, on seed 213 without a `K` (its
+/// bound below the truth; the curve fit stood on 2 of seeds 0..300, `K` missing on 1). The
+/// walk, added or in the term's place, passes: it stands, and `K` is never missing.
+#[test]
+fn a_chance_low_at_the_last_octaves_does_not_lose_the_walk() {
+    let records: Vec<_> = (200..224)
+        .map(|seed| campaign::record(0, 10.0, 14_400.0, seed))
+        .collect();
+    for r in &records {
+        let k = r.identified.k / CASES[0].random_walk;
+        eprintln!(
+            "seed {:2}: K / K_true {k:.3}, terms {:?}, curve fit {}, check {}",
+            r.seed, r.identified.times, r.identified.curve_fit, r.identified.check_holds
+        );
+    }
+    let missing = records.iter().filter(|r| r.identified.k == 0.0).count();
+    let within = records
+        .iter()
+        .filter(|r| (0.7..=1.3).contains(&(r.identified.k / CASES[0].random_walk)))
+        .count();
+    assert_eq!(missing, 0, "K missing on {missing} of 24");
+    assert!(records.iter().all(|r| !r.identified.curve_fit));
+    assert!(within >= 21, "K within 30 % on {within} of 24");
+    assert!(records.iter().all(|r| r.identified.check_holds));
+}
