@@ -99,6 +99,11 @@ impl Output for OrderResult {
 
 /// Checks the settings, reads the record and evaluates the criteria.
 pub fn run(args: &Args) -> Result<OrderResult, Fail> {
+    run_with(args, None)
+}
+
+/// [`run`] on the samples `given` (the Python package's arrays) in place of the files'.
+pub fn run_with(args: &Args, given: Option<&[f64]>) -> Result<OrderResult, Fail> {
     check_order("--max-order", args.max_order)?;
     if args.method.recursive() {
         return Err(Fail(format!(
@@ -106,7 +111,10 @@ pub fn run(args: &Args) -> Result<OrderResult, Fail> {
             args.method.name()
         )));
     }
-    let x = args.input.read()?;
+    let x = match given {
+        Some(x) => x.to_vec(),
+        None => args.input.read()?,
+    };
     let config = BatchConfig::new(1.0)?.with_demean(!args.no_demean);
     with_order!(args.max_order, criteria(args.method, &x, &config)).map_err(|e| args.input.fail(e))
 }

@@ -31,6 +31,14 @@ impl Output for Checksums {
     }
 }
 
+/// The lattices' input sequence of the parity run (`SAMPLES` samples, every 997th NaN), for
+/// replaying it through the estimators elsewhere (the Python package's tests).
+pub fn input() -> Result<Vec<f32>, Fail> {
+    shared::input()
+        .map(Iterator::collect)
+        .ok_or_else(|| Fail("parity run refused".into()))
+}
+
 /// Runs the parity sequence through both lattices.
 pub fn run() -> Result<Checksums, Fail> {
     let (f32, fixed) = shared::checksums().ok_or_else(|| Fail("parity run refused".into()))?;

@@ -130,13 +130,22 @@ pub fn noise_checksum() -> Option<u64> {
     Some(h.0)
 }
 
-/// `(f32 checksum, fixed-point checksum)`, or `None` if a configuration is refused.
-pub fn checksums() -> Option<(u64, u64)> {
+/// The input sequence of the lattices' run: `SAMPLES` samples of the seeded AR(2), every
+/// 997th one NaN; `None` if the simulator refuses its model.
+pub fn input() -> Option<impl Iterator<Item = f32>> {
     let truth = ArModel::new([1.2f32, -0.5], 0.25, 3.0, 0.01).ok()?;
     let mut sim = ArSimulator::new(truth);
     let mut rng = ChaCha8Rng::seed_from_u64(SEED);
     sim.burn_in(&mut rng, 1000);
+    Some((0..SAMPLES).map(move |n| {
+        let x: f32 = sim.next(&mut rng);
+        if n % 997 == 996 { f32::NAN } else { x }
+    }))
+}
 
+/// `(f32 checksum, fixed-point checksum)`, or `None` if a configuration is refused.
+pub fn checksums() -> Option<(u64, u64)> {
+    let mut input = input()?;
     let config = Config::new(0.999f32, 0.01).ok()?;
     let channel = Channel::new(0.1).ok()?;
     let fixed_config = FixedConfig::new(&config).ok()?;
@@ -144,9 +153,7 @@ pub fn checksums() -> Option<(u64, u64)> {
     let mut float = Lattice::<f32, P>::new(&config, &channel);
     let mut fixed = FixedLattice::<P>::new(&fixed_config, &fixed_channel);
     let (mut hf, mut hq) = (Fnv::new(), Fnv::new());
-    for n in 0..SAMPLES {
-        let x: f32 = sim.next(&mut rng);
-        let x = if n % 997 == 996 { f32::NAN } else { x };
+    for x in &mut input {
         if let Some(e) = float.update(&config, x) {
             hf.bytes(&e.to_bits().to_le_bytes());
             for v in float

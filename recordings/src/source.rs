@@ -192,6 +192,16 @@ pub fn stream(
     request: &Request,
     each: &mut dyn FnMut(&[f64]),
 ) -> Result<Read, Fail> {
+    stream_stamped(files, request, &mut |_, values| each(values))
+}
+
+/// [`stream`], passing each row's timestamp (ns) too: `None` where the row has none that was
+/// read (no time column, a stamp that is not a number with the rate given, a message stamped 0).
+pub fn stream_stamped(
+    files: &[PathBuf],
+    request: &Request,
+    each: &mut dyn FnMut(Option<i64>, &[f64]),
+) -> Result<Read, Fail> {
     // Each file's kind, found once (each is opened for it).
     let kinds: Vec<Kind> = files.iter().map(|f| Kind::of(f)).collect();
     let kind = kinds[0];
@@ -332,7 +342,7 @@ fn autopilot_stream(
     files: &[PathBuf],
     kind: Kind,
     request: &Request,
-    each: &mut dyn FnMut(&[f64]),
+    each: &mut dyn FnMut(Option<i64>, &[f64]),
 ) -> Result<Read, Fail> {
     if files.len() > 1 {
         return Err(with_file(
@@ -372,7 +382,7 @@ fn autopilot_stream(
         for (v, &i) in values.iter_mut().zip(&picks) {
             *v = axes[i];
         }
-        each(&values);
+        each(Some(stamp), &values);
     };
     let mut skipped = Skipped::default();
     if kind == Kind::DataFlash {
@@ -685,7 +695,7 @@ fn messages(
     kind: Kind,
     topic: Option<&str>,
     request: &Request,
-    each: &mut dyn FnMut(&[f64]),
+    each: &mut dyn FnMut(Option<i64>, &[f64]),
 ) -> Result<Read, Fail> {
     let read = match kind {
         Kind::Mcap => mcap::read_selected,
@@ -741,7 +751,7 @@ fn messages(
             for (v, &i) in values.iter_mut().zip(&picks) {
                 *v = frame.axes[i];
             }
-            each(&values);
+            each((frame.stamp_ns != 0).then_some(frame.stamp_ns), &values);
         })
         .map_err(|e| Fail(e.to_string()))?;
         skipped.undecodable += s.undecodable;
@@ -805,12 +815,13 @@ fn row_values(
     values: &mut [f64],
     cells: &[&str],
     request: &Request,
-    each: &mut dyn FnMut(&[f64]),
+    stamp: Option<i64>,
+    each: &mut dyn FnMut(Option<i64>, &[f64]),
 ) -> Result<(), String> {
     for ((v, cell), name) in values.iter_mut().zip(cells).zip(request.columns) {
         *v = csv::finite(name)(cell)?;
     }
-    each(values);
+    each(stamp, values);
     Ok(())
 }
 
@@ -831,7 +842,7 @@ fn is_time(name: &str) -> bool {
 fn csv_stream(
     files: &[PathBuf],
     request: &Request,
-    each: &mut dyn FnMut(&[f64]),
+    each: &mut dyn FnMut(Option<i64>, &[f64]),
 ) -> Result<Read, Fail> {
     let mut units: Option<Vec<Option<Unit>>> = None;
     let mut unknown: Vec<Option<String>> = Vec::new();
@@ -902,7 +913,7 @@ fn csv_stream(
                     // A first stamp that is no number says nothing of the unit: its sample is
                     // kept (with --rate) and the next stamp is asked, or it is refused as such.
                     None if first().is_none() && !strict => {
-                        return row_values(&mut values, cells, request, &mut *each);
+                        return row_values(&mut values, cells, request, None, &mut *each);
                     }
                     None if first().is_none() => {
                         return Err(format!("timestamp '{}' is not a number", csv::shown(last)));
@@ -918,7 +929,7 @@ fn csv_stream(
                     None => {
                         // The rate is given: stamps of unknown unit are not read.
                         time.set(None);
-                        return row_values(&mut values, cells, request, &mut *each);
+                        return row_values(&mut values, cells, request, None, &mut *each);
                     }
                 };
                 time.set(Some((i, Some(unit))));
@@ -928,7 +939,7 @@ fn csv_stream(
                     Err(_) => {
                         // The rate is given: the sample stays, its stamp (not a number) is
                         // left out of the stamps' statistics, which still check the rate.
-                        return row_values(&mut values, cells, request, &mut *each);
+                        return row_values(&mut values, cells, request, None, &mut *each);
                     }
                 }
             }
@@ -940,7 +951,7 @@ fn csv_stream(
             if !strict && !request.drop_backward {
                 // The rate is given: the sample stays, its stamp is left out of the stamps'
                 // statistics, which still check the rate given.
-                return row_values(&mut values, cells, request, &mut *each);
+                return row_values(&mut values, cells, request, Some(t), &mut *each);
             }
             timing.drop_one();
             if !request.drop_backward {
@@ -951,7 +962,7 @@ fn csv_stream(
             }
             return Ok(());
         }
-        row_values(&mut values, cells, request, &mut *each)
+        row_values(&mut values, cells, request, stamp, &mut *each)
     };
     csv::read_rows(files, &mut select, &mut row).map_err(|e: DataError| Fail(e.to_string()))?;
     Ok(Read {

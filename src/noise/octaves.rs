@@ -2,7 +2,7 @@
 //! equivalent degrees of freedom of each.
 
 use crate::Scalar;
-use crate::allan::{AllanStream, overlapping_avar};
+use crate::allan::{self, AllanStream, overlapping_avar};
 
 use super::{NoiseError, indexed};
 
@@ -216,13 +216,15 @@ impl<const L: usize> Octaves<L> {
         }
         let mut avar = [0.0; L];
         let mut len = 0usize;
+        // The mean once for every octave (the same bits as `overlapping_avar`'s).
+        let mean = if x.is_empty() { 0.0 } else { allan::mean(x) };
         for (j, slot) in indexed(avar.iter_mut()) {
             let m = 1usize << j.min(63);
             if j >= 63 || x.len() / 2 < m {
                 break;
             }
             // m >= 1, 2m <= n and every sample finite: the estimate exists.
-            let Ok(v) = overlapping_avar(x, m) else { break };
+            let v = allan::centred_avar(x, m, mean);
             // Sums of m samples of about 1e152 or more overflow.
             if !v.to_f64().is_finite() {
                 return Err(NoiseError::Overflow);

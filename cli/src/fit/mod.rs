@@ -2,6 +2,8 @@
 
 mod recursive;
 
+pub use recursive::centre;
+
 use imu_ar::batch::{BatchConfig, BatchError};
 use imu_ar::recursive::Gate;
 use serde::Serialize;
@@ -9,11 +11,11 @@ use serde::Serialize;
 use crate::error::Fail;
 use crate::input::{
     Input, Prior, check_decimate, check_delta, check_lambda, check_order, check_rate, check_span,
-    default_delta,
+    decimated, default_delta,
 };
 use crate::method::{DEFAULT_LAMBDA, GaussMarkov, Method, ScalarKind, batch_fit, with_order};
 use crate::output::{Output, json};
-use recursive::{Recursive, Scale, centre, fixed_fit, recursive_fit};
+use recursive::{Recursive, Scale, fixed_fit, recursive_fit};
 
 /// The arguments of `imu-ar fit`.
 #[derive(clap::Args)]
@@ -206,6 +208,12 @@ impl Output for FitResult {
 /// Checks the settings, reads the record and fits it; warns on stderr when most samples were
 /// rejected.
 pub fn run(args: &Args) -> Result<FitResult, Fail> {
+    run_with(args, None)
+}
+
+/// [`run`] on the samples `given` (the Python package's arrays) in place of the files': the
+/// same checks, fit and result.
+pub fn run_with(args: &Args, given: Option<&[f64]>) -> Result<FitResult, Fail> {
     let Args {
         ref input,
         method,
@@ -276,7 +284,10 @@ pub fn run(args: &Args) -> Result<FitResult, Fail> {
         Some(k) => Some(Gate::new(k as f32, 16).map_err(|e| Fail(format!("--gate {k}: {e}")))?),
         None => None,
     };
-    let x = input.load(decimate)?;
+    let x = match given {
+        Some(x) => decimated(&input.files, x, decimate)?,
+        None => input.load(decimate)?,
+    };
     if let Some(n) = settle.filter(|&n| n >= x.len()) {
         return Err(input.fail(format!(
             "--settle {n}: the record has {} samples; the settled start needs more than it holds",

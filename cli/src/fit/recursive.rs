@@ -97,7 +97,7 @@ fn config_in<T: FloatArith>(r: &Recursive) -> Result<(Config<T>, Channel<T>), Fa
 /// The offset removed in f64 before a fit in f32 or fixed point: the mean of the samples that
 /// f32 can hold when the mean is removed (so that rounding to f32 does not erase a small
 /// signal on a large offset), else 0.
-pub(super) fn centre(x: &[f64], demean: bool) -> f64 {
+pub fn centre(x: &[f64], demean: bool) -> f64 {
     if !demean {
         return 0.0;
     }

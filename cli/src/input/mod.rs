@@ -53,6 +53,9 @@ pub struct Input {
     pub unit: Option<String>,
 }
 
+/// The timestamp of a sample that has none ([`Input::series_stamped`]).
+pub const NO_STAMP: i64 = i64::MIN;
+
 /// A record's samples, and what its reader found.
 pub struct Series {
     /// The samples, in [`Series::unit`].
@@ -79,6 +82,20 @@ impl Input {
     /// The column's samples in the unit of `--unit`, with the timestamps' statistics when
     /// `want_time` (or when the record is a bag or an MCAP file, or `--time-column` is given).
     pub fn series(&self, want_time: bool) -> Result<Series, Fail> {
+        self.series_with(want_time, None)
+    }
+
+    /// [`Input::series`], with each sample's timestamp (ns since the epoch or the log's start;
+    /// [`NO_STAMP`] where none was read) pushed to `stamps`.
+    pub fn series_stamped(&self, want_time: bool, stamps: &mut Vec<i64>) -> Result<Series, Fail> {
+        self.series_with(want_time, Some(stamps))
+    }
+
+    fn series_with(
+        &self,
+        want_time: bool,
+        mut stamps: Option<&mut Vec<i64>>,
+    ) -> Result<Series, Fail> {
         let columns = [self.column.clone()];
         let request = Request {
             columns: &columns,
@@ -90,7 +107,12 @@ impl Input {
             instance: self.instance,
         };
         let mut x = Vec::new();
-        let read = source::stream(&self.files, &request, &mut |v| x.push(v[0]))?;
+        let read = source::stream_stamped(&self.files, &request, &mut |t, v| {
+            x.push(v[0]);
+            if let Some(s) = stamps.as_deref_mut() {
+                s.push(t.unwrap_or(NO_STAMP));
+            }
+        })?;
         if let Some(w) = read.skipped.cut_short_warning() {
             eprintln!("imu-ar: warning: {}", self.fail(w).0);
         }
@@ -115,6 +137,17 @@ impl Input {
             unit,
             skipped: read.skipped,
         })
+    }
+
+    /// Samples a caller holds (the Python package's arrays) in place of the files': as
+    /// [`Input::series`] gives them, in `--unit` (a label here), without timestamps.
+    pub fn given(&self, x: &[f64]) -> Series {
+        Series {
+            x: x.to_vec(),
+            timing: None,
+            unit: self.unit.clone().unwrap_or_else(|| "units".into()),
+            skipped: Skipped::default(),
+        }
     }
 
     /// `e` after the names of the files.

@@ -336,6 +336,12 @@ pub struct NoiseResult {
 
 /// Checks the settings, reads the record, fits and checks the model and draws its plot.
 pub fn run(args: &Args) -> Result<NoiseResult, Fail> {
+    run_with(args, None)
+}
+
+/// [`run`] on the samples `given` (the Python package's arrays) in place of the files': the
+/// same checks, fit and result; the rate is `--rate`.
+pub fn run_with(args: &Args, given: Option<&[f64]>) -> Result<NoiseResult, Fail> {
     if let Some(r) = args.rate {
         check_rate(r)?;
     }
@@ -347,7 +353,10 @@ pub fn run(args: &Args) -> Result<NoiseResult, Fail> {
     if let Some(path) = &args.plot {
         plot::check_path(path)?;
     }
-    let series = args.input.series(args.rate.is_none())?;
+    let series = match given {
+        Some(x) => args.input.given(x),
+        None => args.input.series(args.rate.is_none())?,
+    };
     let rate = series.rate(args.rate, &args.input)?;
     let x = decimated(&args.input.files, &series.x, args.decimate)?;
     check_span("--rate", rate, x.len())?;
@@ -632,6 +641,21 @@ impl Fitting {
 }
 
 impl NoiseResult {
+    /// The variance of the white measurement noise in the filter, `N^2 / Dt`.
+    pub fn measurement_variance(&self) -> f64 {
+        self.details.measurement_variance
+    }
+
+    /// The names of the filter's states, in the order of `phi`.
+    pub fn states(&self) -> &[String] {
+        &self.details.states
+    }
+
+    /// The unit of the record.
+    pub fn unit(&self) -> &str {
+        &self.details.unit
+    }
+
     /// `N` read as the Allan deviation at `tau = 1 s`, where the record has that octave pair.
     pub fn white_noise_at_1s(&self) -> Option<f64> {
         self.details.white_noise_at_1s
