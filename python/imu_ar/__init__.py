@@ -386,10 +386,14 @@ class NoiseModel:
             other = self._refit(float(filter_rate))
             r, mv, states = other._result, other._measurement_variance, other._states
         rate = float(filter_rate) if filter_rate is not None else self._filter_rate()
+        # A model without states (white noise only) has 0 x 0 matrices.
+        def matrix(rows: Any) -> np.ndarray:
+            return np.array(rows, dtype=float).reshape(len(rows), len(rows))
+
         return Kalman(
-            np.array(r["phi"], dtype=float).reshape(len(r["phi"]), -1),
-            np.array(r["q"], dtype=float).reshape(len(r["q"]), -1),
-            np.array(r["p0"], dtype=float).reshape(len(r["p0"]), -1),
+            matrix(r["phi"]),
+            matrix(r["q"]),
+            matrix(r["p0"]),
             float(mv),
             list(states),
             rate,

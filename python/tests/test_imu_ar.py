@@ -349,3 +349,13 @@ def test_long_calls_release_the_gil():
         during = [s for s in ticks if start < s < end]
         # A thread holding the GIL for the whole call would let the counter tick once at most.
         assert len(during) >= 5, (len(during), end - start)
+
+
+def test_a_model_without_states_has_empty_matrices():
+    """White noise only: no state, so 0 x 0 matrices and the white measurement variance."""
+    x = np.random.default_rng(0).normal(size=5000)
+    model = imu_ar.noise(x, rate=100.0)
+    assert model.to_dict()["phi"] == []
+    k = model.kalman()
+    assert k.phi.shape == k.q.shape == k.p0.shape == (0, 0)
+    assert np.isfinite(k.measurement_variance) and k.measurement_variance > 0.0
