@@ -225,36 +225,15 @@ impl<T: FloatArith + Send + Sync, const P: usize> Replay for Float<T, P> {
             restarts: Some(health.restarts),
             non_finite: Some(health.non_finite),
             outliers: Some(health.outliers),
-            ..blank(
-                model.a().iter().map(|v| v.to_f64()).collect(),
+            ..FitResult::new(
+                "",
+                "",
+                0,
                 model.mean().to_f64() + offset,
+                model.a().iter().map(|v| v.to_f64()).collect(),
                 model.noise_variance().to_f64(),
             )
         })
-    }
-}
-
-/// A result with the model's numbers, every optional key absent.
-fn blank(a: Vec<f64>, mean: f64, noise_variance: f64) -> FitResult {
-    FitResult {
-        method: "",
-        scalar: "",
-        order: a.len(),
-        n: 0,
-        mean,
-        a,
-        noise_variance,
-        reflection: None,
-        lambda: None,
-        delta: None,
-        scale: None,
-        restarts: None,
-        non_finite: None,
-        outliers: None,
-        saturated: None,
-        clipped: None,
-        rate_hz: None,
-        gauss_markov: None,
     }
 }
 
@@ -336,9 +315,12 @@ impl<const P: usize> Replay for Fixed<P> {
             clipped: Some(health.clipped),
             non_finite: Some(health.non_finite),
             outliers: Some(health.outliers),
-            ..blank(
-                model.a().iter().map(|&v| f64::from(v)).collect(),
+            ..FitResult::new(
+                "",
+                "",
+                0,
                 f64::from(model.mean()) + offset,
+                model.a().iter().map(|&v| f64::from(v)).collect(),
                 f64::from(model.noise_variance()),
             )
         })

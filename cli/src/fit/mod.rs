@@ -124,7 +124,7 @@ pub struct FitResult {
 
 impl FitResult {
     /// A fit of `n` samples with the keys every method reports; the others are absent.
-    fn new(
+    pub fn new(
         method: &'static str,
         scalar: &'static str,
         n: usize,
