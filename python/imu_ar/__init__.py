@@ -21,7 +21,9 @@ from __future__ import annotations
 
 import json
 import math
+import operator
 import os
+import tempfile
 from pathlib import Path
 from typing import Any, Dict, Iterable, List, NamedTuple, Optional, Sequence, Tuple, Union
 
@@ -54,7 +56,7 @@ __all__ = [
 
 __version__ = _native.__version__
 
-PathLike = Union[str, "os.PathLike[str]"]
+PathLike = Union[str, bytes, "os.PathLike[str]", "os.PathLike[bytes]"]
 
 # The name the tool's messages give an array passed from Python (where it names a file).
 _ARRAY = "<array>"
@@ -76,14 +78,45 @@ def _num(v: float) -> str:
 
 
 def _is_path(x: Any) -> bool:
-    return isinstance(x, (str, os.PathLike))
+    return isinstance(x, (str, bytes, os.PathLike))
+
+
+def _path(p: Any) -> str:
+    """A path as the tool takes it: bytes and names that are not UTF-8 pass through
+    ``os.fsdecode`` and come back to the file system byte for byte."""
+    return os.fsdecode(os.fspath(p))
 
 
 def _files(path: Union[PathLike, Sequence[PathLike]]) -> List[str]:
     """One file, or several read as one record."""
     if _is_path(path):
-        return [os.fspath(path)]
-    return [os.fspath(p) for p in path]
+        return [_path(path)]
+    files = [_path(p) for p in path]
+    if not files:
+        raise ValueError("path: no files given")
+    return files
+
+
+def _int(name: str, v: Any, minimum: int = 0) -> int:
+    """``v`` as an integer option: an ``int`` (or numpy integer) of at least ``minimum``;
+    ``TypeError`` for a float or anything else, ``ValueError`` below the minimum."""
+    try:
+        i = operator.index(v)
+    except TypeError:
+        raise TypeError(f"{name}: an integer is needed, not {type(v).__name__} {v!r}") from None
+    if i < minimum:
+        raise ValueError(f"{name} {i}: must be at least {minimum}")
+    return i
+
+
+def _names(name: str, v: Any) -> List[str]:
+    """A list of names; one string is one name (not its characters)."""
+    if isinstance(v, (str, bytes)):
+        v = [v]
+    out = [os.fsdecode(c) if isinstance(c, bytes) else str(c) for c in v]
+    if not out:
+        raise ValueError(f"{name}: none given")
+    return out
 
 
 def _input_flags(
@@ -100,7 +133,7 @@ def _input_flags(
     if frame_id is not None:
         argv += ["--frame-id", frame_id]
     if instance is not None:
-        argv += ["--instance", str(int(instance))]
+        argv += ["--instance", str(_int("instance", instance))]
     if time_column is not None:
         argv += ["--time-column", time_column]
     if drop_backward:
@@ -114,24 +147,6 @@ def _input_flags(
 
 _AXES = ["gx", "gy", "gz", "ax", "ay", "az"]
 _NO_STAMP = np.iinfo(np.int64).min
-_TIME_NAMES = {"t", "time", "timestamp", "stamp", "sec", "seconds"}
-
-
-def _csv_columns(path: str) -> List[str]:
-    """The data columns of a CSV file's header: every column but a time column."""
-    with open(path, newline="") as f:
-        header = f.readline().strip()
-    names = [c.strip() for c in header.split(",")]
-    out = []
-    for name in names:
-        bare = name.lstrip("#").split("[")[0].strip().lower()
-        timed = bare in _TIME_NAMES or any(
-            bare.startswith(p) and bare[len(p):] in ("s", "ms", "us", "ns")
-            for p in ("t_", "time_", "timestamp_", "stamp_")
-        )
-        if not timed:
-            out.append(name)
-    return out
 
 
 class Record(NamedTuple):
@@ -178,12 +193,13 @@ def read(
     files = _files(path)
     if columns is None:
         if _native.kind(files[0]) == "Csv" and os.path.isfile(files[0]):
-            columns = _csv_columns(files[0])
+            columns = _native.csv_columns(files[0], time_column)
         else:
             columns = list(_AXES)
-    columns = [str(c) for c in columns]
-    if not columns:
-        raise ValueError(f"{files[0]}: no columns to read")
+        if not columns:
+            raise ValueError(f"{files[0]}: no columns to read")
+    else:
+        columns = _names("columns", columns)
     flags = _input_flags(topic, frame_id, instance, time_column, drop_backward, unit)
     data = []
     units = []
@@ -212,32 +228,46 @@ def read(
 # --- Allan deviation -----------------------------------------------------------------------
 
 
-class Adev(NamedTuple):
-    """The overlapping Allan deviation, as ``allantools.oadev`` returns it:
-    ``(taus, devs, errs, ns)``: the averaging times (s), the deviations, their errors
-    ``dev / sqrt(n)`` and the number of second differences ``n`` behind each."""
-
+class _AdevTuple(NamedTuple):
     taus: np.ndarray
     devs: np.ndarray
     errs: np.ndarray
     ns: np.ndarray
 
+
+class Adev(_AdevTuple):
+    """The overlapping Allan deviation, as ``allantools.oadev`` returns it:
+    ``(taus, devs, errs, ns)``: the averaging times (s), the deviations, their errors
+    ``dev / sqrt(n)`` and the number of second differences ``n`` behind each; ``rate`` is the
+    sample rate (Hz), ``m`` the averaging factors, ``edf`` and ``avar`` as below."""
+
+    rate: float
+
+    def __new__(
+        cls, taus: np.ndarray, devs: np.ndarray, errs: np.ndarray, ns: np.ndarray, rate: float
+    ) -> "Adev":
+        self = super().__new__(cls, taus, devs, errs, ns)
+        self.rate = float(rate)
+        return self
+
+    def __getnewargs__(self) -> Tuple[Any, ...]:
+        return (*self, self.rate)
+
+    @property
+    def m(self) -> np.ndarray:
+        """The averaging factors ``tau x rate``."""
+        return np.round(self.taus * self.rate)
+
     @property
     def edf(self) -> np.ndarray:
-        """Equivalent degrees of freedom for white frequency noise (Howe, Allan and Barnes,
-        SP 1065 eq. 42), for chi-squared intervals of the deviations."""
-        n = self.ns + 2 * self._m() - 1.0  # the samples
-        m = self._m()
+        """Equivalent degrees of freedom of each deviation for white frequency noise (Howe,
+        Allan and Barnes, NIST SP 1065, eq. 42, ``N`` the phase points: the samples plus one),
+        for chi-squared intervals of the deviations."""
+        m = self.m
+        n = self.ns + 2.0 * m  # the phase points, n + 1 for n rate samples
         return (3.0 * (n - 1.0) / (2.0 * m) - 2.0 * (n - 2.0) / n) * (4.0 * m * m) / (
             4.0 * m * m + 5.0
         )
-
-    def _m(self) -> np.ndarray:
-        """The averaging factors: ``ns + 2 m`` is the same for every tau."""
-        if len(self.taus) >= 2 and self.taus[-1] > self.taus[0]:
-            rate = (self.ns[0] - self.ns[-1]) / (2.0 * (self.taus[-1] - self.taus[0]))
-            return np.round(self.taus * rate)
-        return np.ones_like(self.taus)
 
     @property
     def avar(self) -> np.ndarray:
@@ -287,9 +317,15 @@ def adev(x: Any, rate: float = 1.0, taus: Union[str, Iterable[float]] = "octave"
     if len(m) == 0:
         raise ValueError(f"no averaging time leaves two second differences in {len(x)} samples")
     avar = _native.octave_avar(x, [int(v) for v in m])
+    if not np.all(np.isfinite(avar)):
+        tau = m[~np.isfinite(avar)][0] / rate
+        raise ValueError(
+            f"the Allan variance at tau = {tau:g} s overflows f64 (values of about 1e154 or "
+            "more); rescale the samples"
+        )
     ns = (len(x) - 2 * m + 1).astype(float)
     devs = np.sqrt(avar)
-    return Adev(m / rate, devs, devs / np.sqrt(ns), ns)
+    return Adev(m / rate, devs, devs / np.sqrt(ns), ns, rate)
 
 
 # --- the noise model -----------------------------------------------------------------------
@@ -475,9 +511,9 @@ def noise(
     tail: List[str] = []
     if rate is not None:
         tail += ["--rate", _num(rate)]
-    tail += ["--gm-states", str(int(gm_states))]
+    tail += ["--gm-states", str(_int("gm_states", gm_states))]
     if ar_order is not None:
-        tail += ["--ar-order", str(int(ar_order))]
+        tail += ["--ar-order", str(_int("ar_order", ar_order))]
     if oscillators:
         tail.append("--oscillators")
     if ramp:
@@ -486,7 +522,7 @@ def noise(
         tail.append("--curve-fit")
     if filter_rate is not None:
         tail += ["--filter-rate", _num(filter_rate)]
-    tail += ["--decimate", str(int(decimate))]
+    tail += ["--decimate", str(_int("decimate", decimate, 1))]
     if _is_path(x) or (isinstance(x, (list, tuple)) and x and all(_is_path(p) for p in x)):
         if column is None:
             raise ValueError("column: a recording's column must be named")
@@ -511,22 +547,56 @@ def noise(
 # --- characterise --------------------------------------------------------------------------
 
 
+def _without(argv: List[str], flag: str) -> List[str]:
+    """``argv`` without ``flag`` and its value."""
+    out: List[str] = []
+    skip = False
+    for a in argv:
+        if skip:
+            skip = False
+        elif a == flag:
+            skip = True
+        else:
+            out.append(a)
+    return out
+
+
 class Characterisation:
     """The six axes' noise models of a recording (``imu-ar characterise``): ``axes`` maps
     ``gx .. az`` to a :class:`NoiseModel` (in SI units: rad/s, m/s^2); ``rate``, ``n``,
     ``timing`` and ``skipped`` as the tool reports them. :meth:`write` writes the parameter
     files."""
 
-    def __init__(self, result: Dict[str, Any], argv: List[str]) -> None:
+    def __init__(
+        self,
+        result: Dict[str, Any],
+        argv: List[str],
+        filters: List[Tuple[float, List[str], float]],
+    ) -> None:
         self._result = result
         self._argv = argv
         self.rate: float = result["rate_hz"]
         self.n: int = result["n"]
         self.timing: Optional[Dict[str, Any]] = result.get("timing")
         self.skipped: Dict[str, int] = result["skipped"]
-        self.axes: Dict[str, NoiseModel] = {
-            a["axis"]: NoiseModel(a["model"], math.nan, [], a["unit"]) for a in result["axes"]
-        }
+
+        def refit(axis: str) -> Any:
+            # The recording characterised again with the filter at another rate.
+            def at(f: float) -> NoiseModel:
+                again = [*_without(argv, "--filter-rate"), "--filter-rate", _num(f)]
+                with tempfile.TemporaryDirectory(prefix="imu-ar-") as tmp:
+                    out, fs = _native.characterise(
+                        [*again, "--out", tmp, "--format", "state-space", "--json"]
+                    )
+                return Characterisation(json.loads(out), again, fs).axes[axis]
+
+            return at
+
+        self.axes: Dict[str, NoiseModel] = {}
+        for a, (mv, states, filter_rate) in zip(result["axes"], filters):
+            model = NoiseModel(a["model"], mv, states, a["unit"], refit(a["axis"]))
+            model._filter = filter_rate  # type: ignore[attr-defined]
+            self.axes[a["axis"]] = model
         self.columns: Dict[str, str] = {a["axis"]: a["column"] for a in result["axes"]}
 
     def to_dict(self) -> Dict[str, Any]:
@@ -539,8 +609,10 @@ class Characterisation:
         """Writes the parameter files of ``formats`` (kalibr, openvins, vins, orbslam3, px4,
         ardupilot, state-space, or all) and the plots into ``dir``, as ``imu-ar characterise
         --out DIR --format ...`` (the recording is read again); returns the files written."""
-        argv = [*self._argv, "--out", os.fspath(dir), "--format", ",".join(formats), "--json"]
-        return list(json.loads(_native.characterise(argv))["files"])
+        argv = [*self._argv, "--out", _path(dir), "--format", ",".join(_names("formats", formats)),
+                "--json"]
+        out, _ = _native.characterise(argv)
+        return list(json.loads(out)["files"])
 
     def __repr__(self) -> str:
         return f"Characterisation(n={self.n}, rate={self.rate}, axes={list(self.axes)})"
@@ -566,12 +638,11 @@ def characterise(
     horizon: Optional[float] = None,
 ) -> Characterisation:
     """All six axes of a recording in one streaming pass, as ``imu-ar characterise``: per axis
-    the noise model; ``.write(dir, formats=[...])`` writes the parameter files."""
-    import tempfile
-
+    the noise model (with its filter form at ``filter_rate``: ``axes["gx"].kalman()``);
+    ``.write(dir, formats=[...])`` writes the parameter files."""
     argv = ["characterise", *_files(path)]
     if columns is not None:
-        argv += ["--columns", ",".join(str(c) for c in columns)]
+        argv += ["--columns", ",".join(_names("columns", columns))]
     argv += _input_flags(topic, frame_id, instance, time_column, drop_backward)
     if rate is not None:
         argv += ["--rate", _num(rate)]
@@ -579,7 +650,7 @@ def characterise(
         argv += ["--gyro-unit", gyro_unit]
     if accel_unit is not None:
         argv += ["--accel-unit", accel_unit]
-    argv += ["--gm-states", str(int(gm_states))]
+    argv += ["--gm-states", str(_int("gm_states", gm_states))]
     for flag, on in (("--oscillators", oscillators), ("--ramp", ramp), ("--curve-fit", curve_fit)):
         if on:
             argv.append(flag)
@@ -588,8 +659,10 @@ def characterise(
     if horizon is not None:
         argv += ["--horizon", _num(horizon)]
     with tempfile.TemporaryDirectory(prefix="imu-ar-") as tmp:
-        out = _native.characterise([*argv, "--out", tmp, "--format", "state-space", "--json"])
-    return Characterisation(json.loads(out), argv)
+        out, filters = _native.characterise(
+            [*argv, "--out", tmp, "--format", "state-space", "--json"]
+        )
+    return Characterisation(json.loads(out), argv, filters)
 
 
 # --- AR fits -------------------------------------------------------------------------------
@@ -632,7 +705,7 @@ _METHODS = {"ls": "ls", "ols": "ls", "yule-walker": "yule-walker", "yule_walker"
 def _method(method: str) -> str:
     try:
         return _METHODS[method.lower()]
-    except KeyError:
+    except (KeyError, AttributeError):
         raise ValueError(
             f"method {method!r}: ls, yule-walker, burg, rls, lattice or sftf"
         ) from None
@@ -651,19 +724,23 @@ def fit_ar(
     delta: Optional[float] = None,
 ) -> ArFit:
     """An AR(``order``) model of ``x`` as ``imu-ar fit``: ``method`` "ls" (conditional least
-    squares, as statsmodels' ``AutoReg``), "yule-walker" (biased autocovariance, as
-    statsmodels' ``yule_walker(..., method="mle")``), "burg" (as statsmodels' ``burg``), or a
-    recursive one ("rls", "lattice", "sftf": the model after the last sample, in ``scalar``
-    f64, f32 or fixed). ``x`` may also be a path, with a ``(path, column)`` tuple."""
+    squares on ``x`` less its mean, without a constant: the coefficients of statsmodels'
+    ``AutoReg(x - x.mean(), lags=order, trend="n")``), "yule-walker" (biased autocovariance:
+    statsmodels' ``yule_walker(x, order, method="mle")``, coefficients and variance), "burg"
+    (the coefficients of statsmodels' ``burg(x, order)``; the noise variance is the Burg
+    recursion's, ``x.var() * prod(1 - reflection**2)``, where statsmodels gives its own
+    residual estimate), or a recursive one ("rls", "lattice", "sftf": the model after the
+    last sample, in ``scalar`` f64, f32 or fixed). With ``demean=False`` nothing is
+    subtracted. ``x`` may also be a path, with a ``(path, column)`` tuple."""
     argv = ["fit"]
     if isinstance(x, tuple) and len(x) == 2 and _is_path(x[0]):
-        argv += [os.fspath(x[0]), "--column", str(x[1])]
+        argv += [_path(x[0]), "--column", str(x[1])]
         samples = None
     else:
         samples = _samples(x)
         argv += [_ARRAY, "--column", "x"]
-    argv += ["--method", _method(method), "--order", str(int(order)), "--scalar", scalar,
-             "--decimate", str(int(decimate))]
+    argv += ["--method", _method(method), "--order", str(_int("order", order, 1)), "--scalar",
+             str(scalar), "--decimate", str(_int("decimate", decimate, 1))]
     if rate is not None:
         argv += ["--rate", _num(rate)]
     if not demean:
@@ -692,7 +769,7 @@ def order_criteria(x: Any, max_order: int, method: str = "burg", *, demean: bool
     """AIC, AICc, BIC and FPE of the AR fits of orders 0 to ``max_order`` by ``method`` (ls,
     yule-walker or burg), and the order each selects, as ``imu-ar order``."""
     samples = _samples(x)
-    argv = ["order", _ARRAY, "--column", "x", "--max-order", str(int(max_order)),
+    argv = ["order", _ARRAY, "--column", "x", "--max-order", str(_int("max_order", max_order)),
             "--method", _method(method)]
     if not demean:
         argv.append("--no-demean")
@@ -736,7 +813,7 @@ class _Recursive:
         scale: Optional[float] = None,
     ) -> None:
         self._est = _native.Estimator(
-            self._method, scalar or self._scalar_default, int(order), float(lam),
+            self._method, scalar or self._scalar_default, _int("order", order, 1), float(lam),
             None if delta is None else float(delta), None if rate is None else float(rate),
             bool(demean), None if offset is None else float(offset),
             None if scale is None else float(scale),
@@ -744,7 +821,12 @@ class _Recursive:
 
     def update(self, x: Any, trace: bool = False) -> Any:
         """Takes the samples ``x``; returns each one's a-priori prediction error
-        ``x_n - xhat_n`` (NaN for a rejected sample). With ``trace`` (the lattices), returns
+        ``x_n - xhat_n``, or NaN for a sample the estimator did not take (NaN or infinite, at
+        the fixed-point format's rail, rejected by a gate: counted in the model's
+        ``non_finite``, ``saturated``, ``outliers``) and for one on which it restarted (its
+        state broke down or, in fixed point, saturated: counted in ``restarts``; the model
+        held is the one from before). Calls from several threads take turns, each ``x`` in one
+        piece. With ``trace`` (the lattices), returns
         ``(errors, internals)``: per sample ``e, f_1..f_P, kf_1..kf_P, kb_1..kb_P, F_0..F_P``
         (float64 for a float lattice; for the fixed-point lattice the numbers' bit patterns
         as int64: I5F27, I3F29 and I24F40), zeros for a rejected sample."""

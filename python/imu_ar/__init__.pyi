@@ -9,7 +9,7 @@ import numpy.typing as npt
 
 __version__: str
 
-PathLike = Union[str, os.PathLike[str]]
+PathLike = Union[str, bytes, os.PathLike[str], os.PathLike[bytes]]
 ArrayLike = npt.ArrayLike
 
 class Record(NamedTuple):
@@ -34,11 +34,24 @@ def read(
     unit: Optional[str] = ...,
 ) -> Record: ...
 
-class Adev(NamedTuple):
+class _AdevTuple(NamedTuple):
     taus: npt.NDArray[np.float64]
     devs: npt.NDArray[np.float64]
     errs: npt.NDArray[np.float64]
     ns: npt.NDArray[np.float64]
+
+class Adev(_AdevTuple):
+    rate: float
+    def __new__(
+        cls,
+        taus: npt.NDArray[np.float64],
+        devs: npt.NDArray[np.float64],
+        errs: npt.NDArray[np.float64],
+        ns: npt.NDArray[np.float64],
+        rate: float,
+    ) -> Adev: ...
+    @property
+    def m(self) -> npt.NDArray[np.float64]: ...
     @property
     def edf(self) -> npt.NDArray[np.float64]: ...
     @property
@@ -112,6 +125,12 @@ class Characterisation:
     skipped: Dict[str, int]
     axes: Dict[str, NoiseModel]
     columns: Dict[str, str]
+    def __init__(
+        self,
+        result: Dict[str, Any],
+        argv: List[str],
+        filters: List[Tuple[float, List[str], float]],
+    ) -> None: ...
     def to_dict(self) -> Dict[str, Any]: ...
     def write(self, dir: PathLike, formats: Sequence[str] = ...) -> List[str]: ...
 
@@ -145,6 +164,7 @@ class ArFit:
     noise_variance: float
     reflection: Optional[npt.NDArray[np.float64]]
     gauss_markov: Optional[Dict[str, float]]
+    def __init__(self, result: Dict[str, Any]) -> None: ...
     def to_dict(self) -> Dict[str, Any]: ...
 
 def fit_ar(

@@ -9,7 +9,8 @@ use std::path::PathBuf;
 use clap::{CommandFactory, Parser};
 use imu_ar_cli::error::{Fail, clap_error};
 use imu_ar_cli::input::Input;
-use imu_ar_cli::input::source::Kind;
+use imu_ar_cli::input::csv::{header, position};
+use imu_ar_cli::input::source::{Kind, is_time};
 use imu_ar_cli::output::json_line;
 use imu_ar_cli::{characterise as ch, fit as fi, noise as no, order as or, parity as pa};
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
@@ -43,9 +44,9 @@ pub struct ReadArgs {
 
 /// `argv` (without the program's name) parsed as the tool parses it; its error is the tool's
 /// one line.
-pub fn parse(argv: &[String]) -> Result<Command, Fail> {
+pub fn parse(argv: &[OsString]) -> Result<Command, Fail> {
     let args: Vec<OsString> = std::iter::once(OsString::from("imu-ar"))
-        .chain(argv.iter().map(OsString::from))
+        .chain(argv.iter().cloned())
         .collect();
     Command::try_parse_from(&args).map_err(|e| Fail(clap_error(&e, &Command::command(), &args)))
 }
@@ -53,7 +54,7 @@ pub fn parse(argv: &[String]) -> Result<Command, Fail> {
 /// Parses `argv`, then runs `f` on the command without the GIL; errors become exceptions.
 fn run<T: Send>(
     py: Python<'_>,
-    argv: &[String],
+    argv: &[OsString],
     f: impl FnOnce(Command) -> Result<T, Fail> + Send,
 ) -> PyResult<T> {
     py.detach(|| guarded(|| f(parse(argv)?)))
@@ -79,7 +80,7 @@ fn other() -> Fail {
 #[pyo3(signature = (argv, x=None))]
 pub fn noise(
     py: Python<'_>,
-    argv: Vec<String>,
+    argv: Vec<OsString>,
     x: Option<PyReadonlyArray1<'_, f64>>,
 ) -> PyResult<(String, f64, Vec<String>, String)> {
     let x = samples(&x)?;
@@ -102,7 +103,7 @@ pub fn noise(
 #[pyo3(signature = (argv, x=None))]
 pub fn fit(
     py: Python<'_>,
-    argv: Vec<String>,
+    argv: Vec<OsString>,
     x: Option<PyReadonlyArray1<'_, f64>>,
 ) -> PyResult<String> {
     let x = samples(&x)?;
@@ -117,7 +118,7 @@ pub fn fit(
 #[pyo3(signature = (argv, x=None))]
 pub fn order(
     py: Python<'_>,
-    argv: Vec<String>,
+    argv: Vec<OsString>,
     x: Option<PyReadonlyArray1<'_, f64>>,
 ) -> PyResult<String> {
     let x = samples(&x)?;
@@ -127,12 +128,32 @@ pub fn order(
     })
 }
 
-/// `_native.characterise(argv)`: `imu-ar characterise --json`.
+/// Per axis of a characterisation: the filter's measurement variance, its states' names and
+/// its rate.
+pub type AxisFilter = (f64, Vec<String>, f64);
+
+/// `_native.characterise(argv)`: `imu-ar characterise --json`, and per axis the measurement
+/// variance, the states and the rate of its filter form.
 #[pyfunction]
-pub fn characterise(py: Python<'_>, argv: Vec<String>) -> PyResult<String> {
-    run(py, &argv, |c| match c {
-        Command::Characterise(args) => json_line(&ch::run(&args)?),
-        _ => Err(other()),
+pub fn characterise(py: Python<'_>, argv: Vec<OsString>) -> PyResult<(String, Vec<AxisFilter>)> {
+    run(py, &argv, |c| {
+        let Command::Characterise(args) = c else {
+            return Err(other());
+        };
+        let r = ch::run(&args)?;
+        let axes = r
+            .axes
+            .iter()
+            .map(|a| {
+                let m = &a.model;
+                (
+                    m.measurement_variance(),
+                    m.states().to_vec(),
+                    m.filter_rate(),
+                )
+            })
+            .collect();
+        Ok((json_line(&r)?, axes))
     })
 }
 
@@ -150,7 +171,7 @@ pub type Column<'py> = (
 /// timestamps (ns; the least int64 where a sample has none), the timestamps' report as JSON
 /// (or `None`), the unit and the skipped messages' summary.
 #[pyfunction]
-pub fn read<'py>(py: Python<'py>, argv: Vec<String>, want_time: bool) -> PyResult<Column<'py>> {
+pub fn read<'py>(py: Python<'py>, argv: Vec<OsString>, want_time: bool) -> PyResult<Column<'py>> {
     let (x, t, timing, unit, skipped) = run(py, &argv, |c| {
         let Command::Read(args) = c else {
             return Err(other());
@@ -167,6 +188,26 @@ pub fn read<'py>(py: Python<'py>, argv: Vec<String>, want_time: bool) -> PyResul
         unit,
         skipped,
     ))
+}
+
+/// `_native.csv_columns(path)`: the data columns of a CSV file's header (every column but a
+/// time column or `time_column`), as the tool reads the header.
+#[pyfunction]
+#[pyo3(signature = (path, time_column=None))]
+pub fn csv_columns(path: PathBuf, time_column: Option<String>) -> PyResult<Vec<String>> {
+    let header =
+        guarded(|| header(&[path]).map_err(|e| Fail(e.to_string()))).map_err(to_py_checked)?;
+    // As the reader picks it (a `time_column` that names none is the reader's to refuse).
+    let time = match time_column {
+        Some(t) => position(&header, &t).ok(),
+        None => header.iter().position(|c| is_time(c)),
+    };
+    Ok(header
+        .into_iter()
+        .enumerate()
+        .filter(|&(i, _)| Some(i) != time)
+        .map(|(_, c)| c)
+        .collect())
 }
 
 /// `_native.kind(path)`: the kind of recording `path` is (`Csv`, `Bag`, `Mcap`, ...).
@@ -203,8 +244,8 @@ pub fn centre(x: PyReadonlyArray1<'_, f64>) -> PyResult<f64> {
 mod tests {
     use super::*;
 
-    fn line(args: &[&str]) -> Vec<String> {
-        args.iter().map(|s| s.to_string()).collect()
+    fn line(args: &[&str]) -> Vec<OsString> {
+        args.iter().map(OsString::from).collect()
     }
 
     #[test]

@@ -4,13 +4,17 @@
 //! last sample is reported as `imu-ar fit --method ... --json` reports it, so that a record
 //! replayed from Python gives the tool's model bit for bit.
 
+use std::sync::Mutex;
+
 use imu_ar::recursive::{
     Channel, Config, Estimator as _, FixedChannel, FixedConfig, FixedLattice, FloatArith, Lattice,
     Rls, Sftf,
 };
 use imu_ar_cli::error::Fail;
 use imu_ar_cli::fit::{FitResult, centre};
-use imu_ar_cli::input::{check_delta, check_lambda, check_order, check_rate, default_delta};
+use imu_ar_cli::input::{
+    check_delta, check_lambda, check_order, check_rate, default_delta, number,
+};
 use imu_ar_cli::method::GaussMarkov;
 use imu_ar_cli::output::json_line;
 use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1};
@@ -103,10 +107,13 @@ impl Settings {
             check_rate(r).map_err(|Fail(e)| Fail(e.replace("--rate", "rate")))?;
         }
         if let Some(s) = self.scale.filter(|s| !(s.is_finite() && *s > 0.0)) {
-            return Err(Fail(format!("scale {s}: must be positive and finite")));
+            return Err(Fail(format!(
+                "scale {}: must be positive and finite",
+                number(s)
+            )));
         }
         if let Some(o) = self.offset.filter(|o| !o.is_finite()) {
-            return Err(Fail(format!("offset {o}: must be finite")));
+            return Err(Fail(format!("offset {}: must be finite", number(o))));
         }
         Ok(())
     }
@@ -148,8 +155,13 @@ fn config_in<T: FloatArith>(s: &Settings, delta: f64) -> Result<(Config<T>, Chan
     let config = Config::new(T::from_f64(s.lambda), T::from_f64(s.dt()))
         .map_err(|e| Fail(e.to_string()))?
         .with_demean(s.demean);
-    let channel = Channel::new(T::from_f64(delta))
-        .map_err(|e| Fail(format!("delta {delta}: {e} in {}", s.scalar.name())))?;
+    let channel = Channel::new(T::from_f64(delta)).map_err(|e| {
+        Fail(format!(
+            "delta {}: {e} in {}",
+            number(delta),
+            s.scalar.name()
+        ))
+    })?;
     Ok((config, channel))
 }
 
@@ -249,12 +261,13 @@ impl<const P: usize> Fixed<P> {
         let (config, channel) = config_in::<f32>(s, delta)?;
         let channel = FixedChannel::new(&channel, scale as f32).map_err(|e| {
             Fail(format!(
-                "scale {scale}: {e} (delta x scale^2 = {:e} must be in [1e-9, 1e6))",
+                "scale {}: {e} (delta x scale^2 = {:e} must be in [1e-9, 1e6))",
+                number(scale),
                 delta * scale * scale
             ))
         })?;
-        let config =
-            FixedConfig::new(&config).map_err(|e| Fail(format!("lam {}: {e}", s.lambda)))?;
+        let config = FixedConfig::new(&config)
+            .map_err(|e| Fail(format!("lam {}: {e}", number(s.lambda))))?;
         let lattice = FixedLattice::with_prior(&config, &channel, &[0.0; P])
             .map_err(|e| Fail(e.to_string()))?;
         Ok(Self {
@@ -437,10 +450,24 @@ pub type Replayed<'py> = (Bound<'py, PyArray1<f64>>, Option<Bound<'py, PyAny>>);
 
 /// `_native.Estimator(method, scalar, order, lam, delta, rate, demean, offset, scale)`: one of
 /// the device's recursive estimators (the Python classes `Rls`, `Lattice`, `Sftf` and
-/// `FixedLattice` hold one).
-#[pyclass(module = "imu_ar._native")]
+/// `FixedLattice` hold one). Its calls from several threads take turns: each `update` takes
+/// its samples in one piece, after or before another thread's.
+#[pyclass(module = "imu_ar._native", frozen)]
 pub struct Estimator {
-    inner: Replayer,
+    inner: Mutex<Replayer>,
+}
+
+impl Estimator {
+    /// The estimator, once no other call holds it (without the GIL).
+    fn with<T>(&self, f: impl FnOnce(&mut Replayer) -> Result<T, Fail>) -> Result<T, Fail> {
+        let mut inner = self.inner.lock().map_err(|_| {
+            Fail(
+                "the estimator failed in an earlier call (an internal error); make a new one"
+                    .into(),
+            )
+        })?;
+        guarded(|| f(&mut inner))
+    }
 }
 
 #[pymethods]
@@ -492,7 +519,9 @@ impl Estimator {
             scale,
         };
         let inner = guarded(|| Replayer::new(settings)).map_err(to_py_checked)?;
-        Ok(Self { inner })
+        Ok(Self {
+            inner: Mutex::new(inner),
+        })
     }
 
     /// Takes the samples `x`; returns each one's a-priori prediction error (NaN for a rejected
@@ -500,30 +529,29 @@ impl Estimator {
     /// Releases the GIL.
     #[pyo3(signature = (x, trace=false))]
     fn update<'py>(
-        &mut self,
+        &self,
         py: Python<'py>,
         x: PyReadonlyArray1<'py, f64>,
         trace: bool,
     ) -> PyResult<Replayed<'py>> {
         let x = x.as_slice()?;
-        if trace && self.inner.settings.method != Method::Lattice {
-            return Err(pyo3::exceptions::PyValueError::new_err(
-                "trace: only the lattices trace their internals",
-            ));
-        }
-        let inner = &mut self.inner;
-        let (errors, t) = py
+        let (errors, t, settings) = py
             .detach(|| {
-                guarded(|| {
+                self.with(|inner| {
+                    if trace && inner.settings.method != Method::Lattice {
+                        return Err(Fail(
+                            "trace: only the lattices trace their internals".into(),
+                        ));
+                    }
                     let mut t = Trace::default();
                     let e = inner.update(x, trace.then_some(&mut t))?;
-                    Ok((e, t))
+                    Ok((e, t, inner.settings))
                 })
             })
             .map_err(to_py_checked)?;
-        let width = 4 * self.inner.settings.order + 2;
+        let width = 4 * settings.order + 2;
         let rows = errors.len();
-        let traced = match (trace, self.inner.settings.scalar) {
+        let traced = match (trace, settings.scalar) {
             (false, _) => None,
             (true, Scalar::Fixed) => Some(
                 PyArray1::from_vec(py, t.bits)
@@ -540,14 +568,16 @@ impl Estimator {
     }
 
     /// The model after the last sample, as the JSON object of `imu-ar fit --json`.
-    fn model_json(&self) -> PyResult<String> {
-        guarded(|| json_line(&self.inner.result()?)).map_err(to_py_checked)
+    fn model_json(&self, py: Python<'_>) -> PyResult<String> {
+        py.detach(|| self.with(|inner| json_line(&inner.result()?)))
+            .map_err(to_py_checked)
     }
 
     /// Samples taken.
     #[getter]
-    fn n(&self) -> usize {
-        self.inner.n
+    fn n(&self, py: Python<'_>) -> PyResult<usize> {
+        py.detach(|| self.with(|inner| Ok(inner.n)))
+            .map_err(to_py_checked)
     }
 }
 

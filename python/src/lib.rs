@@ -28,6 +28,7 @@ fn native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(commands::characterise, m)?)?;
     m.add_function(wrap_pyfunction!(commands::read, m)?)?;
     m.add_function(wrap_pyfunction!(commands::kind, m)?)?;
+    m.add_function(wrap_pyfunction!(commands::csv_columns, m)?)?;
     m.add_function(wrap_pyfunction!(commands::parity_input, m)?)?;
     m.add_function(wrap_pyfunction!(commands::parity, m)?)?;
     m.add_function(wrap_pyfunction!(commands::centre, m)?)?;

@@ -2,6 +2,7 @@
 
 import json
 import math
+import os
 import struct
 import subprocess
 import sys
@@ -35,11 +36,36 @@ def test_adev_is_allantools_oadev(white_walk, taus):
     np.testing.assert_allclose(ours.ns + 2 * m - 1, len(x))
 
 
-def test_adev_edf_of_white_noise_at_m_1():
+def _edf(n_phase, m):
+    """SP 1065 eq. 42: the overlapping Allan variance's edf for white FM, N phase points."""
+    big = n_phase
+    return (3 * (big - 1) / (2 * m) - 2 * (big - 2) / big) * 4 * m * m / (4 * m * m + 5)
+
+
+def test_adev_edf_of_white_noise():
     n = 10_000
-    r = imu_ar.adev(np.random.default_rng(0).normal(size=n), rate=1.0)
-    # SP 1065 eq. 42 at m = 1: (3(N-1)/2 - 2(N-2)/N) 4/9.
-    assert r.edf[0] == pytest.approx((1.5 * (n - 1) - 2 * (n - 2) / n) * 4 / 9)
+    r = imu_ar.adev(np.random.default_rng(0).normal(size=n), rate=4.0)
+    # n rate samples are n + 1 phase points.
+    np.testing.assert_allclose(r.edf, [_edf(n + 1, m) for m in 2.0 ** np.arange(len(r.taus))],
+                               rtol=1e-14)
+    np.testing.assert_array_equal(r.m, 2.0 ** np.arange(len(r.taus)))
+    assert r.rate == 4.0
+
+
+def test_adev_edf_at_a_single_tau_is_that_tau_s():
+    n = 1000
+    r = imu_ar.adev(np.random.default_rng(0).normal(size=n), rate=10.0, taus=[1.6])
+    assert r.m.tolist() == [16.0]
+    assert r.edf[0] == pytest.approx(_edf(n + 1, 16), rel=1e-14)
+    # Still the four arrays allantools users unpack.
+    taus, devs, errs, ns = r
+    assert ns[0] == n + 1 - 2 * 16
+
+
+def test_adev_refuses_an_overflowing_variance():
+    x = np.random.default_rng(0).normal(size=1000) * 1e300
+    with pytest.raises(ValueError, match="overflows"):
+        imu_ar.adev(x, rate=1.0)
 
 
 def test_adev_of_a_real_record(adis):
@@ -359,3 +385,120 @@ def test_a_model_without_states_has_empty_matrices():
     k = model.kalman()
     assert k.phi.shape == k.q.shape == k.p0.shape == (0, 0)
     assert np.isfinite(k.measurement_variance) and k.measurement_variance > 0.0
+
+
+def test_characterise_axes_have_their_filter_form(adis, tool, tmp_path):
+    c = imu_ar.characterise(adis, columns=["gx", "gy", "gz", "ax", "ay", "az"],
+                            gyro_unit="deg/s", accel_unit="g", gm_states=1)
+    gx = c.axes["gx"]
+    k = gx.kalman()
+    assert k.filter_rate == c.rate
+    # The white measurement noise N^2 x rate, and a state per term of the model.
+    assert k.measurement_variance == pytest.approx(gx.white_noise**2 * c.rate, rel=1e-9)
+    assert len(k.states) == k.phi.shape[0] == len(gx.to_dict()["phi"])
+    k50 = gx.kalman(50.0)
+    out = tool.json("characterise", adis, "--columns", "gx,gy,gz,ax,ay,az", "--gyro-unit",
+                    "deg/s", "--accel-unit", "g", "--gm-states", "1", "--filter-rate", "50",
+                    "--out", tmp_path / "tool", "--format", "state-space")
+    want = out["axes"][0]["model"]
+    assert k50.filter_rate == 50.0
+    np.testing.assert_array_equal(k50.q, np.array(want["q"]).reshape(k50.q.shape))
+    np.testing.assert_array_equal(k50.phi, np.array(want["phi"]).reshape(k50.phi.shape))
+
+
+def test_a_nan_in_the_first_samples_leaves_the_default_delta_finite():
+    x = np.random.default_rng(5).normal(size=5000)
+    x[[3, 10]] = [math.nan, math.inf]
+    for cls in (imu_ar.Rls, imu_ar.Lattice, imu_ar.Sftf, imu_ar.FixedLattice):
+        est = cls(2, rate=100.0)
+        e = est.update(x)
+        assert np.isnan(e[[3, 10]]).all() and np.isfinite(np.delete(e, [3, 10])).all()
+        m = est.model().to_dict()
+        assert m["non_finite"] == 2
+        # 0.1 x the variance of the finite ones among the first 1000 samples.
+        head = x[:1000][np.isfinite(x[:1000])]
+        assert m["delta"] == pytest.approx(0.1 * head.var(), rel=1e-12)
+        assert np.all(np.abs(m["a"]) < 0.2), m["a"]
+
+
+def test_every_nan_error_is_counted(tmp_path):
+    """A NaN error is a sample not taken or a restart, and the model counts each."""
+    x = np.random.default_rng(1).normal(size=20_000)
+    x[[100, 5000]] = math.nan
+    for order in (31, 32):
+        est = imu_ar.FixedLattice(order)
+        e = est.update(x)
+        m = est.model().to_dict()
+        counted = m["restarts"] + m["non_finite"] + m["saturated"] + m["outliers"]
+        assert m["restarts"] >= 1 and m["non_finite"] == 2
+        assert np.isnan(e).sum() == counted, (order, m)
+
+
+def test_one_estimator_from_two_threads_takes_turns():
+    x = np.random.default_rng(2).normal(size=400_000)
+    est = imu_ar.Lattice(4)
+    errors = []
+
+    def run(chunk):
+        errors.append(est.update(chunk))
+
+    threads = [threading.Thread(target=run, args=(c,)) for c in np.array_split(x, 4)]
+    for t in threads:
+        t.start()
+    while any(t.is_alive() for t in threads):
+        assert est.n in (0, 100_000, 200_000, 300_000, 400_000)
+    for t in threads:
+        t.join()
+    assert len(errors) == 4 and est.n == len(x)
+    assert est.model().n == len(x)
+
+
+def test_paths_that_are_not_utf8_or_bytes(small_csv, tmp_path):
+    path, x = small_csv
+    odd = tmp_path / "caf\udce9.csv"  # the file system's bytes b"caf\xe9.csv"
+    try:
+        odd.write_bytes(path.read_bytes())
+    except (UnicodeEncodeError, OSError):
+        pytest.skip("this file system takes no such name")
+    for p in (odd, str(odd), bytes(odd), [bytes(odd)]):
+        rec = imu_ar.read(p)
+        np.testing.assert_array_equal(rec.x, x)
+    assert imu_ar.noise(bytes(odd), column="gx").n == len(x)
+
+
+def test_a_binary_file_read_as_csv_raises_the_tool_s_error(tmp_path):
+    path = tmp_path / "random.csv"
+    path.write_bytes(bytes(range(256)) * 20)
+    with pytest.raises(ValueError, match="random.csv"):
+        imu_ar.read(path)
+
+
+def test_a_string_is_one_name_not_its_characters(small_csv, adis, tmp_path):
+    path, x = small_csv
+    np.testing.assert_array_equal(imu_ar.read(path, columns="gx").x, x)
+    c = imu_ar.characterise(adis, columns="gx,gy,gz,ax,ay,az", gyro_unit="deg/s",
+                            accel_unit="g", gm_states=0)
+    files = c.write(tmp_path / "out", formats="kalibr")
+    # Kalibr's imu.yaml and the plots (a string split into characters named no format).
+    assert sorted(os.path.basename(f) for f in files) == ["accel.png", "gyro.png", "imu.yaml"]
+
+
+@pytest.mark.parametrize(
+    "call,error,match",
+    [
+        (lambda: imu_ar.Rls(-1), ValueError, "order -1"),
+        (lambda: imu_ar.Rls(2.7), TypeError, "integer"),
+        (lambda: imu_ar.read([]), ValueError, "no files"),
+        (lambda: imu_ar.fit_ar(np.ones(100), 2, None), ValueError, "method"),
+        (lambda: imu_ar.fit_ar(np.ones(100), 2.5), TypeError, "integer"),
+        (lambda: imu_ar.noise(np.ones(100), 10.0, gm_states=-1), ValueError, "gm_states -1"),
+        (lambda: imu_ar.noise(np.ones(100), 10.0, decimate=0), ValueError, "decimate 0"),
+        (lambda: imu_ar.order_criteria(np.ones(100), 3.0), TypeError, "integer"),
+        (lambda: imu_ar.Lattice(2, delta=1e300), ValueError, "delta 1e300"),
+        (lambda: imu_ar.Lattice(2, lam=1e300), ValueError, "1e300"),
+    ],
+)
+def test_bad_options_raise_clear_errors(call, error, match):
+    with pytest.raises(error, match=match) as e:
+        call()
+    assert len(str(e.value)) < 300, str(e.value)

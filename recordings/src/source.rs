@@ -825,8 +825,10 @@ fn row_values(
     Ok(())
 }
 
-/// The names a time column goes by.
-fn is_time(name: &str) -> bool {
+/// Whether a CSV column's name is one a time column goes by (`t`, `time`, `timestamp`,
+/// `stamp`, `sec`, `seconds`, or `t_`, `time_`, `timestamp_`, `stamp_` and a time unit; with or
+/// without a unit bracket or a leading `#`).
+pub fn is_time(name: &str) -> bool {
     let bare = split_unit(name).0.to_ascii_lowercase();
     let bare = bare.trim_start_matches('#');
     matches!(

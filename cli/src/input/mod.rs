@@ -352,7 +352,10 @@ pub fn number(v: f64) -> String {
 /// A `--lambda` in (0, 1].
 pub fn check_lambda(lambda: f64) -> Result<(), Fail> {
     if !(lambda > 0.0 && lambda <= 1.0) {
-        return Err(Fail(format!("--lambda {lambda}: must be in (0, 1]")));
+        return Err(Fail(format!(
+            "--lambda {}: must be in (0, 1]",
+            number(lambda)
+        )));
     }
     Ok(())
 }
@@ -366,7 +369,7 @@ pub fn check_delta(delta: f64) -> Result<(), Fail> {
 fn check_weight(flag: &str, delta: f64) -> Result<(), Fail> {
     Channel::<f64>::new(delta)
         .map(|_| ())
-        .map_err(|e| Fail(format!("{flag} {delta}: {e}")))
+        .map_err(|e| Fail(format!("{flag} {}: {e}", number(delta))))
 }
 
 /// A prior model to start a recursive estimator from, and its weight (`fit`, `report`).
@@ -423,12 +426,15 @@ pub fn check_span(flag: &str, rate: f64, samples: usize) -> Result<(), Fail> {
     Ok(())
 }
 
-/// 0.1 x the variance of the first 1000 samples (what firmware sees at start-up), or 1 when
-/// that is 0; an error when that variance overflows f64.
+/// 0.1 x the variance of the finite samples among the first 1000 (what firmware sees at
+/// start-up; NaN and infinities are rejected there), or 1 when that is 0 or there are none;
+/// an error when that variance overflows f64.
 pub fn default_delta(x: &[f64]) -> Result<f64, String> {
-    let head = &x[..x.len().min(1000)];
-    let mean = head.iter().sum::<f64>() / head.len() as f64;
-    let var = head.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / head.len() as f64;
+    // The finite ones among the first 1000 (the estimators reject the others).
+    let head = || x[..x.len().min(1000)].iter().filter(|v| v.is_finite());
+    let n = head().count().max(1) as f64;
+    let mean = head().sum::<f64>() / n;
+    let var = head().map(|v| (v - mean) * (v - mean)).sum::<f64>() / n;
     if !var.is_finite() {
         return Err(
             "the variance of the first 1000 samples (for the default --delta) overflows \
@@ -437,4 +443,30 @@ pub fn default_delta(x: &[f64]) -> Result<f64, String> {
         );
     }
     Ok(if var > 0.0 { 0.1 * var } else { 1.0 })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_default_delta_is_that_of_the_finite_samples() {
+        let x: Vec<f64> = (0..1500).map(|i| f64::from(i % 7)).collect();
+        let mut holed = x.clone();
+        for i in [0, 3, 500] {
+            holed[i] = f64::NAN;
+        }
+        holed[9] = f64::INFINITY;
+        let finite: Vec<f64> = x[..1000]
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| ![0, 3, 9, 500].contains(i))
+            .map(|(_, v)| *v)
+            .collect();
+        let mean = finite.iter().sum::<f64>() / finite.len() as f64;
+        let var = finite.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / finite.len() as f64;
+        assert_eq!(default_delta(&holed), Ok(0.1 * var));
+        assert_eq!(default_delta(&[f64::NAN; 10]), Ok(1.0));
+        assert!(default_delta(&[1e200, -1e200]).is_err());
+    }
 }

@@ -646,6 +646,11 @@ impl NoiseResult {
         self.details.measurement_variance
     }
 
+    /// The filter's rate, Hz, of `phi`, `q` and `p0`.
+    pub fn filter_rate(&self) -> f64 {
+        self.details.filter_rate_hz
+    }
+
     /// The names of the filter's states, in the order of `phi`.
     pub fn states(&self) -> &[String] {
         &self.details.states
