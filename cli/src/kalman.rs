@@ -9,7 +9,7 @@ use imu_ar::model::Matrix;
 use serde::Serialize;
 
 use crate::error::Fail;
-use crate::input::{Record, check_rate, check_span};
+use crate::input::{Record, check_rate, check_span, number};
 use crate::method::{GaussMarkov, Method, batch_fit, with_order};
 use crate::output::{Output, json};
 
@@ -111,7 +111,8 @@ pub fn run(args: &Args) -> Result<Handoff, Fail> {
     let filter_rate = match filter_rate {
         Some(f) => check_rate(f).map_err(|_| {
             Fail(format!(
-                "--filter-rate {f}: must be a positive number of Hz"
+                "--filter-rate {}: must be a positive number of Hz",
+                number(f)
             ))
         })?,
         None => rate,
@@ -196,8 +197,9 @@ fn handoff<const P: usize>(
         }
         None if steps > f64::from(u32::MAX) => {
             return Err(Fail(format!(
-                "--filter-rate {filter_rate}: one filter step would be {ratio:e} model steps, \
-                 more than the {} supported",
+                "--filter-rate {}: one filter step would be {ratio:e} model steps, more than \
+                 the {} supported",
+                number(filter_rate),
                 u32::MAX
             )));
         }
@@ -207,9 +209,11 @@ fn handoff<const P: usize>(
         }
         None => {
             return Err(Fail(format!(
-                "--filter-rate {filter_rate}: the model's rate ({rate} Hz) is not an integer \
-                 multiple of it, and only an AR(1) with 0 < a_1 < 1 (a Gauss-Markov process) \
-                 can be sampled at any rate"
+                "--filter-rate {}: the model's rate ({} Hz) is not an integer multiple of \
+                 it, and only an AR(1) with 0 < a_1 < 1 (a Gauss-Markov process) can be \
+                 sampled at any rate",
+                number(filter_rate),
+                number(rate)
             )));
         }
     };

@@ -19,6 +19,7 @@ numbers. The long calls release the GIL.
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import operator
@@ -83,8 +84,30 @@ def _is_path(x: Any) -> bool:
 
 def _path(p: Any) -> str:
     """A path as the tool takes it: bytes and names that are not UTF-8 pass through
-    ``os.fsdecode`` and come back to the file system byte for byte."""
-    return os.fsdecode(os.fspath(p))
+    ``os.fsdecode`` and come back to the file system byte for byte; a name that starts with
+    ``-`` is a file's (``./-``), never an option or standard input."""
+    p = os.fsdecode(os.fspath(p))
+    return os.path.join(".", p) if p.startswith("-") else p
+
+
+# The tool's flags that take no value.
+_SWITCHES = {"--oscillators", "--ramp", "--curve-fit", "--no-demean", "--drop-backward", "--json"}
+
+
+def _cli(argv: List[str]) -> List[str]:
+    """``argv`` with each flag joined to its value (``--column=-x``): a value that starts with
+    ``-`` (a negative number, a column's name) is then never read as a flag."""
+    out: List[str] = []
+    i = 0
+    while i < len(argv):
+        a = argv[i]
+        if a.startswith("--") and "=" not in a and a not in _SWITCHES and i + 1 < len(argv):
+            out.append(f"{a}={argv[i + 1]}")
+            i += 2
+        else:
+            out.append(a)
+            i += 1
+    return out
 
 
 def _files(path: Union[PathLike, Sequence[PathLike]]) -> List[str]:
@@ -154,8 +177,9 @@ class Record(NamedTuple):
 
     ``x`` has one column per name of ``columns`` (shape ``(n, k)``; 1-D for one column);
     ``t_ns`` holds each sample's timestamp in ns as the record gives it (int64; the least
-    int64 where a sample has none: no time column, or a stamp that is not a number), ``t`` the
-    same in s from the first (NaN where none); ``rate`` is the timestamps' rate (``None`` when they give none); ``timing`` is the tool's
+    int64 where a sample has none, as in a CSV file without a time column), ``t`` the same in
+    s from the first (NaN where none); ``rate`` is the timestamps' rate, or the one given
+    (``None`` when neither); ``timing`` is the tool's
     report of them (``imu-ar ... --json``'s ``timing``), ``units`` the unit of each column,
     ``skipped`` the tool's summary of skipped messages (or ``None``).
     """
@@ -180,6 +204,7 @@ def read(
     time_column: Optional[str] = None,
     drop_backward: bool = False,
     unit: Optional[str] = None,
+    rate: Optional[float] = None,
 ) -> Record:
     """Reads columns of a recording with the tool's readers.
 
@@ -189,6 +214,8 @@ def read(
     for the logs ``gx, gy, gz, ax, ay, az`` [default: every CSV column but the time column, or
     the six axes]. ``unit`` converts columns of known unit (rad/s, deg/s, deg/h, m/s^2, g, mg).
     The timestamps are checked as the tool checks them; ``Record.timing`` is their report.
+    With ``rate`` (Hz) they are read as they are, unchecked (``timing`` is then ``None``): for
+    records whose stamps the tool refuses (no unit, mixed rates) or lacks.
     """
     files = _files(path)
     if columns is None:
@@ -201,13 +228,17 @@ def read(
     else:
         columns = _names("columns", columns)
     flags = _input_flags(topic, frame_id, instance, time_column, drop_backward, unit)
+    if rate is not None:
+        flags += ["--rate", _num(rate)]
     data = []
     units = []
     timing = None
     skipped = None
     stamps = None
     for c in columns:
-        x, t_ns, t, u, s = _native.read(["read", *files, "--column", c, *flags], timing is None)
+        x, t_ns, t, u, s = _native.read(
+            _cli(["read", *files, "--column", c, *flags]), timing is None
+        )
         data.append(x)
         units.append(u)
         if t is not None and timing is None:
@@ -216,7 +247,10 @@ def read(
             stamps = t_ns
         skipped = skipped or s
     x = data[0] if len(data) == 1 else np.column_stack(data)
-    rate = timing["rate_hz"] if timing else None
+    if rate is None:
+        rate = timing["rate_hz"] if timing else None
+    else:
+        rate = float(rate)
     missing = stamps == _NO_STAMP
     seconds = np.full(len(stamps), np.nan)
     if (~missing).any():
@@ -252,6 +286,9 @@ class Adev(_AdevTuple):
 
     def __getnewargs__(self) -> Tuple[Any, ...]:
         return (*self, self.rate)
+
+    def _replace(self, **fields: Any) -> "Adev":
+        return Adev(*_AdevTuple(*self)._replace(**fields), self.rate)
 
     @property
     def m(self) -> np.ndarray:
@@ -333,12 +370,15 @@ def adev(x: Any, rate: float = 1.0, taus: Union[str, Iterable[float]] = "octave"
 
 class Kalman(NamedTuple):
     """The model in a Kalman filter at ``filter_rate``: the transition ``phi``, the process
-    noise ``q`` and the initial covariance ``p0`` of one step, the white measurement noise's
-    variance and the states' names."""
+    noise ``q`` and the initial covariance ``p0`` of one step, the measurement row ``h`` (a
+    sample is ``h @ state + v``: 1 on each state, but 0 on an oscillator's ``dx/dt`` and -1
+    on the earlier quantisation state), the variance of the white ``v`` and the states'
+    names."""
 
     phi: np.ndarray
     q: np.ndarray
     p0: np.ndarray
+    h: np.ndarray
     measurement_variance: float
     states: List[str]
     filter_rate: float
@@ -367,10 +407,12 @@ class NoiseModel:
         states: List[str],
         unit: str,
         refit: Optional[Any] = None,
+        h: Optional[Sequence[float]] = None,
     ) -> None:
         self._result = result
         self._measurement_variance = measurement_variance
         self._states = list(states)
+        self._h = [1.0] * len(self._states) if h is None else list(h)
         self.unit = unit
         self._refit = refit
         self.rate: float = result["rate_hz"]
@@ -411,8 +453,9 @@ class NoiseModel:
 
     def kalman(self, filter_rate: Optional[float] = None) -> Kalman:
         """The model's filter form at ``filter_rate`` Hz [default: the model's rate]: ``phi``,
-        ``q``, ``p0`` and the measurement variance, as ``imu-ar noise --filter-rate``."""
-        r, mv, states = self._result, self._measurement_variance, self._states
+        ``q``, ``p0``, ``h`` and the measurement variance, as ``imu-ar noise --filter-rate``
+        (another rate than the fit's fits the record again)."""
+        r, mv, states, h = self._result, self._measurement_variance, self._states, self._h
         if filter_rate is not None and float(filter_rate) != self._filter_rate():
             if self._refit is None:
                 raise ValueError(
@@ -420,7 +463,8 @@ class NoiseModel:
                     "imu_ar.noise(..., filter_rate=...)"
                 )
             other = self._refit(float(filter_rate))
-            r, mv, states = other._result, other._measurement_variance, other._states
+            r, mv, states, h = (other._result, other._measurement_variance, other._states,
+                                other._h)
         rate = float(filter_rate) if filter_rate is not None else self._filter_rate()
         # A model without states (white noise only) has 0 x 0 matrices.
         def matrix(rows: Any) -> np.ndarray:
@@ -430,6 +474,7 @@ class NoiseModel:
             matrix(r["phi"]),
             matrix(r["q"]),
             matrix(r["p0"]),
+            np.array(h, dtype=float),
             float(mv),
             list(states),
             rate,
@@ -533,15 +578,24 @@ def noise(
             raise ValueError("rate: the sample rate of an array must be given (Hz)")
         samples = _samples(x)
         argv += [_ARRAY, "--column", "x", *_input_flags(unit=unit)]
-    out, mv, states, u = _native.noise([*argv, *tail, "--json"], samples)
-
-    def refit(f: float) -> NoiseModel:
-        return noise(x, rate, gm_states, ar_order, oscillators, ramp=ramp, curve_fit=curve_fit,
-                     filter_rate=f, decimate=decimate, unit=unit, column=column, topic=topic)
-
-    model = NoiseModel(json.loads(out), mv, states, u, refit)
+    out, mv, states, u, h = _native.noise(_cli([*argv, *tail, "--json"]), samples)
+    refit = functools.partial(
+        _noise_at, x, rate, gm_states, ar_order, oscillators, ramp, curve_fit, decimate, unit,
+        column, topic,
+    )
+    model = NoiseModel(json.loads(out), mv, states, u, refit, h)
     model._filter = float(filter_rate) if filter_rate is not None else None  # type: ignore[attr-defined]
     return model
+
+
+def _noise_at(
+    x: Any, rate: Any, gm_states: Any, ar_order: Any, oscillators: Any, ramp: Any,
+    curve_fit: Any, decimate: Any, unit: Any, column: Any, topic: Any, filter_rate: float,
+) -> NoiseModel:
+    """:func:`noise` again at another filter rate (a module function: a model pickles)."""
+    return noise(x, rate, gm_states, ar_order, oscillators, ramp=ramp, curve_fit=curve_fit,
+                 filter_rate=filter_rate, decimate=decimate, unit=unit, column=column,
+                 topic=topic)
 
 
 # --- characterise --------------------------------------------------------------------------
@@ -561,6 +615,21 @@ def _without(argv: List[str], flag: str) -> List[str]:
     return out
 
 
+def _characterised(argv: List[str]) -> "Characterisation":
+    """``imu-ar characterise`` of ``argv``, its files into a folder that is then removed."""
+    with tempfile.TemporaryDirectory(prefix="imu-ar-") as tmp:
+        out, filters = _native.characterise(
+            _cli([*argv, "--out", tmp, "--format", "state-space", "--json"])
+        )
+    return Characterisation(json.loads(out), argv, filters)
+
+
+def _axis_at(argv: List[str], axis: str, filter_rate: float) -> "NoiseModel":
+    """The recording characterised again with the filter at another rate: ``axis``'s model."""
+    again = [*_without(argv, "--filter-rate"), "--filter-rate", _num(filter_rate)]
+    return _characterised(again).axes[axis]
+
+
 class Characterisation:
     """The six axes' noise models of a recording (``imu-ar characterise``): ``axes`` maps
     ``gx .. az`` to a :class:`NoiseModel` (in SI units: rad/s, m/s^2); ``rate``, ``n``,
@@ -571,7 +640,7 @@ class Characterisation:
         self,
         result: Dict[str, Any],
         argv: List[str],
-        filters: List[Tuple[float, List[str], float]],
+        filters: List[Tuple[float, List[str], float, List[float]]],
     ) -> None:
         self._result = result
         self._argv = argv
@@ -580,21 +649,10 @@ class Characterisation:
         self.timing: Optional[Dict[str, Any]] = result.get("timing")
         self.skipped: Dict[str, int] = result["skipped"]
 
-        def refit(axis: str) -> Any:
-            # The recording characterised again with the filter at another rate.
-            def at(f: float) -> NoiseModel:
-                again = [*_without(argv, "--filter-rate"), "--filter-rate", _num(f)]
-                with tempfile.TemporaryDirectory(prefix="imu-ar-") as tmp:
-                    out, fs = _native.characterise(
-                        [*again, "--out", tmp, "--format", "state-space", "--json"]
-                    )
-                return Characterisation(json.loads(out), again, fs).axes[axis]
-
-            return at
-
         self.axes: Dict[str, NoiseModel] = {}
-        for a, (mv, states, filter_rate) in zip(result["axes"], filters):
-            model = NoiseModel(a["model"], mv, states, a["unit"], refit(a["axis"]))
+        for a, (mv, states, filter_rate, h) in zip(result["axes"], filters):
+            refit = functools.partial(_axis_at, argv, a["axis"])
+            model = NoiseModel(a["model"], mv, states, a["unit"], refit, h)
             model._filter = filter_rate  # type: ignore[attr-defined]
             self.axes[a["axis"]] = model
         self.columns: Dict[str, str] = {a["axis"]: a["column"] for a in result["axes"]}
@@ -611,7 +669,7 @@ class Characterisation:
         --out DIR --format ...`` (the recording is read again); returns the files written."""
         argv = [*self._argv, "--out", _path(dir), "--format", ",".join(_names("formats", formats)),
                 "--json"]
-        out, _ = _native.characterise(argv)
+        out, _ = _native.characterise(_cli(argv))
         return list(json.loads(out)["files"])
 
     def __repr__(self) -> str:
@@ -636,10 +694,14 @@ def characterise(
     curve_fit: bool = False,
     filter_rate: Optional[float] = None,
     horizon: Optional[float] = None,
+    loop_rate: Optional[float] = None,
+    sysid: Optional[int] = None,
 ) -> Characterisation:
     """All six axes of a recording in one streaming pass, as ``imu-ar characterise``: per axis
     the noise model (with its filter form at ``filter_rate``: ``axes["gx"].kalman()``);
-    ``.write(dir, formats=[...])`` writes the parameter files."""
+    ``.write(dir, formats=[...])`` writes the parameter files (``loop_rate``: the autopilot's
+    loop rate, Hz, that sets EKF3's step in the ArduPilot file; ``sysid``: the vehicle's
+    system id in the PX4 file)."""
     argv = ["characterise", *_files(path)]
     if columns is not None:
         argv += ["--columns", ",".join(_names("columns", columns))]
@@ -658,11 +720,11 @@ def characterise(
         argv += ["--filter-rate", _num(filter_rate)]
     if horizon is not None:
         argv += ["--horizon", _num(horizon)]
-    with tempfile.TemporaryDirectory(prefix="imu-ar-") as tmp:
-        out, filters = _native.characterise(
-            [*argv, "--out", tmp, "--format", "state-space", "--json"]
-        )
-    return Characterisation(json.loads(out), argv, filters)
+    if loop_rate is not None:
+        argv += ["--loop-rate", _num(loop_rate)]
+    if sysid is not None:
+        argv += ["--sysid", str(_int("sysid", sysid))]
+    return _characterised(argv)
 
 
 # --- AR fits -------------------------------------------------------------------------------
@@ -749,7 +811,7 @@ def fit_ar(
         argv += ["--lambda", _num(lam)]
     if delta is not None:
         argv += ["--delta", _num(delta)]
-    return ArFit(json.loads(_native.fit([*argv, "--json"], samples)))
+    return ArFit(json.loads(_native.fit(_cli([*argv, "--json"]), samples)))
 
 
 class OrderCriteria(NamedTuple):
@@ -773,7 +835,7 @@ def order_criteria(x: Any, max_order: int, method: str = "burg", *, demean: bool
             "--method", _method(method)]
     if not demean:
         argv.append("--no-demean")
-    r = json.loads(_native.order([*argv, "--json"], samples))
+    r = json.loads(_native.order(_cli([*argv, "--json"]), samples))
 
     def arr(v: List[Optional[float]]) -> np.ndarray:
         return np.array([math.nan if c is None else c for c in v], dtype=float)
@@ -790,9 +852,9 @@ class _Recursive:
     """A recursive estimator of the library, run sample by sample on what ``update`` is given.
 
     ``lam`` is the forgetting factor; ``delta`` the initial regularisation [default: the tool's,
-    0.1 x the variance of the first 1000 samples of the first update]; ``rate`` gives the model
-    its time scale; ``demean`` removes the running mean; ``offset`` is subtracted in f64 before
-    the samples reach the estimator [default: the tool's: 0 in f64, the first update's mean
+    0.1 x the variance of the finite ones among the first 1000 samples of the first update, 1
+    when that is 0]; ``rate`` gives the model its time scale; ``demean`` removes the running
+    mean; ``offset`` is subtracted in f64 before the samples reach the estimator [default: the tool's: 0 in f64, the first update's mean
     (:func:`centre`) in f32 and fixed point]. Replayed over a record in one ``update``, the
     defaults are the tool's and :meth:`model` is ``imu-ar fit --method ... --json``'s object.
     """
@@ -841,6 +903,15 @@ class _Recursive:
     def n(self) -> int:
         """Samples taken."""
         return self._est.n
+
+    def __copy__(self) -> "_Recursive":
+        """A copy, state and all: the copy and the original go on apart."""
+        other = object.__new__(type(self))
+        other._est = self._est.copy()
+        return other
+
+    def __deepcopy__(self, memo: Dict[int, Any]) -> "_Recursive":
+        return self.__copy__()
 
 
 class Rls(_Recursive):

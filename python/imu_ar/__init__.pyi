@@ -32,6 +32,7 @@ def read(
     time_column: Optional[str] = ...,
     drop_backward: bool = ...,
     unit: Optional[str] = ...,
+    rate: Optional[float] = ...,
 ) -> Record: ...
 
 class _AdevTuple(NamedTuple):
@@ -63,6 +64,7 @@ class Kalman(NamedTuple):
     phi: npt.NDArray[np.float64]
     q: npt.NDArray[np.float64]
     p0: npt.NDArray[np.float64]
+    h: npt.NDArray[np.float64]
     measurement_variance: float
     states: List[str]
     filter_rate: float
@@ -97,6 +99,7 @@ class NoiseModel:
         states: List[str],
         unit: str,
         refit: Optional[Callable[[float], "NoiseModel"]] = ...,
+        h: Optional[Sequence[float]] = ...,
     ) -> None: ...
     def to_dict(self) -> Dict[str, Any]: ...
     def kalman(self, filter_rate: Optional[float] = ...) -> Kalman: ...
@@ -129,7 +132,7 @@ class Characterisation:
         self,
         result: Dict[str, Any],
         argv: List[str],
-        filters: List[Tuple[float, List[str], float]],
+        filters: List[Tuple[float, List[str], float, List[float]]],
     ) -> None: ...
     def to_dict(self) -> Dict[str, Any]: ...
     def write(self, dir: PathLike, formats: Sequence[str] = ...) -> List[str]: ...
@@ -152,6 +155,8 @@ def characterise(
     curve_fit: bool = ...,
     filter_rate: Optional[float] = ...,
     horizon: Optional[float] = ...,
+    loop_rate: Optional[float] = ...,
+    sysid: Optional[int] = ...,
 ) -> Characterisation: ...
 
 class ArFit:
@@ -210,6 +215,8 @@ class _Recursive:
     def model(self) -> ArFit: ...
     @property
     def n(self) -> int: ...
+    def __copy__(self) -> _Recursive: ...
+    def __deepcopy__(self, memo: Dict[int, Any]) -> _Recursive: ...
 
 class Rls(_Recursive): ...
 class Lattice(_Recursive): ...

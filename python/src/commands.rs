@@ -8,9 +8,9 @@ use std::path::PathBuf;
 
 use clap::{CommandFactory, Parser};
 use imu_ar_cli::error::{Fail, clap_error};
-use imu_ar_cli::input::Input;
 use imu_ar_cli::input::csv::{header, position};
 use imu_ar_cli::input::source::{Kind, is_time};
+use imu_ar_cli::input::{Input, check_rate};
 use imu_ar_cli::output::json_line;
 use imu_ar_cli::{characterise as ch, fit as fi, noise as no, order as or, parity as pa};
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
@@ -40,6 +40,9 @@ pub struct ReadArgs {
     /// The column.
     #[command(flatten)]
     pub input: Input,
+    /// The sample rate, Hz: the timestamps are then read as they are, unchecked.
+    #[arg(long)]
+    pub rate: Option<f64>,
 }
 
 /// `argv` (without the program's name) parsed as the tool parses it; its error is the tool's
@@ -74,15 +77,19 @@ fn other() -> Fail {
     Fail("the command line names another command".into())
 }
 
+/// What `_native.noise` returns: the JSON object, the measurement variance, the filter's
+/// states, the unit and the measurement row.
+pub type Noise = (String, f64, Vec<String>, String, Vec<f64>);
+
 /// `_native.noise(argv, x=None)`: `imu-ar noise` on the files of `argv`, or on `x`; the JSON
-/// object, the measurement variance, the filter's states and the unit.
+/// object, the measurement variance, the filter's states, the unit and the measurement row.
 #[pyfunction]
 #[pyo3(signature = (argv, x=None))]
 pub fn noise(
     py: Python<'_>,
     argv: Vec<OsString>,
     x: Option<PyReadonlyArray1<'_, f64>>,
-) -> PyResult<(String, f64, Vec<String>, String)> {
+) -> PyResult<Noise> {
     let x = samples(&x)?;
     run(py, &argv, |c| {
         let Command::Noise(args) = c else {
@@ -94,6 +101,7 @@ pub fn noise(
             r.measurement_variance(),
             r.states().to_vec(),
             r.unit().to_string(),
+            r.h().to_vec(),
         ))
     })
 }
@@ -128,9 +136,9 @@ pub fn order(
     })
 }
 
-/// Per axis of a characterisation: the filter's measurement variance, its states' names and
-/// its rate.
-pub type AxisFilter = (f64, Vec<String>, f64);
+/// Per axis of a characterisation: the filter's measurement variance, its states' names, its
+/// rate and its measurement row.
+pub type AxisFilter = (f64, Vec<String>, f64, Vec<f64>);
 
 /// `_native.characterise(argv)`: `imu-ar characterise --json`, and per axis the measurement
 /// variance, the states and the rate of its filter form.
@@ -150,6 +158,7 @@ pub fn characterise(py: Python<'_>, argv: Vec<OsString>) -> PyResult<(String, Ve
                     m.measurement_variance(),
                     m.states().to_vec(),
                     m.filter_rate(),
+                    m.h().to_vec(),
                 )
             })
             .collect();
@@ -176,8 +185,13 @@ pub fn read<'py>(py: Python<'py>, argv: Vec<OsString>, want_time: bool) -> PyRes
         let Command::Read(args) = c else {
             return Err(other());
         };
+        if let Some(r) = args.rate {
+            check_rate(r)?;
+        }
         let mut t = Vec::new();
-        let s = args.input.series_stamped(want_time, &mut t)?;
+        let s = args
+            .input
+            .series_stamped(want_time && args.rate.is_none(), &mut t)?;
         let timing = s.timing.as_ref().map(json_line).transpose()?;
         Ok((s.x, t, timing, s.unit, s.skipped.summary()))
     })?;

@@ -106,6 +106,13 @@ impl Settings {
         if let Some(r) = self.rate {
             check_rate(r).map_err(|Fail(e)| Fail(e.replace("--rate", "rate")))?;
         }
+        if self.scale.is_some() && self.scalar != Scalar::Fixed {
+            return Err(Fail(format!(
+                "scale: only the fixed-point lattice takes a scale, not {} in {}",
+                self.method.name(),
+                self.scalar.name()
+            )));
+        }
         if let Some(s) = self.scale.filter(|s| !(s.is_finite() && *s > 0.0)) {
             return Err(Fail(format!(
                 "scale {}: must be positive and finite",
@@ -114,6 +121,15 @@ impl Settings {
         }
         if let Some(o) = self.offset.filter(|o| !o.is_finite()) {
             return Err(Fail(format!("offset {}: must be finite", number(o))));
+        }
+        if let Some(o) = self.offset.filter(|o| o.abs() > f64::from(f32::MAX))
+            && self.scalar != Scalar::F64
+        {
+            return Err(Fail(format!(
+                "offset {}: beyond f32's range, in which the samples less the offset reach the \
+                 estimator",
+                number(o)
+            )));
         }
         Ok(())
     }
@@ -141,9 +157,21 @@ pub trait Replay: Send + Sync {
     /// The model after the last sample, as `imu-ar fit` reports it (without `n`, the
     /// settings and the rate, which the caller adds).
     fn result(&self, offset: f64) -> Result<FitResult, Fail>;
+    /// A copy, state and all.
+    fn boxed(&self) -> Box<dyn Replay>;
+}
+
+/// The refusal of a model when there is none: what the estimator counted says why.
+fn no_model(h: &imu_ar::recursive::Health) -> Fail {
+    Fail(format!(
+        "no finite model: none since the last restart (restarts {}, non-finite {}, saturated \
+         {}, clipped {}, outliers {})",
+        h.restarts, h.non_finite, h.saturated, h.clipped, h.outliers
+    ))
 }
 
 /// A float estimator.
+#[derive(Clone)]
 enum Float<T: FloatArith, const P: usize> {
     Rls(Config<T>, Box<Rls<T, P>>),
     Lattice(Config<T>, Box<Lattice<T, P>>),
@@ -187,7 +215,11 @@ impl<T: FloatArith + Send + Sync, const P: usize> Float<T, P> {
     }
 }
 
-impl<T: FloatArith + Send + Sync, const P: usize> Replay for Float<T, P> {
+impl<T: FloatArith + Send + Sync + 'static, const P: usize> Replay for Float<T, P> {
+    fn boxed(&self) -> Box<dyn Replay> {
+        Box::new(self.clone())
+    }
+
     fn run(
         &mut self,
         x: &[f64],
@@ -231,7 +263,7 @@ impl<T: FloatArith + Send + Sync, const P: usize> Replay for Float<T, P> {
                 (model, l.health(), k)
             }
         };
-        let model = model.ok_or_else(|| Fail("no finite model".into()))?;
+        let model = model.ok_or_else(|| no_model(&health))?;
         Ok(FitResult {
             reflection: reflection.map(|k| k.iter().map(|v| v.to_f64()).collect()),
             restarts: Some(health.restarts),
@@ -250,6 +282,7 @@ impl<T: FloatArith + Send + Sync, const P: usize> Replay for Float<T, P> {
 }
 
 /// The fixed-point lattice.
+#[derive(Clone)]
 struct Fixed<const P: usize> {
     config: FixedConfig,
     channel: FixedChannel,
@@ -279,6 +312,10 @@ impl<const P: usize> Fixed<P> {
 }
 
 impl<const P: usize> Replay for Fixed<P> {
+    fn boxed(&self) -> Box<dyn Replay> {
+        Box::new(self.clone())
+    }
+
     fn run(
         &mut self,
         x: &[f64],
@@ -315,7 +352,7 @@ impl<const P: usize> Replay for Fixed<P> {
         let model = self
             .lattice
             .model(&self.config)
-            .ok_or_else(|| Fail("no finite model".into()))?;
+            .ok_or_else(|| no_model(&health))?;
         Ok(FitResult {
             reflection: model
                 .reflection()
@@ -415,7 +452,16 @@ impl Replayer {
                     .fold(0.0f64, |m, v| m.max(v.abs()));
                 if peak > 0.0 { 8.0 / peak } else { 1.0 }
             });
-            self.started = Some((build(s, delta, scale)?, offset, delta));
+            let built = build(s, delta, scale).map_err(|Fail(e)| match s.scale {
+                Some(_) => Fail(e),
+                None if s.scalar == Scalar::Fixed => Fail(format!(
+                    "{e}; that scale is the default, 8 / max |x - offset| of the first update \
+                     (offset {})",
+                    number(offset)
+                )),
+                None => Fail(e),
+            })?;
+            self.started = Some((built, offset, delta));
         }
         let mut errors = Vec::with_capacity(x.len());
         if let Some((e, offset, _)) = &mut self.started {
@@ -423,6 +469,15 @@ impl Replayer {
         }
         self.n += x.len();
         Ok(errors)
+    }
+
+    /// A copy, state and all.
+    pub fn copy(&self) -> Self {
+        Self {
+            settings: self.settings,
+            started: self.started.as_ref().map(|(e, o, d)| (e.boxed(), *o, *d)),
+            n: self.n,
+        }
     }
 
     /// The model after the last sample, as `imu-ar fit --json` gives it.
@@ -571,6 +626,16 @@ impl Estimator {
     fn model_json(&self, py: Python<'_>) -> PyResult<String> {
         py.detach(|| self.with(|inner| json_line(&inner.result()?)))
             .map_err(to_py_checked)
+    }
+
+    /// A copy of the estimator, state and all (`copy.copy` and `copy.deepcopy`).
+    fn copy(&self, py: Python<'_>) -> PyResult<Self> {
+        let inner = py
+            .detach(|| self.with(|inner| Ok(inner.copy())))
+            .map_err(to_py_checked)?;
+        Ok(Self {
+            inner: Mutex::new(inner),
+        })
     }
 
     /// Samples taken.

@@ -502,3 +502,182 @@ def test_bad_options_raise_clear_errors(call, error, match):
     with pytest.raises(error, match=match) as e:
         call()
     assert len(str(e.value)) < 300, str(e.value)
+
+
+def test_the_readme_example_prints_what_the_readme_says(adis, tmp_path, capsys):
+    matplotlib = pytest.importorskip("matplotlib")
+    matplotlib.use("Agg")
+    from conftest import DATA, REPO
+
+    text = (REPO / "README.md").read_text()
+    section = text[text.index("## From Python"):]
+    code = section[section.index("```python") + len("```python"):]
+    code = code[: code.index("```")]
+    printed = section[section.index("It prints `") + len("It prints `"):]
+    printed = printed[: printed.index("`")]
+    code = code.replace('"../shared/data/imu/', '"' + str(DATA) + "/")
+    code = code.replace('"docs/plots/python-adis-gx.png"', repr(str(tmp_path / "gx.png")))
+    exec(compile(code, "README.md", "exec"), {})
+    assert capsys.readouterr().out.strip() == printed
+    assert (tmp_path / "gx.png").stat().st_size > 1000
+
+
+# --- the second red-team pass --------------------------------------------------------------
+
+
+def test_read_with_a_rate_takes_stamps_the_tool_refuses(tmp_path):
+    path = tmp_path / "unitless.csv"
+    path.write_text("time,gx\n0,1\n0.01,2\n0.02,3\n0.03,5\n")
+    with pytest.raises(ValueError, match="rate"):
+        imu_ar.read(path)
+    rec = imu_ar.read(path, rate=100.0)
+    np.testing.assert_array_equal(rec.x, [1.0, 2.0, 3.0, 5.0])
+    assert rec.rate == 100.0 and rec.timing is None
+
+
+def test_kalman_carries_the_measurement_row(adis, tool, tmp_path):
+    c = imu_ar.characterise(adis, columns=["gx", "gy", "gz", "ax", "ay", "az"],
+                            gyro_unit="deg/s", accel_unit="g")
+    tool("characterise", adis, "--columns", "gx,gy,gz,ax,ay,az", "--gyro-unit", "deg/s",
+         "--accel-unit", "g", "--out", tmp_path, "--format", "state-space")
+    space = json.loads((tmp_path / "state_space.json").read_text())
+    # The file names the axes "gyro x" .. "accel z", in the order gx .. az.
+    assert len(space["axes"]) == 6
+    for model, a in zip(c.axes.values(), space["axes"]):
+        k = model.kalman()
+        assert k.states == a["states"]
+        np.testing.assert_array_equal(k.h, a["h"])
+    # Quantisation: its two states enter the sample as q_k/Dt - q_(k-1)/Dt.
+    rng = np.random.default_rng(3)
+    n = 400_000
+    x = rng.normal(size=n) * 0.1 + 1e-5 * np.arange(n) / 100
+    k = imu_ar.noise(x, rate=100.0).kalman()
+    q = [i for i, s in enumerate(k.states) if s.startswith("quantization")]
+    assert len(q) == 2, k.states
+    assert k.h[q].tolist() == [1.0, -1.0]
+    assert len(k.h) == len(k.states) == k.phi.shape[0]
+
+
+def test_names_that_start_with_a_dash_are_names(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    x = np.random.default_rng(4).normal(size=3000)
+    with open("-dash.csv", "w") as f:
+        f.write("t_s,-x\n")
+        for i, v in enumerate(x):
+            f.write(f"{i / 100:.2f},{float(v)!r}\n")
+    rec = imu_ar.read("-dash.csv", columns=["-x"])
+    np.testing.assert_array_equal(rec.x, x)
+    assert imu_ar.noise("-dash.csv", column="-x").n == len(x)
+    # "-" is a file's name, not standard input.
+    with pytest.raises(FileNotFoundError):
+        imu_ar.read("-", columns=["gx"])
+    with pytest.raises(ValueError, match="-5"):
+        imu_ar.noise(x, -5.0)
+
+
+def test_no_model_says_what_the_estimator_counted():
+    x = np.random.default_rng(0).normal(size=50_000)
+    e = imu_ar.Sftf(32, lam=1.0, scalar="f32")
+    errors = e.update(x)
+    # f32 at order 32 without forgetting: the recursion breaks down again and again.
+    with pytest.raises(ValueError, match=f"restarts {np.isnan(errors).sum()}, non-finite 0"):
+        e.model()
+
+
+def test_noise_messages_name_the_cause():
+    x = np.random.default_rng(0).normal(size=5000)
+    x[77] = math.nan
+    with pytest.raises(ValueError, match="sample 77 is NaN or infinite"):
+        imu_ar.noise(x, rate=100.0)
+    ramp = np.arange(5000.0) + 1e-3 * np.random.default_rng(1).normal(size=5000)
+    with pytest.raises(ValueError, match="rate ramp"):
+        imu_ar.noise(ramp, rate=100.0)
+    assert imu_ar.noise(ramp, rate=100.0, ramp=True).rate_ramp > 0
+
+
+def test_adev_replace_keeps_the_rate():
+    a = imu_ar.adev(np.random.default_rng(0).normal(size=4000), rate=10.0)
+    b = a._replace(devs=a.devs * 2)
+    assert b.rate == 10.0 and isinstance(b, imu_ar.Adev)
+    np.testing.assert_array_equal(b.edf, a.edf)
+    np.testing.assert_array_equal(b.devs, 2 * a.devs)
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda x: imu_ar.noise(x, 100.0, filter_rate=1e300),
+        lambda x: imu_ar.noise(x, 100.0, filter_rate=1e-300),
+        lambda x: imu_ar.noise(x, 100.0).kalman(1e300),
+    ],
+)
+def test_huge_numbers_in_messages_are_short(call):
+    x = np.random.default_rng(0).normal(size=5000)
+    with pytest.raises(ValueError) as e:
+        call(x)
+    assert len(str(e.value)) < 300, str(e.value)
+
+
+def test_huge_characterise_options_in_messages_are_short(adis):
+    for kw in ({"filter_rate": 1e300}, {"horizon": 1e-300}):
+        with pytest.raises(ValueError) as e:
+            imu_ar.characterise(adis, columns="gx,gy,gz,ax,ay,az", gyro_unit="deg/s",
+                                accel_unit="g", **kw)
+        assert len(str(e.value)) < 300, str(e.value)
+
+
+def test_fixed_point_offsets_and_scales_are_checked():
+    x = np.random.default_rng(0).normal(size=3000)
+    with pytest.raises(ValueError, match="offset 1e300"):
+        imu_ar.FixedLattice(2, offset=1e300)
+    with pytest.raises(ValueError, match="offset 1e300"):
+        imu_ar.Lattice(2, scalar="f32", offset=1e300)
+    with pytest.raises(ValueError, match="default.*offset 1e22"):
+        imu_ar.FixedLattice(2, offset=1e22).update(x)
+    with pytest.raises(ValueError, match="scale"):
+        imu_ar.Lattice(2, scale=2.0)
+    # A spike moves the default offset (the mean) so far that every sample saturates: the
+    # refusal of a model says so.
+    z = x.copy()
+    z[1500] = 1e6
+    est = imu_ar.FixedLattice(2, delta=0.1, scale=2.0)
+    est.update(z)
+    with pytest.raises(ValueError, match="saturated 3000"):
+        est.model()
+
+
+def test_models_pickle_and_estimators_copy(small_csv):
+    import copy
+    import pickle
+
+    _, x = small_csv
+    model = imu_ar.noise(x, rate=100.0, gm_states=1)
+    again = pickle.loads(pickle.dumps(model))
+    assert again.to_dict() == model.to_dict()
+    np.testing.assert_array_equal(again.kalman(50.0).q, model.kalman(50.0).q)
+    a = imu_ar.adev(x, rate=100.0)
+    b = pickle.loads(pickle.dumps(a))
+    assert b.rate == 100.0 and np.array_equal(b.edf, a.edf)
+
+    est = imu_ar.Lattice(3)
+    est.update(x[:20_000])
+    twin = copy.copy(est)
+    deep = copy.deepcopy(est)
+    e1 = est.update(x[20_000:])
+    assert twin.n == deep.n == 20_000
+    np.testing.assert_array_equal(twin.update(x[20_000:]), e1)
+    assert twin.model() == est.model()
+
+
+def test_characterise_writes_the_autopilots_steps(adis, tool, tmp_path):
+    c = imu_ar.characterise(adis, columns="gx,gy,gz,ax,ay,az", gyro_unit="deg/s",
+                            accel_unit="g", loop_rate=200.0, sysid=7)
+    c.write(tmp_path / "py", formats=["px4", "ardupilot"])
+    tool("characterise", adis, "--columns", "gx,gy,gz,ax,ay,az", "--gyro-unit", "deg/s",
+         "--accel-unit", "g", "--loop-rate", "200", "--sysid", "7", "--out", tmp_path / "tool",
+         "--format", "px4,ardupilot")
+    names = sorted(p.name for p in (tmp_path / "tool").iterdir() if p.suffix != ".png")
+    assert names == sorted(p.name for p in (tmp_path / "py").iterdir() if p.suffix != ".png")
+    for n in names:
+        assert (tmp_path / "py" / n).read_bytes() == (tmp_path / "tool" / n).read_bytes(), n
+    assert "Vehicle 7" in (tmp_path / "py" / "px4.params").read_text()

@@ -86,7 +86,9 @@ pub enum NoiseError {
     Capacity,
     /// A fitted parameter overflows `f64` (Allan variances near the top of its range).
     Overflow,
-    /// The Allan variances span too many decades (about 1e300) for their weights: no model.
+    /// The fit gives no noise at all for Allan variances that have some: they span too many
+    /// decades (about 1e300) for their weights, or they rise as a rate ramp's do (`tau^2`)
+    /// and the model has no ramp.
     Range,
     /// A model's parameter is out of range ([`NoiseModel::new`]): a coefficient or `sigma`
     /// negative or not finite, a correlation time, decay time or frequency not positive and
@@ -129,9 +131,11 @@ impl fmt::Display for NoiseError {
                 "a fitted parameter overflows f64: the Allan variances are too large; rescale \
                  the data",
             ),
-            Self::Range => {
-                f.write_str("the Allan variances span more decades than f64 can weigh (about 300)")
-            }
+            Self::Range => f.write_str(
+                "no term of the model fits these Allan variances: they span more decades than \
+                 f64 can weigh (about 300), or they rise as a rate ramp's (tau^2) and the \
+                 model has no ramp",
+            ),
             Self::Parameter => f.write_str(
                 "a noise model parameter is out of range (a negative or non-finite coefficient \
                  or sigma, a time or frequency not positive, or Gauss-Markov terms out of order)",

@@ -24,7 +24,7 @@ use crate::export::{AxisModel, Format, ImuModel, write};
 use crate::input::source::{self, AXES, Kind, Request};
 use crate::input::timing::TimingSummary;
 use crate::input::units::{Quantity, Unit};
-use crate::input::{check_rate, check_span, resolve_rate, summary};
+use crate::input::{check_rate, check_span, number, resolve_rate, summary};
 use crate::method::with_order;
 use crate::noise::units::Units;
 use crate::noise::{Fitted, Fitting, ModelArgs, NoiseResult, OCTAVES, plot};
@@ -159,7 +159,8 @@ pub fn run(args: &Args) -> Result<Characterisation, Fail> {
         && !(h.is_finite() && h >= 1.0)
     {
         return Err(Fail(format!(
-            "--horizon {h}: must be a number of seconds from 1 (the overbound runs from 1 s)"
+            "--horizon {}: must be a number of seconds from 1 (the overbound runs from 1 s)",
+            number(h)
         )));
     }
     let columns = columns(args)?;

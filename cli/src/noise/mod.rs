@@ -22,7 +22,7 @@ use crate::chart;
 use crate::error::Fail;
 use crate::export::{AxisModel, StateSpace};
 use crate::input::timing::TimingSummary;
-use crate::input::{Input, check_decimate, check_order, check_rate, check_span, decimated};
+use crate::input::{Input, check_decimate, check_order, check_rate, check_span, decimated, number};
 use crate::kalman::{AllanRow, allan_text};
 use crate::method::with_order;
 use crate::output::{Output, json};
@@ -102,7 +102,8 @@ impl ModelArgs {
         if let Some(f) = self.filter_rate {
             check_rate(f).map_err(|_| {
                 Fail(format!(
-                    "--filter-rate {f}: must be a positive number of Hz"
+                    "--filter-rate {}: must be a positive number of Hz",
+                    number(f)
                 ))
             })?;
         }
@@ -277,6 +278,7 @@ pub struct Details {
     unit: String,
     filter_rate_hz: f64,
     states: Vec<String>,
+    h: Vec<f64>,
     white_term: f64,
     white_noise_at_1s: Option<f64>,
     measurement_variance: f64,
@@ -354,7 +356,12 @@ pub fn run_with(args: &Args, given: Option<&[f64]>) -> Result<NoiseResult, Fail>
         plot::check_path(path)?;
     }
     let series = match given {
-        Some(x) => args.input.given(x),
+        Some(x) => {
+            if let Some(i) = x.iter().position(|v| !v.is_finite()) {
+                return Err(args.input.fail(format!("sample {i} is NaN or infinite")));
+            }
+            args.input.given(x)
+        }
         None => args.input.series(args.rate.is_none())?,
     };
     let rate = series.rate(args.rate, &args.input)?;
@@ -501,7 +508,7 @@ impl Fitting {
         let form = model.kalman(1.0 / self.filter_rate, rw_p0).map_err(|e| {
             Fail(format!(
                 "--filter-rate {}: no filter form at this step: {e}",
-                self.filter_rate
+                number(self.filter_rate)
             ))
         })?;
         let mut result = self.result(&model, ar, &model.ieee952(octaves), &form, &check);
@@ -632,6 +639,7 @@ impl Fitting {
                 unit: self.units.name.clone(),
                 filter_rate_hz: self.filter_rate,
                 states: space.states,
+                h: space.h,
                 white_term: model.white_term(),
                 white_noise_at_1s: ieee.white_noise_at_1s,
                 measurement_variance: form.measurement_variance,
@@ -644,6 +652,12 @@ impl NoiseResult {
     /// The variance of the white measurement noise in the filter, `N^2 / Dt`.
     pub fn measurement_variance(&self) -> f64 {
         self.details.measurement_variance
+    }
+
+    /// The filter's measurement row over its states: 1, but 0 on an oscillator's `dx/dt` and
+    /// -1 on the earlier quantisation state.
+    pub fn h(&self) -> &[f64] {
+        &self.details.h
     }
 
     /// The filter's rate, Hz, of `phi`, `q` and `p0`.

@@ -219,7 +219,7 @@ fn kalman_refuses_a_filter_step_beyond_u32() {
             "--filter-rate",
             "1e-12",
         ],
-        "--filter-rate 0.000000000001: one filter step would be 1e14 model steps",
+        "--filter-rate 1e-12: one filter step would be 1e14 model steps",
     );
     std::fs::remove_file(file).unwrap();
 }
