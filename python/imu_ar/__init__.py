@@ -111,10 +111,11 @@ def _cli(argv: List[str]) -> List[str]:
 
 
 def _files(path: Union[PathLike, Sequence[PathLike]]) -> List[str]:
-    """One file, or several read as one record."""
+    """One file, or several read as one record, as absolute paths: a model's refit and a
+    characterisation's files read them again wherever the working directory has gone."""
     if _is_path(path):
-        return [_path(path)]
-    files = [_path(p) for p in path]
+        return [os.path.abspath(_path(path))]
+    files = [os.path.abspath(_path(p)) for p in path]
     if not files:
         raise ValueError("path: no files given")
     return files
@@ -124,6 +125,8 @@ def _int(name: str, v: Any, minimum: int = 0) -> int:
     """``v`` as an integer option: an ``int`` (or numpy integer) of at least ``minimum``;
     ``TypeError`` for a float or anything else, ``ValueError`` below the minimum."""
     try:
+        if isinstance(v, (bool, np.bool_)):
+            raise TypeError
         i = operator.index(v)
     except TypeError:
         raise TypeError(f"{name}: an integer is needed, not {type(v).__name__} {v!r}") from None
@@ -214,8 +217,9 @@ def read(
     for the logs ``gx, gy, gz, ax, ay, az`` [default: every CSV column but the time column, or
     the six axes]. ``unit`` converts columns of known unit (rad/s, deg/s, deg/h, m/s^2, g, mg).
     The timestamps are checked as the tool checks them; ``Record.timing`` is their report.
-    With ``rate`` (Hz) they are read as they are, unchecked (``timing`` is then ``None``): for
-    records whose stamps the tool refuses (no unit, mixed rates) or lacks.
+    With ``rate`` (Hz) they need not pass those checks (for records whose stamps the tool
+    refuses: no unit, mixed rates); where they still give a rate, ``rate`` must agree with it
+    within 1 %, as the tool requires, and ``timing`` is their report (else ``None``).
     """
     files = _files(path)
     if columns is None:
@@ -289,6 +293,28 @@ class Adev(_AdevTuple):
 
     def _replace(self, **fields: Any) -> "Adev":
         return Adev(*_AdevTuple(*self)._replace(**fields), self.rate)
+
+    @classmethod
+    def _make(cls, iterable: Iterable[Any]) -> "Adev":
+        """An ``Adev`` of ``(taus, devs, errs, ns, rate)``: the rate is part of it."""
+        items = list(iterable)
+        if len(items) != 5:
+            raise TypeError(
+                f"Adev._make: (taus, devs, errs, ns, rate) needed, not {len(items)} items"
+            )
+        return cls(*items)
+
+    def __eq__(self, other: object) -> bool:
+        return (
+            isinstance(other, Adev)
+            and self.rate == other.rate
+            and all(np.array_equal(a, b) for a, b in zip(self, other))
+        )
+
+    def __ne__(self, other: object) -> bool:
+        return not self == other
+
+    __hash__ = None  # type: ignore[assignment]
 
     @property
     def m(self) -> np.ndarray:
@@ -579,8 +605,11 @@ def noise(
         samples = _samples(x)
         argv += [_ARRAY, "--column", "x", *_input_flags(unit=unit)]
     out, mv, states, u, h = _native.noise(_cli([*argv, *tail, "--json"]), samples)
+    # The refit reads what this fit read: the samples as they are now (a copy, not the
+    # caller's buffer), the files by their absolute paths.
+    again = _files(x) if samples is None else samples.copy()
     refit = functools.partial(
-        _noise_at, x, rate, gm_states, ar_order, oscillators, ramp, curve_fit, decimate, unit,
+        _noise_at, again, rate, gm_states, ar_order, oscillators, ramp, curve_fit, decimate, unit,
         column, topic,
     )
     model = NoiseModel(json.loads(out), mv, states, u, refit, h)
@@ -601,20 +630,6 @@ def _noise_at(
 # --- characterise --------------------------------------------------------------------------
 
 
-def _without(argv: List[str], flag: str) -> List[str]:
-    """``argv`` without ``flag`` and its value."""
-    out: List[str] = []
-    skip = False
-    for a in argv:
-        if skip:
-            skip = False
-        elif a == flag:
-            skip = True
-        else:
-            out.append(a)
-    return out
-
-
 def _characterised(argv: List[str]) -> "Characterisation":
     """``imu-ar characterise`` of ``argv``, its files into a folder that is then removed."""
     with tempfile.TemporaryDirectory(prefix="imu-ar-") as tmp:
@@ -626,7 +641,9 @@ def _characterised(argv: List[str]) -> "Characterisation":
 
 def _axis_at(argv: List[str], axis: str, filter_rate: float) -> "NoiseModel":
     """The recording characterised again with the filter at another rate: ``axis``'s model."""
-    again = [*_without(argv, "--filter-rate"), "--filter-rate", _num(filter_rate)]
+    # Joined, a flag's value is part of its token: only the filter rate's own token goes.
+    kept = [a for a in _cli(argv) if not a.startswith("--filter-rate=")]
+    again = [*kept, f"--filter-rate={_num(filter_rate)}"]
     return _characterised(again).axes[axis]
 
 

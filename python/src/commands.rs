@@ -40,7 +40,8 @@ pub struct ReadArgs {
     /// The column.
     #[command(flatten)]
     pub input: Input,
-    /// The sample rate, Hz: the timestamps are then read as they are, unchecked.
+    /// The sample rate, Hz: the timestamps need not then pass the checks, but where they give
+    /// a rate it must agree within 1 %.
     #[arg(long)]
     pub rate: Option<f64>,
 }
@@ -192,6 +193,10 @@ pub fn read<'py>(py: Python<'py>, argv: Vec<OsString>, want_time: bool) -> PyRes
         let s = args
             .input
             .series_stamped(want_time && args.rate.is_none(), &mut t)?;
+        // A rate given must agree with the stamps where they give one, as everywhere.
+        if args.rate.is_some() {
+            s.rate(args.rate, &args.input)?;
+        }
         let timing = s.timing.as_ref().map(json_line).transpose()?;
         Ok((s.x, t, timing, s.unit, s.skipped.summary()))
     })?;

@@ -681,3 +681,62 @@ def test_characterise_writes_the_autopilots_steps(adis, tool, tmp_path):
     for n in names:
         assert (tmp_path / "py" / n).read_bytes() == (tmp_path / "tool" / n).read_bytes(), n
     assert "Vehicle 7" in (tmp_path / "py" / "px4.params").read_text()
+
+
+# --- the third red-team pass ---------------------------------------------------------------
+
+
+def test_a_refit_uses_the_samples_fitted_not_the_callers_buffer():
+    x = np.random.default_rng(9).normal(size=50_000) + np.cumsum(
+        np.random.default_rng(10).normal(0, 1e-3, 50_000))
+    model = imu_ar.noise(x, rate=100.0, ar_order=0)
+    want = imu_ar.noise(x.copy(), rate=100.0, ar_order=0, filter_rate=50.0).kalman()
+    x *= 10.0
+    np.testing.assert_array_equal(model.kalman(50.0).q, want.q)
+
+
+def test_refits_and_writes_find_the_record_after_a_chdir(small_csv, tmp_path, monkeypatch):
+    path, _ = small_csv
+    monkeypatch.chdir(path.parent)
+    model = imu_ar.noise(path.name, column="gx")
+    want = imu_ar.noise(path.name, column="gx", filter_rate=50.0).kalman()
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)
+    np.testing.assert_array_equal(model.kalman(50.0).q, want.q)
+
+
+def test_read_with_a_rate_that_contradicts_the_stamps_raises(small_csv):
+    path, _ = small_csv
+    with pytest.raises(ValueError, match="timestamps give 100"):
+        imu_ar.read(path, rate=200.0)
+    rec = imu_ar.read(path, rate=100.2)
+    assert rec.rate == 100.2 and rec.timing["rate_hz"] == pytest.approx(100.0, rel=1e-6)
+
+
+def test_adev_make_and_equality_carry_the_rate():
+    a = imu_ar.adev(np.random.default_rng(0).normal(size=4000), rate=100.0)
+    with pytest.raises(TypeError, match="rate"):
+        imu_ar.Adev._make(tuple(a))
+    b = imu_ar.Adev._make([*a, 100.0])
+    assert b == a and b.rate == 100.0
+    assert imu_ar.Adev(*a, 50.0) != a
+
+
+def test_a_value_equal_to_a_flag_survives_a_refit(adis, tmp_path):
+    x = imu_ar.read(adis).x[:20_000]
+    path = tmp_path / "odd.csv"
+    with open(path, "w") as f:
+        f.write("--filter-rate,gx,gy,gz,ax,ay,az\n")
+        for i, row in enumerate(x):
+            f.write(f"{i / 100:.2f}," + ",".join(repr(float(v)) for v in row) + "\n")
+    kw = dict(time_column="--filter-rate", rate=100.0, gyro_unit="deg/s", accel_unit="g",
+              gm_states=1)
+    c = imu_ar.characterise(path, **kw)
+    want = imu_ar.characterise(path, filter_rate=50.0, **kw)
+    np.testing.assert_array_equal(c.axes["gx"].kalman(50.0).q, want.axes["gx"].kalman().q)
+
+
+def test_a_bool_is_not_an_order():
+    with pytest.raises(TypeError, match="integer"):
+        imu_ar.Lattice(True)
