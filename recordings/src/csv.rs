@@ -379,7 +379,7 @@ pub fn shown(cell: &str) -> String {
 /// A cell as a number, as `str::parse::<f64>` reads it (the same values and the same
 /// refusals), faster.
 fn number(cell: &str) -> Option<f64> {
-    fast_float2::parse::<f64, _>(cell).ok()
+    crate::decimal::plain(cell.as_bytes()).or_else(|| fast_float2::parse::<f64, _>(cell).ok())
 }
 
 /// A cell as a finite number, or what is wrong with it.

@@ -14,6 +14,7 @@
 pub mod bag;
 pub mod csv;
 pub mod dataflash;
+mod decimal;
 pub mod error;
 pub mod frame;
 pub mod mcap;

@@ -282,19 +282,33 @@ fn characterise(
         .map(|(a, u)| a.octaves(1.0 / rate, u.to_si * u.to_si))
         .collect::<Result<Vec<_>, _>>()
         .map_err(|e| with_file(&args.files, e))?;
-    let mut results = Vec::new();
-    let mut paints = Vec::new();
-    let mut models = Vec::new();
-    for i in 0..6 {
+    // The gyros' fits on a thread of their own beside the accelerometers': the first axis
+    // that fails (in their order) is the one named.
+    let fit = |i: usize| -> Result<Fitted<'_>, Fail> {
         let fail = |e: String| with_file(&args.files, format!("{} ({}): {e}", AXES[i], columns[i]));
         if axes[i].is_constant() {
             return Err(fail("constant (a stuck sensor?): no noise to model".into()));
         }
+        fit_axis(&fits[i], &axes[i], &octaves[i], units[i].to_si).map_err(|Fail(e)| fail(e))
+    };
+    let fitted: Vec<Result<Fitted<'_>, Fail>> = std::thread::scope(|scope| {
+        let gyros = scope.spawn(|| (0..3).map(fit).collect::<Vec<_>>());
+        let accelerometers: Vec<_> = (3..6).map(fit).collect();
+        let mut all = gyros
+            .join()
+            .unwrap_or_else(|_| vec![Err(Fail("the gyros' fits stopped".into()))]);
+        all.extend(accelerometers);
+        all
+    });
+    let mut results = Vec::new();
+    let mut paints = Vec::new();
+    let mut models = Vec::new();
+    for (i, fitted) in fitted.into_iter().enumerate() {
         let Fitted {
             result,
             paint,
             axis,
-        } = fit_axis(&fits[i], &axes[i], &octaves[i], units[i].to_si).map_err(|Fail(e)| fail(e))?;
+        } = fitted?;
         results.push(AxisResult {
             axis: AXES[i],
             column: columns[i].clone(),
@@ -316,12 +330,9 @@ fn characterise(
         sysid: args.sysid,
         origin: None,
     };
+    // The two plots drawn side by side, the gyros' on a thread of their own.
     let draw = |dir: &Path| -> Result<Vec<PathBuf>, Fail> {
-        let mut drawn = Vec::new();
-        for (name, range, what) in [
-            ("gyro.png", 0..3, "gyro"),
-            ("accel.png", 3..6, "accelerometer"),
-        ] {
+        let one = |(name, range, what): (&str, std::ops::Range<usize>, &str)| {
             let path = dir.join(name);
             let panels: Vec<(&crate::noise::Paint, String)> = range
                 .map(|i| {
@@ -342,9 +353,17 @@ fn characterise(
                     args.out.join(name).display()
                 ))
             })?;
-            drawn.push(path);
-        }
-        Ok(drawn)
+            Ok(path)
+        };
+        let (gyro, accel) = std::thread::scope(|scope| {
+            let gyro = scope.spawn(|| one(("gyro.png", 0..3, "gyro")));
+            let accel = one(("accel.png", 3..6, "accelerometer"));
+            let gyro = gyro
+                .join()
+                .unwrap_or_else(|_| Err(Fail("the gyros' plot stopped".into())));
+            (gyro, accel)
+        });
+        Ok(vec![gyro?, accel?])
     };
     let files = write_all(formats, &imu, args.horizon, &args.out, &draw)?;
 

@@ -431,7 +431,7 @@ pub fn run_with(args: &Args, given: Option<&[f64]>) -> Result<NoiseResult, Fail>
 }
 
 /// What draws a fit's decomposition on an area, with a caption.
-pub(crate) type Paint<'a> = Box<dyn Fn(&plot::Area, &str) -> Result<(), String> + 'a>;
+pub(crate) type Paint<'a> = Box<dyn Fn(&plot::Area, &str) -> Result<(), String> + Send + Sync + 'a>;
 
 /// A fitted and checked model: its result, and what draws it.
 pub(crate) struct Fitted<'a> {
