@@ -23,6 +23,41 @@ pub fn csv_column(data: &[u8]) {
     }
 }
 
+/// A cell as the CSV reader reads it, against the standard library: every text that
+/// `str::parse::<f64>` reads to a finite number is read to the same bits (the reader's own
+/// parser of plain decimals, or fast-float2 for the rest); anything it reads is finite.
+pub fn decimal_number(data: &[u8]) {
+    // The bytes as a plain decimal too (a sign, digits, a point where the first byte says):
+    // the reader's own parser's path, every length and digit.
+    if let Some((&first, digits)) = data.split_first() {
+        let mut text: String = digits.iter().map(|b| char::from(b'0' + b % 10)).collect();
+        text.insert(usize::from(first >> 1) % (text.len() + 1), '.');
+        if first & 1 == 1 {
+            text.insert(0, '-');
+        }
+        same_as_std(&text);
+    }
+    if let Ok(text) = std::str::from_utf8(data) {
+        same_as_std(text);
+    }
+}
+
+/// [`decimal_number`]'s check of one text.
+fn same_as_std(text: &str) {
+    let ours = imu_ar_recordings::csv::finite("x")(text);
+    match text.parse::<f64>() {
+        Ok(v) if v.is_finite() => match ours {
+            Ok(o) => assert_eq!(o.to_bits(), v.to_bits(), "{text:?}: {o} against {v}"),
+            Err(e) => panic!("{text:?}: {e}, the standard library reads {v}"),
+        },
+        _ => {
+            if let Ok(o) = ours {
+                assert!(o.is_finite(), "{text:?}: {o}");
+            }
+        }
+    }
+}
+
 /// A scratch file of its own for each call (the tests replay on several threads).
 fn scratch(extension: &str) -> PathBuf {
     static CALLS: AtomicU64 = AtomicU64::new(0);

@@ -45,6 +45,11 @@ fn the_csv_corpus_reads_without_a_panic() {
 }
 
 #[test]
+fn the_decimal_corpus_reads_as_the_standard_library_reads_it() {
+    replay("decimal_number", 20, checks::decimal_number);
+}
+
+#[test]
 fn the_ros_corpus_reads_without_a_panic() {
     replay("ros_read", 290, checks::ros_read);
 }
