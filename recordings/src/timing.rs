@@ -215,10 +215,42 @@ fn coarser(buckets: &[Bucket], bits: u32) -> Vec<Bucket> {
     out
 }
 
+/// Sorts `intervals`: by counting when they span fewer values than twice their number (a
+/// clock's intervals, all close to its period: three passes, no comparisons), else by
+/// comparing. `counts` is the counting's table, kept for the next time.
+fn sort_intervals(intervals: &mut [i64], counts: &mut Vec<u32>) {
+    let (Some(&low), Some(&high)) = (intervals.iter().min(), intervals.iter().max()) else {
+        return;
+    };
+    let span = high.abs_diff(low);
+    if span >= 2 * intervals.len() as u64 || u32::try_from(intervals.len()).is_err() {
+        intervals.sort_unstable();
+        return;
+    }
+    counts.clear();
+    counts.resize(span as usize + 1, 0);
+    for &iv in intervals.iter() {
+        counts[iv.abs_diff(low) as usize] += 1;
+    }
+    let mut at = 0;
+    for (offset, &count) in counts.iter().enumerate() {
+        let count = count as usize;
+        // low + offset <= high: no overflow.
+        intervals[at..at + count].fill(low + offset as i64);
+        at += count;
+    }
+}
+
 /// `buckets` (in the order of their keys) with the intervals `more` (emptied) in, at `bits`
-/// significant bits, into `out` (emptied first).
-fn merge_into(buckets: &[Bucket], more: &mut Vec<i64>, bits: u32, out: &mut Vec<Bucket>) {
-    more.sort_unstable();
+/// significant bits, into `out` (emptied first); `counts` a table for [`sort_intervals`].
+fn merge_into(
+    buckets: &[Bucket],
+    more: &mut Vec<i64>,
+    bits: u32,
+    out: &mut Vec<Bucket>,
+    counts: &mut Vec<u32>,
+) {
+    sort_intervals(more, counts);
     out.clear();
     let add = |out: &mut Vec<Bucket>, b: &Bucket| match out.last_mut() {
         Some(last) if last.key == b.key => last.merge(b),
@@ -247,7 +279,7 @@ fn merge_into(buckets: &[Bucket], more: &mut Vec<i64>, bits: u32, out: &mut Vec<
 /// [`merge_into`] a new vector.
 fn merged(buckets: &[Bucket], more: &mut Vec<i64>, bits: u32) -> Vec<Bucket> {
     let mut out = Vec::with_capacity(buckets.len() + 64);
-    merge_into(buckets, more, bits, &mut out);
+    merge_into(buckets, more, bits, &mut out, &mut Vec::new());
     out
 }
 
@@ -343,6 +375,8 @@ pub struct Timing {
     /// Intervals not yet in the histogram, sorted in all at once (a fraction of a table
     /// lookup per interval).
     pending: Vec<i64>,
+    /// The table that sorts the pending intervals by counting.
+    counts: Vec<u32>,
     /// Significant bits of the buckets' keys (64: every interval its own).
     bits: u32,
 }
@@ -369,7 +403,13 @@ impl Timing {
         }
         self.pending.push(t.saturating_sub(self.last));
         if self.pending.len() >= PENDING {
-            merge_into(&self.buckets, &mut self.pending, self.bits, &mut self.spare);
+            merge_into(
+                &self.buckets,
+                &mut self.pending,
+                self.bits,
+                &mut self.spare,
+                &mut self.counts,
+            );
             std::mem::swap(&mut self.buckets, &mut self.spare);
             while self.buckets.len() > DISTINCT && self.bits > 1 {
                 self.bits -= 1;
@@ -608,6 +648,31 @@ mod tests {
                 t
             })
             .collect()
+    }
+
+    /// Intervals sorted by counting are those sorted by comparing: clustered about a period,
+    /// spread past the counting's limit, at both ends of `i64`, one, none, all equal.
+    #[test]
+    fn intervals_sorted_by_counting_are_sorted() {
+        let mut next = crate::xorshift(0x1234_5678_9abc_def1);
+        let mut counts = Vec::new();
+        for case in 0..2_000u64 {
+            let n = (next() % 5_000) as usize;
+            let (base, spread) = match case % 5 {
+                0 => (2_500_000, 1 + next() % 200),
+                1 => (1, 1 + next() % (2 * n as u64 + 3)),
+                2 => (i64::MAX - 10_000, 1 + next() % 10_000),
+                3 => (1, u64::MAX >> 2),
+                _ => (7, 1),
+            };
+            let mut v: Vec<i64> = (0..n)
+                .map(|_| base.saturating_add((next() % spread) as i64))
+                .collect();
+            let mut expected = v.clone();
+            expected.sort_unstable();
+            sort_intervals(&mut v, &mut counts);
+            assert_eq!(v, expected, "case {case}");
+        }
     }
 
     /// From every interval directly: the median, and the rate of the intervals within 25 % of

@@ -204,8 +204,10 @@ fn characterise(
         instance: args.instance,
     };
     // The rows go in batches to a second thread, which keeps the six axes' statistics while
-    // this one reads and parses: the two halves of the work overlap.
-    let (send, receive) = std::sync::mpsc::sync_channel::<Vec<[f64; 6]>>(4);
+    // this one reads and parses: the two halves of the work overlap. The queue holds 32
+    // batches (6 MB) so that neither waits while the other is off its core (three threads
+    // share two cores on small machines).
+    let (send, receive) = std::sync::mpsc::sync_channel::<Vec<[f64; 6]>>(32);
     let worker = |mut axes: Vec<AxisStream<OCTAVES>>| {
         let mut column = Vec::with_capacity(BATCH);
         for batch in receive {
