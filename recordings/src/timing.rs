@@ -215,8 +215,8 @@ fn coarser(buckets: &[Bucket], bits: u32) -> Vec<Bucket> {
     out
 }
 
-/// Sorts `intervals`: by counting when they span fewer values than twice their number (a
-/// clock's intervals, all close to its period: three passes, no comparisons), else by
+/// Sorts `intervals`: by counting when they span at most twice as many values as there are
+/// intervals (a clock's, all close to its period: four passes, no comparisons), else by
 /// comparing. `counts` is the counting's table, kept for the next time.
 fn sort_intervals(intervals: &mut [i64], counts: &mut Vec<u32>) {
     let (Some(&low), Some(&high)) = (intervals.iter().min(), intervals.iter().max()) else {
