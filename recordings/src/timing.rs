@@ -216,12 +216,15 @@ fn coarser(buckets: &[Bucket], bits: u32) -> Vec<Bucket> {
 }
 
 /// Sorts `intervals`: by counting when they span at most twice as many values as there are
-/// intervals (a clock's, all close to its period: four passes, no comparisons), else by
+/// intervals (a clock's, all close to its period: three passes, no comparisons), else by
 /// comparing. `counts` is the counting's table, kept for the next time.
 fn sort_intervals(intervals: &mut [i64], counts: &mut Vec<u32>) {
-    let (Some(&low), Some(&high)) = (intervals.iter().min(), intervals.iter().max()) else {
+    let Some(&first) = intervals.first() else {
         return;
     };
+    let (low, high) = intervals
+        .iter()
+        .fold((first, first), |(lo, hi), &iv| (lo.min(iv), hi.max(iv)));
     let span = high.abs_diff(low);
     if span >= 2 * intervals.len() as u64 || u32::try_from(intervals.len()).is_err() {
         intervals.sort_unstable();
