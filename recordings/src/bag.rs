@@ -71,6 +71,8 @@ pub fn read_selected(
     // The connections, from the index section.
     let mut ids = Vec::new();
     let mut callers: Vec<(u32, String)> = Vec::new();
+    // The topic's connections of another type.
+    let mut others: Vec<(String, u32, String)> = Vec::new();
     let mut imu_topics = Vec::new();
     let mut all_topics = Vec::new();
     // Each chunk's position, and the receive times of its first and last message.
@@ -91,10 +93,8 @@ pub fn read_selected(
         let name = c.storage_topic.to_string();
         if c.storage_topic == topic {
             if c.tp != IMU_TYPE {
-                return Err(fail(format!(
-                    "topic '{topic}' has type {}, not {IMU_TYPE}",
-                    c.tp
-                )));
+                others.push((c.tp.to_string(), c.id, c.caller_id.to_string()));
+                continue;
             }
             if c.md5sum != IMU_MD5 {
                 let md5: String = c.md5sum.iter().map(|b| format!("{b:02x}")).collect();
@@ -112,6 +112,29 @@ pub fn read_selected(
         if !all_topics.contains(&name) {
             all_topics.push(name);
         }
+    }
+    if let Some(other) = others.first() {
+        return Err(fail(if ids.is_empty() {
+            format!("topic '{topic}' has type {}, not {IMU_TYPE}", other.0)
+        } else {
+            format!(
+                "topic '{topic}' carries {IMU_TYPE} (connection{} {}) and {}: one topic, one \
+                 type of message; keep the IMU's connections (rosbag filter) and read those",
+                if ids.len() > 1 { "s" } else { "" },
+                ids.iter()
+                    .map(u32::to_string)
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                others
+                    .iter()
+                    .map(|(tp, id, caller)| match caller.as_str() {
+                        "" => format!("{tp} (connection {id})"),
+                        _ => format!("{tp} (connection {id}, from {caller})"),
+                    })
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        }));
     }
     if ids.is_empty() {
         return Err(fail(absent_topic(

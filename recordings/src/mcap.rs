@@ -403,6 +403,18 @@ impl Channels {
                 let schema = self.schemas.get(&c.schema_id);
                 let name = schema.map_or("", |s| s.0.as_str());
                 if c.topic == topic {
+                    if schema.is_some() && name != IMU_SCHEMA && !self.wanted.is_empty() {
+                        return Err(format!(
+                            "topic '{topic}' carries {IMU_SCHEMA} (channel {}) and {name} \
+                             (channel {}): one topic, one type of message",
+                            self.wanted
+                                .iter()
+                                .map(u16::to_string)
+                                .collect::<Vec<_>>()
+                                .join(", "),
+                            c.id
+                        ));
+                    }
                     check_channel(topic, c.schema_id, schema, &c.message_encoding)?;
                     if !self.wanted.contains(&c.id) {
                         self.wanted.push(c.id);

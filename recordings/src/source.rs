@@ -374,7 +374,7 @@ fn autopilot_stream(
         count += 1;
         // Microseconds since boot, to nanoseconds.
         let stamp = (time_us * 1e3).round() as i64;
-        if let Step::Backward { last } = timing.push(stamp) {
+        if let Some(last) = not_after(timing.push(stamp), stamp) {
             timing.drop_one();
             backward.get_or_insert((count, stamp, last));
             return;
@@ -743,7 +743,7 @@ fn messages(
             count += 1;
             if frame.stamp_ns == 0 {
                 unstamped += 1;
-            } else if let Step::Backward { last } = timing.push(frame.stamp_ns) {
+            } else if let Some(last) = not_after(timing.push(frame.stamp_ns), frame.stamp_ns) {
                 timing.drop_one();
                 backward.get_or_insert((count, frame.stamp_ns, last));
                 return;
@@ -799,6 +799,17 @@ fn messages(
 /// The unit of a message's axis `i` (of [`AXES`]).
 fn si_unit(i: usize) -> Option<Unit> {
     Unit::parse(if i < 3 { "rad/s" } else { "m/s^2" })
+}
+
+/// The stamp before a message's stamp `t` that did not move `step` forward: a log's or a
+/// bag's stamps come from a clock that resolves its samples, so a repeated stamp is a message
+/// repeated, as backward as one before it.
+fn not_after(step: Step, t: i64) -> Option<i64> {
+    match step {
+        Step::Forward => None,
+        Step::Backward { last } => Some(last),
+        Step::Repeat => Some(t),
+    }
 }
 
 /// The refusal of stamps that go backwards.
@@ -947,8 +958,14 @@ fn csv_stream(
             }
             None => (cells, None),
         };
-        if let Some(t) = stamp
-            && let Step::Backward { last } = timing.push(t)
+        let step = stamp.map(|t| (t, timing.push(t)));
+        if let Some((_, Step::Repeat)) = step
+            && !request.drop_backward
+        {
+            // Kept: the summary tells a clock coarser than its samples from samples repeated.
+            timing.keep_repeat();
+        } else if let Some((t, step)) = step
+            && let Some(last) = not_after(step, t)
         {
             if !strict && !request.drop_backward {
                 // The rate is given: the sample stays, its stamp is left out of the stamps'

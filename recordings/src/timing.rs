@@ -2,6 +2,7 @@
 //! gathered in one streaming pass with bounded memory.
 
 use serde::Serialize;
+use std::cmp::Ordering;
 
 /// The unit of a time column.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -187,11 +188,14 @@ fn decimal_ns(cell: &str, scale: i64) -> Option<i128> {
 pub enum Step {
     /// After the last one (or the first): the sample counts.
     Forward,
-    /// At or before the last one: `last` is the last accepted stamp, ns.
+    /// Before the last one: `last` is the last accepted stamp, ns.
     Backward {
         /// The last accepted stamp, ns.
         last: i64,
     },
+    /// Equal to the last one: a clock coarser than the samples' interval, or a sample
+    /// repeated. [`Timing::keep_repeat`] keeps it, [`Timing::drop_one`] drops it.
+    Repeat,
 }
 
 /// The most buckets held: past them, every bucket's width doubles (one significant bit less).
@@ -371,6 +375,12 @@ pub struct Timing {
     first: Option<i64>,
     last: i64,
     dropped: u64,
+    /// Stamps pushed.
+    pushed: u64,
+    /// Samples kept whose stamp equals the one before, and the first of them (its number
+    /// among the stamps pushed, its stamp).
+    repeats: u64,
+    first_repeat: Option<(u64, i64)>,
     /// The histogram, in the order of the intervals.
     buckets: Vec<Bucket>,
     /// The histogram before the last merge: its allocation, for the next.
@@ -396,12 +406,16 @@ impl Timing {
     /// Takes the stamp `t` (ns) of the next sample: [`Step::Forward`] when it is later than the
     /// last accepted one, which it then becomes.
     pub fn push(&mut self, t: i64) -> Step {
+        self.pushed += 1;
         let Some(_) = self.first else {
             self.first = Some(t);
             self.last = t;
             return Step::Forward;
         };
-        if t <= self.last {
+        if t == self.last {
+            return Step::Repeat;
+        }
+        if t < self.last {
             return Step::Backward { last: self.last };
         }
         self.pending.push(t.saturating_sub(self.last));
@@ -423,9 +437,16 @@ impl Timing {
         Step::Forward
     }
 
-    /// Counts a sample dropped for its backward stamp.
+    /// Counts a sample dropped for its backward (or repeated) stamp.
     pub fn drop_one(&mut self) {
         self.dropped += 1;
+    }
+
+    /// Keeps the sample whose stamp was a [`Step::Repeat`]: the summary takes it as a sample
+    /// of a clock coarser than its samples, where the stamps show one; else it names it.
+    pub fn keep_repeat(&mut self) {
+        self.repeats += 1;
+        self.first_repeat.get_or_insert((self.pushed, self.last));
     }
 
     /// The samples dropped so far.
@@ -465,41 +486,51 @@ impl Timing {
                 break;
             }
         }
-        // Intervals are judged against the median; where that leaves under 90 % regular (stamps
-        // rounded to a coarse clock: 5 and 6 ms at 180 Hz), against the mean interval.
         let span = self.span_ns();
-        let mut classes = classes(&buckets, median);
-        if (classes.regular as f64) < 0.9 * intervals as f64 {
-            let by_mean = self::classes(&buckets, span / intervals as f64);
-            if by_mean.regular > classes.regular {
-                classes = by_mean;
-            }
-        }
-        let Classes {
-            reference,
-            short,
-            gaps,
-            missing,
-            regular,
-            sum,
-        } = classes;
-        // The rate: the mean of the regular intervals (exact for rounded stamps); their jitter
-        // about it.
-        let mean = sum / regular.max(1) as f64;
-        let (sq, worst) = jitter(&buckets, reference, mean);
+        let resolution = resolution(&buckets, self.bits);
+        let judged = judged(&buckets, median, span, intervals, resolution, self.repeats);
+        let Judged {
+            classes:
+                Classes {
+                    reference,
+                    short,
+                    gaps,
+                    missing,
+                    regular,
+                    ..
+                },
+            period,
+            repeats,
+            window,
+        } = judged;
+        let (sq, worst) = jitter(&buckets, &window, period);
+        // Repeats counted as samples are intervals of 0: a deviation of -1 each.
+        let (sq, worst) = if repeats > 0 {
+            (sq + repeats as f64, worst.max(1.0))
+        } else {
+            (sq, worst)
+        };
         let summary = TimingSummary {
             unit: unit.name(),
             header_stamps: unit == TimeUnit::HeaderStamps,
-            rate_hz: 1e9 / mean,
+            rate_hz: 1e9 / period,
             median_interval_s: median * 1e-9,
-            jitter_rms: (sq / regular.max(1) as f64).sqrt(),
+            jitter_rms: (sq / (regular + repeats).max(1) as f64).sqrt(),
             jitter_max: worst,
             gaps,
             missing_samples: missing,
             short_intervals: short,
             dropped_backward: self.dropped,
             span_s: span * 1e-9,
+            resolution_s: resolution.map(|q| q as f64 * 1e-9),
+            repeated: self.repeats,
+            unexplained_repeat: if repeats == self.repeats {
+                None
+            } else {
+                self.first_repeat
+            },
         };
+        let (regular, intervals) = (regular + repeats, intervals + repeats);
         if (regular as f64) < 0.9 * intervals as f64 {
             return Err(format!(
                 "the timestamps show mixed rates: only {regular} of {intervals} intervals lie \
@@ -527,41 +558,217 @@ impl Timing {
     }
 }
 
-/// The intervals of the histogram against `reference` (ns): within 25 % of it regular, else
-/// short or gaps (a bucket, at most 0.1 % wide, judged by its mean).
-fn classes(buckets: &[Bucket], reference: f64) -> Classes {
+/// Which intervals are a clock's own (regular), the others short or gaps.
+#[derive(Clone, Copy, Debug)]
+enum Window {
+    /// Within 25 % of the reference interval (ns).
+    Ratio(f64),
+    /// For stamps rounded to a quantum `q` (ns) coarser than a quarter of the interval: within
+    /// one quantum of the reference (a clock's intervals rounded down or up), ends included
+    /// while the reference is only a first guess, or within 25 % of it. A gap of `skip` ns
+    /// more than a whole number of periods is what a clock whose stamps repeat shows between
+    /// distinct stamps (the quantum less a period).
+    Quantum {
+        reference: f64,
+        q: f64,
+        inclusive: bool,
+        skip: f64,
+    },
+}
+
+impl Window {
+    fn reference(&self) -> f64 {
+        match *self {
+            Window::Ratio(reference) | Window::Quantum { reference, .. } => reference,
+        }
+    }
+
+    /// Whether `iv` (ns) is shorter than the window (Less), in it (Equal) or a gap (Greater).
+    fn judge(&self, iv: f64) -> Ordering {
+        match *self {
+            Window::Ratio(reference) => {
+                let r = iv / reference;
+                if r < 0.75 {
+                    Ordering::Less
+                } else if r > 1.25 {
+                    Ordering::Greater
+                } else {
+                    Ordering::Equal
+                }
+            }
+            Window::Quantum {
+                reference,
+                q,
+                inclusive,
+                ..
+            } => {
+                let d = iv - reference;
+                if d.abs() < q || (inclusive && d.abs() == q) || d.abs() <= 0.25 * reference {
+                    Ordering::Equal
+                } else if d < 0.0 {
+                    Ordering::Less
+                } else {
+                    Ordering::Greater
+                }
+            }
+        }
+    }
+}
+
+/// The largest power of ten (ns) that divides every interval: the stamps' resolution, known
+/// while every interval has a bucket of its own (`bits` 64).
+fn resolution(buckets: &[Bucket], bits: u32) -> Option<i64> {
+    if bits < 64 {
+        return None;
+    }
+    let mut q = 1_000_000_000_000_000_000i64;
+    for b in buckets {
+        while q > 1 && b.key % q != 0 {
+            q /= 10;
+        }
+    }
+    Some(q)
+}
+
+/// How a histogram's intervals were judged: their classes, the clock's period (ns), the
+/// repeated stamps counted as its samples, and the window.
+struct Judged {
+    classes: Classes,
+    period: f64,
+    repeats: u64,
+    window: Window,
+}
+
+/// The histogram's intervals (`intervals` of them, over `span` ns, with `repeats` stamps
+/// equal to the one before left out) judged against the `median` interval, or where that
+/// leaves under 90 % regular (stamps rounded to a coarse clock: 5 and 6 ms at 180 Hz), against
+/// the mean interval.
+///
+/// Stamps rounded to a quantum (`resolution`, ns) coarser than a quarter of the interval show
+/// intervals a quantum apart (3 and 4 ms at 325 Hz, 2 and 3 ms at 340 Hz); stamps coarser than
+/// the interval repeat (200 Hz to 10 ms: 0 and 10 ms). Where the intervals show that (one
+/// about a period off the median, too close to be a gap; repeats while the intervals are one
+/// quantum; mixed intervals within a quantum of the mean), the regular intervals are those
+/// within a quantum of the period, and the period is their mean over the samples they hold:
+/// the span's, for a record without gaps.
+fn judged(
+    buckets: &[Bucket],
+    median: f64,
+    span: f64,
+    intervals: u64,
+    resolution: Option<i64>,
+    repeats: u64,
+) -> Judged {
+    let by_ratio = |reference: f64| {
+        let window = Window::Ratio(reference);
+        (window, classes(buckets, &window))
+    };
+    let (mut window, mut c) = by_ratio(median);
+    let mean = span / intervals as f64;
+    if (c.regular as f64) < 0.9 * intervals as f64 {
+        let (w, by_mean) = by_ratio(mean);
+        if by_mean.regular > c.regular {
+            (window, c) = (w, by_mean);
+        }
+    }
+    let ratio = Judged {
+        period: c.sum / c.regular.max(1) as f64,
+        classes: c,
+        repeats: 0,
+        window,
+    };
+    let Some(q) = resolution.map(|q| q as f64) else {
+        return ratio;
+    };
+    let coarse_repeats = repeats > 0 && q == median;
+    let rounded = 4.0 * q > median
+        && buckets.iter().any(|b| {
+            let r = b.mean() / median;
+            (0.5..0.75).contains(&r) || (r > 1.25 && r < 1.5)
+        });
+    let mixed = (ratio.classes.regular as f64) < 0.9 * intervals as f64 && 4.0 * q > mean;
+    if !(coarse_repeats || rounded || mixed) {
+        return ratio;
+    }
+    let counted = if coarse_repeats { repeats } else { 0 };
+    let mut reference = if rounded && !coarse_repeats {
+        median
+    } else {
+        span / (intervals + counted) as f64
+    };
+    let mut inclusive = true;
+    let mut judged = None;
+    for _ in 0..4 {
+        let window = Window::Quantum {
+            reference,
+            q,
+            inclusive,
+            skip: if counted > 0 { q - reference } else { 0.0 },
+        };
+        let c = classes(buckets, &window);
+        let held = c.regular + counted;
+        if held == 0 {
+            return ratio;
+        }
+        reference = c.sum / held as f64;
+        inclusive = false;
+        judged = Some(Judged {
+            period: reference,
+            classes: c,
+            repeats: counted,
+            window,
+        });
+    }
+    match judged {
+        Some(j) if j.classes.regular + j.repeats >= ratio.classes.regular => j,
+        _ => ratio,
+    }
+}
+
+/// The intervals of the histogram judged by `window`: regular, short or gaps (a bucket, at
+/// most 0.1 % wide, by its mean), each gap missing the periods it spans less one.
+fn classes(buckets: &[Bucket], window: &Window) -> Classes {
+    let reference = window.reference();
+    let skip = match *window {
+        Window::Quantum { skip, .. } => skip,
+        Window::Ratio(_) => 0.0,
+    };
     let mut c = Classes {
         reference,
         ..Classes::default()
     };
     for b in buckets {
-        let (n, r) = (b.count, b.mean() / reference);
-        if r < 0.75 {
-            c.short += n;
-        } else if r > 1.25 {
-            c.gaps += n;
-            // Each gap misses the periods it spans less one: per interval where the bucket's
-            // intervals all round alike, else from their sum.
-            let periods = |iv: i64| (iv as f64 / reference).round();
-            c.missing += if periods(b.min) == periods(b.max) {
-                n * (periods(b.min) as u64).saturating_sub(1)
-            } else {
-                (b.total() / reference - n as f64).round().max(0.0) as u64
-            };
-        } else {
-            c.regular += n;
-            c.sum += b.total();
+        let n = b.count;
+        match window.judge(b.mean()) {
+            Ordering::Less => c.short += n,
+            Ordering::Greater => {
+                c.gaps += n;
+                // Each gap misses the periods it spans less one: per interval where the
+                // bucket's intervals all round alike, else from their sum.
+                let periods = |iv: i64| ((iv as f64 - skip) / reference).round();
+                c.missing += if periods(b.min) == periods(b.max) {
+                    n * (periods(b.min) as u64).saturating_sub(1)
+                } else {
+                    ((b.total() - n as f64 * skip) / reference - n as f64)
+                        .round()
+                        .max(0.0) as u64
+                };
+            }
+            Ordering::Equal => {
+                c.regular += n;
+                c.sum += b.total();
+            }
         }
     }
     c
 }
 
-/// The regular intervals against `reference` (as [`classes`] judges them): the sum of their
-/// squared deviations from `mean`, relative to it, and the largest.
-fn jitter(buckets: &[Bucket], reference: f64, mean: f64) -> (f64, f64) {
+/// The regular intervals as `window` judges them: the sum of their squared deviations from
+/// `mean`, relative to it, and the largest.
+fn jitter(buckets: &[Bucket], window: &Window, mean: f64) -> (f64, f64) {
     let (mut sq, mut worst) = (0.0, 0.0f64);
     for b in buckets {
-        if (0.75..=1.25).contains(&(b.mean() / reference)) {
+        if window.judge(b.mean()) == Ordering::Equal {
             sq += b.square_deviations(mean);
             let extreme = |iv: i64| (iv as f64 / mean - 1.0).abs();
             worst = worst.max(extreme(b.min)).max(extreme(b.max));
@@ -609,9 +816,34 @@ pub struct TimingSummary {
     pub dropped_backward: u64,
     /// From the first stamp to the last, s.
     pub span_s: f64,
+    /// The largest power of ten that divides every interval, s: the stamps' resolution (none
+    /// known past 65,536 distinct intervals).
+    pub resolution_s: Option<f64>,
+    /// Samples kept whose stamp equals the one before: a clock coarser than the samples'
+    /// interval (their rate is then the span's), or, where the stamps resolve the interval,
+    /// samples repeated, which [`TimingSummary::repeat_refusal`] names.
+    pub repeated: u64,
+    /// The first repeated stamp the stamps' resolution does not explain: its number among the
+    /// stamps, and the stamp, ns.
+    #[serde(skip)]
+    pub unexplained_repeat: Option<(u64, i64)>,
 }
 
 impl TimingSummary {
+    /// The refusal of stamps that repeat the one before although they resolve the samples'
+    /// interval (a record read for its stamps' rate must not have them).
+    pub fn repeat_refusal(&self) -> Option<String> {
+        let (at, stamp) = self.unexplained_repeat?;
+        Some(format!(
+            "{} timestamps equal the one before (the first: sample {at}, {stamp} ns), and the \
+             stamps resolve {:e} s, finer than the interval {:e} s: samples repeated? \
+             --drop-backward drops such samples and counts them",
+            self.repeated,
+            self.resolution_s.unwrap_or(1e-9),
+            self.median_interval_s
+        ))
+    }
+
     /// One line for the text outputs.
     pub fn text(&self) -> String {
         format!(
@@ -626,7 +858,20 @@ impl TimingSummary {
             self.missing_samples,
             self.short_intervals,
             self.dropped_backward
-        )
+        ) + &self.coarse_text()
+    }
+
+    /// For stamps whose resolution is coarser than a quarter of the interval: what the rate
+    /// was taken from.
+    fn coarse_text(&self) -> String {
+        match self.resolution_s {
+            Some(q) if self.repeated > 0 || 4.0 * q > self.median_interval_s => format!(
+                "; stamps to {q:e} s, {} repeated: the rate over the intervals within a \
+                 quantum of the period",
+                self.repeated
+            ),
+            _ => String::new(),
+        }
     }
 }
 
@@ -893,5 +1138,121 @@ mod tests {
         }
         let s = summary_of(&t);
         assert_eq!((s.gaps, s.missing_samples), (2, 1999));
+    }
+
+    /// Stamps of a clock at `rate_hz` (offset by a third of a period) rounded down to
+    /// `resolution_ns`, from an epoch in ns, skipping the samples `skip` says.
+    fn coarse(
+        n: usize,
+        rate_hz: f64,
+        resolution_ns: i64,
+        skip: impl Fn(usize) -> bool,
+    ) -> Vec<i64> {
+        let period = 1e9 / rate_hz;
+        (0..n)
+            .filter(|&i| !skip(i))
+            .map(|i| {
+                let t = ((i as f64 + 1.0 / 3.0) * period) as i64;
+                1_700_000_000_000_000_000 + t / resolution_ns * resolution_ns
+            })
+            .collect()
+    }
+
+    /// Every stamp pushed, those equal to the one before kept as repeats.
+    fn summary_keeping_repeats(t: &[i64]) -> TimingSummary {
+        let mut timing = Timing::new();
+        for &s in t {
+            match timing.push(s) {
+                Step::Forward => {}
+                Step::Repeat => timing.keep_repeat(),
+                Step::Backward { .. } => panic!("{s} went backwards"),
+            }
+        }
+        timing.summary(TimeUnit::Nanoseconds).unwrap()
+    }
+
+    #[test]
+    fn stamps_rounded_to_whole_milliseconds_give_the_clocks_rate() {
+        // Intervals of 3 and 4 ms (325 Hz), 2 and 3 ms (340 Hz), 1 and 2 ms (600 Hz), 5 and
+        // 6 ms (180 Hz), nearly all 3 ms (333 Hz), or all 3 ms (333.33 Hz).
+        for rate in [325.0, 340.0, 333.0, 600.0, 180.0, 1000.0 / 3.0, 777.0] {
+            let t = coarse(60_000, rate, 1_000_000, |_| false);
+            let s = summary_keeping_repeats(&t);
+            let span = (t[t.len() - 1] - t[0]) as f64;
+            assert!(
+                (s.rate_hz / (59_999e9 / span) - 1.0).abs() < 1e-12,
+                "{rate} Hz: {} Hz",
+                s.rate_hz
+            );
+            assert!(
+                (s.rate_hz / rate - 1.0).abs() < 1e-4,
+                "{rate}: {}",
+                s.rate_hz
+            );
+            assert_eq!(
+                (s.gaps, s.missing_samples, s.short_intervals, s.repeated),
+                (0, 0, 0, 0),
+                "{rate} Hz"
+            );
+            assert_eq!(s.resolution_s, Some(1e-3));
+        }
+    }
+
+    #[test]
+    fn gaps_in_coarse_stamps_count_the_samples_they_miss() {
+        // 325 Hz to whole ms: runs of 1 to 5 samples missing at 40 places.
+        let missed = |i: usize| i % 1_500 >= 700 && i % 1_500 < 700 + (i / 1_500) % 5 + 1;
+        let t = coarse(60_000, 325.0, 1_000_000, missed);
+        let s = summary_keeping_repeats(&t);
+        let lost = (0..60_000).filter(|&i| missed(i)).count() as u64;
+        assert_eq!((s.gaps, s.missing_samples), (40, lost));
+        assert!((s.rate_hz / 325.0 - 1.0).abs() < 1e-4, "{}", s.rate_hz);
+    }
+
+    #[test]
+    fn stamps_coarser_than_the_samples_repeat_and_the_span_gives_the_rate() {
+        // 200 Hz stamped to 10 ms (every other stamp repeats), 100 Hz stamped to whole
+        // seconds (99 of 100 repeat), 300 Hz to 10 ms (two of three).
+        for (rate, resolution) in [
+            (200.0, 10_000_000),
+            (100.0, 1_000_000_000),
+            (300.0, 10_000_000),
+        ] {
+            let t = coarse(72_000, rate, resolution, |_| false);
+            let s = summary_keeping_repeats(&t);
+            let distinct = 1 + t.windows(2).filter(|w| w[1] > w[0]).count() as u64;
+            assert_eq!(s.repeated, 72_000 - distinct);
+            // Within a quantum over the span: the most stamps that coarse can tell.
+            let span = (t[t.len() - 1] - t[0]) as f64;
+            let bound = resolution as f64 / span;
+            assert!(
+                (s.rate_hz / rate - 1.0).abs() < bound,
+                "{rate}: {}",
+                s.rate_hz
+            );
+            assert_eq!((s.gaps, s.missing_samples), (0, 0), "{rate} Hz");
+            assert_eq!(s.repeat_refusal(), None, "{rate} Hz");
+        }
+    }
+
+    #[test]
+    fn a_clock_stamped_to_its_own_period_keeps_its_gaps() {
+        // 1 kHz to whole ms: intervals of 2 ms are samples missing, not rounding.
+        let t = coarse(20_000, 1000.0, 1_000_000, |i| i % 100 == 50);
+        let s = summary_keeping_repeats(&t);
+        assert_eq!(s.rate_hz, 1000.0);
+        assert_eq!((s.gaps, s.missing_samples), (200, 200));
+    }
+
+    #[test]
+    fn a_repeated_stamp_of_a_fine_clock_is_refused_naming_the_first() {
+        let mut t = stamps(1_000, 3_000);
+        t[400] = t[399];
+        let s = summary_keeping_repeats(&t);
+        assert_eq!(s.repeated, 1);
+        let e = s.repeat_refusal().expect("refused");
+        assert!(e.contains(&format!("sample 401, {} ns", t[400])), "{e}");
+        // The rate is the other stamps'.
+        assert!((s.rate_hz / 400.0 - 1.0).abs() < 1e-3, "{}", s.rate_hz);
     }
 }

@@ -387,8 +387,7 @@ fn characterise(
 }
 
 /// Writes every file of `formats` and the plots `draw` makes, or none: each into a fresh
-/// folder in `out` first, moved into `out` once all are written (and moved back out when a
-/// move fails midway).
+/// folder in `out` first, moved into `out` once all are written ([`commit`]).
 pub(crate) fn write_all(
     formats: &[Format],
     imu: &ImuModel,
@@ -408,32 +407,73 @@ pub(crate) fn write_all(
             Ok(paths)
         });
     let moved = written.and_then(|paths| {
-        let target = |p: &PathBuf| out.join(p.file_name().unwrap_or_default());
-        if let Some(to) = paths.iter().map(target).find(|to| to.is_dir()) {
-            return Err(Fail(format!(
-                "{}: is a directory; no file was written",
-                to.display()
-            )));
-        }
-        // A move that fails undoes the ones before it.
-        let mut done: Vec<(PathBuf, PathBuf)> = Vec::new();
-        for p in &paths {
-            let to = target(p);
-            if let Err(e) = std::fs::rename(p, &to) {
-                for (from, to) in done.iter().rev() {
-                    let _ = std::fs::rename(to, from);
-                }
-                return Err(cannot(e));
-            }
-            done.push((p.clone(), to));
-        }
-        Ok(done
-            .iter()
-            .map(|(_, to)| to.display().to_string())
-            .collect())
+        commit(&paths, out, &staging.join("kept"), &|from, to| {
+            std::fs::rename(from, to)
+        })
     });
     let _ = std::fs::remove_dir_all(&staging);
     moved
+}
+
+/// Moves the files `paths` into `out` by `rename`, all or none. The files of the same names
+/// already there are kept first (linked, or copied, into the folder `kept`); when a move
+/// fails, the ones before it are undone and the kept files put back, and the error names the
+/// file that could not be replaced.
+fn commit(
+    paths: &[PathBuf],
+    out: &Path,
+    kept: &Path,
+    rename: &dyn Fn(&Path, &Path) -> std::io::Result<()>,
+) -> Result<Vec<String>, Fail> {
+    let target = |p: &PathBuf| out.join(p.file_name().unwrap_or_default());
+    let unchanged = "; the files in the folder are as they were";
+    if let Some(to) = paths.iter().map(target).find(|to| to.is_dir()) {
+        return Err(Fail(format!(
+            "{}: is a directory; no file was written",
+            to.display()
+        )));
+    }
+    std::fs::create_dir_all(kept).map_err(|e| Fail(format!("{}: {e}", kept.display())))?;
+    // Each new file, where it goes, and the old file kept.
+    let mut moves: Vec<(&PathBuf, PathBuf, Option<PathBuf>)> = Vec::new();
+    for p in paths {
+        let to = target(p);
+        let old = match to.symlink_metadata() {
+            Ok(_) => {
+                let keep = kept.join(p.file_name().unwrap_or_default());
+                std::fs::hard_link(&to, &keep)
+                    .or_else(|_| std::fs::copy(&to, &keep).map(drop))
+                    .map_err(|e| {
+                        Fail(format!(
+                            "{}: cannot be kept while it is replaced: {e}; no file was written",
+                            to.display()
+                        ))
+                    })?;
+                Some(keep)
+            }
+            Err(_) => None,
+        };
+        moves.push((p, to, old));
+    }
+    for (k, (from, to, _)) in moves.iter().enumerate() {
+        if let Err(e) = rename(from, to) {
+            for (from, to, old) in moves[..k].iter().rev() {
+                match old {
+                    Some(old) => {
+                        let _ = rename(old, to);
+                    }
+                    None => {
+                        let _ = rename(to, from);
+                    }
+                }
+            }
+            return Err(Fail(format!("{}: {e}{unchanged}", to.display())));
+        }
+    }
+    Ok(moves
+        .iter()
+        .map(|(_, to, _)| to.display().to_string())
+        .collect())
 }
 
 /// One axis's composite, with the AR part (order by BIC, 0 to [`LAGS`]) from its streamed
@@ -660,5 +700,96 @@ impl Output for Characterisation {
         }
         s += &format!("wrote {}\n", self.files.join(", "));
         s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A folder `out` with the old files `a`, `b` and `c`, and new `a` to `d` staged in it.
+    fn staged(name: &str) -> (PathBuf, Vec<PathBuf>) {
+        let out = std::env::temp_dir().join(format!("imu-ar-commit-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&out);
+        let staging = out.join(".staging");
+        std::fs::create_dir_all(&staging).unwrap();
+        for f in ["a", "b", "c"] {
+            std::fs::write(out.join(f), format!("old {f}")).unwrap();
+        }
+        let paths = ["a", "b", "c", "d"]
+            .iter()
+            .map(|f| {
+                let p = staging.join(f);
+                std::fs::write(&p, format!("new {f}")).unwrap();
+                p
+            })
+            .collect();
+        (out, paths)
+    }
+
+    fn contents(out: &Path) -> Vec<(String, String)> {
+        let mut v: Vec<(String, String)> = std::fs::read_dir(out)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.is_file())
+            .map(|p| {
+                let name = p.file_name().unwrap().to_string_lossy().into_owned();
+                (name, std::fs::read_to_string(&p).unwrap())
+            })
+            .collect();
+        v.sort();
+        v
+    }
+
+    #[test]
+    fn a_move_that_fails_leaves_the_old_files_as_they_were() {
+        let old = |out: &Path| {
+            ["a", "b", "c"]
+                .iter()
+                .map(|f| (f.to_string(), format!("old {f}")))
+                .collect::<Vec<_>>()
+                == contents(out)
+        };
+        // The move of each file in turn fails (as an immutable file's replacement does).
+        for failing in ["a", "b", "c", "d"] {
+            let (out, paths) = staged(failing);
+            let rename = |from: &Path, to: &Path| {
+                if to.file_name() == Some(failing.as_ref())
+                    && from.starts_with(out.join(".staging"))
+                {
+                    Err(std::io::Error::from(std::io::ErrorKind::PermissionDenied))
+                } else {
+                    std::fs::rename(from, to)
+                }
+            };
+            let Err(e) = commit(&paths, &out, &out.join(".staging/kept"), &rename) else {
+                panic!("{failing}: committed");
+            };
+            assert!(
+                e.0.starts_with(&format!("{}: ", out.join(failing).display())),
+                "{}",
+                e.0
+            );
+            assert!(
+                e.0.ends_with("the files in the folder are as they were"),
+                "{}",
+                e.0
+            );
+            assert!(old(&out), "{failing}: {:?}", contents(&out));
+            std::fs::remove_dir_all(&out).unwrap();
+        }
+        // And none fails: every new file is in place.
+        let (out, paths) = staged("none");
+        let written = commit(&paths, &out, &out.join(".staging/kept"), &|from, to| {
+            std::fs::rename(from, to)
+        })
+        .unwrap_or_else(|e| panic!("{}", e.0));
+        assert_eq!(written.len(), 4);
+        let new: Vec<(String, String)> = ["a", "b", "c", "d"]
+            .iter()
+            .map(|f| (f.to_string(), format!("new {f}")))
+            .collect();
+        assert_eq!(contents(&out), new);
+        std::fs::remove_dir_all(&out).unwrap();
     }
 }

@@ -351,32 +351,54 @@ fn overbound_lines(n: f64, k: f64, b: &Bounded, h: f64, asked: bool) -> Vec<Stri
             _ => String::new(),
         }
     )];
-    let ratio = |x: f64, of: f64, name: &str, floored: bool| {
-        let over = if floored { "floor" } else { name };
-        format!("{name}_H/{over} = {}", short(x / of))
+    // Against the fitted value, and against the floor where the overbound started from one
+    // (a zero fit, or a K raised to what an axis without one leaves room for).
+    let ratio = |x: f64, of: f64, fitted: f64, name: &str| {
+        if of == fitted {
+            format!("{name}_H/{name} = {}", short(x / of))
+        } else if fitted > 0.0 {
+            format!(
+                "{name}_H/floor = {}, {name}_H/{name} = {}",
+                short(x / of),
+                short(x / fitted)
+            )
+        } else {
+            format!("{name}_H/floor = {}", short(x / of))
+        }
     };
     lines.push(format!(
         "  N_H = {} (fitted N = {}, {}), K_H = {} (fitted K = {}, {}).",
         short(nh),
         short(n),
-        ratio(nh, b.n_ref, "N", n <= 0.0),
+        ratio(nh, b.n_ref, n, "N"),
         short(kh),
         short(k),
-        ratio(kh, b.k_ref, "K", k <= 0.0)
+        ratio(kh, b.k_ref, k, "K")
     ));
     let octave = |j: usize| {
         let (i, tau, _) = b.rows[j];
         format!("the model at tau = {} s ({})", short(tau), AXIS_NAMES[i])
     };
+    let (n_at, k_at) = (
+        if b.n_ref == n { "N" } else { "N's floor" },
+        if b.k_ref == k { "K" } else { "K's floor" },
+    );
     lines.push(match limits {
         _ if b.rows.is_empty() => format!(
             "  No octave of the model lies in [{FROM_TAU} s, H]: N and K written as fitted."
         ),
-        [Limit::White, Limit::RandomWalk] => "  N_H = N and K_H = K: the fitted white noise and \
-                                              random walk already overbound the model there."
-            .to_string(),
-        [Limit::White, Limit::Octave(j)] => format!("  N_H = N; K_H set by {}.", octave(j)),
-        [Limit::RandomWalk, Limit::Octave(j)] => format!("  K_H = K; N_H set by {}.", octave(j)),
+        [Limit::White, Limit::RandomWalk] if b.n_ref == n && b.k_ref == k => {
+            "  N_H = N and K_H = K: the fitted white noise and random walk already overbound \
+             the model there."
+                .to_string()
+        }
+        [Limit::White, Limit::RandomWalk] => {
+            format!("  N_H = {n_at} and K_H = {k_at}: they already overbound the model there.")
+        }
+        [Limit::White, Limit::Octave(j)] => format!("  N_H = {n_at}; K_H set by {}.", octave(j)),
+        [Limit::RandomWalk, Limit::Octave(j)] => {
+            format!("  K_H = {k_at}; N_H set by {}.", octave(j))
+        }
         [Limit::Octave(p), Limit::Octave(q)] => {
             format!("  Set by {} and {}.", octave(p), octave(q))
         }
@@ -618,4 +640,56 @@ pub fn orbslam3(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> 
             num(a.k),
             frequency as u64
         ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A bound from `(n_ref, k_ref)` set by both references, over one octave.
+    fn bounded_at(n_ref: f64, k_ref: f64) -> Bounded {
+        Bounded {
+            n_ref,
+            k_ref,
+            floors: Vec::new(),
+            rows: vec![(0, 1.0, 1e-12)],
+            bound: Overbound {
+                n: n_ref,
+                k: k_ref,
+                limits: [Limit::White, Limit::RandomWalk],
+            },
+        }
+    }
+
+    #[test]
+    fn a_random_walk_raised_to_an_axis_floor_is_named_as_such() {
+        // A fitted K of 2.0941e-5 raised to 9.0681e-5, the upper end of another axis's
+        // interval: K_H is the floor, 4.33 times the fitted K.
+        let lines = overbound_lines(1e-3, 2.0941e-5, &bounded_at(1e-3, 9.0681e-5), 100.0, false);
+        let text = lines.join("\n");
+        assert!(
+            text.contains("K_H/floor = 1.0000e0, K_H/K = 4.3303e0"),
+            "{text}"
+        );
+        assert!(
+            text.contains("  N_H = N and K_H = K's floor: they already"),
+            "{text}"
+        );
+        assert!(!text.contains("K_H = K:"), "{text}");
+        // Fitted references: as they were.
+        let text = overbound_lines(1e-3, 2e-5, &bounded_at(1e-3, 2e-5), 100.0, false).join("\n");
+        assert!(
+            text.contains(
+                "N_H/N = 1.0000e0), K_H = 2.0000e-5 (fitted K = 2.0000e-5, K_H/K = 1.0000e0)"
+            ),
+            "{text}"
+        );
+        assert!(text.contains("N_H = N and K_H = K: the fitted"), "{text}");
+        // No fitted K: against the floor alone.
+        let text = overbound_lines(1e-3, 0.0, &bounded_at(1e-3, 5e-5), 100.0, false).join("\n");
+        assert!(
+            text.contains("(fitted K = 0.0000e0, K_H/floor = 1.0000e0)"),
+            "{text}"
+        );
+    }
 }

@@ -215,8 +215,10 @@ pub fn resolve_rate(given: Option<f64>, timing: Option<&TimingSummary>) -> Resul
     }
 }
 
-/// The timestamps' summary: an error when they give no single rate and it is `needed`
-/// (`--rate` was not given); otherwise such timestamps are not reported.
+/// The timestamps' summary: an error when they give no single rate, or repeat where they
+/// resolve the interval, and it is `needed` (`--rate` was not given); otherwise such
+/// timestamps are not reported, or their repeats are (the rate the others give checks
+/// `--rate`).
 pub fn summary(
     timing: Option<(timing::Timing, timing::TimeUnit)>,
     needed: bool,
@@ -224,7 +226,10 @@ pub fn summary(
     match timing.map(|(t, u)| t.summary(u)) {
         Some(Err(e)) if needed => Err(e),
         Some(Err(_)) | None => Ok(None),
-        Some(Ok(s)) => Ok(Some(s)),
+        Some(Ok(s)) => match s.repeat_refusal() {
+            Some(e) if needed => Err(e),
+            _ => Ok(Some(s)),
+        },
     }
 }
 

@@ -171,6 +171,35 @@ fn a_topic_of_another_type_is_named() {
 }
 
 #[test]
+fn a_topic_of_two_types_names_both() {
+    // Three strings (connection 0) and ten IMU messages (connection 1) on /imu0.
+    let path = fixture("string-and-imu.bag");
+    let (got, result) = collect(reader("ros1"), &path, "/imu0");
+    assert_eq!(
+        problem(&path, result),
+        "topic '/imu0' carries sensor_msgs/Imu (connection 1) and std_msgs/String (connection \
+         0): one topic, one type of message; keep the IMU's connections (rosbag \
+         filter) and read those"
+    );
+    assert!(got.is_empty());
+    // In MCAP: an IMU channel, then a string channel on its topic.
+    let path = temp_dir("two-types").join("two-types.mcap");
+    let mut w = mcap::Writer::new(std::fs::File::create(&path).unwrap()).unwrap();
+    let imu = w.add_schema("sensor_msgs/msg/Imu", "ros2msg", b"").unwrap();
+    let string = w.add_schema("std_msgs/msg/String", "ros2msg", b"").unwrap();
+    w.add_channel(imu, "/imu", "cdr", &BTreeMap::new()).unwrap();
+    w.add_channel(string, "/imu", "cdr", &BTreeMap::new())
+        .unwrap();
+    w.finish().unwrap();
+    drop(w);
+    assert_eq!(
+        problem(&path, mcap_reader::read(&path, "/imu", &mut |_| {})),
+        "topic '/imu' carries sensor_msgs/msg/Imu (channel 1) and std_msgs/msg/String (channel \
+         2): one topic, one type of message"
+    );
+}
+
+#[test]
 fn other_mcap_encodings_are_refused() {
     let dir = temp_dir("encoding");
     // The IMU channel declared as json (its bytes are CDR).

@@ -910,3 +910,105 @@ fn an_mcap_file_whose_structure_is_damaged_is_refused() {
         }
     }
 }
+
+/// `noise --json` of the column gx of `file`, with `extra` arguments.
+fn noise_json(file: &Path, extra: &[&str]) -> serde_json::Value {
+    let mut args = vec!["noise", path(file), "--column", "gx", "--json"];
+    args.extend_from_slice(extra);
+    json(&imu_ar(&args))
+}
+
+#[test]
+fn stamps_rounded_to_a_coarse_clock_give_the_clocks_rate() {
+    let dir = temp_dir("coarse-stamps");
+    let frames = noise(24_000, 5);
+    // The same samples with no time column: the model at the rate given.
+    let mut plain = "gx\n".to_string();
+    for f in &frames {
+        writeln!(plain, "{:e}", f.axes[0]).unwrap();
+    }
+    let plain_file = dir.join("plain.csv");
+    std::fs::write(&plain_file, plain).unwrap();
+    // 325 Hz to whole ms (intervals of 3 and 4 ms), 340 Hz to whole ms (2 and 3 ms), and
+    // 200 Hz to 10 ms, in seconds (every other stamp repeats).
+    for (rate, header, stamp) in [
+        (
+            325.0,
+            "t [ms]",
+            &(|t: f64| format!("{}", (t * 1e3).floor())) as &dyn Fn(f64) -> String,
+        ),
+        (340.0, "t [ms]", &|t: f64| format!("{}", (t * 1e3).floor())),
+        (200.0, "t [s]", &|t: f64| {
+            format!("{:.2}", (t * 100.0).floor() / 100.0)
+        }),
+    ] {
+        let mut text = format!("{header},gx\n");
+        for (i, f) in frames.iter().enumerate() {
+            let t = 1_700_000_000.0 + (i as f64 + 0.5) / rate;
+            writeln!(text, "{},{:e}", stamp(t), f.axes[0]).unwrap();
+        }
+        let file = dir.join(format!("{rate}.csv"));
+        std::fs::write(&file, text).unwrap();
+        let got = noise_json(&file, &[]);
+        let timing = &got["timing"];
+        let stamped = timing["rate_hz"].as_f64().unwrap();
+        assert!((stamped / rate - 1.0).abs() < 1e-4, "{rate} Hz: {timing}");
+        assert_eq!(timing["gaps"], 0, "{rate} Hz: {timing}");
+        assert_eq!(timing["short_intervals"], 0, "{rate} Hz: {timing}");
+        // The model is the plain samples' at the rate the stamps give.
+        let r = format!("{stamped}");
+        let expected = noise_json(&plain_file, &["--rate", &r]);
+        assert_eq!(got["white_noise"], expected["white_noise"], "{rate} Hz");
+        // The clock's rate, given, agrees with the stamps.
+        let r = format!("{rate}");
+        let given = noise_json(&file, &["--rate", &r]);
+        assert_eq!(
+            given["white_noise"],
+            noise_json(&plain_file, &["--rate", &r])["white_noise"],
+            "{rate} Hz"
+        );
+    }
+}
+
+#[test]
+fn a_repeated_stamp_of_a_fine_clock_is_refused_after_the_file_is_read() {
+    let dir = temp_dir("repeated-stamp");
+    let frames = noise(2_000, 3);
+    let mut text = "t_ns,gx\n".to_string();
+    for (i, f) in frames.iter().enumerate() {
+        let t = if i == 700 {
+            frames[699].stamp_ns
+        } else {
+            f.stamp_ns
+        };
+        writeln!(text, "{t},{:e}", f.axes[0]).unwrap();
+    }
+    let file = dir.join("repeat.csv");
+    std::fs::write(&file, text).unwrap();
+    let out = imu_ar(&["noise", path(&file), "--column", "gx"]);
+    assert_one_line_failure(&out);
+    let e = stderr(&out);
+    assert!(
+        e.contains(&format!(
+            "1 timestamps equal the one before (the first: sample 701, {} ns)",
+            frames[699].stamp_ns
+        )),
+        "{e}"
+    );
+    // Dropped on request, and counted.
+    let dropped = noise_json(&file, &["--drop-backward"]);
+    assert_eq!(dropped["timing"]["dropped_backward"], 1);
+    assert_eq!(dropped["n"], 1_999);
+    // With --rate the sample stays and the other stamps still check the rate.
+    let kept = noise_json(&file, &["--rate", "100"]);
+    assert_eq!(
+        (kept["n"].clone(), kept["timing"]["repeated"].clone()),
+        (2_000.into(), 1.into())
+    );
+    let out = imu_ar(&["noise", path(&file), "--column", "gx", "--rate", "200"]);
+    assert!(
+        stderr(&out).contains("--rate 200: the timestamps give 99.99"),
+        "{}",
+        stderr(&out)
+    );
+}
