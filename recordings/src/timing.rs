@@ -381,6 +381,10 @@ pub struct Timing {
     /// among the stamps pushed, its stamp).
     repeats: u64,
     first_repeat: Option<(u64, i64)>,
+    /// The last interval and how many times in a row it came, and the most times any did:
+    /// a clock's rounded intervals alternate, a record of two rates runs long on each.
+    run: (i64, u64),
+    longest_run: u64,
     /// The histogram, in the order of the intervals.
     buckets: Vec<Bucket>,
     /// The histogram before the last merge: its allocation, for the next.
@@ -418,7 +422,14 @@ impl Timing {
         if t < self.last {
             return Step::Backward { last: self.last };
         }
-        self.pending.push(t.saturating_sub(self.last));
+        let iv = t.saturating_sub(self.last);
+        self.pending.push(iv);
+        if iv == self.run.0 {
+            self.run.1 += 1;
+            self.longest_run = self.longest_run.max(self.run.1);
+        } else {
+            self.run = (iv, 1);
+        }
         if self.pending.len() >= PENDING {
             merge_into(
                 &self.buckets,
@@ -488,7 +499,13 @@ impl Timing {
         }
         let span = self.span_ns();
         let resolution = resolution(&buckets, self.bits);
-        let judged = judged(&buckets, median, span, intervals, resolution, self.repeats);
+        let judged = judged(
+            &buckets,
+            (median, span, intervals),
+            resolution,
+            self.repeats,
+            self.longest_run.max(1),
+        );
         let Judged {
             classes:
                 Classes {
@@ -641,8 +658,8 @@ struct Judged {
 
 /// The histogram's intervals (`intervals` of them, over `span` ns, with `repeats` stamps
 /// equal to the one before left out) judged against the `median` interval, or where that
-/// leaves under 90 % regular (stamps rounded to a coarse clock: 5 and 6 ms at 180 Hz), against
-/// the mean interval.
+/// leaves under 90 % regular and they [`alternate`] (stamps rounded to a coarse clock: 5 and
+/// 6 ms at 180 Hz), against the mean interval.
 ///
 /// Stamps rounded to a quantum (`resolution`, ns) coarser than a quarter of the interval show
 /// intervals a quantum apart (3 and 4 ms at 325 Hz, 2 and 3 ms at 340 Hz); stamps coarser than
@@ -653,11 +670,10 @@ struct Judged {
 /// the span's, for a record without gaps.
 fn judged(
     buckets: &[Bucket],
-    median: f64,
-    span: f64,
-    intervals: u64,
+    (median, span, intervals): (f64, f64, u64),
     resolution: Option<i64>,
     repeats: u64,
+    longest_run: u64,
 ) -> Judged {
     let by_ratio = |reference: f64| {
         let window = Window::Ratio(reference);
@@ -667,7 +683,7 @@ fn judged(
     let mean = span / intervals as f64;
     if (c.regular as f64) < 0.9 * intervals as f64 {
         let (w, by_mean) = by_ratio(mean);
-        if by_mean.regular > c.regular {
+        if by_mean.regular > c.regular && alternate(buckets, &w, intervals, longest_run) {
             (window, c) = (w, by_mean);
         }
     }
@@ -720,9 +736,29 @@ fn judged(
         });
     }
     match judged {
-        Some(j) if j.classes.regular + j.repeats >= ratio.classes.regular => j,
+        Some(j)
+            if j.classes.regular + j.repeats >= ratio.classes.regular
+                && (counted > 0 || alternate(buckets, &j.window, intervals, longest_run)) =>
+        {
+            j
+        }
         _ => ratio,
     }
+}
+
+/// Whether the regular intervals of `j` alternate as a rounded clock's do: the less common
+/// of them come about every `intervals / fewer` intervals, so no interval comes many more
+/// times in a row (`longest_run`) than that, allowing for jitter (a geometric run's longest
+/// grows as the logarithm of their number). Two rates within a quantum of each other (3 ms,
+/// then 4 ms) run half the record each.
+fn alternate(buckets: &[Bucket], window: &Window, intervals: u64, longest_run: u64) -> bool {
+    let (regular, most) = buckets
+        .iter()
+        .filter(|b| window.judge(b.mean()) == Ordering::Equal)
+        .fold((0, 0), |(all, most), b| (all + b.count, b.count.max(most)));
+    let fewer = regular - most;
+    fewer == 0
+        || (longest_run as f64) <= ((intervals as f64).ln() + 4.0) * intervals as f64 / fewer as f64
 }
 
 /// The intervals of the histogram judged by `window`: regular, short or gaps (a bucket, at
@@ -1242,6 +1278,29 @@ mod tests {
         let s = summary_keeping_repeats(&t);
         assert_eq!(s.rate_hz, 1000.0);
         assert_eq!((s.gaps, s.missing_samples), (200, 200));
+    }
+
+    #[test]
+    fn two_rates_a_quantum_apart_are_mixed_rates_not_a_rounded_clock() {
+        // 500 Hz then 333.33 Hz (2 ms, then 3 ms), 333.33 Hz then 500 Hz, 1 kHz then 500 Hz
+        // (1 ms, then 2 ms), to whole ms.
+        for (a, b) in [
+            (500.0, 1000.0 / 3.0),
+            (1000.0 / 3.0, 500.0),
+            (1000.0, 500.0),
+        ] {
+            let mut t = coarse(30_000, a, 1_000_000, |_| false);
+            let end = t[t.len() - 1];
+            t.extend(coarse(30_000, b, 1_000_000, |_| false).iter().map(|s| {
+                end + 1_000_000_000 / b as i64 / 1_000_000 * 1_000_000
+                    + (s - 1_700_000_000_000_000_000)
+            }));
+            let mut timing = Timing::new();
+            t.iter()
+                .for_each(|&s| assert_eq!(timing.push(s), Step::Forward));
+            let e = timing.summary(TimeUnit::Nanoseconds).unwrap_err();
+            assert!(e.contains("mixed rates"), "{a}, {b}: {e}");
+        }
     }
 
     #[test]
