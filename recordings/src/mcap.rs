@@ -154,6 +154,11 @@ pub fn read_selected(
         tally,
         ..
     } = state;
+    if let (true, Some((name, _))) = (channels.wanted.is_empty(), channels.others.first()) {
+        return Err(fail(format!(
+            "topic '{topic}' has type {name}, not {IMU_SCHEMA}"
+        )));
+    }
     if channels.wanted.is_empty() {
         return Err(fail(absent_topic(
             IMU_SCHEMA,
@@ -388,12 +393,35 @@ struct Channels {
     all_topics: Vec<String>,
     /// Channel ID to topic and schema ID, of every channel.
     known: HashMap<u16, (String, u16)>,
+    /// The channels on the topic of another schema: its name, and the channel's ID.
+    others: Vec<(String, u16)>,
 }
 
 impl Channels {
     /// Takes in a schema or channel record; an error when it is a channel on `topic` that
-    /// cannot be read.
+    /// cannot be read, or the topic has channels of the IMU's schema and another's.
     fn add(&mut self, record: Record<'_>, topic: &str) -> Result<(), String> {
+        self.take(record, topic)?;
+        if self.wanted.is_empty() || self.others.is_empty() {
+            return Ok(());
+        }
+        let ids = |ids: &mut dyn Iterator<Item = u16>| {
+            ids.map(|id| id.to_string()).collect::<Vec<_>>().join(", ")
+        };
+        Err(format!(
+            "topic '{topic}' carries {IMU_SCHEMA} (channel {}) and {}: one topic, one type of \
+             message",
+            ids(&mut self.wanted.iter().copied()),
+            self.others
+                .iter()
+                .map(|(name, id)| format!("{name} (channel {id})"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ))
+    }
+
+    /// [`Channels::add`] without the check of the topic's schemas.
+    fn take(&mut self, record: Record<'_>, topic: &str) -> Result<(), String> {
         match record {
             Record::Schema { header, .. } => {
                 self.schemas
@@ -402,19 +430,11 @@ impl Channels {
             Record::Channel(c) => {
                 let schema = self.schemas.get(&c.schema_id);
                 let name = schema.map_or("", |s| s.0.as_str());
-                if c.topic == topic {
-                    if schema.is_some() && name != IMU_SCHEMA && !self.wanted.is_empty() {
-                        return Err(format!(
-                            "topic '{topic}' carries {IMU_SCHEMA} (channel {}) and {name} \
-                             (channel {}): one topic, one type of message",
-                            self.wanted
-                                .iter()
-                                .map(u16::to_string)
-                                .collect::<Vec<_>>()
-                                .join(", "),
-                            c.id
-                        ));
+                if c.topic == topic && schema.is_some() && name != IMU_SCHEMA {
+                    if !self.others.iter().any(|o| o.1 == c.id) {
+                        self.others.push((name.to_string(), c.id));
                     }
+                } else if c.topic == topic {
                     check_channel(topic, c.schema_id, schema, &c.message_encoding)?;
                     if !self.wanted.contains(&c.id) {
                         self.wanted.push(c.id);

@@ -238,14 +238,15 @@ pub fn read_db3(
         })
         .map_err(sql)?;
     let (mut ids, mut imu_topics, mut all_topics) = (Vec::new(), Vec::new(), Vec::new());
+    // The topic's rows of another type: the type, and the row's id.
+    let mut others: Vec<(String, i64)> = Vec::new();
     for row in rows {
         let (id, name, ty, format) = row.map_err(sql)?;
+        if name == topic && ty != IMU_SCHEMA {
+            others.push((ty, id));
+            continue;
+        }
         if name == topic {
-            if ty != IMU_SCHEMA {
-                return Err(fail(format!(
-                    "topic '{topic}' has type {ty}, not {IMU_SCHEMA}"
-                )));
-            }
             if format != "cdr" {
                 return Err(fail(format!(
                     "unknown encoding '{}' on topic '{topic}' (supported: cdr)",
@@ -260,6 +261,25 @@ pub fn read_db3(
         if !all_topics.contains(&name) {
             all_topics.push(name);
         }
+    }
+    if let Some((ty, _)) = others.first() {
+        return Err(fail(if ids.is_empty() {
+            format!("topic '{topic}' has type {ty}, not {IMU_SCHEMA}")
+        } else {
+            let list = |ids: &mut dyn Iterator<Item = i64>| {
+                ids.map(|id| id.to_string()).collect::<Vec<_>>().join(", ")
+            };
+            format!(
+                "topic '{topic}' carries {IMU_SCHEMA} (topic row {}) and {}: one topic, one \
+                 type of message",
+                list(&mut ids.iter().copied()),
+                others
+                    .iter()
+                    .map(|(ty, id)| format!("{ty} (topic row {id})"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        }));
     }
     if ids.is_empty() {
         return Err(fail(absent_topic(

@@ -417,6 +417,7 @@ impl Timing {
             return Step::Forward;
         };
         if t == self.last {
+            self.count_run(0);
             return Step::Repeat;
         }
         if t < self.last {
@@ -424,12 +425,7 @@ impl Timing {
         }
         let iv = t.saturating_sub(self.last);
         self.pending.push(iv);
-        if iv == self.run.0 {
-            self.run.1 += 1;
-            self.longest_run = self.longest_run.max(self.run.1);
-        } else {
-            self.run = (iv, 1);
-        }
+        self.count_run(iv);
         if self.pending.len() >= PENDING {
             merge_into(
                 &self.buckets,
@@ -446,6 +442,16 @@ impl Timing {
         }
         self.last = t;
         Step::Forward
+    }
+
+    /// Counts the interval `iv` (0 for a repeated stamp) into the runs of equal intervals.
+    fn count_run(&mut self, iv: i64) {
+        if iv == self.run.0 {
+            self.run.1 += 1;
+            self.longest_run = self.longest_run.max(self.run.1);
+        } else {
+            self.run = (iv, 1);
+        }
     }
 
     /// Counts a sample dropped for its backward (or repeated) stamp.
@@ -519,6 +525,7 @@ impl Timing {
             period,
             repeats,
             window,
+            other,
         } = judged;
         let (sq, worst) = jitter(&buckets, &window, period);
         // Repeats counted as samples are intervals of 0: a deviation of -1 each.
@@ -540,6 +547,8 @@ impl Timing {
             dropped_backward: self.dropped,
             span_s: span * 1e-9,
             resolution_s: resolution.map(|q| q as f64 * 1e-9),
+            span_rate_hz: 1e9 * (intervals + self.repeats) as f64 / span,
+            other_rate_hz: other,
             repeated: self.repeats,
             unexplained_repeat: if repeats == self.repeats {
                 None
@@ -580,17 +589,12 @@ impl Timing {
 enum Window {
     /// Within 25 % of the reference interval (ns).
     Ratio(f64),
-    /// For stamps rounded to a quantum `q` (ns) coarser than a quarter of the interval: within
-    /// one quantum of the reference (a clock's intervals rounded down or up), ends included
-    /// while the reference is only a first guess, or within 25 % of it. A gap of `skip` ns
+    /// For stamps rounded to a quantum `q` (ns) coarser than a quarter of the interval: under
+    /// one and a half periods (the reference, ns), or up to the period rounded up to whole
+    /// quanta (a clock's intervals rounded down or up, jitter either way). A gap of `skip` ns
     /// more than a whole number of periods is what a clock whose stamps repeat shows between
     /// distinct stamps (the quantum less a period).
-    Quantum {
-        reference: f64,
-        q: f64,
-        inclusive: bool,
-        skip: f64,
-    },
+    Quantum { reference: f64, q: f64, skip: f64 },
 }
 
 impl Window {
@@ -613,17 +617,9 @@ impl Window {
                     Ordering::Equal
                 }
             }
-            Window::Quantum {
-                reference,
-                q,
-                inclusive,
-                ..
-            } => {
-                let d = iv - reference;
-                if d.abs() < q || (inclusive && d.abs() == q) || d.abs() <= 0.25 * reference {
+            Window::Quantum { reference, q, .. } => {
+                if iv < 1.5 * reference || iv <= (reference / q).ceil() * q {
                     Ordering::Equal
-                } else if d < 0.0 {
-                    Ordering::Less
                 } else {
                     Ordering::Greater
                 }
@@ -654,6 +650,8 @@ struct Judged {
     period: f64,
     repeats: u64,
     window: Window,
+    /// The rate of the other reading, where stamps rounded to a quantum have two.
+    other: Option<f64>,
 }
 
 /// The histogram's intervals (`intervals` of them, over `span` ns, with `repeats` stamps
@@ -683,7 +681,7 @@ fn judged(
     let mean = span / intervals as f64;
     if (c.regular as f64) < 0.9 * intervals as f64 {
         let (w, by_mean) = by_ratio(mean);
-        if by_mean.regular > c.regular && alternate(buckets, &w, intervals, longest_run) {
+        if by_mean.regular > c.regular && alternate(buckets, &w, 0, longest_run, false) {
             (window, c) = (w, by_mean);
         }
     }
@@ -692,33 +690,35 @@ fn judged(
         classes: c,
         repeats: 0,
         window,
+        other: None,
     };
     let Some(q) = resolution.map(|q| q as f64) else {
         return ratio;
     };
-    let coarse_repeats = repeats > 0 && q == median;
+    // A clock faster than its stamps: repeats, at least 1 % of the samples, between intervals
+    // of one quantum.
+    let coarse_repeats =
+        q == median && repeats > 0 && 100 * repeats >= intervals.saturating_add(repeats);
+    // A period just over one quantum: intervals of one and two quanta, which are as well a
+    // clock of one quantum's period that misses samples; read as rounding only where the
+    // longer ones come as evenly as rounding makes them.
+    let just_over = q == median && repeats == 0 && buckets.iter().any(|b| b.key as f64 == 2.0 * q);
     let rounded = 4.0 * q > median
         && buckets.iter().any(|b| {
             let r = b.mean() / median;
-            (0.5..0.75).contains(&r) || (r > 1.25 && r < 1.5)
+            (0.5..0.75).contains(&r) || (r > 1.25 && r <= 1.5)
         });
     let mixed = (ratio.classes.regular as f64) < 0.9 * intervals as f64 && 4.0 * q > mean;
-    if !(coarse_repeats || rounded || mixed) {
+    if !(coarse_repeats || just_over || rounded || mixed) {
         return ratio;
     }
     let counted = if coarse_repeats { repeats } else { 0 };
-    let mut reference = if rounded && !coarse_repeats {
-        median
-    } else {
-        span / (intervals + counted) as f64
-    };
-    let mut inclusive = true;
+    let mut reference = span / (intervals + counted) as f64;
     let mut judged = None;
     for _ in 0..4 {
         let window = Window::Quantum {
             reference,
             q,
-            inclusive,
             skip: if counted > 0 { q - reference } else { 0.0 },
         };
         let c = classes(buckets, &window);
@@ -727,38 +727,59 @@ fn judged(
             return ratio;
         }
         reference = c.sum / held as f64;
-        inclusive = false;
         judged = Some(Judged {
             period: reference,
             classes: c,
             repeats: counted,
             window,
+            other: Some(1e9 / ratio.period),
         });
     }
     match judged {
         Some(j)
             if j.classes.regular + j.repeats >= ratio.classes.regular
-                && (counted > 0 || alternate(buckets, &j.window, intervals, longest_run)) =>
+                && alternate(buckets, &j.window, counted, longest_run, q == median) =>
         {
             j
         }
-        _ => ratio,
+        // The intervals as samples missing; rounding's rate the other reading.
+        Some(j) => Judged {
+            other: Some(1e9 / j.period),
+            ..ratio
+        },
+        None => ratio,
     }
 }
 
-/// Whether the regular intervals of `j` alternate as a rounded clock's do: the less common
-/// of them come about every `intervals / fewer` intervals, so no interval comes many more
-/// times in a row (`longest_run`) than that, allowing for jitter (a geometric run's longest
-/// grows as the logarithm of their number). Two rates within a quantum of each other (3 ms,
-/// then 4 ms) run half the record each.
-fn alternate(buckets: &[Bucket], window: &Window, intervals: u64, longest_run: u64) -> bool {
+/// Whether the regular intervals `window` judges (and `zeros` repeated stamps) alternate as
+/// a rounded clock's do: the less common of them come about every `n / fewer` intervals, so
+/// no interval comes many more times in a row (`longest_run`) than that: twice that and 8
+/// more where `tight` (rounding without jitter spaces them evenly), else allowing for jitter
+/// (a geometric run's longest grows as the logarithm of their number). Two rates within a
+/// quantum of each other (3 ms, then 4 ms) run half the record each; a clock that misses
+/// samples at random runs the logarithm of their number longer than one that rounds.
+fn alternate(
+    buckets: &[Bucket],
+    window: &Window,
+    zeros: u64,
+    longest_run: u64,
+    tight: bool,
+) -> bool {
     let (regular, most) = buckets
         .iter()
         .filter(|b| window.judge(b.mean()) == Ordering::Equal)
-        .fold((0, 0), |(all, most), b| (all + b.count, b.count.max(most)));
+        .fold((zeros, zeros), |(all, most), b| {
+            (all + b.count, b.count.max(most))
+        });
     let fewer = regular - most;
+    let spacing = regular as f64 / fewer as f64;
     fewer == 0
-        || (longest_run as f64) <= ((intervals as f64).ln() + 4.0) * intervals as f64 / fewer as f64
+        || (longest_run as f64)
+            <= if tight {
+                2.0 * spacing + 8.0
+            } else {
+                ((regular as f64).ln() + 4.0) * spacing
+            }
 }
 
 /// The intervals of the histogram judged by `window`: regular, short or gaps (a bucket, at
@@ -855,6 +876,14 @@ pub struct TimingSummary {
     /// The largest power of ten that divides every interval, s: the stamps' resolution (none
     /// known past 65,536 distinct intervals).
     pub resolution_s: Option<f64>,
+    /// The rate of the samples over the span (every stamp kept, repeats too, less one, over
+    /// it), Hz: the rate, where no sample is missing.
+    pub span_rate_hz: f64,
+    /// The rate of the other reading of stamps rounded to a quantum, Hz: intervals within 25 %
+    /// of the median where the rate was read as rounding's, or rounding's where it was not;
+    /// a given rate may match either.
+    #[serde(skip)]
+    pub other_rate_hz: Option<f64>,
     /// Samples kept whose stamp equals the one before: a clock coarser than the samples'
     /// interval (their rate is then the span's), or, where the stamps resolve the interval,
     /// samples repeated, which [`TimingSummary::repeat_refusal`] names.
@@ -1273,11 +1302,109 @@ mod tests {
 
     #[test]
     fn a_clock_stamped_to_its_own_period_keeps_its_gaps() {
-        // 1 kHz to whole ms: intervals of 2 ms are samples missing, not rounding.
-        let t = coarse(20_000, 1000.0, 1_000_000, |i| i % 100 == 50);
+        // 1 kHz to whole ms, 1 % of the samples missing at random: intervals of 2 ms are
+        // samples missing, not rounding.
+        let mut next = crate::xorshift(0x5eed_0f9a_9501);
+        let drop: Vec<bool> = (0..20_000).map(|_| next().is_multiple_of(100)).collect();
+        let t = coarse(20_000, 1000.0, 1_000_000, |i| drop[i]);
+        let lost = drop.iter().filter(|&&d| d).count() as u64;
         let s = summary_keeping_repeats(&t);
         assert_eq!(s.rate_hz, 1000.0);
-        assert_eq!((s.gaps, s.missing_samples), (200, 200));
+        assert_eq!(s.missing_samples, lost);
+        // Missing every 100th sample is as well a 990 Hz clock rounded: read so, the other
+        // reading kept for a rate given.
+        let t = coarse(20_000, 1000.0, 1_000_000, |i| i % 100 == 50);
+        let s = summary_keeping_repeats(&t);
+        assert!((s.rate_hz / 990.0 - 1.0).abs() < 1e-4, "{}", s.rate_hz);
+        assert_eq!(s.other_rate_hz, Some(1000.0));
+        // And the clock missing samples at random has rounding's rate as its other reading.
+        let t = coarse(20_000, 1000.0, 1_000_000, |i| drop[i]);
+        let other = summary_keeping_repeats(&t)
+            .other_rate_hz
+            .expect("two readings");
+        assert!(
+            (other / (1000.0 * (1.0 - lost as f64 / 20_000.0)) - 1.0).abs() < 1e-3,
+            "{other}"
+        );
+    }
+
+    #[test]
+    fn periods_just_over_a_quantum_are_read_as_rounding() {
+        // 950 and 480 Hz to whole ms, 95 Hz to 10 ms, 0.95 Hz to whole seconds, rounded down
+        // and to the nearest.
+        for (rate, q, n) in [
+            (950.0, 1_000_000, 20_000),
+            (480.0, 1_000_000, 20_000),
+            (95.0, 10_000_000, 20_000),
+            (0.95, 1_000_000_000, 2_000),
+        ] {
+            for nearest in [false, true] {
+                let period = 1e9 / rate;
+                let t: Vec<i64> = (0..n)
+                    .map(|i| {
+                        let t = (i as f64 + 0.3) * period;
+                        let k = if nearest {
+                            (t / q as f64).round()
+                        } else {
+                            (t / q as f64).floor()
+                        };
+                        k as i64 * q
+                    })
+                    .collect();
+                let s = summary_keeping_repeats(&t);
+                let truth = (n - 1) as f64 * 1e9 / (t[n - 1] - t[0]) as f64;
+                assert!(
+                    (s.rate_hz / truth - 1.0).abs() < 1e-9,
+                    "{rate} Hz: {}",
+                    s.rate_hz
+                );
+                assert!((truth / rate - 1.0).abs() < 2e-3, "{rate} Hz: {truth}");
+                assert_eq!((s.gaps, s.missing_samples), (0, 0), "{rate} Hz");
+            }
+        }
+    }
+
+    #[test]
+    fn jitter_under_coarse_stamps_leaves_the_rate_unbiased() {
+        // 325 Hz, Gaussian jitter of 50, 100 and 200 us on each stamp, to whole ms.
+        for sd in [50_000.0, 100_000.0, 200_000.0] {
+            let mut next = crate::xorshift(0x0123_4567_89ab_cdef);
+            let mut gauss = || {
+                (0..12)
+                    .map(|_| (next() >> 11) as f64 / (1u64 << 53) as f64)
+                    .sum::<f64>()
+                    - 6.0
+            };
+            let period = 1e9 / 325.0;
+            let t: Vec<i64> = (0..60_000)
+                .map(|i| {
+                    let t = 1e12 + i as f64 * period + sd * gauss();
+                    (t / 1e6).round() as i64 * 1_000_000
+                })
+                .collect();
+            let s = summary_keeping_repeats(&t);
+            assert!(
+                (s.rate_hz / 325.0 - 1.0).abs() < 1e-4,
+                "sd {sd}: {}",
+                s.rate_hz
+            );
+            assert!(s.missing_samples <= 3, "sd {sd}: {}", s.missing_samples);
+        }
+    }
+
+    #[test]
+    fn a_few_repeats_of_a_clock_stamped_to_its_period_are_samples_repeated() {
+        // 1 kHz, exact ns stamps (1 ms apart): two samples written twice.
+        let mut t: Vec<i64> = (0..20_000)
+            .map(|i| 1_600_000_000_000_000_000 + i * 1_000_000)
+            .collect();
+        t.insert(5_000, t[4_999]);
+        t.insert(100, t[99]);
+        let s = summary_keeping_repeats(&t);
+        assert_eq!(s.repeated, 2);
+        let e = s.repeat_refusal().expect("refused");
+        assert!(e.contains("sample 101"), "{e}");
+        assert_eq!(s.rate_hz, 1000.0);
     }
 
     #[test]

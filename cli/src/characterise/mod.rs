@@ -171,6 +171,12 @@ pub fn run(args: &Args) -> Result<Characterisation, Fail> {
         .ancestors()
         .take_while(|p| !p.as_os_str().is_empty() && !p.exists())
         .collect();
+    if args.out.exists() && !args.out.is_dir() {
+        return Err(Fail(format!(
+            "--out {}: is a file, not a folder",
+            args.out.display()
+        )));
+    }
     std::fs::create_dir_all(&args.out)
         .map_err(|e| Fail(format!("--out {}: cannot create: {e}", args.out.display())))?;
     let result = characterise(args, &config, given, &formats, &columns);
@@ -406,8 +412,15 @@ pub(crate) fn write_all(
             paths.extend(draw(&staging)?);
             Ok(paths)
         });
+    // The files of the formats not asked for, an earlier run's: set aside with the commit,
+    // so that the folder holds one run's files.
+    let stale: Vec<&str> = Format::ALL
+        .iter()
+        .filter(|f| !formats.contains(f))
+        .map(|f| f.file_name())
+        .collect();
     let moved = written.and_then(|paths| {
-        commit(&paths, out, &staging.join("kept"), &|from, to| {
+        commit(&paths, &stale, out, &staging.join("kept"), &|from, to| {
             std::fs::rename(from, to)
         })
     });
@@ -415,12 +428,14 @@ pub(crate) fn write_all(
     moved
 }
 
-/// Moves the files `paths` into `out` by `rename`, all or none. The files of the same names
-/// already there are kept first (linked, or copied, into the folder `kept`); when a move
-/// fails, the ones before it are undone and the kept files put back, and the error names the
-/// file that could not be replaced.
+/// Moves the files `paths` into `out` by `rename`, and the files named `stale` there (of an
+/// earlier run) out of it, all or none. The files of the same names already there are kept
+/// first (linked, or copied, into the folder `kept`, where the stale ones go too); when a
+/// move fails, the ones before it are undone and the kept files put back, and the error names
+/// the file that could not be replaced.
 fn commit(
     paths: &[PathBuf],
+    stale: &[&str],
     out: &Path,
     kept: &Path,
     rename: &dyn Fn(&Path, &Path) -> std::io::Result<()>,
@@ -455,8 +470,31 @@ fn commit(
         };
         moves.push((p, to, old));
     }
+    // A stale file set aside is a move from the folder into `kept`, undone the same way.
+    let aside: Vec<(PathBuf, PathBuf)> = stale
+        .iter()
+        .map(|name| (out.join(name), kept.join(name)))
+        .filter(|(at, _)| at.is_file())
+        .collect();
+    for (k, (at, keep)) in aside.iter().enumerate() {
+        if let Err(e) = rename(at, keep) {
+            for (at, keep) in aside[..k].iter().rev() {
+                let _ = rename(keep, at);
+            }
+            return Err(Fail(format!(
+                "{}: an earlier run's file, cannot be set aside: {e}{unchanged}",
+                at.display()
+            )));
+        }
+    }
+    let restore_aside = || {
+        for (at, keep) in aside.iter().rev() {
+            let _ = rename(keep, at);
+        }
+    };
     for (k, (from, to, _)) in moves.iter().enumerate() {
         if let Err(e) = rename(from, to) {
+            restore_aside();
             for (from, to, old) in moves[..k].iter().rev() {
                 match old {
                     Some(old) => {
@@ -707,13 +745,14 @@ impl Output for Characterisation {
 mod tests {
     use super::*;
 
-    /// A folder `out` with the old files `a`, `b` and `c`, and new `a` to `d` staged in it.
+    /// A folder `out` with the old files `a`, `b`, `c` and `e` (a format not asked for this
+    /// time), and new `a` to `d` staged in it.
     fn staged(name: &str) -> (PathBuf, Vec<PathBuf>) {
         let out = std::env::temp_dir().join(format!("imu-ar-commit-{}-{name}", std::process::id()));
         let _ = std::fs::remove_dir_all(&out);
         let staging = out.join(".staging");
         std::fs::create_dir_all(&staging).unwrap();
-        for f in ["a", "b", "c"] {
+        for f in ["a", "b", "c", "e"] {
             std::fs::write(out.join(f), format!("old {f}")).unwrap();
         }
         let paths = ["a", "b", "c", "d"]
@@ -744,25 +783,26 @@ mod tests {
     #[test]
     fn a_move_that_fails_leaves_the_old_files_as_they_were() {
         let old = |out: &Path| {
-            ["a", "b", "c"]
+            ["a", "b", "c", "e"]
                 .iter()
                 .map(|f| (f.to_string(), format!("old {f}")))
                 .collect::<Vec<_>>()
                 == contents(out)
         };
-        // The move of each file in turn fails (as an immutable file's replacement does).
-        for failing in ["a", "b", "c", "d"] {
+        // The move of each file in turn fails (as an immutable file's replacement does), the
+        // stale `e` set aside too.
+        for failing in ["a", "b", "c", "d", "e"] {
             let (out, paths) = staged(failing);
             let rename = |from: &Path, to: &Path| {
-                if to.file_name() == Some(failing.as_ref())
-                    && from.starts_with(out.join(".staging"))
-                {
+                let forward =
+                    from.parent() == Some(&out.join(".staging")) || from.parent() == Some(&out);
+                if from.file_name() == Some(failing.as_ref()) && forward {
                     Err(std::io::Error::from(std::io::ErrorKind::PermissionDenied))
                 } else {
                     std::fs::rename(from, to)
                 }
             };
-            let Err(e) = commit(&paths, &out, &out.join(".staging/kept"), &rename) else {
+            let Err(e) = commit(&paths, &["e"], &out, &out.join(".staging/kept"), &rename) else {
                 panic!("{failing}: committed");
             };
             assert!(
@@ -778,11 +818,15 @@ mod tests {
             assert!(old(&out), "{failing}: {:?}", contents(&out));
             std::fs::remove_dir_all(&out).unwrap();
         }
-        // And none fails: every new file is in place.
+        // And none fails: every new file is in place, the stale one gone.
         let (out, paths) = staged("none");
-        let written = commit(&paths, &out, &out.join(".staging/kept"), &|from, to| {
-            std::fs::rename(from, to)
-        })
+        let written = commit(
+            &paths,
+            &["e"],
+            &out,
+            &out.join(".staging/kept"),
+            &|from, to| std::fs::rename(from, to),
+        )
         .unwrap_or_else(|e| panic!("{}", e.0));
         assert_eq!(written.len(), 4);
         let new: Vec<(String, String)> = ["a", "b", "c", "d"]

@@ -157,8 +157,8 @@ impl Input {
 }
 
 impl Series {
-    /// The sample rate: `--rate` when given (an error when the timestamps give one more than
-    /// 1 % away), else the timestamps'. Errors name `input`'s files.
+    /// The sample rate: `--rate` when given (an error when the timestamps give none within
+    /// 1 % of it), else the timestamps'. Errors name `input`'s files.
     pub fn rate(&self, given: Option<f64>, input: &Input) -> Result<f64, Fail> {
         resolve_rate(given, self.timing.as_ref()).map_err(|e| input.fail(e.0))
     }
@@ -167,23 +167,27 @@ impl Series {
 /// The highest rate taken from timestamps without `--rate` to confirm it, Hz.
 pub const MAX_STAMPED_RATE: f64 = 10_000.0;
 
-/// The sample rate: `given` (`--rate`) when there is one (an error when the timestamps give
-/// one more than 1 % away), else the timestamps' (an error above [`MAX_STAMPED_RATE`]: such
+/// The sample rate: `given` (`--rate`) when there is one (an error when it is more than 1 %
+/// from the timestamps' rate and from the other reading of stamps rounded to a quantum), else the timestamps' (an error above [`MAX_STAMPED_RATE`]: such
 /// a rate is more often a time unit mistaken).
 pub fn resolve_rate(given: Option<f64>, timing: Option<&TimingSummary>) -> Result<f64, Fail> {
     match (given, timing) {
         (Some(r), Some(t)) => {
             let r = check_rate(r)?;
-            if (r / t.rate_hz - 1.0).abs() > 0.01 {
+            // The stamps' rate, or for stamps rounded to a quantum, the other reading of their
+            // intervals (rounding, or samples missing).
+            let agrees = |v: f64| (r / v - 1.0).abs() <= 0.01;
+            if !(agrees(t.rate_hz) || t.other_rate_hz.is_some_and(agrees)) {
                 return Err(Fail(format!(
-                    "--rate {}: {} give {} Hz",
+                    "--rate {}: {} give {} Hz ({} Hz over their span)",
                     number(r),
                     if t.header_stamps {
                         "the messages' header stamps"
                     } else {
                         "the timestamps"
                     },
-                    t.rate_hz
+                    t.rate_hz,
+                    t.span_rate_hz
                 )));
             }
             Ok(r)

@@ -182,21 +182,32 @@ fn a_topic_of_two_types_names_both() {
          filter) and read those"
     );
     assert!(got.is_empty());
-    // In MCAP: an IMU channel, then a string channel on its topic.
-    let path = temp_dir("two-types").join("two-types.mcap");
-    let mut w = mcap::Writer::new(std::fs::File::create(&path).unwrap()).unwrap();
-    let imu = w.add_schema("sensor_msgs/msg/Imu", "ros2msg", b"").unwrap();
-    let string = w.add_schema("std_msgs/msg/String", "ros2msg", b"").unwrap();
-    w.add_channel(imu, "/imu", "cdr", &BTreeMap::new()).unwrap();
-    w.add_channel(string, "/imu", "cdr", &BTreeMap::new())
-        .unwrap();
-    w.finish().unwrap();
-    drop(w);
-    assert_eq!(
-        problem(&path, mcap_reader::read(&path, "/imu", &mut |_| {})),
-        "topic '/imu' carries sensor_msgs/msg/Imu (channel 1) and std_msgs/msg/String (channel \
-         2): one topic, one type of message"
-    );
+    // In MCAP: an IMU channel and a string channel on one topic, in either order.
+    for imu_first in [true, false] {
+        let path = temp_dir("two-types").join(format!("two-types-{imu_first}.mcap"));
+        let mut w = mcap::Writer::new(std::fs::File::create(&path).unwrap()).unwrap();
+        let imu = w.add_schema("sensor_msgs/msg/Imu", "ros2msg", b"").unwrap();
+        let string = w.add_schema("std_msgs/msg/String", "ros2msg", b"").unwrap();
+        let order = if imu_first {
+            [imu, string]
+        } else {
+            [string, imu]
+        };
+        for schema in order {
+            w.add_channel(schema, "/imu", "cdr", &BTreeMap::new())
+                .unwrap();
+        }
+        w.finish().unwrap();
+        drop(w);
+        let (imu, string) = if imu_first { (1, 2) } else { (2, 1) };
+        assert_eq!(
+            problem(&path, mcap_reader::read(&path, "/imu", &mut |_| {})),
+            format!(
+                "topic '/imu' carries sensor_msgs/msg/Imu (channel {imu}) and \
+                 std_msgs/msg/String (channel {string}): one topic, one type of message"
+            )
+        );
+    }
 }
 
 #[test]

@@ -43,3 +43,27 @@ fn a_negative_count_names_its_argument() {
     assert!(err.contains("--n"), "the message does not name --n: {err}");
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
 }
+
+/// An `--out` that is a file is named as such.
+#[test]
+fn an_out_folder_that_is_a_file_is_named_as_such() {
+    let file = common::temp_file("out-is-a-file", "not a folder");
+    let input = common::temp_file(
+        "out-is-a-file.csv",
+        "gx,gy,gz,ax,ay,az\n1,2,3,4,5,6\n2,3,4,5,6,7\n",
+    );
+    let out = imu_ar(&[
+        "characterise",
+        input.to_str().unwrap(),
+        "--rate",
+        "100",
+        "--out",
+        file.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = stderr(&out);
+    assert_eq!(
+        err.trim_end(),
+        format!("imu-ar: --out {}: is a file, not a folder", file.display())
+    );
+}

@@ -695,6 +695,39 @@ fn a_database_with_a_timestamp_that_is_not_an_integer_is_refused() {
 }
 
 #[test]
+fn a_database_topic_of_two_types_names_both() {
+    let dir = temp_dir("db3-two-types");
+    for (name, first) in [("imu-first.db3", false), ("string-first.db3", true)] {
+        let file = dir.join(name);
+        std::fs::copy(fixture("noise.db3"), &file).unwrap();
+        let db = rusqlite::Connection::open(&file).unwrap();
+        if first {
+            // The string row before the IMU's: the IMU's moved to id 3.
+            db.execute("UPDATE topics SET id = 3 WHERE id = 1", [])
+                .unwrap();
+            db.execute("UPDATE messages SET topic_id = 3", []).unwrap();
+        }
+        db.execute(
+            "INSERT INTO topics VALUES (2, '/imu0', 'std_msgs/msg/String', 'cdr', '', '')",
+            [],
+        )
+        .unwrap();
+        drop(db);
+        let (got, result) = read(&file, None);
+        let imu = if first { 3 } else { 1 };
+        assert_eq!(
+            result,
+            Err(format!(
+                "topic '/imu0' carries sensor_msgs/msg/Imu (topic row {imu}) and \
+                 std_msgs/msg/String (topic row 2): one topic, one type of message"
+            )),
+            "{name}"
+        );
+        assert!(got.is_empty());
+    }
+}
+
+#[test]
 fn an_mcap_record_that_overruns_its_chunk_is_a_damaged_file() {
     // Found by the `ros_read` fuzz target: an uncompressed chunk whose last record claims more
     // bytes than the chunk holds (the mcap crate's reader overflowed its count on it).
@@ -929,8 +962,9 @@ fn stamps_rounded_to_a_coarse_clock_give_the_clocks_rate() {
     }
     let plain_file = dir.join("plain.csv");
     std::fs::write(&plain_file, plain).unwrap();
-    // 325 Hz to whole ms (intervals of 3 and 4 ms), 340 Hz to whole ms (2 and 3 ms), and
-    // 200 Hz to 10 ms, in seconds (every other stamp repeats).
+    // 325 Hz to whole ms (intervals of 3 and 4 ms), 340 Hz to whole ms (2 and 3 ms), 950 Hz
+    // (1 and 2 ms), 480 Hz (2 and 3 ms), and 200 Hz to 10 ms, in seconds (every other stamp
+    // repeats).
     for (rate, header, stamp) in [
         (
             325.0,
@@ -938,6 +972,9 @@ fn stamps_rounded_to_a_coarse_clock_give_the_clocks_rate() {
             &(|t: f64| format!("{}", (t * 1e3).floor())) as &dyn Fn(f64) -> String,
         ),
         (340.0, "t [ms]", &|t: f64| format!("{}", (t * 1e3).floor())),
+        // Just over one and two quanta: 950 and 480 Hz to the nearest ms.
+        (950.0, "t [ms]", &|t: f64| format!("{}", (t * 1e3).round())),
+        (480.0, "t [ms]", &|t: f64| format!("{}", (t * 1e3).round())),
         (200.0, "t [s]", &|t: f64| {
             format!("{:.2}", (t * 100.0).floor() / 100.0)
         }),
