@@ -662,10 +662,11 @@ struct Judged {
 /// Stamps rounded to a quantum (`resolution`, ns) coarser than a quarter of the interval show
 /// intervals a quantum apart (3 and 4 ms at 325 Hz, 2 and 3 ms at 340 Hz); stamps coarser than
 /// the interval repeat (200 Hz to 10 ms: 0 and 10 ms). Where the intervals show that (one
-/// about a period off the median, too close to be a gap; repeats while the intervals are one
-/// quantum; mixed intervals within a quantum of the mean), the regular intervals are those
-/// within a quantum of the period, and the period is their mean over the samples they hold:
-/// the span's, for a record without gaps.
+/// about a period off the median, too close to be a gap; repeats, 1 % of the samples or more,
+/// while the intervals are one quantum; intervals of one and two quanta; mixed intervals
+/// within four quanta of the mean) and they [`alternate`], the regular intervals are those
+/// [`Window::Quantum`] takes, and the period is their mean over the samples they hold: the
+/// span's, for a record without gaps.
 fn judged(
     buckets: &[Bucket],
     (median, span, intervals): (f64, f64, u64),
@@ -901,7 +902,7 @@ impl TimingSummary {
         let (at, stamp) = self.unexplained_repeat?;
         Some(format!(
             "{} timestamps equal the one before (the first: sample {at}, {stamp} ns), and the \
-             stamps resolve {:e} s, finer than the interval {:e} s: samples repeated? \
+             stamps, to {:e} s, resolve the interval {:e} s: samples repeated? \
              --drop-backward drops such samples and counts them",
             self.repeated,
             self.resolution_s.unwrap_or(1e-9),
@@ -931,8 +932,8 @@ impl TimingSummary {
     fn coarse_text(&self) -> String {
         match self.resolution_s {
             Some(q) if self.repeated > 0 || 4.0 * q > self.median_interval_s => format!(
-                "; stamps to {q:e} s, {} repeated: the rate over the intervals within a \
-                 quantum of the period",
+                "; stamps to {q:e} s, {} repeated: the rate over the samples between \
+                 distinct stamps",
                 self.repeated
             ),
             _ => String::new(),

@@ -351,7 +351,8 @@ pub fn check_rate(rate: f64) -> Result<f64, Fail> {
 pub fn number(v: f64) -> String {
     let plain = v.to_string();
     let exponent = format!("{v:e}");
-    if exponent.len() < plain.len() {
+    // Up to ten characters as written (1000, 0.0001); past that the shorter.
+    if plain.len() > 10 && exponent.len() < plain.len() {
         exponent
     } else {
         plain
@@ -457,6 +458,20 @@ pub fn default_delta(x: &[f64]) -> Result<f64, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn numbers_are_shown_as_written_unless_long() {
+        for (v, shown) in [
+            (1000.0, "1000"),
+            (325.5, "325.5"),
+            (0.0001, "0.0001"),
+            (1e300, "1e300"),
+            (1e-300, "1e-300"),
+            (123456.789, "123456.789"),
+        ] {
+            assert_eq!(number(v), shown);
+        }
+    }
 
     #[test]
     fn the_default_delta_is_that_of_the_finite_samples() {
