@@ -972,7 +972,11 @@ fn csv_stream(
                 // statistics, which still check the rate given.
                 return row_values(&mut values, cells, request, Some(t), &mut *each);
             }
-            timing.drop_one();
+            if step == Step::Repeat {
+                timing.drop_repeat();
+            } else {
+                timing.drop_one();
+            }
             if !request.drop_backward {
                 return Err(format!(
                     "timestamp {t} ns is not after the one before ({last} ns); \

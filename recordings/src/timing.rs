@@ -198,6 +198,9 @@ pub enum Step {
     Repeat,
 }
 
+/// The most samples a stamp is counted with one by one: a stamp with more counts with them.
+const GROUPS: u64 = 1 << 12;
+
 /// The most buckets held: past them, every bucket's width doubles (one significant bit less).
 const DISTINCT: usize = 1 << 16;
 
@@ -385,6 +388,21 @@ pub struct Timing {
     /// a clock's rounded intervals alternate, a record of two rates runs long on each.
     run: (i64, u64),
     longest_run: u64,
+    /// Repeats kept before the first interval, and since the last: the first and the last
+    /// stamp's own samples, which a coarse clock's rate leaves out (their times within the
+    /// quantum are not known). And the first interval, ns.
+    leading_repeats: u64,
+    trailing_repeats: u64,
+    first_interval: Option<i64>,
+    /// Samples dropped for a stamp equal to the one before.
+    dropped_repeats: u64,
+    /// The samples of each stamp but the last (their number, up to [`GROUPS`], or over),
+    /// counted by number; the last stamp's number and how many stamps in a row held it, and
+    /// the most in a row: a clock faster than its stamps holds as many at every stamp, or two
+    /// numbers alternating, two rates hold one number for long and then another.
+    groups: Vec<u64>,
+    group_run: (u64, u64),
+    longest_group_run: u64,
     /// The histogram, in the order of the intervals.
     buckets: Vec<Bucket>,
     /// The histogram before the last merge: its allocation, for the next.
@@ -426,6 +444,9 @@ impl Timing {
         let iv = t.saturating_sub(self.last);
         self.pending.push(iv);
         self.count_run(iv);
+        self.first_interval.get_or_insert(iv);
+        self.count_group(self.trailing_repeats + 1);
+        self.trailing_repeats = 0;
         if self.pending.len() >= PENDING {
             merge_into(
                 &self.buckets,
@@ -442,6 +463,21 @@ impl Timing {
         }
         self.last = t;
         Step::Forward
+    }
+
+    /// Counts a stamp that held `size` samples.
+    fn count_group(&mut self, size: u64) {
+        let slot = size.min(GROUPS) as usize;
+        if self.groups.len() <= slot {
+            self.groups.resize(slot + 1, 0);
+        }
+        self.groups[slot] += 1;
+        if size == self.group_run.0 {
+            self.group_run.1 += 1;
+            self.longest_group_run = self.longest_group_run.max(self.group_run.1);
+        } else {
+            self.group_run = (size, 1);
+        }
     }
 
     /// Counts the interval `iv` (0 for a repeated stamp) into the runs of equal intervals.
@@ -464,6 +500,17 @@ impl Timing {
     pub fn keep_repeat(&mut self) {
         self.repeats += 1;
         self.first_repeat.get_or_insert((self.pushed, self.last));
+        self.trailing_repeats += 1;
+        if self.first_interval.is_none() {
+            self.leading_repeats += 1;
+        }
+    }
+
+    /// Drops the sample whose stamp was a [`Step::Repeat`] (counted as dropped): the summary
+    /// refuses such drops where the stamps are a clock coarser than its samples.
+    pub fn drop_repeat(&mut self) {
+        self.dropped += 1;
+        self.dropped_repeats += 1;
     }
 
     /// The samples dropped so far.
@@ -509,8 +556,10 @@ impl Timing {
             &buckets,
             (median, span, intervals),
             resolution,
-            self.repeats,
+            (self.repeats, self.leading_repeats, self.trailing_repeats),
+            self.first_interval.unwrap_or(0),
             self.longest_run.max(1),
+            (&self.groups, self.longest_group_run.max(1)),
         );
         let Judged {
             classes:
@@ -526,6 +575,7 @@ impl Timing {
             repeats,
             window,
             other,
+            mixed: judged_mixed,
         } = judged;
         let (sq, worst) = jitter(&buckets, &window, period);
         // Repeats counted as samples are intervals of 0: a deviation of -1 each.
@@ -557,6 +607,27 @@ impl Timing {
             },
         };
         let (regular, intervals) = (regular + repeats, intervals + repeats);
+        if judged_mixed {
+            return Err(format!(
+                "the timestamps show mixed rates: stamped to {:e} s, they keep one pattern for \
+                 long (up to {} intervals, or stamps, in a row) and then another, where one \
+                 clock's alternate; one record must have one rate (or give --rate)",
+                resolution.unwrap_or(1) as f64 * 1e-9,
+                self.longest_run.max(self.longest_group_run)
+            ));
+        }
+        if resolution.is_some_and(|q| q as f64 == median)
+            && self.dropped_repeats > 0
+            && 100 * self.dropped_repeats >= intervals + self.dropped_repeats
+        {
+            return Err(format!(
+                "--drop-backward dropped {} samples whose stamp equals the one before, while \
+                 the stamps step by their quantum ({:e} s): a clock faster than its stamps, \
+                 whose repeats are samples; read it without --drop-backward",
+                self.dropped_repeats,
+                median * 1e-9
+            ));
+        }
         if (regular as f64) < 0.9 * intervals as f64 {
             return Err(format!(
                 "the timestamps show mixed rates: only {regular} of {intervals} intervals lie \
@@ -590,10 +661,12 @@ enum Window {
     /// Within 25 % of the reference interval (ns).
     Ratio(f64),
     /// For stamps rounded to a quantum `q` (ns) coarser than a quarter of the interval: under
-    /// one and a half periods (the reference, ns), or up to the period rounded up to whole
-    /// quanta (a clock's intervals rounded down or up, jitter either way). A gap of `skip` ns
-    /// more than a whole number of periods is what a clock whose stamps repeat shows between
-    /// distinct stamps (the quantum less a period).
+    /// one and a half periods (the reference, ns) and half a quantum (a period of two quanta
+    /// rounds to one, two and three), or up to a period and a quantum (and a quarter: a clock
+    /// of one quantum's period jittered across its edges steps 0, 1 and 2 quanta): a clock's
+    /// intervals rounded down or up, jitter either way. A gap of `skip` ns more than a whole
+    /// number of periods is what a clock whose stamps repeat shows between distinct stamps
+    /// (the quantum less a period).
     Quantum { reference: f64, q: f64, skip: f64 },
 }
 
@@ -618,7 +691,7 @@ impl Window {
                 }
             }
             Window::Quantum { reference, q, .. } => {
-                if iv < 1.5 * reference || iv <= (reference / q).ceil() * q {
+                if iv < 1.5 * reference + 0.5 * q || iv <= reference + 1.25 * q {
                     Ordering::Equal
                 } else {
                     Ordering::Greater
@@ -652,6 +725,8 @@ struct Judged {
     window: Window,
     /// The rate of the other reading, where stamps rounded to a quantum have two.
     other: Option<f64>,
+    /// Whether the intervals run long on each of a few values: two rates.
+    mixed: bool,
 }
 
 /// The histogram's intervals (`intervals` of them, over `span` ns, with `repeats` stamps
@@ -671,8 +746,10 @@ fn judged(
     buckets: &[Bucket],
     (median, span, intervals): (f64, f64, u64),
     resolution: Option<i64>,
-    repeats: u64,
+    (repeats, leading, trailing): (u64, u64, u64),
+    first_interval: i64,
     longest_run: u64,
+    (groups, longest_group_run): (&[u64], u64),
 ) -> Judged {
     let by_ratio = |reference: f64| {
         let window = Window::Ratio(reference);
@@ -686,12 +763,17 @@ fn judged(
             (window, c) = (w, by_mean);
         }
     }
+    // Stamps to a quantum of 5 % of the interval or more take few values: two rates within
+    // 25 % of each other (3 ms, then 4 ms) run long on each.
+    let coarse = resolution.is_some_and(|q| 20.0 * q as f64 >= median);
+    let mixed_runs = coarse && !alternate(buckets, &window, 0, longest_run, false);
     let ratio = Judged {
         period: c.sum / c.regular.max(1) as f64,
         classes: c,
         repeats: 0,
         window,
         other: None,
+        mixed: mixed_runs,
     };
     let Some(q) = resolution.map(|q| q as f64) else {
         return ratio;
@@ -714,6 +796,14 @@ fn judged(
         return ratio;
     }
     let counted = if coarse_repeats { repeats } else { 0 };
+    // A coarse clock's first and last stamps hold samples at unknown times within their
+    // quantum: the rate runs from the first sample of the second stamp to the first of the
+    // last (the first interval and both end stamps' repeats left out).
+    let (end_samples, end_sum) = if coarse_repeats {
+        (leading + trailing + 1, first_interval as f64)
+    } else {
+        (0, 0.0)
+    };
     let mut reference = span / (intervals + counted) as f64;
     let mut judged = None;
     for _ in 0..4 {
@@ -723,29 +813,42 @@ fn judged(
             skip: if counted > 0 { q - reference } else { 0.0 },
         };
         let c = classes(buckets, &window);
-        let held = c.regular + counted;
+        let held = (c.regular + counted).saturating_sub(end_samples);
         if held == 0 {
             return ratio;
         }
-        reference = c.sum / held as f64;
+        reference = (c.sum - end_sum) / held as f64;
         judged = Some(Judged {
             period: reference,
             classes: c,
             repeats: counted,
             window,
             other: Some(1e9 / ratio.period),
+            mixed: false,
         });
     }
     match judged {
         Some(j)
             if j.classes.regular + j.repeats >= ratio.classes.regular
-                && alternate(buckets, &j.window, counted, longest_run, q == median) =>
+                && alternate(
+                    buckets,
+                    &j.window,
+                    counted,
+                    longest_run,
+                    q == median && counted == 0,
+                )
+                && (counted == 0
+                    || (groups_even(buckets, &j.window, counted, longest_run)
+                        && sizes_alternate(groups, longest_group_run))) =>
         {
             j
         }
         // The intervals as samples missing; rounding's rate the other reading.
+        // A clock faster than its stamps whose stamps hold uneven numbers of samples: two
+        // rates.
         Some(j) => Judged {
             other: Some(1e9 / j.period),
+            mixed: ratio.mixed || counted > 0,
             ..ratio
         },
         None => ratio,
@@ -781,6 +884,32 @@ fn alternate(
             } else {
                 ((regular as f64).ln() + 4.0) * spacing
             }
+}
+
+/// Whether a clock of two samples or more a stamp holds about as many at every stamp: no run
+/// of equal intervals (`longest_run`, repeats or steps) beyond 1.3 times the mean samples a
+/// stamp, and 4 more. Two rates (100 Hz, then 50 Hz, to whole seconds) hold 100 and 50
+/// samples a stamp. (Under two a stamp, jitter at the quanta's edges scatters them.)
+fn groups_even(buckets: &[Bucket], window: &Window, zeros: u64, longest_run: u64) -> bool {
+    let steps: u64 = buckets
+        .iter()
+        .filter(|b| window.judge(b.mean()) == Ordering::Equal)
+        .map(|b| b.count)
+        .sum();
+    zeros < steps
+        || (longest_run as f64) <= 1.3 * (steps + zeros) as f64 / steps.max(1) as f64 + 4.0
+}
+
+/// Whether the samples a stamp holds (`groups`, counted by number) alternate as one clock's
+/// do: the less common numbers come about every `stamps / fewer` stamps, so no number comes
+/// many more stamps in a row (`longest_group_run`) than that, allowing for jitter. Two rates
+/// (300 Hz, then 200 Hz, to 10 ms) hold 3 samples a stamp for long, then 2.
+fn sizes_alternate(groups: &[u64], longest_group_run: u64) -> bool {
+    let stamps: u64 = groups.iter().sum();
+    let most = groups.iter().copied().max().unwrap_or(0);
+    let fewer = stamps - most;
+    fewer == 0
+        || (longest_group_run as f64) <= ((stamps as f64).ln() + 4.0) * stamps as f64 / fewer as f64
 }
 
 /// The intervals of the histogram judged by `window`: regular, short or gaps (a bucket, at
@@ -1441,5 +1570,136 @@ mod tests {
         assert!(e.contains(&format!("sample 401, {} ns", t[400])), "{e}");
         // The rate is the other stamps'.
         assert!((s.rate_hz / 400.0 - 1.0).abs() < 1e-3, "{}", s.rate_hz);
+    }
+
+    /// `n` stamps of a clock at `rate` Hz (switching to `then` after `switch` samples),
+    /// starting `offset` periods in, with Gaussian jitter of `sd` ns, rounded down (or to the
+    /// nearest) to `q` ns.
+    fn clock(
+        (rate, then, switch): (f64, f64, usize),
+        n: usize,
+        (q, nearest): (i64, bool),
+        (offset, sd): (f64, f64),
+    ) -> Vec<i64> {
+        let mut next = crate::xorshift(0x0ddb_a11c_0ffe_e123);
+        let mut gauss = || {
+            (0..12)
+                .map(|_| (next() >> 11) as f64 / (1u64 << 53) as f64)
+                .sum::<f64>()
+                - 6.0
+        };
+        let mut t = offset * 1e9 / rate;
+        (0..n)
+            .map(|i| {
+                let stamp = t + sd * gauss();
+                t += 1e9 / if i < switch { rate } else { then };
+                let k = stamp / q as f64;
+                q * if nearest { k.round() } else { k.floor() } as i64
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_clock_faster_than_its_stamps_gives_its_rate_however_they_round() {
+        // 100 Hz to whole seconds and 5 kHz to 10 ms, rounded down (the first and the last
+        // stamp each hold a whole quantum's samples) or to the nearest, at several phases.
+        for (rate, q, n) in [(100.0, 1_000_000_000, 1_000), (5_000.0, 10_000_000, 1_000)] {
+            for nearest in [false, true] {
+                for offset in [0.0, 0.3, 0.7] {
+                    let t = clock((rate, rate, n), n, (q, nearest), (offset, 0.0));
+                    let s = summary_keeping_repeats(&t);
+                    assert!(
+                        (s.rate_hz / rate - 1.0).abs() < 1e-9,
+                        "{rate} Hz, nearest {nearest}, offset {offset}: {}",
+                        s.rate_hz
+                    );
+                }
+            }
+        }
+        // 320 Hz to 10 ms (3 and 4 samples a stamp) and 200 Hz, with 300 us of jitter.
+        for rate in [320.0, 200.0] {
+            let t = clock(
+                (rate, rate, 20_000),
+                20_000,
+                (10_000_000, true),
+                (0.0, 300_000.0),
+            );
+            let s = summary_keeping_repeats(&t);
+            assert!(
+                (s.rate_hz / rate - 1.0).abs() < 1e-3,
+                "{rate} Hz: {}",
+                s.rate_hz
+            );
+            assert_eq!(s.missing_samples, 0, "{rate} Hz");
+        }
+    }
+
+    #[test]
+    fn a_period_of_two_quanta_with_jitter_is_one_rate() {
+        // 500 Hz to whole ms, a quarter period off the grid, 10 us of jitter: 1, 2 and 3 ms;
+        // 1 kHz on the quanta's edges, 10 us of jitter, rounded down: 0, 1 and 2 ms; 990 Hz
+        // to the nearest ms with 30 us of jitter (repeats 1.3 % of the samples).
+        for (rate, nearest, (offset, sd)) in [
+            (500.0, true, (0.25, 10_000.0)),
+            (1_000.0, false, (0.0, 10_000.0)),
+            (990.0, true, (0.0, 30_000.0)),
+        ] {
+            let t = clock(
+                (rate, rate, 5_000),
+                5_000,
+                (1_000_000, nearest),
+                (offset, sd),
+            );
+            let s = summary_keeping_repeats(&t);
+            assert!(
+                (s.rate_hz / rate - 1.0).abs() < 1e-3,
+                "{rate}: {}",
+                s.rate_hz
+            );
+            assert_eq!(s.missing_samples, 0, "{rate}");
+            assert_eq!(s.repeat_refusal(), None, "{rate}");
+        }
+    }
+
+    #[test]
+    fn two_rates_under_coarse_stamps_are_mixed_rates() {
+        // 3 ms then 4 ms and 4 ms then 3 ms (whole ms), 100 Hz then 50 Hz (whole seconds),
+        // 2 kHz then 1 kHz (whole ms), 300 Hz then 200 Hz (10 ms: 3 samples a stamp, then 2).
+        for (rates, n, q) in [
+            ((1000.0 / 3.0, 250.0, 2_500), 5_000, 1_000_000),
+            ((250.0, 1000.0 / 3.0, 2_500), 5_000, 1_000_000),
+            ((100.0, 50.0, 2_500), 5_000, 1_000_000_000),
+            ((2_000.0, 1_000.0, 4_500), 5_000, 1_000_000),
+            ((300.0, 200.0, 2_500), 5_000, 10_000_000),
+        ] {
+            let t = clock(rates, n, (q, true), (0.0, 0.0));
+            let mut timing = Timing::new();
+            for &s in &t {
+                if timing.push(s) == Step::Repeat {
+                    timing.keep_repeat();
+                }
+            }
+            let e = timing.summary(TimeUnit::Nanoseconds).unwrap_err();
+            assert!(e.contains("mixed rates"), "{rates:?}: {e}");
+        }
+    }
+
+    #[test]
+    fn dropping_a_coarse_clocks_repeats_is_refused() {
+        // 2 kHz to whole ms: every other stamp repeats; --drop-backward would halve the rate.
+        let t = clock(
+            (2_000.0, 2_000.0, 3_000),
+            3_000,
+            (1_000_000, true),
+            (0.0, 0.0),
+        );
+        let mut timing = Timing::new();
+        for &s in &t {
+            if timing.push(s) == Step::Repeat {
+                timing.drop_repeat();
+            }
+        }
+        let e = timing.summary(TimeUnit::Nanoseconds).unwrap_err();
+        assert!(e.contains("read it without --drop-backward"), "{e}");
     }
 }
