@@ -576,6 +576,7 @@ impl Timing {
             window,
             other,
             mixed: judged_mixed,
+            few,
         } = judged;
         let (sq, worst) = jitter(&buckets, &window, period);
         // Repeats counted as samples are intervals of 0: a deviation of -1 each.
@@ -614,6 +615,20 @@ impl Timing {
                  clock's alternate; one record must have one rate (or give --rate)",
                 resolution.unwrap_or(1) as f64 * 1e-9,
                 self.longest_run.max(self.longest_group_run)
+            ));
+        }
+        // Rounded stamps tell the rate to a quantum over the span, or where several samples
+        // share a stamp, to a period over it.
+        let uncertain = match window {
+            Window::Quantum { q, .. } => (if repeats > 0 { period } else { q }) > 0.01 * span,
+            Window::Ratio(_) => false,
+        };
+        if few || uncertain {
+            return Err(format!(
+                "the timestamps, rounded to {:e} s, span {:e} s: too few to tell the rate to \
+                 1 % (give --rate)",
+                resolution.unwrap_or(1) as f64 * 1e-9,
+                span * 1e-9
             ));
         }
         if resolution.is_some_and(|q| q as f64 == median)
@@ -727,6 +742,8 @@ struct Judged {
     other: Option<f64>,
     /// Whether the intervals run long on each of a few values: two rates.
     mixed: bool,
+    /// Whether rounded stamps were read with too few samples between the end stamps.
+    few: bool,
 }
 
 /// The histogram's intervals (`intervals` of them, over `span` ns, with `repeats` stamps
@@ -774,6 +791,7 @@ fn judged(
         window,
         other: None,
         mixed: mixed_runs,
+        few: false,
     };
     let Some(q) = resolution.map(|q| q as f64) else {
         return ratio;
@@ -815,7 +833,7 @@ fn judged(
         let c = classes(buckets, &window);
         let held = (c.regular + counted).saturating_sub(end_samples);
         if held == 0 {
-            return ratio;
+            return Judged { few: true, ..ratio };
         }
         reference = (c.sum - end_sum) / held as f64;
         judged = Some(Judged {
@@ -825,6 +843,7 @@ fn judged(
             window,
             other: Some(1e9 / ratio.period),
             mixed: false,
+            few: false,
         });
     }
     match judged {
@@ -902,13 +921,17 @@ fn groups_even(buckets: &[Bucket], window: &Window, zeros: u64, longest_run: u64
 
 /// Whether the samples a stamp holds (`groups`, counted by number) alternate as one clock's
 /// do: the less common numbers come about every `stamps / fewer` stamps, so no number comes
-/// many more stamps in a row (`longest_group_run`) than that, allowing for jitter. Two rates
-/// (300 Hz, then 200 Hz, to 10 ms) hold 3 samples a stamp for long, then 2.
+/// many more stamps in a row (`longest_group_run`) than that, allowing for jitter, nor for a
+/// twentieth of the stamps. Two rates (300 Hz, then 200 Hz, to 10 ms) hold 3 samples a stamp
+/// for long, then 2.
 fn sizes_alternate(groups: &[u64], longest_group_run: u64) -> bool {
     let stamps: u64 = groups.iter().sum();
     let most = groups.iter().copied().max().unwrap_or(0);
     let fewer = stamps - most;
+    // Ties at the quanta's edges (2 kHz to whole ms) hold one number for a while: a run
+    // counts only past a twentieth of the stamps.
     fewer == 0
+        || 20 * longest_group_run <= stamps
         || (longest_group_run as f64) <= ((stamps as f64).ln() + 4.0) * stamps as f64 / fewer as f64
 }
 
@@ -1685,6 +1708,17 @@ mod tests {
     }
 
     #[test]
+    fn a_clock_at_half_a_quantum_is_one_rate_however_its_ties_round() {
+        // 2 kHz to the nearest ms (ties to even), the times computed in seconds as a logger
+        // would: samples on the quanta's edges round either way, in stretches.
+        let t: Vec<i64> = (0..3_000)
+            .map(|i| (i as f64 / 2_000.0 / 1e-3).round_ties_even() as i64 * 1_000_000)
+            .collect();
+        let s = summary_keeping_repeats(&t);
+        assert!((s.rate_hz / 2_000.0 - 1.0).abs() < 1e-3, "{}", s.rate_hz);
+    }
+
+    #[test]
     fn dropping_a_coarse_clocks_repeats_is_refused() {
         // 2 kHz to whole ms: every other stamp repeats; --drop-backward would halve the rate.
         let t = clock(
@@ -1701,5 +1735,31 @@ mod tests {
         }
         let e = timing.summary(TimeUnit::Nanoseconds).unwrap_err();
         assert!(e.contains("read it without --drop-backward"), "{e}");
+    }
+
+    #[test]
+    fn a_few_coarse_stamps_do_not_tell_the_rate() {
+        // 200 Hz to 10 ms, 4 to 20 samples; 950 Hz to whole ms, 20 and 60 samples: the
+        // quantum is more than 1 % of the span. (Eight samples of 950 Hz to whole ms, all
+        // 1 ms apart, are a clean 1 kHz clock's.)
+        for (rate, q, sizes) in [
+            (200.0, 10_000_000, &[4, 8, 20][..]),
+            (950.0, 1_000_000, &[20, 60][..]),
+        ] {
+            for &n in sizes {
+                let t = clock((rate, rate, n), n, (q, false), (0.0, 0.0));
+                let mut timing = Timing::new();
+                for &s in &t {
+                    if timing.push(s) == Step::Repeat {
+                        timing.keep_repeat();
+                    }
+                }
+                let e = timing.summary(TimeUnit::Nanoseconds).unwrap_err();
+                assert!(
+                    e.contains("too few to tell the rate"),
+                    "{rate} Hz, {n}: {e}"
+                );
+            }
+        }
     }
 }
