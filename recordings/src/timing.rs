@@ -895,14 +895,18 @@ fn alternate(
             (all + b.count, b.count.max(most))
         });
     let fewer = regular - most;
-    let spacing = regular as f64 / fewer as f64;
-    fewer == 0
-        || (longest_run as f64)
-            <= if tight {
-                2.0 * spacing + 8.0
-            } else {
-                ((regular as f64).ln() + 4.0) * spacing
-            }
+    if tight {
+        fewer == 0 || longest_run as f64 <= 2.0 * regular as f64 / fewer as f64 + 8.0
+    } else {
+        runs_alternate(longest_run, regular, fewer)
+    }
+}
+
+/// Whether of `total` things, `fewer` of them the less common, no one comes `longest` times
+/// in a row beyond a jittered alternation's: the spacing `total / fewer` times the logarithm
+/// of their number and 4 (a geometric run's longest grows as that logarithm).
+fn runs_alternate(longest: u64, total: u64, fewer: u64) -> bool {
+    fewer == 0 || longest as f64 <= ((total as f64).ln() + 4.0) * total as f64 / fewer as f64
 }
 
 /// Whether a clock of two samples or more a stamp holds about as many at every stamp: no run
@@ -930,9 +934,7 @@ fn sizes_alternate(groups: &[u64], longest_group_run: u64) -> bool {
     let fewer = stamps - most;
     // Ties at the quanta's edges (2 kHz to whole ms) hold one number for a while: a run
     // counts only past a twentieth of the stamps.
-    fewer == 0
-        || 20 * longest_group_run <= stamps
-        || (longest_group_run as f64) <= ((stamps as f64).ln() + 4.0) * stamps as f64 / fewer as f64
+    20 * longest_group_run <= stamps || runs_alternate(longest_group_run, stamps, fewer)
 }
 
 /// The intervals of the histogram judged by `window`: regular, short or gaps (a bucket, at
@@ -1378,15 +1380,21 @@ mod tests {
 
     /// Every stamp pushed, those equal to the one before kept as repeats.
     fn summary_keeping_repeats(t: &[i64]) -> TimingSummary {
+        pushed(t, true).summary(TimeUnit::Nanoseconds).unwrap()
+    }
+
+    /// Every stamp pushed, those equal to the one before kept (or dropped).
+    fn pushed(t: &[i64], keep: bool) -> Timing {
         let mut timing = Timing::new();
         for &s in t {
             match timing.push(s) {
                 Step::Forward => {}
-                Step::Repeat => timing.keep_repeat(),
+                Step::Repeat if keep => timing.keep_repeat(),
+                Step::Repeat => timing.drop_repeat(),
                 Step::Backward { .. } => panic!("{s} went backwards"),
             }
         }
-        timing.summary(TimeUnit::Nanoseconds).unwrap()
+        timing
     }
 
     #[test]
@@ -1696,13 +1704,7 @@ mod tests {
             ((300.0, 200.0, 2_500), 5_000, 10_000_000),
         ] {
             let t = clock(rates, n, (q, true), (0.0, 0.0));
-            let mut timing = Timing::new();
-            for &s in &t {
-                if timing.push(s) == Step::Repeat {
-                    timing.keep_repeat();
-                }
-            }
-            let e = timing.summary(TimeUnit::Nanoseconds).unwrap_err();
+            let e = pushed(&t, true).summary(TimeUnit::Nanoseconds).unwrap_err();
             assert!(e.contains("mixed rates"), "{rates:?}: {e}");
         }
     }
@@ -1727,13 +1729,9 @@ mod tests {
             (1_000_000, true),
             (0.0, 0.0),
         );
-        let mut timing = Timing::new();
-        for &s in &t {
-            if timing.push(s) == Step::Repeat {
-                timing.drop_repeat();
-            }
-        }
-        let e = timing.summary(TimeUnit::Nanoseconds).unwrap_err();
+        let e = pushed(&t, false)
+            .summary(TimeUnit::Nanoseconds)
+            .unwrap_err();
         assert!(e.contains("read it without --drop-backward"), "{e}");
     }
 
@@ -1748,13 +1746,7 @@ mod tests {
         ] {
             for &n in sizes {
                 let t = clock((rate, rate, n), n, (q, false), (0.0, 0.0));
-                let mut timing = Timing::new();
-                for &s in &t {
-                    if timing.push(s) == Step::Repeat {
-                        timing.keep_repeat();
-                    }
-                }
-                let e = timing.summary(TimeUnit::Nanoseconds).unwrap_err();
+                let e = pushed(&t, true).summary(TimeUnit::Nanoseconds).unwrap_err();
                 assert!(
                     e.contains("too few to tell the rate"),
                     "{rate} Hz, {n}: {e}"
