@@ -201,6 +201,17 @@ pub enum Step {
 /// The most samples a stamp is counted with one by one: a stamp with more counts with them.
 const GROUPS: u64 = 1 << 12;
 
+/// The most marks held: past them, every other one is let go and the blocks between them
+/// double.
+const MARKS: usize = 512;
+
+/// The samples between marks at first.
+const BLOCK: u64 = 16;
+
+/// How far the rate over a stretch of the record without gaps may stray from the record's,
+/// beyond what the stamps' rounding and jitter explain (relative).
+const LOCAL: f64 = 0.02;
+
 /// The most buckets held: past them, every bucket's width doubles (one significant bit less).
 const DISTINCT: usize = 1 << 16;
 
@@ -414,6 +425,87 @@ pub struct Timing {
     counts: Vec<u32>,
     /// Significant bits of the buckets' keys (64: every interval its own).
     bits: u32,
+    /// Samples kept (stamps forward, repeats kept).
+    kept: u64,
+    /// A mark every `block` samples kept, at the first sample of a stamp: the rate between
+    /// any two marks with no gap between them is the record's (two rates under coarse stamps
+    /// show as one clock's alternating intervals, yet run at two rates).
+    marks: Vec<Mark>,
+    block: u64,
+    /// The intervals since the last mark (their longest and shortest in a mark); the last
+    /// stamp forward, as a mark.
+    since: Mark,
+    last_forward: Mark,
+    /// Each distinct interval (while there are at most [`HELD`]), how many times it came,
+    /// and the samples the stamps that open it hold: a clock faster than its stamps has its
+    /// rate from the regular intervals and the samples they hold alone (a gap's opening
+    /// stamp holds samples whose time the gap does not count).
+    held: Vec<Opened>,
+    held_more: bool,
+}
+
+/// The most distinct intervals counted with the samples their opening stamps hold.
+const HELD: usize = 8;
+
+/// An interval (ns), how many times it came, and the samples its opening stamps held.
+type Opened = (i64, u64, u64);
+
+/// The distinct intervals a block between marks counts one by one: stamps rounded to a
+/// quantum take few values, and a gap's samples missing are then known in each block.
+const STEPS: usize = 4;
+
+/// A sample the record's rate is checked at: its number among the samples kept, its stamp
+/// (ns), and the intervals since the mark before (ns): the longest and the shortest, and
+/// while they take at most [`STEPS`] values, each value and how many times it came.
+#[derive(Clone, Copy, Debug)]
+struct Mark {
+    kept: u64,
+    t: i64,
+    longest: i64,
+    shortest: i64,
+    steps: [(i64, u64); STEPS],
+    distinct: usize,
+    more: bool,
+}
+
+impl Mark {
+    /// Counts the interval `iv`.
+    fn count(&mut self, iv: i64, times: u64) {
+        self.longest = self.longest.max(iv);
+        self.shortest = self.shortest.min(iv);
+        if let Some(step) = self.steps[..self.distinct].iter_mut().find(|s| s.0 == iv) {
+            step.1 += times;
+        } else if self.distinct < STEPS {
+            self.steps[self.distinct] = (iv, times);
+            self.distinct += 1;
+        } else {
+            self.more = true;
+        }
+    }
+
+    /// Takes in the intervals of the block `before` ends.
+    fn take(&mut self, before: &Mark) {
+        self.longest = self.longest.max(before.longest);
+        self.shortest = self.shortest.min(before.shortest);
+        for &(iv, times) in &before.steps[..before.distinct] {
+            self.count(iv, times);
+        }
+        self.more |= before.more;
+    }
+}
+
+impl Default for Mark {
+    fn default() -> Self {
+        Self {
+            kept: 0,
+            t: 0,
+            longest: 0,
+            shortest: i64::MAX,
+            steps: [(0, 0); STEPS],
+            distinct: 0,
+            more: false,
+        }
+    }
 }
 
 impl Timing {
@@ -421,6 +513,7 @@ impl Timing {
     pub fn new() -> Self {
         Self {
             bits: 64,
+            block: BLOCK,
             ..Self::default()
         }
     }
@@ -432,6 +525,7 @@ impl Timing {
         let Some(_) = self.first else {
             self.first = Some(t);
             self.last = t;
+            self.mark(t);
             return Step::Forward;
         };
         if t == self.last {
@@ -446,7 +540,10 @@ impl Timing {
         self.count_run(iv);
         self.first_interval.get_or_insert(iv);
         self.count_group(self.trailing_repeats + 1);
+        self.count_held(iv, self.trailing_repeats + 1);
         self.trailing_repeats = 0;
+        self.since.count(iv, 1);
+        self.mark(t);
         if self.pending.len() >= PENDING {
             merge_into(
                 &self.buckets,
@@ -463,6 +560,58 @@ impl Timing {
         }
         self.last = t;
         Step::Forward
+    }
+
+    /// Takes the sample stamped `t`, the first of its stamp, as kept: a mark where the block
+    /// since the last is full (every other mark let go when they are [`MARKS`]).
+    fn mark(&mut self, t: i64) {
+        let here = Mark {
+            kept: self.kept,
+            t,
+            ..self.since
+        };
+        self.kept += 1;
+        self.last_forward = here;
+        if self
+            .marks
+            .last()
+            .is_some_and(|m| here.kept - m.kept < self.block)
+        {
+            return;
+        }
+        self.marks.push(here);
+        self.since = Mark::default();
+        if self.marks.len() == MARKS {
+            // Marks 0, 2, 4, ...: each block takes in the one before it; the last, dropped,
+            // into the block still open.
+            let mut kept = 0;
+            for i in (0..MARKS).step_by(2) {
+                let mut m = self.marks[i];
+                if i > 0 {
+                    m.take(&self.marks[i - 1]);
+                }
+                self.marks[kept] = m;
+                kept += 1;
+            }
+            self.since.take(&self.marks[MARKS - 1]);
+            self.marks.truncate(kept);
+            self.block *= 2;
+        }
+    }
+
+    /// Counts the interval `iv` opened by a stamp that held `size` samples.
+    fn count_held(&mut self, iv: i64, size: u64) {
+        if self.held_more {
+            return;
+        }
+        if let Some(h) = self.held.iter_mut().find(|h| h.0 == iv) {
+            h.1 += 1;
+            h.2 += size;
+        } else if self.held.len() < HELD {
+            self.held.push((iv, 1, size));
+        } else {
+            self.held_more = true;
+        }
     }
 
     /// Counts a stamp that held `size` samples.
@@ -499,6 +648,7 @@ impl Timing {
     /// of a clock coarser than its samples, where the stamps show one; else it names it.
     pub fn keep_repeat(&mut self) {
         self.repeats += 1;
+        self.kept += 1;
         self.first_repeat.get_or_insert((self.pushed, self.last));
         self.trailing_repeats += 1;
         if self.first_interval.is_none() {
@@ -522,6 +672,106 @@ impl Timing {
     fn span_ns(&self) -> f64 {
         let first = self.first.unwrap_or(self.last);
         (i128::from(self.last) - i128::from(first)) as f64
+    }
+
+    /// The marks, the last stamp forward the last of them.
+    fn all_marks(&self) -> Vec<Mark> {
+        let mut marks = self.marks.clone();
+        if marks
+            .last()
+            .is_some_and(|m| m.kept < self.last_forward.kept)
+        {
+            marks.push(Mark {
+                kept: self.last_forward.kept,
+                t: self.last_forward.t,
+                ..self.since
+            });
+        }
+        marks
+    }
+
+    /// The stretch of the record whose rate strays furthest from the record's (period `period`
+    /// ns) beyond what the stamps explain, named, where it strays more than [`LOCAL`] and
+    /// samples lost at random explain: two rates. A stretch runs between marks, its samples
+    /// with those its gaps miss (where its blocks' intervals are known one by one; else it
+    /// has no gap) and no short interval. The stamps of a stretch's end samples are each off
+    /// their true times by their quantum (`resolution`, ns) or by the regular intervals'
+    /// largest deviation from the period, whichever is more; under coarse stamps a lost
+    /// sample need not show as a gap.
+    fn stray(&self, window: &Window, period: f64, resolution: Option<i64>) -> Option<String> {
+        let marks = self.all_marks();
+        let buckets = self.histogram();
+        let deviation = buckets
+            .iter()
+            .filter(|b| window.judge(b.mean()) == Ordering::Equal)
+            .fold(0.0f64, |d, b| {
+                d.max((b.min as f64 - period).abs())
+                    .max((b.max as f64 - period).abs())
+            });
+        let off = deviation.max(resolution.unwrap_or(0) as f64);
+        // The samples a block's gaps miss, and its gaps; none where it has a short interval,
+        // or a gap among intervals not counted one by one.
+        let missed = |m: &Mark| -> Option<(f64, f64)> {
+            let judge = |iv: i64| window.judge(iv as f64);
+            if m.more {
+                return (judge(m.longest) == Ordering::Equal
+                    && judge(m.shortest) == Ordering::Equal)
+                    .then_some((0.0, 0.0));
+            }
+            m.steps[..m.distinct]
+                .iter()
+                .try_fold((0.0, 0.0), |(missing, gaps), &(iv, times)| {
+                    match judge(iv) {
+                        Ordering::Less => None,
+                        Ordering::Equal => Some((missing, gaps)),
+                        Ordering::Greater => Some((
+                            missing + times as f64 * window.missed(iv as f64),
+                            gaps + times as f64,
+                        )),
+                    }
+                })
+        };
+        let blocks: Vec<Option<(f64, f64)>> = marks.iter().map(missed).collect();
+        // The worst stretch: how many samples beyond what the stamps explain it strays, and
+        // its ends.
+        let mut worst: Option<(f64, usize, usize)> = None;
+        for i in 0..marks.len() {
+            let (mut missing, mut gaps) = (0.0, 0.0);
+            for j in i + 1..marks.len() {
+                let Some((m, g)) = blocks[j] else {
+                    break;
+                };
+                (missing, gaps) = (missing + m, gaps + g);
+                let (a, b) = (&marks[i], &marks[j]);
+                let span = (i128::from(b.t) - i128::from(a.t)) as f64;
+                let samples = (b.kept - a.kept) as f64 + missing;
+                // In samples: beyond the stamps' error, the drift allowed, a sample each gap
+                // may miss more or less, and samples lost at random that no interval shows
+                // (of n, sqrt(n) / 2 at most their standard deviation: six of them).
+                let beyond = ((samples * period - span).abs() - 2.0 * off) / period
+                    - LOCAL * samples
+                    - gaps
+                    - 3.0 * samples.sqrt();
+                if beyond > 0.0 && worst.is_none_or(|(w, ..)| beyond > w) {
+                    worst = Some((beyond, i, j));
+                }
+            }
+        }
+        let (_, i, j) = worst?;
+        let (a, b) = (&marks[i], &marks[j]);
+        let first = self.first.unwrap_or(a.t);
+        let since = |t: i64| (i128::from(t) - i128::from(first)) as f64 * 1e-9;
+        Some(format!(
+            "the timestamps show mixed rates: samples {} to {} ({:e} s to {:e} s after the \
+             first stamp) run at {:.6e} Hz, the record at {:.6e} Hz, more than their stamps' \
+             rounding and jitter explain; one record must have one rate (or give --rate)",
+            a.kept + 1,
+            b.kept + 1,
+            since(a.t),
+            since(b.t),
+            1e9 * (b.kept - a.kept) as f64 / (i128::from(b.t) - i128::from(a.t)) as f64,
+            1e9 / period
+        ))
     }
 
     /// The histogram with the pending intervals in.
@@ -557,7 +807,10 @@ impl Timing {
             (median, span, intervals),
             resolution,
             (self.repeats, self.leading_repeats, self.trailing_repeats),
-            self.first_interval.unwrap_or(0),
+            (
+                self.first_interval.unwrap_or(0),
+                (!self.held_more).then_some(&self.held[..]),
+            ),
             self.longest_run.max(1),
             (&self.groups, self.longest_group_run.max(1)),
         );
@@ -666,6 +919,9 @@ impl Timing {
                 )
             });
         }
+        if let Some(stretch) = self.stray(&window, period, resolution) {
+            return Err(stretch);
+        }
         Ok(summary)
     }
 }
@@ -690,6 +946,16 @@ impl Window {
         match *self {
             Window::Ratio(reference) | Window::Quantum { reference, .. } => reference,
         }
+    }
+
+    /// The samples a gap of `iv` ns misses: the periods it spans, less one (and less the
+    /// skip a clock whose stamps repeat shows).
+    fn missed(&self, iv: f64) -> f64 {
+        let skip = match *self {
+            Window::Quantum { skip, .. } => skip,
+            Window::Ratio(_) => 0.0,
+        };
+        (((iv - skip) / self.reference()).round() - 1.0).max(0.0)
     }
 
     /// Whether `iv` (ns) is shorter than the window (Less), in it (Equal) or a gap (Greater).
@@ -764,7 +1030,7 @@ fn judged(
     (median, span, intervals): (f64, f64, u64),
     resolution: Option<i64>,
     (repeats, leading, trailing): (u64, u64, u64),
-    first_interval: i64,
+    (first_interval, held_by): (i64, Option<&[Opened]>),
     longest_run: u64,
     (groups, longest_group_run): (&[u64], u64),
 ) -> Judged {
@@ -831,11 +1097,35 @@ fn judged(
             skip: if counted > 0 { q - reference } else { 0.0 },
         };
         let c = classes(buckets, &window);
-        let held = (c.regular + counted).saturating_sub(end_samples);
+        let (time, held) = match held_by {
+            // The regular intervals and the samples their opening stamps hold, the first
+            // interval left out.
+            Some(by) if coarse_repeats => {
+                let regular = |iv: i64| window.judge(iv as f64) == Ordering::Equal;
+                let (time, held) = by
+                    .iter()
+                    .filter(|h| regular(h.0))
+                    .fold((0.0, 0u64), |(t, n), h| {
+                        (t + h.0 as f64 * h.1 as f64, n + h.2)
+                    });
+                if regular(first_interval) {
+                    (
+                        time - first_interval as f64,
+                        held.saturating_sub(leading + 1),
+                    )
+                } else {
+                    (time, held)
+                }
+            }
+            _ => (
+                c.sum - end_sum,
+                (c.regular + counted).saturating_sub(end_samples),
+            ),
+        };
         if held == 0 {
             return Judged { few: true, ..ratio };
         }
-        reference = (c.sum - end_sum) / held as f64;
+        reference = time / held as f64;
         judged = Some(Judged {
             period: reference,
             classes: c,
@@ -1707,6 +1997,92 @@ mod tests {
             let e = pushed(&t, true).summary(TimeUnit::Nanoseconds).unwrap_err();
             assert!(e.contains("mixed rates"), "{rates:?}: {e}");
         }
+    }
+
+    /// `n` samples at `rate` Hz, from sample `switch` on at `then` Hz, their times in seconds
+    /// rounded to the nearest `q` s, ties to even, as a logger computes them.
+    fn logged(rate: f64, (then, switch): (f64, usize), n: usize, q: f64) -> Vec<i64> {
+        let q_ns = (q * 1e9).round() as i64;
+        (0..n)
+            .map(|i| {
+                let t = if i < switch {
+                    i as f64 / rate
+                } else {
+                    (switch as f64 - 1.0) / rate + (i + 1 - switch) as f64 / then
+                };
+                (t / q).round_ties_even() as i64 * q_ns
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_stretch_at_another_rate_under_coarse_stamps_is_mixed_rates() {
+        // The last tenth at another rate (800 then 600 Hz to whole ms, 100 then 50 Hz to whole
+        // seconds), and 2 kHz then 1 kHz to whole ms from half-way, both on rounding's ties:
+        // each rate alone one clock's, read as one clock at a rate between. The rate between
+        // marks with no gap strays from the record's.
+        for (rate, then, switch, q) in [
+            (800.0, 600.0, 4_500, 1e-3),
+            (100.0, 50.0, 4_500, 1.0),
+            (2_000.0, 1_000.0, 2_500, 1e-3),
+        ] {
+            let t = logged(rate, (then, switch), 5_000, q);
+            let e = pushed(&t, true).summary(TimeUnit::Nanoseconds).unwrap_err();
+            assert!(e.contains("mixed rates"), "{rate} then {then}: {e}");
+            // Each rate alone is one clock.
+            for r in [rate, then] {
+                let s = summary_keeping_repeats(&logged(r, (r, 0), 5_000, q));
+                assert!((s.rate_hz / r - 1.0).abs() < 1e-3, "{r} Hz: {}", s.rate_hz);
+            }
+        }
+    }
+
+    #[test]
+    fn two_rates_a_quarter_apart_under_fine_stamps_are_mixed_rates() {
+        // 333.3 Hz then 250 Hz, half the record each, stamped to the microsecond: the mean
+        // interval (3.5 ms) holds both within 25 %, and the microseconds' rounding breaks the
+        // runs of equal intervals (read as 285.7 Hz before); the stretches run at either rate.
+        let t = logged(1000.0 / 3.0, (250.0, 2_500), 5_000, 1e-6);
+        let e = pushed(&t, true).summary(TimeUnit::Nanoseconds).unwrap_err();
+        assert!(e.contains("mixed rates"), "{e}");
+        let s = summary_keeping_repeats(&logged(250.0, (250.0, 0), 5_000, 1e-6));
+        assert!((s.rate_hz / 250.0 - 1.0).abs() < 1e-6, "{}", s.rate_hz);
+    }
+
+    #[test]
+    fn a_gaps_opening_stamp_holds_samples_the_rate_does_not_count() {
+        // 200 Hz to 10 ms, the last tenth at 100 Hz on rounding's ties: stamps of two samples
+        // 20 ms apart, which a 200 Hz clock shows where it misses every other sample. The
+        // samples of a gap's opening stamp are not the regular intervals' (read as theirs, the
+        // rate was 209.8 Hz): 200 Hz, the tail's 500 samples missing.
+        let t = logged(200.0, (100.0, 4_500), 5_000, 1e-2);
+        let s = summary_keeping_repeats(&t);
+        assert!((s.rate_hz / 200.0 - 1.0).abs() < 5e-3, "{}", s.rate_hz);
+        assert!(s.missing_samples.abs_diff(500) <= 25, "{s:?}");
+        // The clock alone: no sample missing.
+        let s = summary_keeping_repeats(&logged(200.0, (200.0, 0), 5_000, 1e-2));
+        assert_eq!((s.gaps, s.missing_samples), (0, 0), "{s:?}");
+        assert!((s.rate_hz / 200.0 - 1.0).abs() < 1e-3, "{}", s.rate_hz);
+    }
+
+    #[test]
+    fn a_long_record_is_checked_stretch_by_stretch() {
+        // 2,000,000 samples at 400 Hz to whole ms, jittered by 100 us: one clock, however many
+        // times the marks were thinned; the same with the last 3 % at 380 Hz: two rates, where
+        // the 25 % window and the runs see one.
+        let mut next = crate::xorshift(0x5eed_0fa1_17ab_1e00);
+        let mut t: Vec<i64> = Vec::new();
+        let (n, q) = (2_000_000usize, 1_000_000i64);
+        let mut time = 0.0;
+        for i in 0..n {
+            let jitter = ((next() >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 2e5;
+            t.push(((time + jitter) / q as f64).round() as i64 * q);
+            time += 1e9 / if i < n / 100 * 97 { 400.0 } else { 380.0 };
+        }
+        let one = summary_keeping_repeats(&t[..n / 100 * 97]);
+        assert!((one.rate_hz / 400.0 - 1.0).abs() < 1e-4, "{}", one.rate_hz);
+        let e = pushed(&t, true).summary(TimeUnit::Nanoseconds).unwrap_err();
+        assert!(e.contains("mixed rates") && e.contains("3.8"), "{e}");
     }
 
     #[test]

@@ -1008,6 +1008,29 @@ fn stamps_rounded_to_a_coarse_clock_give_the_clocks_rate() {
 }
 
 #[test]
+fn a_stretch_at_another_rate_under_whole_milliseconds_is_mixed_rates() {
+    // 800 Hz, the last tenth at 600 Hz, to the nearest ms: both show intervals of 1 and 2 ms;
+    // the stretch at 600 Hz is named, and --rate reads the record as given.
+    let dir = temp_dir("stretch-rate");
+    let frames = noise(5_000, 4);
+    let mut text = "t [ms],gx\n".to_string();
+    let mut t = 0.0;
+    for (i, f) in frames.iter().enumerate() {
+        writeln!(text, "{},{:e}", (t * 1e3_f64).round(), f.axes[0]).unwrap();
+        t += if i < 4_500 { 1.0 / 800.0 } else { 1.0 / 600.0 };
+    }
+    let file = dir.join("mixed.csv");
+    std::fs::write(&file, text).unwrap();
+    let out = imu_ar(&["noise", path(&file), "--column", "gx"]);
+    assert_one_line_failure(&out);
+    let e = stderr(&out);
+    assert!(e.contains("mixed rates: samples 4"), "{e}");
+    assert!(e.contains("run at 6.0"), "{e}");
+    let given = noise_json(&file, &["--rate", "800"]);
+    assert_eq!(given["n"], 5_000);
+}
+
+#[test]
 fn a_repeated_stamp_of_a_fine_clock_is_refused_after_the_file_is_read() {
     let dir = temp_dir("repeated-stamp");
     let frames = noise(2_000, 3);
