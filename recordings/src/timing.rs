@@ -708,7 +708,8 @@ impl Timing {
                 d.max((b.min as f64 - period).abs())
                     .max((b.max as f64 - period).abs())
             });
-        let off = deviation.max(resolution.unwrap_or(0) as f64);
+        let quantum = resolution.unwrap_or(0) as f64;
+        let off = deviation.max(quantum);
         // The samples a block's gaps miss, and its gaps; none where it has a short interval,
         // or a gap among intervals not counted one by one.
         let missed = |m: &Mark| -> Option<(f64, f64)> {
@@ -745,12 +746,14 @@ impl Timing {
                 let (a, b) = (&marks[i], &marks[j]);
                 let span = (i128::from(b.t) - i128::from(a.t)) as f64;
                 let samples = (b.kept - a.kept) as f64 + missing;
-                // In samples: beyond the stamps' error, the drift allowed, a sample each gap
-                // may miss more or less, and samples lost at random that no interval shows
-                // (of n, sqrt(n) / 2 at most their standard deviation: six of them).
+                // In samples: beyond the stamps' error, the drift allowed, the samples the
+                // gaps miss more or less (each gap's ends rounded apart: a standard deviation
+                // of half a sample and half the samples a quantum holds; three of them over
+                // the gaps), and samples lost at random that no interval shows (of n,
+                // sqrt(n) / 2 at most their standard deviation: six of them).
                 let beyond = ((samples * period - span).abs() - 2.0 * off) / period
                     - LOCAL * samples
-                    - gaps
+                    - 1.5 * (1.0 + quantum / period) * gaps.sqrt()
                     - 3.0 * samples.sqrt();
                 if beyond > 0.0 && worst.is_none_or(|(w, ..)| beyond > w) {
                     worst = Some((beyond, i, j));
@@ -2018,13 +2021,15 @@ mod tests {
     #[test]
     fn a_stretch_at_another_rate_under_coarse_stamps_is_mixed_rates() {
         // The last tenth at another rate (800 then 600 Hz to whole ms, 100 then 50 Hz to whole
-        // seconds), and 2 kHz then 1 kHz to whole ms from half-way, both on rounding's ties:
+        // seconds), and 2 kHz then 1 kHz to whole ms from half-way or for the last tenth, both
+        // on rounding's ties:
         // each rate alone one clock's, read as one clock at a rate between. The rate between
         // marks with no gap strays from the record's.
         for (rate, then, switch, q) in [
             (800.0, 600.0, 4_500, 1e-3),
             (100.0, 50.0, 4_500, 1.0),
             (2_000.0, 1_000.0, 2_500, 1e-3),
+            (2_000.0, 1_000.0, 4_500, 1e-3),
         ] {
             let t = logged(rate, (then, switch), 5_000, q);
             let e = pushed(&t, true).summary(TimeUnit::Nanoseconds).unwrap_err();
