@@ -198,9 +198,6 @@ pub enum Step {
     Repeat,
 }
 
-/// The most samples a stamp is counted with one by one: a stamp with more counts with them.
-const GROUPS: u64 = 1 << 12;
-
 /// The most marks held: past them, every other one is let go and the blocks between them
 /// double.
 const MARKS: usize = 512;
@@ -407,13 +404,6 @@ pub struct Timing {
     first_interval: Option<i64>,
     /// Samples dropped for a stamp equal to the one before.
     dropped_repeats: u64,
-    /// The samples of each stamp but the last (their number, up to [`GROUPS`], or over),
-    /// counted by number; the last stamp's number and how many stamps in a row held it, and
-    /// the most in a row: a clock faster than its stamps holds as many at every stamp, or two
-    /// numbers alternating, two rates hold one number for long and then another.
-    groups: Vec<u64>,
-    group_run: (u64, u64),
-    longest_group_run: u64,
     /// The histogram, in the order of the intervals.
     buckets: Vec<Bucket>,
     /// The histogram before the last merge: its allocation, for the next.
@@ -442,6 +432,11 @@ pub struct Timing {
     /// stamp holds samples whose time the gap does not count).
     held: Vec<Opened>,
     held_more: bool,
+    /// Where the repeated stamps came (kept or dropped): the first's and the last's place
+    /// among the stamps pushed, and the fewest and most stamps between two of them. A clock
+    /// a little faster than its stamps (1005 Hz to whole ms) repeats one every so many.
+    repeat_places: Option<(u64, u64)>,
+    repeat_spacing: (u64, u64),
 }
 
 /// The most distinct intervals counted with the samples their opening stamps hold.
@@ -539,7 +534,6 @@ impl Timing {
         self.pending.push(iv);
         self.count_run(iv);
         self.first_interval.get_or_insert(iv);
-        self.count_group(self.trailing_repeats + 1);
         self.count_held(iv, self.trailing_repeats + 1);
         self.trailing_repeats = 0;
         self.since.count(iv, 1);
@@ -614,21 +608,6 @@ impl Timing {
         }
     }
 
-    /// Counts a stamp that held `size` samples.
-    fn count_group(&mut self, size: u64) {
-        let slot = size.min(GROUPS) as usize;
-        if self.groups.len() <= slot {
-            self.groups.resize(slot + 1, 0);
-        }
-        self.groups[slot] += 1;
-        if size == self.group_run.0 {
-            self.group_run.1 += 1;
-            self.longest_group_run = self.longest_group_run.max(self.group_run.1);
-        } else {
-            self.group_run = (size, 1);
-        }
-    }
-
     /// Counts the interval `iv` (0 for a repeated stamp) into the runs of equal intervals.
     fn count_run(&mut self, iv: i64) {
         if iv == self.run.0 {
@@ -649,6 +628,7 @@ impl Timing {
     pub fn keep_repeat(&mut self) {
         self.repeats += 1;
         self.kept += 1;
+        self.place_repeat();
         self.first_repeat.get_or_insert((self.pushed, self.last));
         self.trailing_repeats += 1;
         if self.first_interval.is_none() {
@@ -661,6 +641,43 @@ impl Timing {
     pub fn drop_repeat(&mut self) {
         self.dropped += 1;
         self.dropped_repeats += 1;
+        self.place_repeat();
+    }
+
+    /// Notes where the stamp just pushed, a repeat, came.
+    fn place_repeat(&mut self) {
+        let at = self.pushed;
+        self.repeat_places = Some(match self.repeat_places {
+            None => (at, at),
+            Some((first, last)) => {
+                let gap = at - last;
+                self.repeat_spacing = if first == last {
+                    (gap, gap)
+                } else {
+                    (
+                        self.repeat_spacing.0.min(gap),
+                        self.repeat_spacing.1.max(gap),
+                    )
+                };
+                (first, at)
+            }
+        });
+    }
+
+    /// Whether the repeated stamps come as a clock a little faster than its stamps repeats
+    /// them: at least three, about evenly spaced (none more than twice the fewest stamps
+    /// apart, and two), from the record's start to its end. Samples written twice come where
+    /// they came.
+    fn repeats_periodic(&self) -> bool {
+        let Some((first, last)) = self.repeat_places else {
+            return false;
+        };
+        let (fewest, most) = self.repeat_spacing;
+        self.repeats + self.dropped_repeats >= 3
+            && fewest > 0
+            && most <= 2 * fewest + 2
+            && first <= most + 2
+            && self.pushed - last <= most + 2
     }
 
     /// The samples dropped so far.
@@ -709,7 +726,18 @@ impl Timing {
                     .max((b.max as f64 - period).abs())
             });
         let quantum = resolution.unwrap_or(0) as f64;
+        // A mark is the first sample of its stamp: where several samples share a stamp it
+        // lies within a period of the stamp's edge (and jitter past a period reorders
+        // stamps), but for the record's first, else within the quantum or the intervals'
+        // deviation.
         let off = deviation.max(quantum);
+        let off_at = |i: usize| match *window {
+            Window::Quantum { skip, .. } if skip > 0.0 && i > 0 => (3.0 * period).min(off),
+            _ => off,
+        };
+        // Whether a lost sample can hide among the regular intervals (two periods, rounded
+        // down a quantum, under the window's top): else every loss shows as a gap.
+        let hidden = matches!(*window, Window::Quantum { .. }) && 3.0 * quantum > period;
         // The samples a block's gaps miss, and its gaps; none where it has a short interval,
         // or a gap among intervals not counted one by one.
         let missed = |m: &Mark| -> Option<(f64, f64)> {
@@ -749,12 +777,12 @@ impl Timing {
                 // In samples: beyond the stamps' error, the drift allowed, the samples the
                 // gaps miss more or less (each gap's ends rounded apart: a standard deviation
                 // of half a sample and half the samples a quantum holds; three of them over
-                // the gaps), and samples lost at random that no interval shows (of n,
-                // sqrt(n) / 2 at most their standard deviation: six of them).
-                let beyond = ((samples * period - span).abs() - 2.0 * off) / period
+                // the gaps), and samples lost at random where no interval need show them (of
+                // n, sqrt(n) / 2 at most their standard deviation: six of them).
+                let beyond = ((samples * period - span).abs() - off_at(i) - off_at(j)) / period
                     - LOCAL * samples
                     - 1.5 * (1.0 + quantum / period) * gaps.sqrt()
-                    - 3.0 * samples.sqrt();
+                    - if hidden { 3.0 * samples.sqrt() } else { 0.0 };
                 if beyond > 0.0 && worst.is_none_or(|(w, ..)| beyond > w) {
                     worst = Some((beyond, i, j));
                 }
@@ -814,8 +842,8 @@ impl Timing {
                 self.first_interval.unwrap_or(0),
                 (!self.held_more).then_some(&self.held[..]),
             ),
+            self.repeats_periodic(),
             self.longest_run.max(1),
-            (&self.groups, self.longest_group_run.max(1)),
         );
         let Judged {
             classes:
@@ -825,7 +853,7 @@ impl Timing {
                     gaps,
                     missing,
                     regular,
-                    ..
+                    sum: regular_sum,
                 },
             period,
             repeats,
@@ -834,19 +862,19 @@ impl Timing {
             mixed: judged_mixed,
             few,
         } = judged;
-        let (sq, worst) = jitter(&buckets, &window, period);
-        // Repeats counted as samples are intervals of 0: a deviation of -1 each.
+        // Where several samples share a stamp, their times within it are not known: the
+        // jitter is the intervals' between distinct stamps, about their mean.
         let (sq, worst) = if repeats > 0 {
-            (sq + repeats as f64, worst.max(1.0))
+            jitter(&buckets, &window, regular_sum / regular.max(1) as f64)
         } else {
-            (sq, worst)
+            jitter(&buckets, &window, period)
         };
         let summary = TimingSummary {
             unit: unit.name(),
             header_stamps: unit == TimeUnit::HeaderStamps,
             rate_hz: 1e9 / period,
             median_interval_s: median * 1e-9,
-            jitter_rms: (sq / (regular + repeats).max(1) as f64).sqrt(),
+            jitter_rms: (sq / regular.max(1) as f64).sqrt(),
             jitter_max: worst,
             gaps,
             missing_samples: missing,
@@ -866,11 +894,11 @@ impl Timing {
         let (regular, intervals) = (regular + repeats, intervals + repeats);
         if judged_mixed {
             return Err(format!(
-                "the timestamps show mixed rates: stamped to {:e} s, they keep one pattern for \
-                 long (up to {} intervals, or stamps, in a row) and then another, where one \
-                 clock's alternate; one record must have one rate (or give --rate)",
+                "the timestamps show mixed rates: stamped to {:e} s, {} of them repeated, they \
+                 fit neither a clock faster than its stamps nor one stamped once a sample; one \
+                 record must have one rate (or give --rate)",
                 resolution.unwrap_or(1) as f64 * 1e-9,
-                self.longest_run.max(self.longest_group_run)
+                self.repeats
             ));
         }
         // Rounded stamps tell the rate to a quantum over the span, or where several samples
@@ -889,7 +917,8 @@ impl Timing {
         }
         if resolution.is_some_and(|q| q as f64 == median)
             && self.dropped_repeats > 0
-            && 100 * self.dropped_repeats >= intervals + self.dropped_repeats
+            && (100 * self.dropped_repeats >= intervals + self.dropped_repeats
+                || self.repeats_periodic())
         {
             return Err(format!(
                 "--drop-backward dropped {} samples whose stamp equals the one before, while \
@@ -1034,8 +1063,8 @@ fn judged(
     resolution: Option<i64>,
     (repeats, leading, trailing): (u64, u64, u64),
     (first_interval, held_by): (i64, Option<&[Opened]>),
+    periodic: bool,
     longest_run: u64,
-    (groups, longest_group_run): (&[u64], u64),
 ) -> Judged {
     let by_ratio = |reference: f64| {
         let window = Window::Ratio(reference);
@@ -1049,26 +1078,23 @@ fn judged(
             (window, c) = (w, by_mean);
         }
     }
-    // Stamps to a quantum of 5 % of the interval or more take few values: two rates within
-    // 25 % of each other (3 ms, then 4 ms) run long on each.
-    let coarse = resolution.is_some_and(|q| 20.0 * q as f64 >= median);
-    let mixed_runs = coarse && !alternate(buckets, &window, 0, longest_run, false);
     let ratio = Judged {
         period: c.sum / c.regular.max(1) as f64,
         classes: c,
         repeats: 0,
         window,
         other: None,
-        mixed: mixed_runs,
+        mixed: false,
         few: false,
     };
     let Some(q) = resolution.map(|q| q as f64) else {
         return ratio;
     };
-    // A clock faster than its stamps: repeats, at least 1 % of the samples, between intervals
+    // A clock faster than its stamps: repeats, at least 1 % of the samples or evenly spaced,
     // of one quantum.
-    let coarse_repeats =
-        q == median && repeats > 0 && 100 * repeats >= intervals.saturating_add(repeats);
+    let coarse_repeats = q == median
+        && repeats > 0
+        && (100 * repeats >= intervals.saturating_add(repeats) || periodic);
     // A period just over one quantum: intervals of one and two quanta, which are as well a
     // clock of one quantum's period that misses samples; read as rounding only where the
     // longer ones come as evenly as rounding makes them.
@@ -1142,16 +1168,7 @@ fn judged(
     match judged {
         Some(j)
             if j.classes.regular + j.repeats >= ratio.classes.regular
-                && alternate(
-                    buckets,
-                    &j.window,
-                    counted,
-                    longest_run,
-                    q == median && counted == 0,
-                )
-                && (counted == 0
-                    || (groups_even(buckets, &j.window, counted, longest_run)
-                        && sizes_alternate(groups, longest_group_run))) =>
+                && (counted > 0 || alternate(buckets, &j.window, 0, longest_run, q == median)) =>
         {
             j
         }
@@ -1200,34 +1217,6 @@ fn alternate(
 /// of their number and 4 (a geometric run's longest grows as that logarithm).
 fn runs_alternate(longest: u64, total: u64, fewer: u64) -> bool {
     fewer == 0 || longest as f64 <= ((total as f64).ln() + 4.0) * total as f64 / fewer as f64
-}
-
-/// Whether a clock of two samples or more a stamp holds about as many at every stamp: no run
-/// of equal intervals (`longest_run`, repeats or steps) beyond 1.3 times the mean samples a
-/// stamp, and 4 more. Two rates (100 Hz, then 50 Hz, to whole seconds) hold 100 and 50
-/// samples a stamp. (Under two a stamp, jitter at the quanta's edges scatters them.)
-fn groups_even(buckets: &[Bucket], window: &Window, zeros: u64, longest_run: u64) -> bool {
-    let steps: u64 = buckets
-        .iter()
-        .filter(|b| window.judge(b.mean()) == Ordering::Equal)
-        .map(|b| b.count)
-        .sum();
-    zeros < steps
-        || (longest_run as f64) <= 1.3 * (steps + zeros) as f64 / steps.max(1) as f64 + 4.0
-}
-
-/// Whether the samples a stamp holds (`groups`, counted by number) alternate as one clock's
-/// do: the less common numbers come about every `stamps / fewer` stamps, so no number comes
-/// many more stamps in a row (`longest_group_run`) than that, allowing for jitter, nor for a
-/// twentieth of the stamps. Two rates (300 Hz, then 200 Hz, to 10 ms) hold 3 samples a stamp
-/// for long, then 2.
-fn sizes_alternate(groups: &[u64], longest_group_run: u64) -> bool {
-    let stamps: u64 = groups.iter().sum();
-    let most = groups.iter().copied().max().unwrap_or(0);
-    let fewer = stamps - most;
-    // Ties at the quanta's edges (2 kHz to whole ms) hold one number for a while: a run
-    // counts only past a twentieth of the stamps.
-    20 * longest_group_run <= stamps || runs_alternate(longest_group_run, stamps, fewer)
 }
 
 /// The intervals of the histogram judged by `window`: regular, short or gaps (a bucket, at
@@ -1307,7 +1296,8 @@ pub struct TimingSummary {
     pub median_interval_s: f64,
     /// The RMS deviation of the regular intervals (within 25 % of the median, or of the mean
     /// interval for coarsely rounded stamps) from their mean (the interval of `rate_hz`),
-    /// relative to it.
+    /// relative to it; where several samples share a stamp (`repeated`), of the intervals
+    /// between distinct stamps from their own mean.
     pub jitter_rms: f64,
     /// Their largest deviation, relative.
     pub jitter_max: f64,
@@ -1350,7 +1340,8 @@ impl TimingSummary {
         Some(format!(
             "{} timestamps equal the one before (the first: sample {at}, {stamp} ns), and the \
              stamps, to {:e} s, resolve the interval {:e} s: samples repeated? \
-             --drop-backward drops such samples and counts them",
+             --drop-backward drops such samples and counts them (a clock a little faster \
+             than its stamps repeats them evenly: give --rate)",
             self.repeated,
             self.resolution_s.unwrap_or(1e-9),
             self.median_interval_s
@@ -2052,6 +2043,63 @@ mod tests {
         assert!(e.contains("mixed rates"), "{e}");
         let s = summary_keeping_repeats(&logged(250.0, (250.0, 0), 5_000, 1e-6));
         assert!((s.rate_hz / 250.0 - 1.0).abs() < 1e-6, "{}", s.rate_hz);
+    }
+
+    #[test]
+    fn stamps_floored_in_float_seconds_are_one_clock() {
+        // A logger's floor(k / rate * 1000) ms (and to 10 ms): the float's error puts a few
+        // stamps a quantum early, in clusters (4 and 6 ms pairs at 200 Hz; 0 and 20 ms at
+        // 100 Hz to 10 ms), once refused as two rates.
+        for (rate, q) in [(200.0, 1e-3), (250.0, 1e-3), (100.0, 1e-2), (500.0, 1e-2)] {
+            let q_ns = (q * 1e9_f64).round() as i64;
+            let t: Vec<i64> = (0..20_000)
+                .map(|k| (k as f64 / rate / q).floor() as i64 * q_ns)
+                .collect();
+            let s = summary_keeping_repeats(&t);
+            assert!((s.rate_hz / rate - 1.0).abs() < 1e-4, "{rate} Hz: {s:?}");
+        }
+    }
+
+    #[test]
+    fn a_clock_a_little_faster_than_its_stamps_repeats_them_evenly() {
+        // 1001, 1005 and 1010 Hz to whole ms: a repeat every 1000, 200 and 100 samples,
+        // under 1 % of them; samples written twice (two, anywhere) are still refused.
+        for rate in [1001i64, 1005, 1010] {
+            let t: Vec<i64> = (0..20_000).map(|k| k * 1_000 / rate * 1_000_000).collect();
+            let s = summary_keeping_repeats(&t);
+            assert_eq!(s.repeat_refusal(), None, "{rate} Hz");
+            assert!(
+                (s.rate_hz / rate as f64 - 1.0).abs() < 1e-4,
+                "{rate} Hz: {s:?}"
+            );
+            // Dropping them would read 1000 Hz: refused.
+            let e = pushed(&t, false)
+                .summary(TimeUnit::Nanoseconds)
+                .unwrap_err();
+            assert!(
+                e.contains("a clock faster than its stamps"),
+                "{rate} Hz: {e}"
+            );
+        }
+    }
+
+    #[test]
+    fn two_rates_under_stamps_of_whole_seconds_are_mixed_rates() {
+        // 400 Hz for the first tenth, then 300 Hz, stamped down to whole seconds: a stamp's
+        // first sample lies within a period of its edge, so the stretches tell the rates
+        // apart (read as 306.35 Hz before); 200 Hz then 190 Hz, stamped to the microsecond.
+        let t = logged(400.0, (300.0, 2_000), 20_000, 1.0);
+        let e = pushed(&t, true).summary(TimeUnit::Nanoseconds).unwrap_err();
+        assert!(e.contains("mixed rates"), "{e}");
+        let t = logged(200.0, (190.0, 10_000), 20_000, 1e-6);
+        let e = pushed(&t, true).summary(TimeUnit::Nanoseconds).unwrap_err();
+        assert!(e.contains("mixed rates"), "{e}");
+        // Each alone: one clock, and under whole seconds no jitter to speak of.
+        for (r, q) in [(400.0, 1.0), (300.0, 1.0), (325.0, 1.0), (190.0, 1e-6)] {
+            let s = summary_keeping_repeats(&logged(r, (r, 0), 20_000, q));
+            assert!((s.rate_hz / r - 1.0).abs() < 1e-3, "{r} Hz: {}", s.rate_hz);
+            assert!(s.jitter_max < 0.01, "{r} Hz: {s:?}");
+        }
     }
 
     #[test]
