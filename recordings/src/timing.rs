@@ -877,7 +877,14 @@ impl Timing {
             jitter_rms: (sq / regular.max(1) as f64).sqrt(),
             jitter_max: worst,
             gaps,
-            missing_samples: missing,
+            // Short intervals are stamps catching up on late ones (a host's latency), whose
+            // gaps miss nothing: no more missing than the span holds periods past the
+            // intervals.
+            missing_samples: if short > 0 {
+                missing.min(((span / period).round() - intervals as f64).max(0.0) as u64)
+            } else {
+                missing
+            },
             short_intervals: short,
             dropped_backward: self.dropped,
             span_s: span * 1e-9,
@@ -1168,7 +1175,9 @@ fn judged(
     match judged {
         Some(j)
             if j.classes.regular + j.repeats >= ratio.classes.regular
-                && (counted > 0 || alternate(buckets, &j.window, 0, longest_run, q == median)) =>
+                && (counted > 0
+                    || q != median
+                    || alternate(buckets, &j.window, 0, longest_run, true)) =>
         {
             j
         }
@@ -1303,7 +1312,9 @@ pub struct TimingSummary {
     pub jitter_max: f64,
     /// Intervals longer than 1.25 times the median.
     pub gaps: u64,
-    /// The samples those gaps miss (each gap's interval over the median, rounded, less one).
+    /// The samples those gaps miss (each gap's interval over the median, rounded, less one;
+    /// where intervals are short too, at most the periods the span holds past the intervals:
+    /// a late stamp's gap, caught up on, misses nothing).
     pub missing_samples: u64,
     /// Intervals shorter than 0.75 times the median.
     pub short_intervals: u64,
@@ -2050,7 +2061,13 @@ mod tests {
         // A logger's floor(k / rate * 1000) ms (and to 10 ms): the float's error puts a few
         // stamps a quantum early, in clusters (4 and 6 ms pairs at 200 Hz; 0 and 20 ms at
         // 100 Hz to 10 ms), once refused as two rates.
-        for (rate, q) in [(200.0, 1e-3), (250.0, 1e-3), (100.0, 1e-2), (500.0, 1e-2)] {
+        for (rate, q) in [
+            (200.0, 1e-3),
+            (250.0, 1e-3),
+            (500.0, 1e-3),
+            (100.0, 1e-2),
+            (500.0, 1e-2),
+        ] {
             let q_ns = (q * 1e9_f64).round() as i64;
             let t: Vec<i64> = (0..20_000)
                 .map(|k| (k as f64 / rate / q).floor() as i64 * q_ns)
@@ -2100,6 +2117,36 @@ mod tests {
             assert!((s.rate_hz / r - 1.0).abs() < 1e-3, "{r} Hz: {}", s.rate_hz);
             assert!(s.jitter_max < 0.01, "{r} Hz: {s:?}");
         }
+    }
+
+    #[test]
+    fn late_stamps_caught_up_on_miss_no_sample() {
+        // 200 Hz, microsecond stamps: every 500 samples the host stalls 80 ms, and the samples
+        // after it come 0.1 ms apart as it catches up; 10 samples lost once, late on.
+        let mut t: Vec<i64> = Vec::new();
+        for k in 0..20_000i64 {
+            if (15_000..15_010).contains(&k) {
+                continue;
+            }
+            let true_ns = k * 5_000_000;
+            let burst = k % 500;
+            let late = if (1..=20).contains(&burst) {
+                let stall_end = (k - burst) * 5_000_000 + 80_000_000;
+                (stall_end + (burst - 1) * 100_000).max(true_ns)
+            } else {
+                true_ns
+            };
+            t.push(late);
+        }
+        let s = summary_keeping_repeats(&t);
+        assert!((s.rate_hz / 200.0 - 1.0).abs() < 1e-3, "{s:?}");
+        assert_eq!(s.missing_samples, 10, "{s:?}");
+        // A logger's floor(k / 500 * 1000) ms: pairs of 1 and 3 ms, nothing missing.
+        let t: Vec<i64> = (0..20_000)
+            .map(|k| (k as f64 / 500.0 * 1000.0).floor() as i64 * 1_000_000)
+            .collect();
+        let s = summary_keeping_repeats(&t);
+        assert_eq!((s.rate_hz, s.missing_samples), (500.0, 0), "{s:?}");
     }
 
     #[test]
