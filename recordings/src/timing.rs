@@ -433,11 +433,20 @@ pub struct Timing {
     held: Vec<Opened>,
     held_more: bool,
     /// Where the repeated stamps came (kept or dropped): the first's and the last's place
-    /// among the stamps pushed, and the fewest and most stamps between two of them. A clock
-    /// a little faster than its stamps (1005 Hz to whole ms) repeats one every so many.
+    /// among the stamps pushed, and the fewest stamps between two of them. A clock a little
+    /// faster than its stamps (1005 Hz to whole ms) repeats one every so many.
     repeat_places: Option<(u64, u64)>,
-    repeat_spacing: (u64, u64),
+    repeat_spacing: u64,
+    /// The interval that reached each stamp repeated (up to [`OPENING`] of them, and whether
+    /// there were more) and the last interval forward: a host's late samples, caught up on,
+    /// repeat the stamp a gap or a short interval reached.
+    repeat_steps: Vec<i64>,
+    repeat_steps_more: bool,
+    last_step: i64,
 }
+
+/// The most repeated stamps whose reaching interval is kept.
+const OPENING: usize = 4096;
 
 /// The most distinct intervals counted with the samples their opening stamps hold.
 const HELD: usize = 8;
@@ -461,6 +470,8 @@ struct Mark {
     steps: [(i64, u64); STEPS],
     distinct: usize,
     more: bool,
+    /// Whether a stamp repeated in the block.
+    repeated: bool,
 }
 
 impl Mark {
@@ -486,6 +497,7 @@ impl Mark {
             self.count(iv, times);
         }
         self.more |= before.more;
+        self.repeated |= before.repeated;
     }
 }
 
@@ -499,6 +511,7 @@ impl Default for Mark {
             steps: [(0, 0); STEPS],
             distinct: 0,
             more: false,
+            repeated: false,
         }
     }
 }
@@ -534,6 +547,7 @@ impl Timing {
         self.pending.push(iv);
         self.count_run(iv);
         self.first_interval.get_or_insert(iv);
+        self.last_step = iv;
         self.count_held(iv, self.trailing_repeats + 1);
         self.trailing_repeats = 0;
         self.since.count(iv, 1);
@@ -628,8 +642,16 @@ impl Timing {
     pub fn keep_repeat(&mut self) {
         self.repeats += 1;
         self.kept += 1;
+        self.since.repeated = true;
         self.place_repeat();
         self.first_repeat.get_or_insert((self.pushed, self.last));
+        if self.trailing_repeats == 0 {
+            if self.repeat_steps.len() < OPENING {
+                self.repeat_steps.push(self.last_step);
+            } else {
+                self.repeat_steps_more = true;
+            }
+        }
         self.trailing_repeats += 1;
         if self.first_interval.is_none() {
             self.leading_repeats += 1;
@@ -652,12 +674,9 @@ impl Timing {
             Some((first, last)) => {
                 let gap = at - last;
                 self.repeat_spacing = if first == last {
-                    (gap, gap)
+                    gap
                 } else {
-                    (
-                        self.repeat_spacing.0.min(gap),
-                        self.repeat_spacing.1.max(gap),
-                    )
+                    self.repeat_spacing.min(gap)
                 };
                 (first, at)
             }
@@ -665,19 +684,14 @@ impl Timing {
     }
 
     /// Whether the repeated stamps come as a clock a little faster than its stamps repeats
-    /// them: at least three, about evenly spaced (none more than twice the fewest stamps
-    /// apart, and two), from the record's start to its end. Samples written twice come where
-    /// they came.
+    /// them: at least three, none closer than half their mean spacing (samples lost, or the
+    /// clock drifting, space them wider; samples written twice come where they came).
     fn repeats_periodic(&self) -> bool {
         let Some((first, last)) = self.repeat_places else {
             return false;
         };
-        let (fewest, most) = self.repeat_spacing;
-        self.repeats + self.dropped_repeats >= 3
-            && fewest > 0
-            && most <= 2 * fewest + 2
-            && first <= most + 2
-            && self.pushed - last <= most + 2
+        let count = self.repeats + self.dropped_repeats;
+        count >= 3 && 2 * self.repeat_spacing * (count - 1) >= last - first
     }
 
     /// The samples dropped so far.
@@ -711,11 +725,17 @@ impl Timing {
     /// ns) beyond what the stamps explain, named, where it strays more than [`LOCAL`] and
     /// samples lost at random explain: two rates. A stretch runs between marks, its samples
     /// with those its gaps miss (where its blocks' intervals are known one by one; else it
-    /// has no gap) and no short interval. The stamps of a stretch's end samples are each off
+    /// has no gap) and no short interval, nor a repeated stamp unless they are `counted` as
+    /// a clock faster than its stamps' samples. The stamps of a stretch's end samples are each off
     /// their true times by their quantum (`resolution`, ns) or by the regular intervals'
     /// largest deviation from the period, whichever is more; under coarse stamps a lost
     /// sample need not show as a gap.
-    fn stray(&self, window: &Window, period: f64, resolution: Option<i64>) -> Option<String> {
+    fn stray(
+        &self,
+        window: &Window,
+        period: f64,
+        (resolution, counted): (Option<i64>, bool),
+    ) -> Option<String> {
         let marks = self.all_marks();
         let buckets = self.histogram();
         let deviation = buckets
@@ -738,10 +758,14 @@ impl Timing {
         // Whether a lost sample can hide among the regular intervals (two periods, rounded
         // down a quantum, under the window's top): else every loss shows as a gap.
         let hidden = matches!(*window, Window::Quantum { .. }) && 3.0 * quantum > period;
-        // The samples a block's gaps miss, and its gaps; none where it has a short interval,
-        // or a gap among intervals not counted one by one.
+        // The samples a block's gaps miss, and its gaps; none where it has a short interval
+        // or a repeated stamp not counted as a sample (a late stamp caught up on), or a gap
+        // among intervals not counted one by one.
         let missed = |m: &Mark| -> Option<(f64, f64)> {
             let judge = |iv: i64| window.judge(iv as f64);
+            if m.repeated && !counted {
+                return None;
+            }
             if m.more {
                 return (judge(m.longest) == Ordering::Equal
                     && judge(m.shortest) == Ordering::Equal)
@@ -818,7 +842,11 @@ impl Timing {
         let buckets = self.histogram();
         let intervals: u64 = buckets.iter().map(|b| b.count).sum();
         if intervals == 0 {
-            return Err("fewer than two timestamps: no rate".into());
+            return Err(if self.pushed > 1 {
+                format!("all {} timestamps are equal: no rate", self.pushed)
+            } else {
+                "fewer than two timestamps: no rate".into()
+            });
         }
         // The median interval, ns: the mean of the bucket that holds it (exact for a clock
         // with few distinct intervals, within 0.1 % for any).
@@ -869,6 +897,19 @@ impl Timing {
         } else {
             jitter(&buckets, &window, period)
         };
+        // The samples the span holds room for past the intervals: where the stamps resolve the
+        // interval, repeated stamps that fill the room gaps leave are a late stamp's samples
+        // caught up on within one quantum (a host's stall); samples written twice overfill it.
+        let room = ((span / period).round() - intervals as f64).max(0.0);
+        let caught_up = repeats == 0
+            && self.repeats > 0
+            && gaps > 0
+            && room >= 0.99 * self.repeats as f64 - 1.0
+            && !self.repeat_steps_more
+            && self
+                .repeat_steps
+                .iter()
+                .all(|&iv| window.judge(iv as f64) != Ordering::Equal);
         let summary = TimingSummary {
             unit: unit.name(),
             header_stamps: unit == TimeUnit::HeaderStamps,
@@ -880,8 +921,8 @@ impl Timing {
             // Short intervals are stamps catching up on late ones (a host's latency), whose
             // gaps miss nothing: no more missing than the span holds periods past the
             // intervals.
-            missing_samples: if short > 0 {
-                missing.min(((span / period).round() - intervals as f64).max(0.0) as u64)
+            missing_samples: if short > 0 || caught_up {
+                missing.min((room - self.repeats as f64).max(0.0) as u64)
             } else {
                 missing
             },
@@ -892,7 +933,7 @@ impl Timing {
             span_rate_hz: 1e9 * (intervals + self.repeats) as f64 / span,
             other_rate_hz: other,
             repeated: self.repeats,
-            unexplained_repeat: if repeats == self.repeats {
+            unexplained_repeat: if repeats == self.repeats || caught_up {
                 None
             } else {
                 self.first_repeat
@@ -958,7 +999,7 @@ impl Timing {
                 )
             });
         }
-        if let Some(stretch) = self.stray(&window, period, resolution) {
+        if let Some(stretch) = self.stray(&window, period, (resolution, repeats > 0)) {
             return Err(stretch);
         }
         Ok(summary)
@@ -2147,6 +2188,55 @@ mod tests {
             .collect();
         let s = summary_keeping_repeats(&t);
         assert_eq!((s.rate_hz, s.missing_samples), (500.0, 0), "{s:?}");
+    }
+
+    #[test]
+    fn a_hosts_stall_caught_up_on_within_a_quantum_repeats_no_sample() {
+        // 200 Hz and 500 Hz to whole ms: every 700 samples the host stalls 8 periods, then
+        // stamps the late samples 0.1 ms apart, several to a millisecond: repeats that fill
+        // the stall's gap, not samples written twice (refused as such before).
+        for rate in [200i64, 500] {
+            let period = 1_000_000_000 / rate;
+            let mut t: Vec<i64> = Vec::new();
+            for k in 0..40_000i64 {
+                let true_ns = k * period;
+                let burst = k % 700;
+                let late = if (1..=12).contains(&burst) {
+                    let stall_end = (k - burst) * period + 8 * period;
+                    (stall_end + (burst - 1) * 100_000).max(true_ns)
+                } else {
+                    true_ns
+                };
+                t.push(late / 1_000_000 * 1_000_000);
+            }
+            let s = summary_keeping_repeats(&t);
+            assert_eq!(s.repeat_refusal(), None, "{rate} Hz: {s:?}");
+            assert!(
+                (s.rate_hz / rate as f64 - 1.0).abs() < 1e-4,
+                "{rate} Hz: {s:?}"
+            );
+            assert_eq!(s.missing_samples, 0, "{rate} Hz: {s:?}");
+        }
+    }
+
+    #[test]
+    fn a_clock_a_little_faster_than_its_stamps_keeps_its_rate_through_losses() {
+        // 1003 Hz to whole ms, 1 % of the samples lost at random, and 20-sample bursts lost:
+        // the repeats come no closer than their spacing, though wider where samples are lost.
+        let mut next = crate::xorshift(0x1003_0000_dead_beef);
+        let t: Vec<i64> = (0..200_000i64)
+            .filter(|&k| !(next() >> 11).is_multiple_of(100) && !(50_000..50_020).contains(&k))
+            .map(|k| k * 1_000 / 1_003 * 1_000_000)
+            .collect();
+        let s = summary_keeping_repeats(&t);
+        assert_eq!(s.repeat_refusal(), None, "{s:?}");
+        // The losses a stamp's samples hide lower the rate by about their share (1 %).
+        assert!((s.rate_hz / 1_003.0 - 1.0).abs() < 0.012, "{s:?}");
+        // Identical stamps: named as such.
+        let e = pushed(&[5; 4], true)
+            .summary(TimeUnit::Nanoseconds)
+            .unwrap_err();
+        assert_eq!(e, "all 4 timestamps are equal: no rate");
     }
 
     #[test]
