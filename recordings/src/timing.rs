@@ -761,8 +761,15 @@ impl Timing {
         // The samples a block's gaps miss, and its gaps; none where it has a short interval
         // or a repeated stamp not counted as a sample (a late stamp caught up on), or a gap
         // among intervals not counted one by one.
+        // Short only a quantum short of short: a stamp a quantum early (a logger's float
+        // floor) makes an interval a quantum short of a regular one.
+        let judge = |iv: i64| match window.judge(iv as f64) {
+            Ordering::Less if window.judge(iv as f64 + quantum) != Ordering::Less => {
+                Ordering::Equal
+            }
+            judged => judged,
+        };
         let missed = |m: &Mark| -> Option<(f64, f64)> {
-            let judge = |iv: i64| window.judge(iv as f64);
             if m.repeated && !counted {
                 return None;
             }
@@ -2253,6 +2260,30 @@ mod tests {
             .summary(TimeUnit::Nanoseconds)
             .unwrap_err();
         assert_eq!(e, "all 4 timestamps are equal: no rate");
+    }
+
+    #[test]
+    fn a_stretch_at_another_rate_under_floored_float_stamps_is_mixed_rates() {
+        // 200 Hz for the first tenth, then 180 Hz, floored to ms in float as a logger does:
+        // the 200 Hz part's 4 ms intervals (a stamp a quantum early) are short of 180 Hz's
+        // window, yet a quantum from its 5 ms; its stretches are checked (read 181.3 Hz before,
+        // a million samples thinning the marks to blocks that each held one).
+        let (n, switch) = (1_000_000usize, 100_000usize);
+        let t: Vec<i64> = (0..n)
+            .map(|i| {
+                let s = if i < switch {
+                    i as f64 / 200.0
+                } else {
+                    (switch as f64 - 1.0) / 200.0 + (i + 1 - switch) as f64 / 180.0
+                };
+                (s * 1000.0).floor() as i64 * 1_000_000
+            })
+            .collect();
+        let e = pushed(&t, true).summary(TimeUnit::Nanoseconds).unwrap_err();
+        assert!(
+            e.contains("mixed rates") && e.contains("run at 199.9"),
+            "{e}"
+        );
     }
 
     #[test]
