@@ -423,9 +423,9 @@ pub struct Timing {
     marks: Vec<Mark>,
     block: u64,
     /// The intervals since the last mark (their longest and shortest in a mark); the last
-    /// stamp forward, as a mark.
+    /// stamp forward: its sample's number among those kept, and the stamp.
     since: Mark,
-    last_forward: Mark,
+    last_forward: (u64, i64),
     /// Each distinct interval (while there are at most [`HELD`]), how many times it came,
     /// and the samples the stamps that open it hold: a clock faster than its stamps has its
     /// rate from the regular intervals and the samples they hold alone (a gap's opening
@@ -479,6 +479,9 @@ impl Mark {
     fn count(&mut self, iv: i64, times: u64) {
         self.longest = self.longest.max(iv);
         self.shortest = self.shortest.min(iv);
+        if self.more {
+            return;
+        }
         if let Some(step) = self.steps[..self.distinct].iter_mut().find(|s| s.0 == iv) {
             step.1 += times;
         } else if self.distinct < STEPS {
@@ -573,21 +576,21 @@ impl Timing {
     /// Takes the sample stamped `t`, the first of its stamp, as kept: a mark where the block
     /// since the last is full (every other mark let go when they are [`MARKS`]).
     fn mark(&mut self, t: i64) {
-        let here = Mark {
-            kept: self.kept,
-            t,
-            ..self.since
-        };
+        let kept = self.kept;
         self.kept += 1;
-        self.last_forward = here;
+        self.last_forward = (kept, t);
         if self
             .marks
             .last()
-            .is_some_and(|m| here.kept - m.kept < self.block)
+            .is_some_and(|m| kept - m.kept < self.block)
         {
             return;
         }
-        self.marks.push(here);
+        self.marks.push(Mark {
+            kept,
+            t,
+            ..self.since
+        });
         self.since = Mark::default();
         if self.marks.len() == MARKS {
             // Marks 0, 2, 4, ...: each block takes in the one before it; the last, dropped,
@@ -708,13 +711,11 @@ impl Timing {
     /// The marks, the last stamp forward the last of them.
     fn all_marks(&self) -> Vec<Mark> {
         let mut marks = self.marks.clone();
-        if marks
-            .last()
-            .is_some_and(|m| m.kept < self.last_forward.kept)
-        {
+        let (kept, t) = self.last_forward;
+        if marks.last().is_some_and(|m| m.kept < kept) {
             marks.push(Mark {
-                kept: self.last_forward.kept,
-                t: self.last_forward.t,
+                kept,
+                t,
                 ..self.since
             });
         }
@@ -1130,7 +1131,7 @@ fn judged(
     let mean = span / intervals as f64;
     if (c.regular as f64) < 0.9 * intervals as f64 {
         let (w, by_mean) = by_ratio(mean);
-        if by_mean.regular > c.regular && alternate(buckets, &w, 0, longest_run, false) {
+        if by_mean.regular > c.regular && alternate(buckets, &w, longest_run, false) {
             (window, c) = (w, by_mean);
         }
     }
@@ -1226,7 +1227,7 @@ fn judged(
             if j.classes.regular + j.repeats >= ratio.classes.regular
                 && (counted > 0
                     || q != median
-                    || alternate(buckets, &j.window, 0, longest_run, true)) =>
+                    || alternate(buckets, &j.window, longest_run, true)) =>
         {
             j
         }
@@ -1242,26 +1243,18 @@ fn judged(
     }
 }
 
-/// Whether the regular intervals `window` judges (and `zeros` repeated stamps) alternate as
+/// Whether the regular intervals `window` judges alternate as
 /// a rounded clock's do: the less common of them come about every `n / fewer` intervals, so
 /// no interval comes many more times in a row (`longest_run`) than that: twice that and 8
 /// more where `tight` (rounding without jitter spaces them evenly), else allowing for jitter
 /// (a geometric run's longest grows as the logarithm of their number). Two rates within a
 /// quantum of each other (3 ms, then 4 ms) run half the record each; a clock that misses
 /// samples at random runs the logarithm of their number longer than one that rounds.
-fn alternate(
-    buckets: &[Bucket],
-    window: &Window,
-    zeros: u64,
-    longest_run: u64,
-    tight: bool,
-) -> bool {
+fn alternate(buckets: &[Bucket], window: &Window, longest_run: u64, tight: bool) -> bool {
     let (regular, most) = buckets
         .iter()
         .filter(|b| window.judge(b.mean()) == Ordering::Equal)
-        .fold((zeros, zeros), |(all, most), b| {
-            (all + b.count, b.count.max(most))
-        });
+        .fold((0, 0), |(all, most), b| (all + b.count, b.count.max(most)));
     let fewer = regular - most;
     if tight {
         fewer == 0 || longest_run as f64 <= 2.0 * regular as f64 / fewer as f64 + 8.0
