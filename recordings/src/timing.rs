@@ -388,10 +388,8 @@ pub struct Timing {
     dropped: u64,
     /// Stamps pushed.
     pushed: u64,
-    /// Samples kept whose stamp equals the one before, and the first of them (its number
-    /// among the stamps pushed, its stamp).
+    /// Samples kept whose stamp equals the one before.
     repeats: u64,
-    first_repeat: Option<(u64, i64)>,
     /// The last interval and how many times in a row it came, and the most times any did:
     /// a clock's rounded intervals alternate, a record of two rates runs long on each.
     run: (i64, u64),
@@ -437,12 +435,41 @@ pub struct Timing {
     /// faster than its stamps (1005 Hz to whole ms) repeats one every so many.
     repeat_places: Option<(u64, u64)>,
     repeat_spacing: u64,
+    /// The repeats of the last stamp forward (the first's place, how many) until the next
+    /// stamp tells whether they are a stamp a quantum early; the repeats that were, and
+    /// their stamps (`paired`); whether the last stamp was; the first repeat that was not
+    /// (its place, the stamp).
+    open_repeats: (u64, u64),
+    paired: (u64, u64),
+    early: bool,
+    first_unpaired: Option<(u64, i64)>,
     /// The interval that reached each stamp repeated (up to [`OPENING`] of them, and whether
     /// there were more) and the last interval forward: a host's late samples, caught up on,
     /// repeat the stamp a gap or a short interval reached.
     repeat_steps: Vec<i64>,
     repeat_steps_more: bool,
     last_step: i64,
+}
+
+/// Places `count` repeats from the `at`-th stamp on among those placed (the first's and the
+/// last's place) and the fewest stamps between two (`spacing`).
+fn place(places: &mut Option<(u64, u64)>, spacing: &mut u64, at: u64, count: u64) {
+    let end = at + (count - 1);
+    *places = Some(match *places {
+        None => (at, end),
+        Some((first, last)) => {
+            let gap = at - last;
+            *spacing = if first == last {
+                gap
+            } else {
+                (*spacing).min(gap)
+            };
+            (first, end)
+        }
+    });
+    if count > 1 {
+        *spacing = 1;
+    }
 }
 
 /// The most repeated stamps whose reaching interval is kept.
@@ -550,8 +577,14 @@ impl Timing {
         self.pending.push(iv);
         self.count_run(iv);
         self.first_interval.get_or_insert(iv);
-        self.last_step = iv;
-        self.count_held(iv, self.trailing_repeats + 1);
+        let reach = std::mem::replace(&mut self.last_step, iv);
+        self.close_repeats(reach, iv);
+        // A stamp a gap reached (longer than any regular interval: two quanta and a
+        // quarter) may hold a host's late samples, caught up on: not the samples of the
+        // interval it opens.
+        if reach <= iv.saturating_mul(2).saturating_add(iv / 4) {
+            self.count_held(iv, self.trailing_repeats + 1);
+        }
         self.trailing_repeats = 0;
         self.since.count(iv, 1);
         self.mark(t);
@@ -647,7 +680,6 @@ impl Timing {
         self.kept += 1;
         self.since.repeated = true;
         self.place_repeat();
-        self.first_repeat.get_or_insert((self.pushed, self.last));
         if self.trailing_repeats == 0 {
             if self.repeat_steps.len() < OPENING {
                 self.repeat_steps.push(self.last_step);
@@ -669,32 +701,68 @@ impl Timing {
         self.place_repeat();
     }
 
-    /// Notes where the stamp just pushed, a repeat, came.
+    /// Notes that the stamp just pushed is a repeat: where it came is known once the next
+    /// stamp tells whether it was a stamp a quantum early.
     fn place_repeat(&mut self) {
-        let at = self.pushed;
-        self.repeat_places = Some(match self.repeat_places {
-            None => (at, at),
-            Some((first, last)) => {
-                let gap = at - last;
-                self.repeat_spacing = if first == last {
-                    gap
-                } else {
-                    self.repeat_spacing.min(gap)
-                };
-                (first, at)
-            }
-        });
+        if self.open_repeats.1 == 0 {
+            self.open_repeats.0 = self.pushed;
+        }
+        self.open_repeats.1 += 1;
+    }
+
+    /// Takes the repeats of the stamp that the interval `reach` reached and that opens `iv`:
+    /// a stamp a quantum early (a logger's floor of float seconds) equals the one before it
+    /// and opens an interval twice the one that reached it (or, where the stamp before was
+    /// early too, as long); else they are placed.
+    fn close_repeats(&mut self, reach: i64, iv: i64) {
+        let (at, count) = std::mem::take(&mut self.open_repeats);
+        let early = count > 0
+            && reach > 0
+            && (reach.checked_mul(2) == Some(iv) || (self.early && reach == iv));
+        self.early = early;
+        if count == 0 {
+            return;
+        }
+        if early {
+            self.paired.0 += count;
+            self.paired.1 += 1;
+        } else {
+            self.first_unpaired.get_or_insert((at, self.last));
+            place(&mut self.repeat_places, &mut self.repeat_spacing, at, count);
+        }
+    }
+
+    /// The repeats not paired with a stamp a quantum early (the last stamp's among them):
+    /// how many, the first's and the last's place and the fewest stamps between two.
+    fn unpaired(&self) -> (u64, Option<(u64, u64)>, u64) {
+        let (mut places, mut spacing) = (self.repeat_places, self.repeat_spacing);
+        let (at, count) = self.open_repeats;
+        if count > 0 {
+            place(&mut places, &mut spacing, at, count);
+        }
+        let all = self.repeats + self.dropped_repeats;
+        (all.saturating_sub(self.paired.0), places, spacing)
     }
 
     /// Whether the repeated stamps come as a clock a little faster than its stamps repeats
     /// them: at least three, none closer than half their mean spacing (samples lost, or the
-    /// clock drifting, space them wider; samples written twice come where they came).
+    /// clock drifting, space them wider; samples written twice come where they came); those
+    /// of a stamp a quantum early left out.
     fn repeats_periodic(&self) -> bool {
-        let Some((first, last)) = self.repeat_places else {
+        let (count, places, spacing) = self.unpaired();
+        let Some((first, last)) = places else {
             return false;
         };
-        let count = self.repeats + self.dropped_repeats;
-        count >= 3 && 2 * self.repeat_spacing * (count - 1) >= last - first
+        count >= 3 && 2 * spacing * (count - 1) >= last - first
+    }
+
+    /// Whether the repeated stamps are all a stamp a quantum early, or come evenly, or are
+    /// no more than the intervals of two quanta (`twos`) left where the early stamps paired
+    /// with theirs: a stretch of stamps a quantum early (a float's floor drifting under the
+    /// quanta) opens with a repeat and closes with an interval of two.
+    fn repeats_explained(&self, twos: u64) -> bool {
+        let unpaired = self.unpaired().0;
+        unpaired == 0 || self.repeats_periodic() || unpaired <= twos.saturating_sub(self.paired.1)
     }
 
     /// The samples dropped so far.
@@ -869,6 +937,15 @@ impl Timing {
         }
         let span = self.span_ns();
         let resolution = resolution(&buckets, self.bits);
+        // Intervals of two quanta, where the quantum is the median: a stamp a quantum early
+        // opens one.
+        let twos = resolution.filter(|&q| q as f64 == median).map_or(0, |q| {
+            buckets
+                .iter()
+                .filter(|b| Some(b.key) == q.checked_mul(2))
+                .map(|b| b.count)
+                .sum()
+        });
         let judged = judged(
             &buckets,
             (median, span, intervals),
@@ -878,7 +955,7 @@ impl Timing {
                 self.first_interval.unwrap_or(0),
                 (!self.held_more).then_some(&self.held[..]),
             ),
-            self.repeats_periodic(),
+            self.repeats_explained(twos),
             self.longest_run.max(1),
         );
         let Judged {
@@ -930,8 +1007,14 @@ impl Timing {
             // Short intervals are stamps catching up on late ones (a host's latency), whose
             // gaps miss nothing: no more missing than the span holds periods past the
             // intervals.
+            // Where several samples share a stamp, a stamp a gap reached may hold a host's
+            // late samples caught up on: no more missing than the span holds room for, give
+            // or take the samples of a quantum (the end stamps' samples lie within theirs).
             missing_samples: if short > 0 || caught_up {
                 missing.min((room - self.repeats as f64).max(0.0) as u64)
+            } else if repeats > 0 {
+                let ends = resolution.unwrap_or(0) as f64 / period;
+                missing.min((room - self.repeats as f64 + ends).round().max(0.0) as u64)
             } else {
                 missing
             },
@@ -945,7 +1028,9 @@ impl Timing {
             unexplained_repeat: if repeats == self.repeats || caught_up {
                 None
             } else {
-                self.first_repeat
+                self.first_unpaired.or_else(|| {
+                    (self.open_repeats.1 > 0).then_some((self.open_repeats.0, self.last))
+                })
             },
         };
         let (regular, intervals) = (regular + repeats, intervals + repeats);
@@ -1008,10 +1093,75 @@ impl Timing {
                 )
             });
         }
+        if let Some(crowded) = (short > 0)
+            .then(|| self.crowded(period, intervals, short))
+            .flatten()
+        {
+            return Err(crowded);
+        }
         if let Some(stretch) = self.stray(&window, period, (resolution, repeats > 0)) {
             return Err(stretch);
         }
         Ok(summary)
+    }
+
+    /// Where `intervals` intervals (`shorts` of them short) are more than the span holds at
+    /// the period (ns) by over 1 % and what jitter explains, a stretch at a faster rate,
+    /// named: a host's late stamps caught up on add no sample (the stall's gap holds them),
+    /// so the stretch check, which leaves out stretches with short intervals, does not see
+    /// it.
+    fn crowded(&self, period: f64, intervals: u64, shorts: u64) -> Option<String> {
+        let held = self.span_ns() / period;
+        let n = intervals as f64;
+        if n - held <= 0.01 * n + 3.0 * n.sqrt() {
+            return None;
+        }
+        // The stretch between marks the furthest ahead of the record's rate.
+        let marks = self.all_marks();
+        let first = marks.first()?;
+        let ahead = |m: &Mark| {
+            (m.kept - first.kept) as f64 - (i128::from(m.t) - i128::from(first.t)) as f64 / period
+        };
+        let (mut low, mut best) = (0, None::<(f64, usize, usize)>);
+        for (j, m) in marks.iter().enumerate() {
+            if ahead(m) < ahead(&marks[low]) {
+                low = j;
+            }
+            let rise = ahead(m) - ahead(&marks[low]);
+            if best.is_none_or(|(r, ..)| rise > r) {
+                best = Some((rise, low, j));
+            }
+        }
+        // Narrowed to where it runs ahead: its latest start that keeps nine tenths of the
+        // rise, and from there the earliest end that keeps eight.
+        let (rise, i, j) = best?;
+        let i = (i..=j)
+            .rev()
+            .find(|&k| ahead(&marks[j]) - ahead(&marks[k]) >= 0.9 * rise)
+            .unwrap_or(i);
+        let j = (i..=j)
+            .find(|&k| ahead(&marks[k]) - ahead(&marks[i]) >= 0.8 * rise)
+            .unwrap_or(j);
+        let (a, b) = (&marks[i], &marks[j]);
+        let since = |t: i64| (i128::from(t) - i128::from(first.t)) as f64 * 1e-9;
+        let stretch = (i128::from(b.t) - i128::from(a.t)) as f64;
+        Some(format!(
+            "the timestamps show mixed rates: {} samples where their span holds {} at {} Hz \
+             ({shorts} intervals short): samples {} to {} ({} s to {} s after the first \
+             stamp) run at {} Hz; one record must have one rate (or give --rate)",
+            intervals + 1,
+            held.round() + 1.0,
+            short(1e9 / period),
+            a.kept + 1,
+            b.kept + 1,
+            short(since(a.t)),
+            short(since(b.t)),
+            short(if stretch > 0.0 {
+                1e9 * (b.kept - a.kept) as f64 / stretch
+            } else {
+                f64::INFINITY
+            })
+        ))
     }
 }
 
@@ -2218,9 +2368,9 @@ mod tests {
             );
             assert_eq!(s.missing_samples, 0, "{rate} Hz: {s:?}");
         }
-        // 950 Hz to the nearest ms, jittered 30 us: its few repeats follow 2 ms intervals, gaps
-        // of a 1 kHz reading that leaves far more room than they fill: not a stall's, so the
-        // 1 kHz reading is not taken (read as 1000 Hz with 263 missing, exit 0, otherwise).
+        // 950 Hz to the nearest ms, jittered 30 us: its few repeats are stamps a quantum early
+        // (fewer than its 2 ms intervals), not a stall's, so the 1 kHz reading with 263
+        // missing is not taken: 950 Hz, nothing missing (refused as samples repeated before).
         let t = clock(
             (950.0, 950.0, 5_000),
             5_000,
@@ -2228,11 +2378,88 @@ mod tests {
             (0.0, 30_000.0),
         );
         assert!(t.windows(2).any(|w| w[0] == w[1]));
-        let s = pushed(&t, true).summary(TimeUnit::Nanoseconds);
+        let s = summary_keeping_repeats(&t);
+        assert!((s.rate_hz / 950.0 - 1.0).abs() < 1e-4, "{s:?}");
+        assert_eq!(s.missing_samples, 0, "{s:?}");
+        // Stalls of 8 periods at 200 Hz to 10 ms, caught up on 0.1 ms apart: a stamp a gap
+        // reached holds the late samples (read 202.05 Hz with 348 missing before).
+        let t: Vec<i64> = (0..40_000i64)
+            .map(|k| {
+                let burst = k % 700;
+                let late = if (1..=12).contains(&burst) {
+                    ((k - burst + 8) * 5_000_000 + (burst - 1) * 100_000).max(k * 5_000_000)
+                } else {
+                    k * 5_000_000
+                };
+                late / 10_000_000 * 10_000_000
+            })
+            .collect();
+        let s = summary_keeping_repeats(&t);
+        assert!((s.rate_hz / 200.0 - 1.0).abs() < 1e-4, "{s:?}");
+        assert!(s.missing_samples <= 2, "{s:?}");
+    }
+
+    #[test]
+    fn a_faster_stretch_of_short_intervals_is_mixed_rates() {
+        // 100 Hz with its last 9.995 % at 200 Hz: the 5 ms intervals are short, as a host's
+        // late stamps caught up on are, but no stall's gap holds them: more samples than the
+        // span holds (read as 100 Hz with 1,998 short intervals, exit 0, before).
+        let t: Vec<i64> = (0..20_000i64)
+            .map(|k| {
+                let switch = 18_001;
+                if k < switch {
+                    k * 10_000_000
+                } else {
+                    switch * 10_000_000 + (k - switch) * 5_000_000
+                }
+            })
+            .collect();
+        let e = pushed(&t, true).summary(TimeUnit::Nanoseconds).unwrap_err();
         assert!(
-            s.as_ref().map_or(true, |s| s.repeat_refusal().is_some()),
-            "{s:?}"
+            e.contains("mixed rates") && e.contains("run at 200 Hz"),
+            "{e}"
         );
+        // A host that stamps its first 400 samples late (2 s, then caught up 0.1 ms apart):
+        // one clock.
+        let t: Vec<i64> = (0..20_000i64)
+            .map(|k| (k * 5_000_000).max(2_000_000_000 + k * 100_000))
+            .collect();
+        let s = summary_keeping_repeats(&t);
+        assert!((s.rate_hz / 200.0 - 1.0).abs() < 1e-4, "{s:?}");
+    }
+
+    #[test]
+    fn stamps_a_quantum_early_are_not_samples_repeated() {
+        // 1 kHz floored to whole ms from float seconds, k / 1000 * 1000: every other stamp a
+        // quantum early in stretches (0 and 2 ms), and a time summed in float whose floor
+        // slips a quantum early for good three times: a repeat, and 2 ms where it slips
+        // back (refused as samples repeated before); with the clock drifting to 1005 Hz its
+        // own repeats, evenly spaced, come too.
+        let floored = |s: f64| (s * 1000.0).floor() as i64 * 1_000_000;
+        let t: Vec<i64> = (0..200_000).map(|k| floored(k as f64 / 1000.0)).collect();
+        assert!(t.windows(2).filter(|w| w[0] == w[1]).count() > 1_000);
+        let mut sum = 0.0;
+        let summed: Vec<i64> = (0..200_000)
+            .map(|_| {
+                let s = floored(sum);
+                sum += 1e-3;
+                s
+            })
+            .collect();
+        assert!(summed.windows(2).any(|w| w[0] == w[1]));
+        let drifting: Vec<i64> = (0..200_000)
+            .map(|k| floored(k as f64 / (1000.0 + 5.0 * k as f64 / 400_000.0)))
+            .collect();
+        for (t, rate) in [(t, 1000.0), (summed, 1000.0), (drifting, 1002.5)] {
+            let s = summary_keeping_repeats(&t);
+            assert!((s.rate_hz / rate - 1.0).abs() < 1e-4, "{rate} Hz: {s:?}");
+            assert_eq!(s.missing_samples, 0, "{rate} Hz: {s:?}");
+        }
+        // A sample written twice, nothing lost: still refused.
+        let mut t: Vec<i64> = (0..20_000).map(|k| k * 1_000_000).collect();
+        t.insert(7_000, 6_999_000_000);
+        let s = pushed(&t, true).summary(TimeUnit::Nanoseconds).unwrap();
+        assert!(s.repeat_refusal().is_some(), "{s:?}");
     }
 
     #[test]
