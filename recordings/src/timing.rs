@@ -876,7 +876,15 @@ impl Timing {
                 (missing, gaps) = (missing + m, gaps + g);
                 let (a, b) = (&marks[i], &marks[j]);
                 let span = (i128::from(b.t) - i128::from(a.t)) as f64;
-                let samples = (b.kept - a.kept) as f64 + missing;
+                // Where several samples share a stamp, a stamp a gap reached may hold a host's
+                // late samples caught up on: the gaps miss no more than the stretch's room.
+                let kept = (b.kept - a.kept) as f64;
+                let samples = kept
+                    + if counted {
+                        missing.min((span / period - kept).max(0.0))
+                    } else {
+                        missing
+                    };
                 // In samples: beyond the stamps' error, the drift allowed, the samples the
                 // gaps miss more or less (each gap's ends rounded apart: a standard deviation
                 // of half a sample and half the samples a quantum holds; three of them over
@@ -2440,6 +2448,34 @@ mod tests {
             .collect();
         let s = summary_keeping_repeats(&t);
         assert!((s.rate_hz / 200.0 - 1.0).abs() < 1e-4, "{s:?}");
+    }
+
+    #[test]
+    fn a_hosts_stall_stamped_at_its_end_where_the_period_is_the_quantum() {
+        // 1 kHz to whole ms and 100 Hz to 10 ms: every `every` samples the host stalls
+        // `stall` periods and stamps the queued samples with the stall's end, sharing its
+        // quantum (read 1010.1, 1111.7 and 111.2 Hz with thousands missing, or refused as
+        // mixed rates, before).
+        for (period, every, stall, n) in [
+            (1_000_000i64, 2_000i64, 20i64, 200_000i64),
+            (1_000_000, 200, 20, 200_000),
+            (10_000_000, 200, 20, 50_000),
+        ] {
+            let t: Vec<i64> = (0..n)
+                .map(|k| {
+                    let into = k % every;
+                    if (1..=stall).contains(&into) {
+                        (k - into + stall) * period
+                    } else {
+                        k * period
+                    }
+                })
+                .collect();
+            let s = summary_keeping_repeats(&t);
+            let rate = 1e9 / period as f64;
+            assert!((s.rate_hz / rate - 1.0).abs() < 1e-4, "{rate} Hz: {s:?}");
+            assert!(s.missing_samples <= 2, "{rate} Hz: {s:?}");
+        }
     }
 
     #[test]
