@@ -374,9 +374,8 @@ fn autopilot_stream(
         count += 1;
         // Microseconds since boot, to nanoseconds.
         let stamp = (time_us * 1e3).round() as i64;
-        if let Some(last) = not_after(timing.push(stamp), stamp) {
-            timing.drop_one();
-            backward.get_or_insert((count, stamp, last));
+        if !take_stamp(&mut timing, stamp, request.drop_backward) {
+            backward.get_or_insert((count, stamp, timing.last()));
             return;
         }
         for (v, &i) in values.iter_mut().zip(&picks) {
@@ -743,9 +742,8 @@ fn messages(
             count += 1;
             if frame.stamp_ns == 0 {
                 unstamped += 1;
-            } else if let Some(last) = not_after(timing.push(frame.stamp_ns), frame.stamp_ns) {
-                timing.drop_one();
-                backward.get_or_insert((count, frame.stamp_ns, last));
+            } else if !take_stamp(&mut timing, frame.stamp_ns, request.drop_backward) {
+                backward.get_or_insert((count, frame.stamp_ns, timing.last()));
                 return;
             }
             for (v, &i) in values.iter_mut().zip(&picks) {
@@ -801,9 +799,29 @@ fn si_unit(i: usize) -> Option<Unit> {
     Unit::parse(if i < 3 { "rad/s" } else { "m/s^2" })
 }
 
-/// The stamp before a message's stamp `t` that did not move `step` forward: a log's or a
-/// bag's stamps come from a clock that resolves its samples, so a repeated stamp is a message
-/// repeated, as backward as one before it.
+/// Takes a message's stamp `t` into `timing`: whether the message is kept. A stamp equal to
+/// the one before is kept (the summary tells a clock coarser than its messages, or a host's
+/// late messages caught up on within its clock's step, from messages repeated), or dropped
+/// and counted with `drop_backward`; one before it is dropped and counted.
+fn take_stamp(timing: &mut Timing, t: i64, drop_backward: bool) -> bool {
+    match timing.push(t) {
+        Step::Forward => true,
+        Step::Repeat if !drop_backward => {
+            timing.keep_repeat();
+            true
+        }
+        Step::Repeat => {
+            timing.drop_repeat();
+            false
+        }
+        Step::Backward { .. } => {
+            timing.drop_one();
+            false
+        }
+    }
+}
+
+/// The stamp before a sample's stamp `t` that did not move `step` forward.
 fn not_after(step: Step, t: i64) -> Option<i64> {
     match step {
         Step::Forward => None,

@@ -386,6 +386,10 @@ pub struct Timing {
     first: Option<i64>,
     last: i64,
     dropped: u64,
+    /// Samples dropped in a row since the last stamp forward, and that stamp's number; the
+    /// longest such run, with the number and the stamp of the stamp before it.
+    drop_run: (u64, u64),
+    longest_drop: (u64, u64, i64),
     /// Stamps pushed.
     pushed: u64,
     /// Samples kept whose stamp equals the one before.
@@ -563,7 +567,9 @@ impl Timing {
     /// last accepted one, which it then becomes.
     pub fn push(&mut self, t: i64) -> Step {
         self.pushed += 1;
+        let forward = (0, self.pushed);
         let Some(_) = self.first else {
+            self.drop_run = forward;
             self.first = Some(t);
             self.last = t;
             self.mark(t);
@@ -576,6 +582,7 @@ impl Timing {
         if t < self.last {
             return Step::Backward { last: self.last };
         }
+        self.drop_run = forward;
         let iv = t.saturating_sub(self.last);
         self.pending.push(iv);
         self.count_run(iv);
@@ -679,6 +686,10 @@ impl Timing {
     /// Counts a sample dropped for its backward (or repeated) stamp.
     pub fn drop_one(&mut self) {
         self.dropped += 1;
+        self.drop_run.0 += 1;
+        if self.drop_run.0 > self.longest_drop.0 {
+            self.longest_drop = (self.drop_run.0, self.drop_run.1, self.last);
+        }
     }
 
     /// Keeps the sample whose stamp was a [`Step::Repeat`]: the summary takes it as a sample
@@ -766,6 +777,11 @@ impl Timing {
     /// Whether the repeated stamps are all a stamp a quantum early, or come evenly.
     fn repeats_explained(&self) -> bool {
         self.unpaired().0 == 0 || self.repeats_periodic()
+    }
+
+    /// The last stamp forward, ns.
+    pub fn last(&self) -> i64 {
+        self.last
     }
 
     /// The samples dropped so far.
@@ -934,6 +950,16 @@ impl Timing {
             } else {
                 "fewer than two timestamps: no rate".into()
             });
+        }
+        // Samples dropped for stamps behind one, many in a row: that stamp jumped ahead, or
+        // the clock back; the rest is not the record's.
+        let (run, at, stamp) = self.longest_drop;
+        if run >= 10 && run.saturating_mul(100) > self.pushed {
+            return Err(format!(
+                "--drop-backward dropped {run} samples in a row, each stamped before sample \
+                 {at} ({stamp} ns): a stamp that jumped ahead, or a clock that jumped back; \
+                 remove that stamp's line or cut the record there"
+            ));
         }
         // The median interval, ns: the mean of the bucket that holds it (exact for a clock
         // with few distinct intervals, within 0.1 % for any).
@@ -2476,6 +2502,36 @@ mod tests {
             assert!((s.rate_hz / rate - 1.0).abs() < 1e-4, "{rate} Hz: {s:?}");
             assert!(s.missing_samples <= 2, "{rate} Hz: {s:?}");
         }
+    }
+
+    #[test]
+    fn a_stamp_that_jumps_ahead_is_not_the_record_dropped_behind_it() {
+        // 40,000 samples at 200 Hz to the microsecond, one stamp 1000 s ahead (a bit flip, a
+        // time source's jump): --drop-backward dropped the 19,999 after it and read a 1000 s
+        // gap missing 200,000 samples. Now refused, naming the stamp; a few stamps a little
+        // back (a host's reordering) are still dropped and counted.
+        let read = |t: &[i64]| {
+            let mut timing = Timing::new();
+            for &s in t {
+                if let Step::Backward { .. } = timing.push(s) {
+                    timing.drop_one();
+                }
+            }
+            timing.summary(TimeUnit::Nanoseconds)
+        };
+        let mut t: Vec<i64> = (0..40_000).map(|k| k * 5_000_000).collect();
+        t[20_001] += 1_000_000_000_000;
+        let e = read(&t).unwrap_err();
+        assert!(
+            e.contains("dropped 19998 samples in a row") && e.contains("before sample 20002"),
+            "{e}"
+        );
+        let mut t: Vec<i64> = (0..40_000).map(|k| k * 5_000_000).collect();
+        for k in [1_000, 9_000, 30_000] {
+            t.swap(k, k + 1);
+        }
+        let s = read(&t).unwrap();
+        assert_eq!((s.rate_hz, s.dropped_backward), (200.0, 3), "{s:?}");
     }
 
     #[test]

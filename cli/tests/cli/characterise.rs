@@ -360,6 +360,66 @@ fn a_white_and_random_walk_record_exports_close_to_its_truth() {
 }
 
 /// `imu-ar ARGS` fails with status 2, one line containing `want`, and nothing on stdout.
+#[test]
+fn header_stamps_coarser_than_the_messages_are_read_as_the_csv_reads_them() {
+    // A driver stamping 200 Hz messages to 10 ms: every other header stamp repeats the one
+    // before, in a bag and a CSV of the same stamps. Read as the CSV is (refused as "not
+    // after the one before", even with --rate, before; --drop-backward then read a 100 Hz
+    // record): 200 Hz, every message.
+    let dir = temp_dir("coarse-header-stamps");
+    let out = dir.join("out");
+    let mut frames = noise_frames();
+    let base = frames[0].stamp_ns / 10_000_000 * 10_000_000;
+    for (i, f) in frames.iter_mut().enumerate() {
+        f.stamp_ns = base + i as i64 * 5_000_000 / 10_000_000 * 10_000_000;
+    }
+    assert!(frames.windows(2).any(|w| w[0].stamp_ns == w[1].stamp_ns));
+    let bag = edited_bag(&dir, "noise.bag", "coarse.bag", &frames);
+    let csv = dir.join("coarse.csv");
+    write_euroc(&csv, &frames);
+    let from_csv = characterise(&[path(&csv)], &out, &[]);
+    for extra in [&[][..], &["--rate", "200"][..]] {
+        let from_bag = characterise(&[path(&bag), "--topic", "/imu0"], &out, extra);
+        assert_eq!(from_bag["n"], 1_200, "{extra:?}");
+        assert_eq!(from_bag["rate_hz"], 200.0, "{extra:?}");
+        assert_eq!(from_bag["timing"]["repeated"], 600, "{extra:?}");
+        assert_eq!(
+            from_bag["axes"][0]["model"]["white_noise"],
+            from_csv["axes"][0]["model"]["white_noise"],
+            "{extra:?}"
+        );
+    }
+    assert_eq!(from_csv["rate_hz"], 200.0);
+    // Dropping them would halve the rate: refused, as for the CSV.
+    refused(
+        &[
+            "characterise",
+            path(&bag),
+            "--topic",
+            "/imu0",
+            "--drop-backward",
+            "--out",
+            path(&out),
+        ],
+        "read it without --drop-backward",
+    );
+    // A fine clock's message repeated: named as such.
+    let mut twice = noise_frames();
+    twice[700].stamp_ns = twice[699].stamp_ns;
+    let bag = edited_bag(&dir, "noise.bag", "twice.bag", &twice);
+    refused(
+        &[
+            "characterise",
+            path(&bag),
+            "--topic",
+            "/imu0",
+            "--out",
+            path(&out),
+        ],
+        "1 timestamps equal the one before",
+    );
+}
+
 fn refused(args: &[&str], want: &str) {
     let out = imu_ar(args);
     assert_one_line_failure(&out);
