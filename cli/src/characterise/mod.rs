@@ -12,6 +12,7 @@ pub mod stream;
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
+use std::sync::{Mutex, MutexGuard, PoisonError};
 
 use imu_ar::ArModel;
 use imu_ar::batch::criteria::Criterion;
@@ -392,6 +393,48 @@ fn characterise(
     })
 }
 
+/// The fresh folder [`write_all`] writes into while it does: [`remove_staging`] removes it
+/// (a signal's handler, before the process ends), and the moves into `out` hold it.
+static STAGING: Mutex<Option<PathBuf>> = Mutex::new(None);
+
+/// The folder being written, locked.
+fn staging() -> MutexGuard<'static, Option<PathBuf>> {
+    STAGING.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+/// Removes the folder [`write_all`] is writing into, if any, once the moves into `out` are
+/// done: for a process that ends on a signal (SIGINT, SIGTERM, SIGHUP), which leaves `out`
+/// as it was, or holding the whole new set.
+pub fn remove_staging() {
+    if let Some(folder) = staging().take() {
+        let _ = std::fs::remove_dir_all(folder);
+    }
+}
+
+/// Removes the folders `.imu-ar-PID` in `out` whose process no longer runs (killed before it
+/// could remove its own), where the system lists its processes in `/proc`.
+fn sweep(out: &Path) {
+    if !Path::new("/proc/self").exists() {
+        return;
+    }
+    let Ok(entries) = std::fs::read_dir(out) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let pid = name
+            .to_str()
+            .and_then(|n| n.strip_prefix(".imu-ar-"))
+            .and_then(|p| p.parse::<u32>().ok());
+        if let Some(pid) = pid
+            && pid != std::process::id()
+            && !Path::new("/proc").join(pid.to_string()).exists()
+        {
+            let _ = std::fs::remove_dir_all(entry.path());
+        }
+    }
+}
+
 /// Writes every file of `formats` and the plots `draw` makes, or none: each into a fresh
 /// folder in `out` first, moved into `out` once all are written ([`commit`]).
 pub(crate) fn write_all(
@@ -401,15 +444,18 @@ pub(crate) fn write_all(
     out: &Path,
     draw: &dyn Fn(&Path) -> Result<Vec<PathBuf>, Fail>,
 ) -> Result<Vec<String>, Fail> {
-    let staging = out.join(format!(".imu-ar-{}", std::process::id()));
+    sweep(out);
+    let staging_folder = out.join(format!(".imu-ar-{}", std::process::id()));
+    let staging_folder = &staging_folder;
+    *staging() = Some(staging_folder.clone());
     let cannot = |e: std::io::Error| Fail(format!("{}: {e}", out.display()));
-    std::fs::create_dir_all(&staging).map_err(cannot)?;
+    std::fs::create_dir_all(staging_folder).map_err(cannot)?;
     let written = formats
         .iter()
-        .map(|f| write(*f, imu, horizon, &staging))
+        .map(|f| write(*f, imu, horizon, staging_folder))
         .collect::<Result<Vec<PathBuf>, Fail>>()
         .and_then(|mut paths| {
-            paths.extend(draw(&staging)?);
+            paths.extend(draw(staging_folder)?);
             Ok(paths)
         });
     // The files of the formats not asked for, an earlier run's: set aside with the commit,
@@ -419,12 +465,19 @@ pub(crate) fn write_all(
         .filter(|f| !formats.contains(f))
         .map(|f| f.file_name())
         .collect();
+    // A signal's handler waits for the moves and the folder's removal.
+    let mut held = staging();
     let moved = written.and_then(|paths| {
-        commit(&paths, &stale, out, &staging.join("kept"), &|from, to| {
-            std::fs::rename(from, to)
-        })
+        commit(
+            &paths,
+            &stale,
+            out,
+            &staging_folder.join("kept"),
+            &|from, to| std::fs::rename(from, to),
+        )
     });
-    let _ = std::fs::remove_dir_all(&staging);
+    let _ = std::fs::remove_dir_all(staging_folder);
+    *held = None;
     moved
 }
 

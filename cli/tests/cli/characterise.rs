@@ -420,6 +420,62 @@ fn header_stamps_coarser_than_the_messages_are_read_as_the_csv_reads_them() {
     );
 }
 
+#[test]
+fn a_run_ended_by_a_signal_leaves_no_folder_behind() {
+    // A folder `.imu-ar-PID` of a process that no longer runs (killed with SIGKILL mid-write)
+    // is swept by the next run; SIGTERM removes the run's own (both were left in `--out`).
+    let dir = temp_dir("signal");
+    let out = dir.join("out");
+    let stale = out.join(".imu-ar-999999999");
+    std::fs::create_dir_all(&stale).unwrap();
+    std::fs::write(stale.join("imu.yaml"), "old").unwrap();
+    let file = dir.join("data.csv");
+    write_euroc(&file, &imu_frames(400_000, 200.0, 3));
+    characterise(&[path(&file)], &out, &[]);
+    let leftovers = |out: &Path| -> Vec<String> {
+        std::fs::read_dir(out)
+            .map(|entries| {
+                entries
+                    .flatten()
+                    .map(|e| e.file_name().to_string_lossy().into_owned())
+                    .filter(|n| n.starts_with(".imu-ar-"))
+                    .collect()
+            })
+            .unwrap_or_default()
+    };
+    assert!(leftovers(&out).is_empty(), "{:?}", leftovers(&out));
+    // SIGTERM while the files are being written (or, if the run is done by then, after).
+    let signalled = dir.join("signalled");
+    std::fs::create_dir_all(&signalled).unwrap();
+    let mut child = common::command()
+        .args(["characterise", path(&file), "--out", path(&signalled)])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while leftovers(&signalled).is_empty() && start.elapsed().as_secs() < 60 {
+        if child.try_wait().unwrap().is_some() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_micros(200));
+    }
+    let kill = std::process::Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    let status = child.wait().unwrap();
+    assert!(
+        !kill.success() || status.code() == Some(130) || status.success(),
+        "{status:?}"
+    );
+    assert!(
+        leftovers(&signalled).is_empty(),
+        "{:?}",
+        leftovers(&signalled)
+    );
+}
+
 fn refused(args: &[&str], want: &str) {
     let out = imu_ar(args);
     assert_one_line_failure(&out);
