@@ -456,6 +456,12 @@ pub struct Timing {
     repeat_steps: Vec<i64>,
     repeat_steps_more: bool,
     last_step: i64,
+    /// Intervals more than four times the one before (up to [`OPENING`] of them, with the one
+    /// before, and whether there were more): the interval that ends a host's catch-up.
+    bridges: Vec<(i64, i64)>,
+    bridges_more: bool,
+    /// The longest interval, its first stamp and its last.
+    widest: (i64, i64, i64),
 }
 
 /// Places `count` repeats from the `at`-th stamp on among those placed (the first's and the
@@ -478,6 +484,12 @@ fn place(places: &mut Option<(u64, u64)>, spacing: &mut u64, at: u64, count: u64
         *spacing = 1;
     }
 }
+
+/// A year, ns: longer than a clock since boot runs in a record.
+const YEAR: i64 = 31_557_600_000_000_000;
+
+/// 2001-01-01 in Unix time, ns: an epoch stamp comes after it.
+const EPOCH_2001: i64 = 978_307_200_000_000_000;
 
 /// The most repeated stamps whose reaching interval is kept.
 const OPENING: usize = 4096;
@@ -588,6 +600,16 @@ impl Timing {
         self.count_run(iv);
         self.first_interval.get_or_insert(iv);
         let reach = std::mem::replace(&mut self.last_step, iv);
+        if iv > self.widest.0 {
+            self.widest = (iv, self.last, t);
+        }
+        if reach > 0 && reach.saturating_mul(4) < iv {
+            if self.bridges.len() < OPENING {
+                self.bridges.push((reach, iv));
+            } else {
+                self.bridges_more = true;
+            }
+        }
         self.close_repeats(reach, iv);
         // A stamp a gap reached (longer than any regular interval: two quanta and a
         // quarter, or where stamps hold two samples or more, a quantum and three quarters),
@@ -951,6 +973,16 @@ impl Timing {
                 "fewer than two timestamps: no rate".into()
             });
         }
+        // A jump from a clock since boot (under a year) to an epoch time (past 2001): two
+        // clocks, not a gap.
+        let (_, from, to) = self.widest;
+        if (0..YEAR).contains(&from) && to > EPOCH_2001 {
+            return Err(format!(
+                "the timestamps jump from {from} ns to {to} ns: from a clock since boot to an \
+                 epoch time (parts of a record stamped by two clocks?); one record must have \
+                 one clock"
+            ));
+        }
         // Samples dropped for stamps behind one, many in a row: that stamp jumped ahead, or
         // the clock back; the rest is not the record's.
         let (run, at, stamp) = self.longest_drop;
@@ -1003,16 +1035,33 @@ impl Timing {
                     short,
                     gaps,
                     missing,
-                    regular,
-                    sum: regular_sum,
+                    mut regular,
+                    sum: mut regular_sum,
                 },
-            period,
+            mut period,
             repeats,
             window,
             other,
             mixed: judged_mixed,
             few,
         } = judged;
+        // The interval that ends a host's catch-up (late stamps close together, then the
+        // clock's own) lies within the window, short of the period by however late the last
+        // caught-up stamp was: not the clock's.
+        if let (Window::Ratio(_), false, true) = (window, self.bridges_more, short > 0) {
+            let (n, sum) = self
+                .bridges
+                .iter()
+                .filter(|&&(before, iv)| {
+                    window.judge(before as f64) == Ordering::Less
+                        && window.judge(iv as f64) == Ordering::Equal
+                })
+                .fold((0u64, 0.0), |(n, sum), &(_, iv)| (n + 1, sum + iv as f64));
+            if n < regular {
+                (regular, regular_sum) = (regular - n, regular_sum - sum);
+                period = regular_sum / regular as f64;
+            }
+        }
         // Where several samples share a stamp, their times within it are not known: the
         // jitter is the intervals' between distinct stamps, about their mean.
         let (sq, worst) = if repeats > 0 {
@@ -2532,6 +2581,71 @@ mod tests {
         }
         let s = read(&t).unwrap();
         assert_eq!((s.rate_hz, s.dropped_backward), (200.0, 3), "{s:?}");
+    }
+
+    #[test]
+    fn the_interval_that_ends_a_catch_up_is_not_the_clocks() {
+        // 200 Hz to the microsecond, a 100 ms stall every 2 s, the late samples stamped
+        // 50 us apart from its end: the interval from the last of them to the clock's next
+        // stamp lies within the window, short of the period (read 200.106 Hz with 53
+        // missing before).
+        let t: Vec<i64> = (0..100_000i64)
+            .map(|k| {
+                let into = k % 400;
+                let stall_end = (k - into) * 5_000_000 + 100_000_000;
+                if (1..=20).contains(&into) {
+                    (stall_end + (into - 1) * 50_000).max(k * 5_000_000)
+                } else {
+                    k * 5_000_000
+                }
+            })
+            .collect();
+        let s = summary_of(&t);
+        assert!(s.short_intervals > 0, "{s:?}");
+        assert!((s.rate_hz / 200.0 - 1.0).abs() < 1e-6, "{s:?}");
+        assert_eq!(s.missing_samples, 0, "{s:?}");
+    }
+
+    #[test]
+    fn a_jump_from_a_clock_since_boot_to_an_epoch_time_is_two_clocks() {
+        // Two parts at 200 Hz, the first stamped since boot, the second in epoch time: read
+        // as a 1.7e9 s gap missing 3.4e11 samples before.
+        let mut t: Vec<i64> = (0..20_000).map(|k| k * 5_000_000).collect();
+        t.extend((0..20_000).map(|k| 1_700_000_000_000_000_000 + k * 5_000_000));
+        let e = pushed(&t, true).summary(TimeUnit::Nanoseconds).unwrap_err();
+        assert!(
+            e.contains("from a clock since boot to an epoch time"),
+            "{e}"
+        );
+        // Epoch stamps alone, and stamps since boot with a day's gap: one clock each.
+        let epoch: Vec<i64> = t[20_000..].to_vec();
+        assert_eq!(summary_of(&epoch).rate_hz, 200.0);
+        let mut boot: Vec<i64> = t[..20_000].to_vec();
+        boot.extend((0..20_000).map(|k| 86_400_000_000_000 + k * 5_000_000));
+        assert_eq!(summary_of(&boot).rate_hz, 200.0);
+    }
+
+    #[test]
+    fn a_clock_drifting_within_two_per_cent_is_one_rate() {
+        // 200 Hz drifting to 196 Hz over the record, stamped to the microsecond (an
+        // oscillator warming up): one rate; two halves at 200 and 194 Hz stray 1.5 % each
+        // from the record's, within the 2 % a drift may take: one rate between, as
+        // documented; 200 and 190 Hz: two.
+        let drifting: Vec<i64> = (0..40_000)
+            .scan(0.0f64, |t, k| {
+                let stamp = (*t / 1e3).round() as i64 * 1_000;
+                *t += 1e9 / (200.0 - 4.0 * k as f64 / 40_000.0);
+                Some(stamp)
+            })
+            .collect();
+        let s = summary_of(&drifting);
+        assert!((s.rate_hz / 198.0 - 1.0).abs() < 2e-3, "{s:?}");
+        let s = summary_of(&logged(200.0, (194.0, 20_000), 40_000, 1e-6));
+        assert!((s.rate_hz / 197.0 - 1.0).abs() < 2e-3, "{s:?}");
+        let e = pushed(&logged(200.0, (190.0, 20_000), 40_000, 1e-6), true)
+            .summary(TimeUnit::Nanoseconds)
+            .unwrap_err();
+        assert!(e.contains("mixed rates"), "{e}");
     }
 
     #[test]
