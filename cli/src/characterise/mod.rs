@@ -402,7 +402,7 @@ fn staging() -> MutexGuard<'static, Option<PathBuf>> {
     STAGING.lock().unwrap_or_else(PoisonError::into_inner)
 }
 
-/// Removes the folder [`write_all`] is writing into, if any, once the moves into `out` are
+/// Removes the folder `write_all` is writing into, if any, once the moves into `out` are
 /// done: for a process that ends on a signal (SIGINT, SIGTERM, SIGHUP), which leaves `out`
 /// as it was, or holding the whole new set.
 pub fn remove_staging() {
