@@ -393,22 +393,34 @@ fn characterise(
     })
 }
 
-/// The fresh folder [`write_all`] writes into while it does: [`remove_staging`] removes it
-/// (a signal's handler, before the process ends), and the moves into `out` hold it.
-static STAGING: Mutex<Option<PathBuf>> = Mutex::new(None);
+/// The fresh folder [`write_all`] writes into while it does (made while this is held),
+/// and whether the process is ending: [`remove_staging`] removes it (a signal's handler,
+/// before the process ends), and the moves into `out` hold it.
+static STAGING: Mutex<(Option<PathBuf>, bool)> = Mutex::new((None, false));
 
-/// The folder being written, locked.
-fn staging() -> MutexGuard<'static, Option<PathBuf>> {
+/// The folder being written, and whether the process is ending, locked.
+fn staging() -> MutexGuard<'static, (Option<PathBuf>, bool)> {
     STAGING.lock().unwrap_or_else(PoisonError::into_inner)
 }
 
 /// Removes the folder `write_all` is writing into, if any, once the moves into `out` are
 /// done: for a process that ends on a signal (SIGINT, SIGTERM, SIGHUP), which leaves `out`
-/// as it was, or holding the whole new set.
+/// as it was, or holding the whole new set. The lock stays taken, so no folder is made after
+/// this; the caller ends the process.
 pub fn remove_staging() {
-    if let Some(folder) = staging().take() {
-        let _ = std::fs::remove_dir_all(folder);
+    let mut held = staging();
+    held.1 = true;
+    if let Some(folder) = held.0.take() {
+        // A file the run creates between a removal's listing and its end leaves the folder
+        // standing: again, until it is gone (no file can be created in it after that).
+        for _ in 0..1000 {
+            match std::fs::remove_dir_all(&folder) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {}
+                _ => break,
+            }
+        }
     }
+    std::mem::forget(held);
 }
 
 /// Removes the folders `.imu-ar-PID` in `out` whose process no longer runs (killed before it
@@ -447,9 +459,15 @@ pub(crate) fn write_all(
     sweep(out);
     let staging_folder = out.join(format!(".imu-ar-{}", std::process::id()));
     let staging_folder = &staging_folder;
-    *staging() = Some(staging_folder.clone());
     let cannot = |e: std::io::Error| Fail(format!("{}: {e}", out.display()));
-    std::fs::create_dir_all(staging_folder).map_err(cannot)?;
+    {
+        let mut held = staging();
+        if held.1 {
+            return Err(Fail("ended by a signal".into()));
+        }
+        held.0 = Some(staging_folder.clone());
+        std::fs::create_dir_all(staging_folder).map_err(cannot)?;
+    }
     let written = formats
         .iter()
         .map(|f| write(*f, imu, horizon, staging_folder))
@@ -477,7 +495,7 @@ pub(crate) fn write_all(
         )
     });
     let _ = std::fs::remove_dir_all(staging_folder);
-    *held = None;
+    held.0 = None;
     moved
 }
 
