@@ -346,6 +346,28 @@ impl Bucket {
         self.max = self.max.max(iv);
     }
 
+    /// Takes `n` intervals `iv`.
+    fn take_n(&mut self, iv: i64, n: u64) {
+        if n == 0 {
+            return;
+        }
+        let d = iv.saturating_sub(self.first);
+        self.count += n;
+        self.sum += i128::from(d) * i128::from(n);
+        self.sq += n as f64 * (d as f64) * (d as f64);
+        self.min = self.min.min(iv);
+        self.max = self.max.max(iv);
+    }
+
+    /// Lets go of `n` of its intervals `iv` (its extremes kept).
+    fn drop_n(&mut self, iv: i64, n: u64) {
+        let n = n.min(self.count);
+        let d = iv.saturating_sub(self.first);
+        self.count -= n;
+        self.sum -= i128::from(d) * i128::from(n);
+        self.sq = (self.sq - n as f64 * (d as f64) * (d as f64)).max(0.0);
+    }
+
     fn merge(&mut self, other: &Self) {
         // The other's intervals about this bucket's first: d' = d + (first' - first).
         let shift = other.first.saturating_sub(self.first);
@@ -437,23 +459,17 @@ pub struct Timing {
     /// The stamp before which stamps are not counted in `held`: a gap's length after the
     /// last stamp a gap reached.
     quiet: Option<i64>,
-    /// Where the repeated stamps came (kept or dropped): the first's and the last's place
-    /// among the stamps pushed, and the fewest stamps between two of them. A clock a little
-    /// faster than its stamps (1005 Hz to whole ms) repeats one every so many.
-    repeat_places: Option<(u64, u64)>,
-    repeat_spacing: u64,
-    /// The repeats of the last stamp forward (the first's place, how many) until the next
-    /// stamp tells whether they are a stamp a quantum early; the repeats that were
-    /// (`paired`); whether the last stamp was; the first repeat that was not (its place, the
-    /// stamp).
-    open_repeats: (u64, u64),
-    paired: u64,
-    early: bool,
-    first_unpaired: Option<(u64, i64)>,
-    /// The interval that reached each stamp repeated (up to [`OPENING`] of them, and whether
-    /// there were more) and the last interval forward: a host's late samples, caught up on,
-    /// repeat the stamp a gap or a short interval reached.
-    repeat_steps: Vec<i64>,
+    /// The repeated stamps (kept or dropped) on the stamps' grid, matched with the places
+    /// intervals leave empty; the stamps forward so far; the first repeat (its place among
+    /// the stamps pushed, the stamp).
+    ledger: Ledger,
+    steps: u64,
+    first_repeat: Option<(u64, i64)>,
+    /// The interval that reached each stamp repeated and its repeats (up to [`OPENING`] of
+    /// them, and whether there were more) and the last interval forward: a host's late
+    /// samples, caught up on, repeat the stamp a gap or a short interval reached.
+    repeat_steps: Vec<(i64, u64)>,
+    repeated_stamps: u64,
     repeat_steps_more: bool,
     last_step: i64,
     /// Intervals more than four times the one before (up to [`OPENING`] of them, with the one
@@ -471,17 +487,354 @@ fn place(places: &mut Option<(u64, u64)>, spacing: &mut u64, at: u64, count: u64
     *places = Some(match *places {
         None => (at, end),
         Some((first, last)) => {
-            let gap = at - last;
+            let gap = at.abs_diff(last);
             *spacing = if first == last {
                 gap
             } else {
                 (*spacing).min(gap)
             };
-            (first, end)
+            (first.min(at), last.max(end))
         }
     });
     if count > 1 {
         *spacing = 1;
+    }
+}
+
+/// The stamps a repeat and an interval with empty places may lie apart and still be one
+/// stamp off its place (a float's floor early by a quantum for a few samples running, up to
+/// 21 in a million samples of `floor(k / 1000 / 0.001)`; a stamp late; a host's late samples
+/// caught up on).
+const LEDGER: u64 = 64;
+
+/// The stamps within which a repeat matched is next to its empty place: those matched
+/// further apart still count where repeats are told apart from a faster clock's (whose
+/// repeats losses nearby would otherwise hide).
+const NEAR: u64 = 16;
+
+/// The most distinct intervals with places filled that a [`Ledger`] keeps.
+const FILLS: usize = 4096;
+
+/// Repeats waiting for an empty place: the number of the stamp forward they repeat, the
+/// first's place among the stamps pushed, that stamp (ns), how many, and whether dropped.
+#[derive(Clone, Copy, Debug)]
+struct Waiting {
+    step: u64,
+    at: u64,
+    stamp: i64,
+    count: u64,
+    dropped: bool,
+}
+
+/// An interval with empty places waiting for a repeat: the number of the stamp that closes
+/// it, the interval (ns), its places still empty and those repeats kept filled.
+#[derive(Clone, Copy, Debug)]
+struct Empty {
+    step: u64,
+    iv: i64,
+    free: u64,
+    filled: u64,
+}
+
+/// Stamps on a grid (the largest power of ten that divides every interval so far): each
+/// interval of `k` units leaves `k - 1` places empty, each repeat is a sample more than its
+/// place. Where a clock's period is the grid, a repeat and an empty place within [`LEDGER`]
+/// stamps of each other are one sample stamped a place off (early, late, or caught up on
+/// after a host's stall): matched, they are two periods, and the places left empty are the
+/// samples lost; the repeats left over are samples more than the clock's places, which a
+/// clock a little faster than its stamps adds evenly and samples written twice add at
+/// random.
+#[derive(Clone, Debug, Default)]
+struct Ledger {
+    /// The grid, ns (0 before the first interval).
+    unit: i64,
+    extras: std::collections::VecDeque<Waiting>,
+    empties: std::collections::VecDeque<Empty>,
+    /// Repeats kept that filled a place, and repeats dropped that would have.
+    matched: u64,
+    matched_dropped: u64,
+    /// Each interval with places filled (ns, how many), how many times; whether there were
+    /// more than [`FILLS`] distinct (the ledger is then of no use).
+    fills: std::collections::BTreeMap<(i64, u64), u64>,
+    full: bool,
+    /// Repeats left over (`unmatched`: no place empty within [`LEDGER`] stamps), the first
+    /// of them (its place and stamp), and where they came (`left`); repeats matched more
+    /// than [`NEAR`] stamps from their place (`far`), and where those not matched near came
+    /// (`near`: both kinds, each counted in its block too).
+    unmatched: u64,
+    first_left: Option<(u64, i64)>,
+    left: Spread,
+    far: u64,
+    near: Spread,
+    /// The stamp forward that closed the last interval with a place left empty, and the most
+    /// stamps forward between two such: the longest run of the clock's own intervals.
+    lone_last: u64,
+    lone_longest: u64,
+    /// Intervals of two units left empty.
+    lone_twos: u64,
+}
+
+impl Ledger {
+    /// Takes the interval `iv` (ns) that closes the `step`-th stamp forward; the repeats left
+    /// over are counted in `since`. A finer grid starts the ledger again.
+    fn step(&mut self, iv: i64, step: u64, since: &mut Mark) {
+        let mut unit = if self.unit == 0 {
+            1_000_000_000_000_000_000
+        } else {
+            self.unit
+        };
+        while unit > 1 && iv % unit != 0 {
+            unit /= 10;
+        }
+        if unit != self.unit {
+            *self = Self {
+                unit,
+                ..Self::default()
+            };
+        }
+        self.expire(step, since);
+        let mut free = (iv / unit).saturating_sub(1).unsigned_abs();
+        let mut filled = 0;
+        while free > 0
+            && let Some(e) = self.extras.back_mut()
+        {
+            let n = e.count.min(free);
+            e.count -= n;
+            free -= n;
+            if e.dropped {
+                self.matched_dropped += n;
+            } else {
+                self.matched += n;
+                filled += n;
+            }
+            let (at_step, at) = (e.step, e.at);
+            if e.count == 0 {
+                self.extras.pop_back();
+            }
+            if at_step + NEAR < step {
+                self.far += n;
+                self.note(at, n, since);
+            }
+        }
+        if free > 0 {
+            self.empties.push_back(Empty {
+                step,
+                iv,
+                free,
+                filled,
+            });
+        } else {
+            self.fill(iv, filled);
+        }
+    }
+
+    /// Takes a repeat of the `step`-th stamp forward (`stamp` ns), the `at`-th stamp pushed,
+    /// kept or `dropped`.
+    fn repeat(&mut self, step: u64, at: u64, stamp: i64, dropped: bool, since: &mut Mark) {
+        if self.unit == 0 {
+            return;
+        }
+        if let Some(&Empty { step: before, .. }) = self.empties.back() {
+            if before + NEAR < step {
+                self.far += 1;
+                self.note(at, 1, since);
+            }
+            let e = self.empties.back_mut().expect("just seen");
+            e.free -= 1;
+            if dropped {
+                self.matched_dropped += 1;
+            } else {
+                self.matched += 1;
+                e.filled += 1;
+            }
+            if e.free == 0 {
+                let Empty { iv, filled, .. } = *e;
+                self.empties.pop_back();
+                self.fill(iv, filled);
+            }
+            return;
+        }
+        match self.extras.back_mut() {
+            Some(w) if w.step == step && w.dropped == dropped => w.count += 1,
+            _ => self.extras.push_back(Waiting {
+                step,
+                at,
+                stamp,
+                count: 1,
+                dropped,
+            }),
+        }
+    }
+
+    /// Lets go of the repeats and the empty places more than [`LEDGER`] stamps before the
+    /// `step`-th.
+    fn expire(&mut self, step: u64, since: &mut Mark) {
+        while let Some(&w) = self.extras.front()
+            && w.step + LEDGER < step
+        {
+            self.extras.pop_front();
+            self.unmatched += w.count;
+            self.first_left.get_or_insert((w.at, w.stamp));
+            self.left.place(w.at, w.count);
+            self.note(w.at, w.count, since);
+        }
+        while let Some(&e) = self.empties.front()
+            && e.step + LEDGER < step
+        {
+            self.empties.pop_front();
+            if e.iv == 2 * self.unit && e.free == 1 {
+                self.lone_twos += 1;
+            }
+            self.lone_longest = self.lone_longest.max(e.step - self.lone_last);
+            self.lone_last = e.step;
+            self.fill(e.iv, e.filled);
+        }
+    }
+
+    /// Notes `count` repeats from the `at`-th stamp pushed on as not matched near their
+    /// place, in the block `since`.
+    fn note(&mut self, at: u64, count: u64, since: &mut Mark) {
+        since.extras += count;
+        self.near.place(at, count);
+    }
+
+    /// The most stamps forward between two intervals with a place left empty (or the
+    /// record's ends), of `steps`: with the repeats matched as samples, the longest run of
+    /// the clock's own intervals.
+    fn longest_run(&self, steps: u64) -> u64 {
+        let (mut last, mut longest) = (self.lone_last, self.lone_longest);
+        for e in &self.empties {
+            longest = longest.max(e.step - last);
+            last = e.step;
+        }
+        longest.max(steps - last)
+    }
+
+    /// A place the last [`NEAR`] stamps left empty (0 or 1): its sample, stamped a place
+    /// late, may lie past the record's end.
+    fn end_empty(&self, steps: u64) -> u64 {
+        let free = self.empties.iter().filter(|e| e.step + NEAR >= steps);
+        free.map(|e| e.free).sum::<u64>().min(1)
+    }
+
+    /// Whether an interval had two places or more filled: a host's stall caught up on.
+    fn stall_fills(&self) -> bool {
+        self.fills.keys().any(|&(_, f)| f > 1) || self.empties.iter().any(|e| e.filled > 1)
+    }
+
+    /// The repeats still waiting for an empty place.
+    fn waiting(&self) -> u64 {
+        self.extras.iter().map(|w| w.count).sum()
+    }
+
+    /// Intervals of two units left empty, those still waiting for a repeat in.
+    fn lone_twos(&self) -> u64 {
+        let waiting = self
+            .empties
+            .iter()
+            .filter(|e| e.iv == 2 * self.unit && e.filled == 0);
+        self.lone_twos + waiting.count() as u64
+    }
+
+    /// The histogram `buckets` (at `bits` significant bits) with the repeats that filled a
+    /// place as the clock's samples: an interval with `f` places filled becomes `f`
+    /// intervals of one unit and one of the rest; `slips` intervals of two units more alike.
+    fn corrected(&self, buckets: &[Bucket], bits: u32, slips: u64) -> Vec<Bucket> {
+        let mut out = buckets.to_vec();
+        let unit = self.unit;
+        let mut split = |iv: i64, f: u64, n: u64| {
+            adjust(&mut out, iv, n, false, bits);
+            adjust(&mut out, unit, f * n, true, bits);
+            adjust(&mut out, iv - f as i64 * unit, n, true, bits);
+        };
+        for (&(iv, f), &n) in &self.fills {
+            split(iv, f, n);
+        }
+        for e in self.empties.iter().filter(|e| e.filled > 0) {
+            split(e.iv, e.filled, 1);
+        }
+        if slips > 0 {
+            split(2 * unit, 1, slips);
+        }
+        out
+    }
+
+    /// Notes that `filled` places of an interval `iv` were filled.
+    fn fill(&mut self, iv: i64, filled: u64) {
+        if filled == 0 || self.full {
+            return;
+        }
+        let fills = self.fills.len();
+        match self.fills.entry((iv, filled)) {
+            std::collections::btree_map::Entry::Occupied(mut o) => *o.get_mut() += 1,
+            std::collections::btree_map::Entry::Vacant(v) if fills < FILLS => {
+                v.insert(1);
+            }
+            std::collections::btree_map::Entry::Vacant(_) => self.full = true,
+        }
+    }
+}
+
+/// `n` intervals `iv` (ns) taken into the histogram `buckets` (at `bits`), or out of it.
+fn adjust(buckets: &mut Vec<Bucket>, iv: i64, n: u64, into: bool, bits: u32) {
+    if n == 0 {
+        return;
+    }
+    let key = Bucket::key(iv, bits);
+    match buckets.binary_search_by_key(&key, |b| b.key) {
+        Ok(i) if into => buckets[i].take_n(iv, n),
+        Ok(i) => {
+            buckets[i].drop_n(iv, n);
+            if buckets[i].count == 0 {
+                buckets.remove(i);
+            }
+        }
+        Err(i) if into => {
+            let mut b = Bucket::of(iv, bits);
+            b.take_n(iv, n - 1);
+            buckets.insert(i, b);
+        }
+        Err(_) => {}
+    }
+}
+
+/// Where repeats came: how many, the first's and the last's place among the stamps pushed,
+/// the fewest stamps between two, and the gaps between successive ones (how many, their sum
+/// and their sum of squares).
+#[derive(Clone, Copy, Debug, Default)]
+struct Spread {
+    count: u64,
+    places: Option<(u64, u64)>,
+    spacing: u64,
+    gaps: (f64, f64, f64),
+}
+
+impl Spread {
+    /// Places `count` repeats from the `at`-th stamp on.
+    fn place(&mut self, at: u64, count: u64) {
+        if let Some((_, last)) = self.places {
+            let gap = at.abs_diff(last) as f64;
+            let (n, sum, sq) = self.gaps;
+            self.gaps = (n + 1.0, sum + gap, sq + gap * gap);
+        }
+        self.count += count;
+        place(&mut self.places, &mut self.spacing, at, count);
+    }
+
+    /// Whether they come as a clock a little faster than its stamps repeats them: at least
+    /// three, none closer than half their mean spacing (samples lost, or the clock drifting,
+    /// space them wider; samples written twice come where they came), or eight or more whose
+    /// gaps vary by under half their mean (a few moved by the matching of repeats nearby;
+    /// samples written twice at random vary by about their mean).
+    fn periodic(&self) -> bool {
+        let Some((first, last)) = self.places else {
+            return false;
+        };
+        let (n, sum, sq) = self.gaps;
+        let mean = sum / n.max(1.0);
+        let even = n >= 8.0 && sq / n - mean * mean < 0.25 * mean * mean;
+        self.count >= 3
+            && (self.spacing.saturating_mul(2 * (self.count - 1)) >= last - first || even)
     }
 }
 
@@ -516,8 +869,10 @@ struct Mark {
     steps: [(i64, u64); STEPS],
     distinct: usize,
     more: bool,
-    /// Whether a stamp repeated in the block.
+    /// Whether a stamp repeated in the block; the repeats left over on the stamps' grid
+    /// (see [`Ledger`]) counted in it.
     repeated: bool,
+    extras: u64,
 }
 
 impl Mark {
@@ -547,6 +902,7 @@ impl Mark {
         }
         self.more |= before.more;
         self.repeated |= before.repeated;
+        self.extras += before.extras;
     }
 }
 
@@ -561,6 +917,7 @@ impl Default for Mark {
             distinct: 0,
             more: false,
             repeated: false,
+            extras: 0,
         }
     }
 }
@@ -610,7 +967,8 @@ impl Timing {
                 self.bridges_more = true;
             }
         }
-        self.close_repeats(reach, iv);
+        self.steps += 1;
+        self.ledger.step(iv, self.steps, &mut self.since);
         // A stamp a gap reached (longer than any regular interval: two quanta and a
         // quarter, or where stamps hold two samples or more, a quantum and three quarters),
         // and those up to the gap's length after it, may hold a host's late samples, caught
@@ -720,13 +1078,20 @@ impl Timing {
         self.repeats += 1;
         self.kept += 1;
         self.since.repeated = true;
-        self.place_repeat();
+        self.place_repeat(false);
         if self.trailing_repeats == 0 {
+            self.repeated_stamps += 1;
             if self.repeat_steps.len() < OPENING {
-                self.repeat_steps.push(self.last_step);
+                self.repeat_steps.push((self.last_step, 1));
             } else {
                 self.repeat_steps_more = true;
             }
+        } else if let Some(step) = self
+            .repeat_steps
+            .last_mut()
+            .filter(|_| !self.repeat_steps_more)
+        {
+            step.1 += 1;
         }
         self.trailing_repeats += 1;
         if self.first_interval.is_none() {
@@ -739,66 +1104,66 @@ impl Timing {
     pub fn drop_repeat(&mut self) {
         self.dropped += 1;
         self.dropped_repeats += 1;
-        self.place_repeat();
+        self.place_repeat(true);
     }
 
-    /// Notes that the stamp just pushed is a repeat: where it came is known once the next
-    /// stamp tells whether it was a stamp a quantum early.
-    fn place_repeat(&mut self) {
-        if self.open_repeats.1 == 0 {
-            self.open_repeats.0 = self.pushed;
-        }
-        self.open_repeats.1 += 1;
-    }
-
-    /// Takes the repeats of the stamp that the interval `reach` reached and that opens `iv`:
-    /// a stamp a quantum early (a logger's floor of float seconds) equals the one before it
-    /// and opens an interval twice the one that reached it (or, where the stamp before was
-    /// early too, as long); else they are placed.
-    fn close_repeats(&mut self, reach: i64, iv: i64) {
-        let (at, count) = std::mem::take(&mut self.open_repeats);
-        let early = count > 0
-            && reach > 0
-            && (reach.checked_mul(2) == Some(iv) || (self.early && reach == iv));
-        self.early = early;
-        if count == 0 {
-            return;
-        }
-        if early {
-            self.paired += count;
-        } else {
-            self.first_unpaired.get_or_insert((at, self.last));
-            place(&mut self.repeat_places, &mut self.repeat_spacing, at, count);
+    /// Notes that the stamp just pushed is a repeat, kept or `dropped`.
+    fn place_repeat(&mut self, dropped: bool) {
+        self.first_repeat.get_or_insert((self.pushed, self.last));
+        if self.first_interval.is_some() {
+            self.ledger
+                .repeat(self.steps, self.pushed, self.last, dropped, &mut self.since);
         }
     }
 
-    /// The repeats not paired with a stamp a quantum early (the last stamp's among them):
-    /// how many, the first's and the last's place and the fewest stamps between two.
-    fn unpaired(&self) -> (u64, Option<(u64, u64)>, u64) {
-        let (mut places, mut spacing) = (self.repeat_places, self.repeat_spacing);
-        let (at, count) = self.open_repeats;
-        if count > 0 {
-            place(&mut places, &mut spacing, at, count);
-        }
-        let all = self.repeats + self.dropped_repeats;
-        (all.saturating_sub(self.paired), places, spacing)
-    }
-
-    /// Whether the repeated stamps come as a clock a little faster than its stamps repeats
-    /// them: at least three, none closer than half their mean spacing (samples lost, or the
-    /// clock drifting, space them wider; samples written twice come where they came); those
-    /// of a stamp a quantum early left out.
+    /// Whether the repeats left over on the stamps' grid come as a clock a little faster
+    /// than its stamps repeats them: at least three, none closer than half their mean
+    /// spacing (samples lost, or the clock drifting, space them wider; samples written twice
+    /// come where they came).
     fn repeats_periodic(&self) -> bool {
-        let (count, places, spacing) = self.unpaired();
-        let Some((first, last)) = places else {
-            return false;
-        };
-        count >= 3 && 2 * spacing * (count - 1) >= last - first
+        let l = &self.ledger;
+        [l.left, l.near].into_iter().any(|mut spread| {
+            for w in &l.extras {
+                spread.place(w.at, w.count);
+            }
+            spread.periodic()
+        })
     }
 
-    /// Whether the repeated stamps are all a stamp a quantum early, or come evenly.
-    fn repeats_explained(&self) -> bool {
-        self.unpaired().0 == 0 || self.repeats_periodic()
+    /// Whether the repeats left over on the stamps' grid, counted block by block, vary from
+    /// block to block as samples written twice at random do (about as much as their mean
+    /// number, a Poisson count's variance), not as a clock faster than its stamps adds them:
+    /// at a steady rate, a block's count off by a sample or two however many. The blocks are
+    /// grouped to hold a dozen each, and the variance taken from neighbours' differences (a
+    /// drifting clock's count changes slowly); fewer than 32 groups tell nothing.
+    fn random_repeats(&self) -> bool {
+        let marks = self.all_marks();
+        // Each mark holds the block before it; the last may be short.
+        let x: Vec<u64> = marks
+            .iter()
+            .skip(1)
+            .take(marks.len().saturating_sub(2))
+            .map(|m| m.extras)
+            .collect();
+        let total: u64 = x.iter().sum();
+        if total == 0 {
+            return false;
+        }
+        let per = (12 * x.len() as u64).div_ceil(total).max(1) as usize;
+        let groups: Vec<f64> = x
+            .chunks_exact(per)
+            .map(|c| c.iter().sum::<u64>() as f64)
+            .collect();
+        if groups.len() < 32 {
+            return false;
+        }
+        let mean = groups.iter().sum::<f64>() / groups.len() as f64;
+        let v = groups
+            .windows(2)
+            .map(|w| (w[1] - w[0]).powi(2))
+            .sum::<f64>()
+            / (2.0 * (groups.len() - 1) as f64);
+        v > 2.0 + 0.4 * mean
     }
 
     /// The last stamp forward, ns.
@@ -954,6 +1319,52 @@ impl Timing {
         ))
     }
 
+    /// The period (ns) of a clock whose regular intervals `window` judges (about `period`
+    /// ns), from the places between the marks: a block between marks with only regular
+    /// intervals and no stamp repeated holds a place for each sample; a stretch of other
+    /// blocks (a gap, a host's stall and its catch-up) holds as many as its time over the
+    /// period, to the nearest, where its end stamps (each a block's whole stamp, off its
+    /// sample's time by the quantum at most) tell that (their quantum under a quarter of
+    /// the period); else the blocks with only regular intervals alone give it.
+    fn places(&self, window: &Window, period: f64) -> f64 {
+        let Window::Quantum { q, .. } = *window else {
+            return period;
+        };
+        let marks = self.all_marks();
+        let clean = |m: &Mark| {
+            !m.repeated
+                && !m.more
+                && m.steps[..m.distinct]
+                    .iter()
+                    .all(|&(iv, _)| window.judge(iv as f64) == Ordering::Equal)
+        };
+        let whole = 4.0 * q < period;
+        let mut period = period;
+        for _ in 0..3 {
+            let (mut places, mut time) = (0.0, 0.0);
+            let mut stretch = 0.0;
+            for pair in marks.windows(2) {
+                let (a, b) = (&pair[0], &pair[1]);
+                let d = (i128::from(b.t) - i128::from(a.t)) as f64;
+                if clean(b) {
+                    if stretch > 0.0 && whole {
+                        places += (stretch / period).round();
+                        time += stretch;
+                    }
+                    stretch = 0.0;
+                    places += (b.kept - a.kept) as f64;
+                    time += d;
+                } else {
+                    stretch += d;
+                }
+            }
+            if places > 0.0 {
+                period = time / places;
+            }
+        }
+        period
+    }
+
     /// The histogram with the pending intervals in.
     fn histogram(&self) -> Vec<Bucket> {
         merged(&self.buckets, &mut self.pending.clone(), self.bits)
@@ -1006,28 +1417,79 @@ impl Timing {
         }
         let span = self.span_ns();
         let resolution = resolution(&buckets, self.bits);
-        // Intervals of two quanta, where the quantum is the median: a stamp a quantum early
-        // opens one, and a stretch of them (a float's floor slipping under the quanta) opens
-        // with a repeat and closes with one.
-        let twos = resolution.filter(|&q| q as f64 == median).map_or(0, |q| {
-            buckets
-                .iter()
-                .filter(|b| Some(b.key) == q.checked_mul(2))
-                .map(|b| b.count)
-                .sum()
-        });
-        let judged = judged(
-            &buckets,
-            (median, span, intervals),
-            resolution,
-            (self.repeats, self.leading_repeats, self.trailing_repeats),
-            (
-                self.first_interval.unwrap_or(0),
-                (!self.held_more).then_some(&self.held[..]),
-            ),
-            self.repeats_explained(),
-            self.longest_run.max(1),
+        // Stamps on the grid of their quantum, where the quantum is the median: repeats
+        // matched with empty places nearby are samples stamped a place off; those left over
+        // are a clock faster than its stamps where they come evenly (or, 1 % of the samples
+        // or more, at a steady rate), else samples written twice. A float's floor slipping a
+        // quantum early for good, then back, leaves as many intervals of two quanta empty
+        // as repeats (no sample lost besides).
+        let ledger = &self.ledger;
+        let grid =
+            resolution.is_some_and(|q| q as f64 == median && ledger.unit == q && !ledger.full);
+        // The repeats still waiting at the record's end: samples more than its places where
+        // none was matched, else the last stamps', whose places lie past the record.
+        let waiting = ledger.waiting();
+        let (mut left, mut slips) = (
+            ledger.unmatched + if ledger.matched == 0 { waiting } else { 0 },
+            0,
         );
+        let twos = ledger.lone_twos();
+        if grid && left > 0 && (left..=left + 2 + left / 10).contains(&twos) {
+            (left, slips) = (0, left);
+        }
+        let near = ledger.unmatched + ledger.far + waiting;
+        let coarse = if grid {
+            near > 0
+                && (self.repeats_periodic() || 100 * near >= self.kept && !self.random_repeats())
+        } else {
+            100 * self.repeats >= intervals.saturating_add(self.repeats) || self.repeats_periodic()
+        };
+        let mut shifted = grid && !coarse && ledger.matched + slips > 0;
+        let held = (!self.held_more).then_some(&self.held[..]);
+        let judge = |buckets: &[Bucket], repeats: u64, longest_run: u64| {
+            judged(
+                buckets,
+                (median, span, buckets.iter().map(|b| b.count).sum()),
+                resolution,
+                (repeats, self.leading_repeats, self.trailing_repeats),
+                (self.first_interval.unwrap_or(0), held),
+                (coarse, self.repeated_stamps),
+                longest_run.max(1),
+            )
+        };
+        let corrected = shifted.then(|| ledger.corrected(&buckets, self.bits, slips));
+        // Repeats matched into a gap's places several at a time (a host's stall caught up
+        // on) are a quantum apart only where the clock's period is the quantum: under a
+        // longer one (its own places left empty, read as rounding) they are a stall's
+        // samples, caught up on within the gap's room.
+        let mut explained = false;
+        if let Some(c) = &corrected
+            && ledger.stall_fills()
+            && matches!(
+                judge(c, 0, ledger.longest_run(self.steps)).window,
+                Window::Quantum { .. }
+            )
+        {
+            (shifted, explained) = (false, true);
+        }
+        let buckets = match corrected {
+            Some(c) if shifted => c,
+            _ => buckets,
+        };
+        let intervals: u64 = buckets.iter().map(|b| b.count).sum();
+        // The repeats not read as intervals: past the first stamp's.
+        let repeats_left = if shifted {
+            self.repeats.saturating_sub(ledger.matched + slips)
+        } else {
+            self.repeats
+        };
+        let judged = if shifted {
+            judge(&buckets, repeats_left, ledger.longest_run(self.steps))
+        } else if explained {
+            judge(&buckets, 0, self.longest_run)
+        } else {
+            judge(&buckets, repeats_left, self.longest_run)
+        };
         let Judged {
             classes:
                 Classes {
@@ -1070,26 +1532,41 @@ impl Timing {
             jitter(&buckets, &window, period)
         };
         // The samples the span holds room for past the intervals: where the stamps resolve the
-        // interval, repeated stamps that fill the room gaps leave, about all of it, are a late
-        // stamp's samples caught up on within one quantum (a host's stall); samples written
-        // twice overfill it, and a misread clock leaves far more room than its repeats.
+        // interval, repeated stamps past the first stamp's that fill the room gaps leave
+        // (without overfilling it: samples written twice) are a late stamp's samples caught
+        // up on within one quantum (a host's stall), each no more than the gap that reached
+        // its stamp misses; a short interval may lie within a gap's room.
         let room = ((span / period).round() - intervals as f64).max(0.0);
-        // Where each repeat has an interval of two quanta to go with it, and the room they
-        // leave is about the repeats' (no sample lost besides), they are stamps a quantum
-        // early.
-        let filled =
-            (0.99 * self.repeats as f64 - 1.0..=1.1 * self.repeats as f64 + 2.0).contains(&room);
-        let slipped = (self.repeats..=self.repeats + 2 + self.repeats / 10).contains(&twos);
+        let later = repeats_left.saturating_sub(self.leading_repeats);
+        let filled = room + short as f64 >= 0.99 * later as f64 - 1.0;
         let caught_up = repeats == 0
-            && self.repeats > 0
-            && gaps > 0
-            && filled
-            && (slipped
-                || !self.repeat_steps_more
-                    && self
-                        .repeat_steps
-                        .iter()
-                        .all(|&iv| window.judge(iv as f64) != Ordering::Equal));
+            && repeats_left > 0
+            && (explained
+                || (gaps > 0 || later == 0)
+                    && filled
+                    && !self.repeat_steps_more
+                    && self.repeat_steps.iter().all(|&(iv, count)| {
+                        match window.judge(iv as f64) {
+                            // A stamp rounded short of the period that holds more samples: a catch-up.
+                            Ordering::Equal => (iv as f64) < 0.75 * period,
+                            Ordering::Greater => count as f64 <= window.missed(iv as f64) + 1.0,
+                            Ordering::Less => true,
+                        }
+                    }));
+        // A rounded clock's catch-ups: stamps short of a period and the interval that ends
+        // them are rounded off their samples' times by up to a quantum each, and the mean of
+        // the regular intervals with them: the rate is the span's over the places it holds
+        // instead (see [`Timing::places`]).
+        let (period, room) = match window {
+            Window::Quantum { .. } if caught_up => {
+                let period = self.places(&window, period);
+                (
+                    period,
+                    ((span / period).round() - intervals as f64).max(0.0),
+                )
+            }
+            _ => (period, room),
+        };
         let summary = TimingSummary {
             unit: unit.name(),
             header_stamps: unit == TimeUnit::HeaderStamps,
@@ -1105,10 +1582,12 @@ impl Timing {
             // late samples caught up on: no more missing than the span holds room for, give
             // or take the samples of a quantum (the end stamps' samples lie within theirs).
             missing_samples: if short > 0 || caught_up {
-                missing.min((room - self.repeats as f64).max(0.0) as u64)
+                missing.min((room - later as f64).max(0.0) as u64)
             } else if repeats > 0 {
                 let ends = resolution.unwrap_or(0) as f64 / period;
                 missing.min((room - self.repeats as f64 + ends).round().max(0.0) as u64)
+            } else if shifted {
+                missing.saturating_sub(ledger.end_empty(self.steps))
             } else {
                 missing
             },
@@ -1116,15 +1595,18 @@ impl Timing {
             dropped_backward: self.dropped,
             span_s: span * 1e-9,
             resolution_s: resolution.map(|q| q as f64 * 1e-9),
-            span_rate_hz: 1e9 * (intervals + self.repeats) as f64 / span,
+            span_rate_hz: 1e9 * (intervals + repeats_left) as f64 / span,
             other_rate_hz: other,
             repeated: self.repeats,
-            unexplained_repeat: if repeats == self.repeats || caught_up {
+            // On the grid, the repeats left over (those at the record's ends are its end
+            // stamps' samples).
+            unexplained_repeat: if repeats == repeats_left || caught_up || grid && left == 0 {
                 None
+            } else if grid {
+                ledger.first_left.map(|(at, stamp)| (at, stamp, left))
             } else {
-                self.first_unpaired.or_else(|| {
-                    (self.open_repeats.1 > 0).then_some((self.open_repeats.0, self.last))
-                })
+                self.first_repeat
+                    .map(|(at, stamp)| (at, stamp, self.repeats))
             },
         };
         let (regular, intervals) = (regular + repeats, intervals + repeats);
@@ -1149,6 +1631,18 @@ impl Timing {
                  1 % (give --rate)",
                 resolution.unwrap_or(1) as f64 * 1e-9,
                 span * 1e-9
+            ));
+        }
+        if grid && ledger.matched_dropped >= 3 && 2 * ledger.matched_dropped > self.dropped_repeats
+        {
+            return Err(format!(
+                "--drop-backward dropped {} samples whose stamp equals the one before, {} of \
+                 them next to an interval that leaves a place empty on the stamps' quantum \
+                 ({:e} s): samples stamped a quantum early or late, or a host's late samples \
+                 caught up on, not samples repeated; read it without --drop-backward",
+                self.dropped_repeats,
+                ledger.matched_dropped,
+                median * 1e-9
             ));
         }
         if resolution.is_some_and(|q| q as f64 == median)
@@ -1305,7 +1799,10 @@ impl Window {
                 }
             }
             Window::Quantum { reference, q, .. } => {
-                if iv < 1.5 * reference + 0.5 * q || iv <= reference + 1.25 * q {
+                if iv < reference - 1.25 * q {
+                    // Shorter than rounding (and jitter across a quantum's edge) makes it.
+                    Ordering::Less
+                } else if iv < 1.5 * reference + 0.5 * q || iv <= reference + 1.25 * q {
                     Ordering::Equal
                 } else {
                     Ordering::Greater
@@ -1364,7 +1861,7 @@ fn judged(
     resolution: Option<i64>,
     (repeats, leading, trailing): (u64, u64, u64),
     (first_interval, held_by): (i64, Option<&[Opened]>),
-    periodic: bool,
+    (coarse, repeated_stamps): (bool, u64),
     longest_run: u64,
 ) -> Judged {
     let by_ratio = |reference: f64| {
@@ -1391,11 +1888,9 @@ fn judged(
     let Some(q) = resolution.map(|q| q as f64) else {
         return ratio;
     };
-    // A clock faster than its stamps: repeats, at least 1 % of the samples or evenly spaced,
-    // of one quantum.
-    let coarse_repeats = q == median
-        && repeats > 0
-        && (100 * repeats >= intervals.saturating_add(repeats) || periodic);
+    // A clock faster than its stamps: repeats (`coarse`: left over on the stamps' grid,
+    // evenly or at a steady rate) of one quantum.
+    let coarse_repeats = q == median && repeats > 0 && coarse;
     // A period just over one quantum: intervals of one and two quanta, which are as well a
     // clock of one quantum's period that misses samples; read as rounding only where the
     // longer ones come as evenly as rounding makes them.
@@ -1403,7 +1898,7 @@ fn judged(
     let rounded = 4.0 * q > median
         && buckets.iter().any(|b| {
             let r = b.mean() / median;
-            (0.5..0.75).contains(&r) || (r > 1.25 && r <= 1.5)
+            ((0.5..0.75).contains(&r) || (r > 1.25 && r <= 1.5)) && b.count > 2 * repeated_stamps
         });
     let mixed = (ratio.classes.regular as f64) < 0.9 * intervals as f64 && 4.0 * q > mean;
     if !(coarse_repeats || just_over || rounded || mixed) {
@@ -1624,25 +2119,34 @@ pub struct TimingSummary {
     /// samples repeated, which [`TimingSummary::repeat_refusal`] names.
     pub repeated: u64,
     /// The first repeated stamp the stamps' resolution does not explain: its number among the
-    /// stamps, and the stamp, ns.
+    /// stamps, the stamp (ns), and how many such repeats there are.
     #[serde(skip)]
-    pub unexplained_repeat: Option<(u64, i64)>,
+    pub unexplained_repeat: Option<(u64, i64, u64)>,
 }
 
 impl TimingSummary {
     /// The refusal of stamps that repeat the one before although they resolve the samples'
     /// interval (a record read for its stamps' rate must not have them).
     pub fn repeat_refusal(&self) -> Option<String> {
-        let (at, stamp) = self.unexplained_repeat?;
-        Some(format!(
-            "{} timestamps equal the one before (the first: sample {at}, {stamp} ns), and the \
-             stamps, to {:e} s, resolve the interval {:e} s: samples repeated? \
-             --drop-backward drops such samples and counts them (a clock a little faster \
-             than its stamps repeats them evenly: give --rate)",
-            self.repeated,
-            self.resolution_s.unwrap_or(1e-9),
-            self.median_interval_s
-        ))
+        let (at, stamp, left) = self.unexplained_repeat?;
+        let (q, interval) = (self.resolution_s.unwrap_or(1e-9), self.median_interval_s);
+        Some(if left == self.repeated {
+            format!(
+                "{left} timestamps equal the one before (the first: sample {at}, {stamp} ns), \
+                 and the stamps, to {q:e} s, resolve the interval {interval:e} s: samples \
+                 repeated? --drop-backward drops such samples and counts them (a clock a \
+                 little faster than its stamps repeats them evenly: give --rate)"
+            )
+        } else {
+            format!(
+                "{} timestamps equal the one before, and {left} of them have no place left \
+                 empty nearby, as a stamp a quantum early or late or a host's stall leaves \
+                 (the first: sample {at}, {stamp} ns); the stamps, to {q:e} s, resolve the \
+                 interval {interval:e} s: samples repeated? give --rate (--drop-backward \
+                 would drop the others too)",
+                self.repeated
+            )
+        })
     }
 
     /// One line for the text outputs.
@@ -2462,10 +2966,9 @@ mod tests {
             );
             assert_eq!(s.missing_samples, 0, "{rate} Hz: {s:?}");
         }
-        // 950 Hz to the nearest ms, jittered 30 us: its few repeats follow 2 ms intervals, gaps
-        // of a 1 kHz reading that leaves far more room than they fill, and far fewer than its
-        // 2 ms intervals: neither a stall's nor a slipping floor's, so the 1 kHz reading is
-        // not taken (read as 1000 Hz with 263 missing, exit 0, otherwise).
+        // 950 Hz to the nearest ms, jittered 30 us: its few repeats are samples rounded a
+        // place off, each next to the place it left, and its own 2 ms intervals, one in 19,
+        // come evenly: 950 Hz, nothing missing (not 1000 Hz with 263 missing, nor refused).
         let t = clock(
             (950.0, 950.0, 5_000),
             5_000,
@@ -2473,11 +2976,10 @@ mod tests {
             (0.0, 30_000.0),
         );
         assert!(t.windows(2).any(|w| w[0] == w[1]));
-        let s = pushed(&t, true).summary(TimeUnit::Nanoseconds);
-        assert!(
-            s.as_ref().map_or(true, |s| s.repeat_refusal().is_some()),
-            "{s:?}"
-        );
+        let s = summary_keeping_repeats(&t);
+        assert_eq!(s.repeat_refusal(), None, "{s:?}");
+        assert!((s.rate_hz / 950.0 - 1.0).abs() < 1e-4, "{s:?}");
+        assert_eq!(s.missing_samples, 0, "{s:?}");
         // Stalls of 8 periods at 200 Hz to 10 ms, caught up on 0.1 ms apart: a stamp a gap
         // reached holds the late samples (read 202.05 Hz with 348 missing before).
         let t: Vec<i64> = (0..40_000i64)
@@ -2675,9 +3177,9 @@ mod tests {
             assert!((s.rate_hz / rate - 1.0).abs() < 1e-4, "{rate} Hz: {s:?}");
             assert_eq!(s.missing_samples, 0, "{rate} Hz: {s:?}");
         }
-        // A sample written twice, nothing lost: still refused; so is a slipping floor's repeat
-        // where samples are lost too (its 2 ms intervals are more than its repeats), which a
-        // reading of its repeats as samples would hide (978.7 Hz).
+        // A sample written twice, nothing lost: still refused. A slipping floor with 2 % of
+        // its samples lost: each slip's repeat matched with a place left empty, the rest the
+        // samples lost (read as the rate of the samples present, 978.7 Hz, before).
         let mut t: Vec<i64> = (0..20_000).map(|k| k * 1_000_000).collect();
         t.insert(7_000, 6_999_000_000);
         let s = pushed(&t, true).summary(TimeUnit::Nanoseconds).unwrap();
@@ -2688,11 +3190,11 @@ mod tests {
             .copied()
             .filter(|_| !(next() >> 11).is_multiple_of(50))
             .collect();
-        let s = pushed(&lossy, true).summary(TimeUnit::Nanoseconds);
-        assert!(
-            s.as_ref().map_or(true, |s| s.repeat_refusal().is_some()),
-            "{s:?}"
-        );
+        let s = summary_keeping_repeats(&lossy);
+        let lost = (summed.len() - lossy.len()) as u64;
+        assert_eq!(s.repeat_refusal(), None, "{s:?}");
+        assert_eq!(s.rate_hz, 1000.0, "{s:?}");
+        assert!(s.missing_samples.abs_diff(lost) <= 1, "{lost} lost: {s:?}");
     }
 
     #[test]
@@ -2863,6 +3365,242 @@ mod tests {
                     "{rate} Hz, {n}: {e}"
                 );
             }
+        }
+    }
+
+    /// A logger's stamps (ns) of `n` samples at `rate` Hz: a host that stalls `length` s
+    /// every `every` samples (from the `first`-th) stamps the samples due meanwhile at the
+    /// stall's end, `apart` ns apart (those due later still, past their own time); each stamp rounded down to `q` ns (or to the nearest),
+    /// or where `float` says, floored from the float seconds `k / rate / (q / 1e9)` as a
+    /// logger does; the samples `lose` picks left out. With the samples lost between the
+    /// first stamp kept and the last.
+    fn logger(
+        (rate, n): (f64, i64),
+        (first, every, length, apart): (i64, i64, f64, i64),
+        (q, nearest, float): (i64, bool, bool),
+        mut lose: impl FnMut(i64) -> bool,
+    ) -> (Vec<i64>, u64) {
+        let period = 1e9 / rate;
+        let mut kept: Vec<(i64, i64)> = Vec::new();
+        for k in 0..n {
+            let due = k as f64 * period;
+            let since = (k - first).rem_euclid(every.max(1));
+            let start = (k - since) as f64 * period;
+            let end = start + length * 1e9;
+            let mut t = due;
+            let queued = (length * rate).ceil() as i64 + 4;
+            if k >= first && length > 0.0 && since < queued {
+                t = t.max(end + (since * apart) as f64);
+            }
+            let stamp = if float {
+                (k as f64 / rate / (q as f64 * 1e-9)).floor() as i64 * q
+            } else if nearest {
+                (t / q as f64).round() as i64 * q
+            } else {
+                (t / q as f64).floor() as i64 * q
+            };
+            if !lose(k) {
+                kept.push((k, stamp));
+            }
+        }
+        let lost = (kept.last().unwrap().0 - kept[0].0 + 1) as u64 - kept.len() as u64;
+        (kept.into_iter().map(|(_, t)| t).collect(), lost)
+    }
+
+    /// A random pick of about one in `one_in` samples.
+    fn random(seed: u64, one_in: u64) -> impl FnMut(i64) -> bool {
+        let mut next = crate::xorshift(seed);
+        move |_| (next() >> 11).is_multiple_of(one_in)
+    }
+
+    #[test]
+    fn a_float_floor_loggers_lost_samples_are_missing_not_a_slower_clock() {
+        // 1 kHz floored from float seconds to 1 ms (k / 1000 / 0.001: 12.8 % of the stamps
+        // a quantum early, up to 21 in a row) and 100 Hz to 10 ms, with 1 % and 0.1 % of the
+        // samples lost; 1 kHz from k / 1000 * 1000 ms with 0.1 %: read as the rate of the
+        // samples present, 991.7 Hz with 142 missing where 968 were lost, or refused as
+        // samples repeated, before.
+        for (rate, q, one_in, seed) in [
+            (1_000.0, 1_000_000, 100, 1),
+            (1_000.0, 1_000_000, 1_000, 2),
+            (100.0, 10_000_000, 100, 3),
+        ] {
+            let (t, lost) = logger(
+                (rate, 100_000),
+                (0, 1, 0.0, 0),
+                (q, false, true),
+                random(seed, one_in),
+            );
+            let s = summary_keeping_repeats(&t);
+            assert_eq!(s.repeat_refusal(), None, "{rate} Hz: {s:?}");
+            assert_eq!(s.rate_hz, rate, "{rate} Hz: {s:?}");
+            assert!(s.missing_samples.abs_diff(lost) <= 1, "{lost} lost: {s:?}");
+        }
+        let mut lose = random(4, 1_000);
+        let mut t = Vec::new();
+        let mut lost = 0;
+        for k in 0..100_000i64 {
+            if lose(k) && k > 0 {
+                lost += 1;
+            } else {
+                t.push((k as f64 / 1000.0 * 1000.0).floor() as i64 * 1_000_000);
+            }
+        }
+        let s = summary_keeping_repeats(&t);
+        assert_eq!(s.rate_hz, 1_000.0, "{s:?}");
+        assert!(s.missing_samples.abs_diff(lost) <= 1, "{lost} lost: {s:?}");
+        // Dropping the early stamps' samples would count them as lost: refused, naming why.
+        let e = pushed(&t, false)
+            .summary(TimeUnit::Nanoseconds)
+            .unwrap_err();
+        assert!(e.contains("stamped a quantum early or late"), "{e}");
+    }
+
+    #[test]
+    fn rows_written_twice_among_stamps_a_quantum_early_are_samples_repeated() {
+        // A float-floor logger at 1 kHz with 0.2 %, 1 % and 3 % of its rows written twice:
+        // read as a clock faster than its stamps (1009.6 Hz at 1 %) before. The repeats
+        // left over come at random, not evenly nor at a steady rate.
+        for (one_in, seed) in [(500, 5), (100, 6), (33, 7)] {
+            let (once, _) = logger(
+                (1_000.0, 100_000),
+                (0, 1, 0.0, 0),
+                (1_000_000, false, true),
+                |_| false,
+            );
+            let mut twice = random(seed, one_in);
+            let t: Vec<i64> = once
+                .iter()
+                .flat_map(|&s| if twice(0) { vec![s, s] } else { vec![s] })
+                .collect();
+            let s = pushed(&t, true).summary(TimeUnit::Nanoseconds);
+            let refusal = s.as_ref().map_or(None, |s| s.repeat_refusal());
+            assert!(
+                refusal
+                    .as_ref()
+                    .is_some_and(|e| e.contains("no place left empty nearby")),
+                "1 in {one_in}: {s:?}"
+            );
+        }
+        // A clock 1.2 % faster than its stamps, jittered 30 us: its repeats left over come
+        // at a steady rate, however the matching moves them.
+        let t = clock(
+            (1_012.0, 1_012.0, 50_000),
+            50_000,
+            (1_000_000, true),
+            (0.0, 30_000.0),
+        );
+        let s = summary_keeping_repeats(&t);
+        assert_eq!(s.repeat_refusal(), None, "{s:?}");
+        assert!((s.rate_hz / 1_012.0 - 1.0).abs() < 1e-4, "{s:?}");
+    }
+
+    #[test]
+    fn stalls_and_samples_lost_where_the_period_is_the_quantum_count_the_loss() {
+        // 1 kHz to whole ms stalling 50 ms every 2 s, 100 Hz to 10 ms stalling 0.2 s every
+        // 5 s, 1 % lost: read as 990.3 and 99.04 Hz with 43 and 4 missing before.
+        for (rate, q, every, length) in [
+            (1_000.0, 1_000_000, 2_000, 0.05),
+            (100.0, 10_000_000, 500, 0.2),
+        ] {
+            let (t, lost) = logger(
+                (rate, 100_000),
+                (every, every, length, 0),
+                (q, false, false),
+                random(8, 100),
+            );
+            let s = summary_keeping_repeats(&t);
+            assert_eq!(s.repeat_refusal(), None, "{rate} Hz: {s:?}");
+            assert_eq!(s.rate_hz, rate, "{rate} Hz: {s:?}");
+            assert!(s.missing_samples.abs_diff(lost) <= 1, "{lost} lost: {s:?}");
+        }
+    }
+
+    #[test]
+    fn a_stall_and_samples_lost_elsewhere_are_not_samples_repeated() {
+        // 200 Hz to the us and to the ms, one 0.1 s stall, five samples lost far from it:
+        // refused as samples repeated before (four were read).
+        for q in [1_000, 1_000_000] {
+            let drops = [1_000, 2_777, 4_554, 6_331, 8_108];
+            let (t, lost) = logger(
+                (200.0, 40_000),
+                (20_000, 1_000_000, 0.1, 0),
+                (q, false, false),
+                |k| drops.contains(&k),
+            );
+            assert_eq!(lost, 5);
+            let s = summary_keeping_repeats(&t);
+            assert_eq!(s.repeat_refusal(), None, "{q}: {s:?}");
+            assert_eq!(s.rate_hz, 200.0, "{q}: {s:?}");
+            assert_eq!(s.missing_samples, 5, "{q}: {s:?}");
+        }
+        // Stalls every 5 s at 200 Hz to the ms, 1 % lost.
+        let (t, lost) = logger(
+            (200.0, 40_000),
+            (1_000, 1_000, 0.1, 0),
+            (1_000_000, false, false),
+            random(9, 100),
+        );
+        let s = summary_keeping_repeats(&t);
+        assert_eq!(s.repeat_refusal(), None, "{s:?}");
+        assert_eq!(s.rate_hz, 200.0, "{s:?}");
+        assert!(s.missing_samples.abs_diff(lost) <= 1, "{lost} lost: {s:?}");
+    }
+
+    #[test]
+    fn a_stall_at_the_records_start_or_end_is_not_samples_repeated() {
+        // 200 Hz to the ms and to the us: its first 40 samples stamped together 0.2 s in
+        // (the first stamp's samples, their times unknown), or its last 50 at the end of a
+        // 0.5 s stall it ends in (the 50 samples past them never came: missing).
+        for q in [1_000, 1_000_000] {
+            let (t, _) = logger(
+                (200.0, 40_000),
+                (0, 1_000_000, 0.2, 0),
+                (q, false, false),
+                |_| false,
+            );
+            let s = summary_keeping_repeats(&t);
+            assert_eq!(s.repeat_refusal(), None, "{q}: {s:?}");
+            assert_eq!((s.rate_hz, s.missing_samples), (200.0, 0), "{q}: {s:?}");
+            let (t, _) = logger(
+                (200.0, 40_000),
+                (39_950, 1_000_000, 0.5, 0),
+                (q, false, false),
+                |_| false,
+            );
+            let s = summary_keeping_repeats(&t);
+            assert_eq!(s.repeat_refusal(), None, "{q}: {s:?}");
+            assert_eq!(s.rate_hz, 200.0, "{q}: {s:?}");
+            // The last stamp's place, 0.5 s on, is one of the 101 its gap holds.
+            assert!(s.missing_samples.abs_diff(50) <= 1, "{q}: {s:?}");
+        }
+    }
+
+    #[test]
+    fn a_rounded_clocks_catch_ups_leave_its_rate() {
+        // 500 Hz to whole ms, stalls of 40 ms caught up on 40 us apart (1 ms intervals, a
+        // clock's rounding at 2 ms too): refused as samples repeated before. 400 Hz (2 and
+        // 3 ms) and 800 Hz (1 and 2 ms) stalling 8 periods every 700 samples, caught up on
+        // 0.1 ms apart: refused, or read 0.2 % fast, before; the rate is the span's over
+        // its places, to the end stamps' quantum where it is under a quarter of the period
+        // (400 Hz), else over the stretches without a stall, to a quantum each (800 Hz).
+        for (rate, every, length, apart, nearest, within) in [
+            (500.0, 1_000, 0.04, 40_000, false, 1e-9),
+            (400.0, 700, 0.02, 100_000, true, 1e-5),
+            (400.0, 700, 0.02, 100_000, false, 1e-5),
+            (800.0, 700, 0.01, 100_000, true, 2e-5),
+            (800.0, 700, 0.01, 100_000, false, 2e-5),
+        ] {
+            let (t, _) = logger(
+                (rate, 100_000),
+                (every, every, length, apart),
+                (1_000_000, nearest, false),
+                |_| false,
+            );
+            let s = summary_keeping_repeats(&t);
+            assert_eq!(s.repeat_refusal(), None, "{rate} Hz: {s:?}");
+            assert!((s.rate_hz / rate - 1.0).abs() < within, "{rate} Hz: {s:?}");
+            assert!(s.missing_samples <= 1, "{rate} Hz: {s:?}");
         }
     }
 }
