@@ -561,9 +561,8 @@ struct Ledger {
     empties: std::collections::VecDeque<Empty>,
     /// The last [`LEDGER`] intervals (the stamp forward each closes, ns), for a finer grid.
     recent: std::collections::VecDeque<(u64, i64)>,
-    /// Repeats kept that filled a place, and repeats dropped that would have.
+    /// Repeats kept that filled a place.
     matched: u64,
-    matched_dropped: u64,
     /// Repeats dropped that would have filled a place beside them.
     beside_dropped: u64,
     /// Each interval with places filled (ns, how many), how many times; whether there were
@@ -638,9 +637,7 @@ impl Ledger {
                     let n = w.count.min(self.empties[i].free);
                     w.count -= n;
                     self.empties[i].free -= n;
-                    if w.dropped {
-                        self.matched_dropped += n;
-                    } else {
+                    if !w.dropped {
                         self.matched += n;
                         self.empties[i].filled += n;
                     }
@@ -677,7 +674,6 @@ impl Ledger {
             e.count -= n;
             free -= n;
             if e.dropped {
-                self.matched_dropped += n;
                 if e.step + 1 >= step {
                     self.beside_dropped += n;
                 }
@@ -723,9 +719,7 @@ impl Ledger {
             let n = w.count.min(e.free);
             w.count -= n;
             e.free -= n;
-            if w.dropped {
-                self.matched_dropped += n;
-            } else {
+            if !w.dropped {
                 self.matched += n;
                 e.filled += n;
             }
@@ -756,9 +750,7 @@ impl Ledger {
             }
             let e = self.empties.back_mut().expect("just seen");
             e.free -= 1;
-            if dropped {
-                self.matched_dropped += 1;
-            } else {
+            if !dropped {
                 self.matched += 1;
                 e.filled += 1;
             }
