@@ -1,0 +1,406 @@
+//! A clock's stamps folded on its period: the rate where the intervals cannot tell it.
+//!
+//! A clock at `f` Hz stamps its samples at `t0 + k / f`, each rounded to the stamps'
+//! quantum, some lost, some caught up late, some written twice. Folded on the right
+//! frequency (each stamp's phase, `f t` modulo one) the stamps bunch within the quantum's
+//! share of a period (`q f`); folded on any other they spread as the phase drifts. The
+//! frequency where they bunch most (the largest Rayleigh power `|sum e^(2 pi i f t)|^2 / n`)
+//! needs no interval to be read, so a lost sample, which leaves an interval of two periods
+//! that rounds like one (a period between one and two quanta), or a host's stall caught up
+//! on, does not move it. Where several samples share a stamp (a clock faster than its
+//! quantum), the stamps that hold two (its beat with the quantum) are folded instead.
+//!
+//! The peak is found on the first stamps, then on four times as many around it, and so on;
+//! the period then is the least-squares line through the stamps, each given the nearest
+//! place on the fold's lattice, and that line is checked stretch by stretch: every stretch
+//! of a one-rate record bunches at the same phase.
+
+use std::f64::consts::TAU;
+
+/// The stamps a search starts with.
+const FIRST: usize = 2048;
+/// The most times a search folds at once.
+const EACH: usize = 16_384;
+/// Stretches a fit is checked in.
+const STRETCHES: usize = 16;
+/// The most phasor sums a search may take (bins times stamps).
+const BUDGET: f64 = 4e8;
+
+/// The Rayleigh power a frequency must pass among `bins` searched: noise alone passes it
+/// once in about 160,000 searches.
+fn threshold(bins: usize) -> f64 {
+    (bins as f64).ln() + 12.0
+}
+
+/// About `most` of the times `t`, picked at random where they are more (a clock's every m-th
+/// sample keeps its phase, but folds alike on rates the m-th part of the clock's apart; a
+/// random pick folds on one).
+pub(super) fn thin(t: &[f64], most: usize) -> Vec<f64> {
+    let every = t.len().div_ceil(most.max(1)) as u64;
+    if every <= 1 {
+        return t.to_vec();
+    }
+    t.iter()
+        .enumerate()
+        .filter(|&(i, _)| {
+            // splitmix64 of the index: the same pick every time.
+            let mut z = (i as u64).wrapping_add(0x9e37_79b9_7f4a_7c15);
+            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+            (z ^ (z >> 31)).is_multiple_of(every)
+        })
+        .map(|(_, &x)| x)
+        .collect()
+}
+
+/// The phasor sums of the times `t` (s) at `bins` frequencies from `lo` Hz, `step` Hz apart,
+/// into `acc`.
+fn sums(t: &[f64], lo: f64, step: f64, bins: usize, acc: &mut Vec<(f64, f64)>) {
+    acc.clear();
+    acc.resize(bins, (0.0, 0.0));
+    for &x in t {
+        let (s, c) = (TAU * (lo * x).fract()).sin_cos();
+        let (ds, dc) = (TAU * (step * x).fract()).sin_cos();
+        let (mut re, mut im) = (c, s);
+        for a in acc.iter_mut() {
+            a.0 += re;
+            a.1 += im;
+            (re, im) = (re * dc - im * ds, re * ds + im * dc);
+        }
+    }
+}
+
+/// The bin of the largest power in `acc` (sums over `n` times), its power, and the peak's
+/// place between its neighbours (a parabola through the three, in bins).
+fn best(acc: &[(f64, f64)], n: usize) -> (f64, f64) {
+    let power = |a: &(f64, f64)| (a.0 * a.0 + a.1 * a.1) / n as f64;
+    let (j, p) = acc
+        .iter()
+        .map(power)
+        .enumerate()
+        .fold((0, -1.0), |b, (j, p)| if p > b.1 { (j, p) } else { b });
+    let shift = if j > 0 && j + 1 < acc.len() {
+        let (l, r) = (power(&acc[j - 1]), power(&acc[j + 1]));
+        let d = l - 2.0 * p + r;
+        if d < 0.0 {
+            (0.5 * (l - r) / d).clamp(-0.5, 0.5)
+        } else {
+            0.0
+        }
+    } else {
+        0.0
+    };
+    (j as f64 + shift, p)
+}
+
+/// Where the times `t` (s from the first, in order) fold tightest between `lo` and `hi` Hz:
+/// the frequency, Hz, where it stands out over the whole record; `None` where no frequency
+/// stands out, or one does only over part of it (a drifting clock, two rates).
+pub(super) fn fold(t: &[f64], lo: f64, hi: f64) -> Option<f64> {
+    let n = t.len();
+    if n < 16 || !(hi > lo && lo > 0.0) {
+        return None;
+    }
+    let mut acc = Vec::new();
+    // The first `k` times, about [`EACH`] of them where they are more.
+    let first = |k: usize| thin(&t[..k], EACH);
+    let mut k = n.min(FIRST);
+    // The whole band on the first stamps, more of them where nothing stands out.
+    let mut f = loop {
+        let span = t[k - 1] - t[0];
+        if span <= 0.0 {
+            return None;
+        }
+        let step = 0.25 / span;
+        let bins = ((hi - lo) / step).ceil() as usize + 1;
+        let x = first(k);
+        if bins as f64 * x.len() as f64 > BUDGET {
+            return None;
+        }
+        sums(&x, lo, step, bins, &mut acc);
+        let (j, p) = best(&acc, x.len());
+        if p > threshold(bins) {
+            break lo + j * step;
+        }
+        if k == n {
+            return None;
+        }
+        k = n.min(4 * k);
+    };
+    // Around the peak, on four times as many stamps at a time.
+    while k < n {
+        let half = 1.0 / (t[k - 1] - t[0]);
+        k = n.min(4 * k);
+        let step = 0.25 / (t[k - 1] - t[0]);
+        let bins = (2.0 * half / step).ceil() as usize + 1;
+        let x = first(k);
+        sums(&x, f - half, step, bins, &mut acc);
+        let (j, p) = best(&acc, x.len());
+        if p <= threshold(bins) {
+            return None;
+        }
+        f = f - half + j * step;
+    }
+    Some(f)
+}
+
+/// A lattice fitted to stamps: `t = origin + k period`, each stamp at its nearest place.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Fit {
+    /// The period, s.
+    pub period: f64,
+    /// The time of place 0, s.
+    pub origin: f64,
+    /// Its standard error, s.
+    pub sigma: f64,
+    /// The share of the stamps in stretches that bunch at the lattice's phase.
+    pub coherent: f64,
+    /// The first stamp and the one past the last of the longest run of stretches that do
+    /// not.
+    pub off: Option<(usize, usize)>,
+    /// The share of the times at the place of the time before, but after a gap: a lattice
+    /// too coarse for them (a multiple of a clock's beat with its quantum folds as the
+    /// clock does).
+    pub crowded: f64,
+}
+
+impl Fit {
+    /// The share of the times `t` (s, in order) within `window` cycles of their place, the
+    /// share of the places from the first time's to the last's with a time so near, and
+    /// how many places that is.
+    pub fn cover(&self, t: &[f64], window: f64) -> (f64, f64, f64) {
+        let (mut near, mut places, mut last) = (0usize, 0usize, f64::NEG_INFINITY);
+        for &x in t {
+            let r = (x - self.origin) / self.period;
+            if (r - r.round()).abs() <= window {
+                near += 1;
+                if r.round() > last {
+                    places += 1;
+                    last = r.round();
+                }
+            }
+        }
+        let ends = |x: f64| ((x - self.origin) / self.period).round();
+        let all = match (t.first(), t.last()) {
+            (Some(&a), Some(&b)) => ends(b) - ends(a) + 1.0,
+            _ => 1.0,
+        };
+        (
+            near as f64 / t.len().max(1) as f64,
+            places as f64 / all,
+            all,
+        )
+    }
+}
+
+impl Fit {
+    /// How far from their places (cycles, 0.02 to 0.3) the times of `sets` bunch: past
+    /// it, every hundredth of a cycle holds no more of them than those 0.3 cycles off or
+    /// more do, give or take three standard errors.
+    pub fn reach(&self, sets: &[&[f64]]) -> f64 {
+        let mut bins = [0u32; 50];
+        for &x in sets.iter().flat_map(|s| s.iter()) {
+            let r = (x - self.origin) / self.period;
+            let off = ((r - r.round()).abs() * 100.0) as usize;
+            bins[off.min(49)] += 1;
+        }
+        let far = bins[30..50].iter().sum::<u32>() as f64 / 20.0;
+        let last = bins[..30]
+            .iter()
+            .rposition(|&b| b as f64 > far + 3.0 * far.max(1.0).sqrt())
+            .map_or(0, |i| i + 1);
+        (last as f64 / 100.0).clamp(0.02, 0.3)
+    }
+
+    /// How many of the times `t` (s) lie within `window` cycles of their place.
+    pub fn near(&self, t: &[f64], window: f64) -> usize {
+        t.iter()
+            .filter(|&&x| {
+                let r = (x - self.origin) / self.period;
+                (r - r.round()).abs() <= window
+            })
+            .count()
+    }
+}
+
+/// The least-squares line `t = origin + k period` through the times `t` (s) each at its
+/// place on the lattice `(origin, period)`, those more than `window` cycles off it left out:
+/// the line's origin, period and the period's standard error.
+fn line(t: &[f64], (origin, period): (f64, f64), window: f64) -> Option<(f64, f64, f64)> {
+    let place = |x: f64| ((x - origin) / period).round();
+    let kept = |x: &&f64| ((**x - origin) / period - place(**x)).abs() <= window;
+    let (mut m, mut sk, mut st) = (0.0, 0.0, 0.0);
+    for &x in t.iter().filter(kept) {
+        m += 1.0;
+        sk += place(x);
+        st += x;
+    }
+    if m < 3.0 {
+        return None;
+    }
+    let (kb, tb) = (sk / m, st / m);
+    let (mut skk, mut skt) = (0.0, 0.0);
+    for &x in t.iter().filter(kept) {
+        let dk = place(x) - kb;
+        skk += dk * dk;
+        skt += dk * (x - tb);
+    }
+    if skk <= 0.0 {
+        return None;
+    }
+    let p = skt / skk;
+    let rss: f64 = t
+        .iter()
+        .filter(kept)
+        .map(|&x| (x - tb - p * (place(x) - kb)).powi(2))
+        .sum();
+    Some((tb - p * kb, p, (rss / (m - 2.0).max(1.0) / skk).sqrt()))
+}
+
+/// The least-squares lattice through the times `t` (s, in order) near the frequency `hz`,
+/// each time at its nearest place: three rounds, the later ones without the times more than
+/// `window` cycles off their place (a host's late stamps). `None` where its stretches are
+/// too few to tell whether they bunch.
+pub(super) fn fit(t: &[f64], hz: f64, window: f64) -> Option<Fit> {
+    let n = t.len();
+    if n < 4 * STRETCHES {
+        return None;
+    }
+    let phase = |x: f64, hz: f64| (TAU * (hz * x).fract()).sin_cos();
+    let (s, c) = t
+        .iter()
+        .map(|&x| phase(x, hz))
+        .fold((0.0, 0.0), |a, p| (a.0 + p.0, a.1 + p.1));
+    let mut period = 1.0 / hz;
+    let mut origin = s.atan2(c) / TAU * period;
+    let mut sigma = f64::INFINITY;
+    for round in 0..3 {
+        let line = line(t, (origin, period), if round == 0 { 0.5 } else { window })?;
+        (origin, period, sigma) = line;
+        if period.is_nan() || period <= 0.0 {
+            return None;
+        }
+    }
+    // Each half's own line, its places kept: a clock whose phase wanders (stamps summed
+    // from jittered intervals) has halves that differ by more than their lines' errors.
+    let (_, a, _) = line(&t[..n / 2], (origin, period), window)?;
+    let (_, b, _) = line(&t[n / 2..], (origin, period), window)?;
+    let sigma = sigma.max((a - b).abs() / 4.0);
+    // Each stretch's mean phasor about the lattice, against the record's: as many
+    // stretches (up to 16, at least 4) as the bunching stands out in, each stretch's mean
+    // straying by its standard error (the record's spread about its mean, over twice the
+    // stretch's length) by chance, half the record's bunching three times that.
+    let phasor = |x: f64| {
+        let r = (x - origin) / period;
+        (TAU * (r - r.round())).sin_cos()
+    };
+    let (s, c) = t
+        .iter()
+        .map(|&x| phasor(x))
+        .fold((0.0, 0.0), |a, p| (a.0 + p.0, a.1 + p.1));
+    let amp = (c * c + s * s).sqrt() / n as f64;
+    let (dc, ds) = (c / (amp * n as f64), s / (amp * n as f64));
+    let stretches = (2..=STRETCHES.ilog2())
+        .rev()
+        .map(|b| 1usize << b)
+        .find(|&m| {
+            let len = (n / m) as f64;
+            0.5 * amp >= 3.0 * ((1.0 - amp * amp).max(1.0 / len) / (2.0 * len)).sqrt()
+        })?;
+    let len = n / stretches;
+    let fits: Vec<bool> = (0..stretches)
+        .map(|j| {
+            let end = if j + 1 == stretches { n } else { (j + 1) * len };
+            let (s, c) = t[j * len..end]
+                .iter()
+                .map(|&x| phasor(x))
+                .fold((0.0, 0.0), |a, p| (a.0 + p.0, a.1 + p.1));
+            (c * dc + s * ds) / (end - j * len) as f64 >= 0.5 * amp
+        })
+        .collect();
+    let coherent = fits.iter().filter(|&&f| f).count() as f64 / stretches as f64;
+    let mut off: Option<(usize, usize)> = None;
+    let mut run = None;
+    for (j, &f) in fits.iter().chain([true].iter()).enumerate() {
+        match (f, run) {
+            (false, None) => run = Some(j),
+            (true, Some(from)) => {
+                let end = if j == stretches { n } else { j * len };
+                if off.is_none_or(|(a, b)| end - from * len > b - a) {
+                    off = Some((from * len, end));
+                }
+                run = None;
+            }
+            _ => {}
+        }
+    }
+    let place = |x: f64| ((x - origin) / period).round();
+    // (A host's late stamp, caught up on after a stall's gap, may share the place of the
+    // sample after it.)
+    let crowded = t
+        .windows(3)
+        .filter(|w| w[1] - w[0] < 1.5 * period && place(w[1]) == place(w[2]))
+        .count() as f64
+        / n as f64;
+    Some(Fit {
+        crowded,
+        period,
+        origin,
+        sigma,
+        coherent,
+        off,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Sample times of a clock at `hz` from `t0` s, each floored to `q` s, with the samples
+    /// `lost` says dropped.
+    fn floored(hz: f64, n: usize, q: f64, mut lost: impl FnMut(usize) -> bool) -> Vec<f64> {
+        let t0 = 0.123_456_7;
+        let first = (t0 / q).floor() * q;
+        (0..n)
+            .filter(|&k| !lost(k))
+            .map(|k| ((t0 + k as f64 / hz) / q).floor() * q - first)
+            .collect()
+    }
+
+    #[test]
+    fn a_clock_between_one_and_two_quanta_folds_on_its_rate_through_losses() {
+        for hz in [550.0, 800.0, 950.0] {
+            let mut next = crate::xorshift(7);
+            let t = floored(hz, 100_000, 1e-3, |_| next().is_multiple_of(100));
+            let f = fold(&t, 0.975 * hz, 1.025 * hz).expect("a peak");
+            assert!((f / hz - 1.0).abs() < 2e-6, "{hz}: {f}");
+            let fit = fit(&t, f, 0.5).unwrap_or_else(|| panic!("{hz}: {f}: no fit"));
+            assert!((fit.period * hz - 1.0).abs() < 1e-7, "{hz}: {fit:?}");
+            assert_eq!(fit.coherent, 1.0, "{hz}");
+        }
+    }
+
+    #[test]
+    fn noise_folds_on_no_rate() {
+        let mut next = crate::xorshift(11);
+        let mut x = 0.0;
+        let t: Vec<f64> = (0..50_000)
+            .map(|_| {
+                x += 1e-3 * (next() % 2000) as f64 / 1000.0;
+                x
+            })
+            .collect();
+        assert_eq!(fold(&t, 950.0, 1050.0), None);
+    }
+
+    #[test]
+    fn two_rates_fold_as_one_only_in_part() {
+        let mut t = floored(800.0, 70_000, 1e-3, |_| false);
+        let end = *t.last().unwrap();
+        t.extend((1..30_000).map(|k| ((end + k as f64 / 760.0) / 1e-3).floor() * 1e-3));
+        if let Some(f) = fold(&t, 780.0, 820.0) {
+            let fit = fit(&t, f, 0.5).expect("a fit");
+            assert!(fit.coherent < 0.9, "{f}: {fit:?}");
+        }
+    }
+}
