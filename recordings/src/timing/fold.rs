@@ -32,25 +32,51 @@ fn threshold(bins: usize) -> f64 {
     (bins as f64).ln() + 12.0
 }
 
-/// About `most` of the times `t`, picked at random where they are more (a clock's every m-th
-/// sample keeps its phase, but folds alike on rates the m-th part of the clock's apart; a
-/// random pick folds on one).
-pub(super) fn thin(t: &[f64], most: usize) -> Vec<f64> {
-    let every = t.len().div_ceil(most.max(1)) as u64;
+/// Whether the `i`-th of `n` things is among about `most` picked at random (splitmix64 of
+/// its number: the same pick every time). A clock's every m-th sample keeps its phase, but
+/// folds alike on rates the m-th part of the clock's apart; a random pick folds on one.
+fn picked(i: usize, n: usize, most: usize) -> bool {
+    let every = n.div_ceil(most.max(1)) as u64;
     if every <= 1 {
-        return t.to_vec();
+        return true;
     }
+    let mut z = (i as u64).wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    (z ^ (z >> 31)).is_multiple_of(every)
+}
+
+/// About `most` of the times `t`, picked at random where they are more.
+fn thin(t: &[f64], most: usize) -> Vec<f64> {
+    let n = t.len();
     t.iter()
         .enumerate()
-        .filter(|&(i, _)| {
-            // splitmix64 of the index: the same pick every time.
-            let mut z = (i as u64).wrapping_add(0x9e37_79b9_7f4a_7c15);
-            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-            (z ^ (z >> 31)).is_multiple_of(every)
-        })
+        .filter(|&(i, _)| picked(i, n, most))
         .map(|(_, &x)| x)
         .collect()
+}
+
+/// The distinct stamps of `stamps` (ns, in order; `distinct` of them), as s from the first:
+/// the first `all` of them, then about `most` more picked at random from the rest.
+pub(super) fn times(stamps: &[i64], distinct: usize, all: usize, most: usize) -> Vec<f64> {
+    let Some(&first) = stamps.first() else {
+        return Vec::new();
+    };
+    let rest = distinct.saturating_sub(all);
+    let mut x = Vec::with_capacity(all.min(distinct) + most.min(rest) + 16);
+    let mut i = 0;
+    let mut last = None;
+    for &s in stamps {
+        if last == Some(s) {
+            continue;
+        }
+        last = Some(s);
+        if i < all || picked(i - all, rest, most) {
+            x.push((i128::from(s) - i128::from(first)) as f64 * 1e-9);
+        }
+        i += 1;
+    }
+    x
 }
 
 /// The phasor sums of the times `t` (s) at `bins` frequencies from `lo` Hz, `step` Hz apart,
