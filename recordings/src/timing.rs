@@ -2071,12 +2071,20 @@ impl Timing {
                 continue;
             }
             // A beat marks each time round but where a sample is lost there: its rate is at
-            // most half as much again as the marks'.
-            let (first, last) = (x[0], x[x.len() - 1]);
+            // most half as much again as the marks' where they come thickest (16 in a row;
+            // a beat in part of the record runs there).
+            // (From the marks' first hundredth to their last: a stray few, a float's floor
+            // or a lost sample, before or after a beat in part of the record.)
+            let bulk = &x[x.len() / 100..x.len() - x.len() / 100];
+            let (first, last) = (bulk[0], bulk[bulk.len() - 1]);
             if last <= first {
                 continue;
             }
-            let most = (0.45 / q).min((1.5 * x.len() as f64 + 8.0) / (last - first));
+            let thickest = x
+                .windows(17)
+                .map(|w| 16.0 / (w[16] - w[0]))
+                .fold(x.len() as f64 / (last - first), f64::max);
+            let most = (0.45 / q).min(1.5 * thickest + 8.0 / span);
             let Some(f) = fold::fold(x, 16.0 / span, most) else {
                 continue;
             };
@@ -2089,7 +2097,7 @@ impl Timing {
                     let f = f / m as f64;
                     let window = (q * f + 0.1).min(0.45);
                     let fit = fold::fit(x, f, window)?;
-                    let (near, covered, places) = fit.cover(x, window);
+                    let (near, covered, places) = fit.cover(bulk, window);
                     // Sixteen times round or more, a mark more each time: the marks near the
                     // beat less the others there (jitter about the beat's edge repeats a
                     // stamp and leaves the next empty; a float's floor stamps a sample early
