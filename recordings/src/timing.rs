@@ -4266,12 +4266,14 @@ mod tests {
     fn two_rates_that_each_keep_their_phase_are_mixed_rates() {
         // Under whole ms: 800 Hz then 760 Hz for the last 30 % (787.6 Hz before), halves at
         // 800 and 750 Hz (774.2 Hz), 400 then 380 Hz (393.8 Hz), floored; 1000 Hz then
-        // 1050 Hz for the last tenth (1004.8 Hz): refused, naming the stretch.
+        // 1050 Hz for the last tenth (1004.8 Hz), or 800 Hz (1000 Hz with samples missing):
+        // refused, naming the stretch.
         for (rate, then, switch) in [
             (800.0, 760.0, 70_000),
             (800.0, 750.0, 50_000),
             (400.0, 380.0, 70_000),
             (1000.0, 1050.0, 90_000),
+            (1000.0, 800.0, 90_000),
         ] {
             let t: Vec<i64> = (0..100_000)
                 .map(|i| {
