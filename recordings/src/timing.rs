@@ -1935,13 +1935,15 @@ impl Timing {
         let q = resolution.map_or(0.0, |q| q as f64 * 1e-9);
         let (hz, span) = (summary.rate_hz, summary.span_s);
         // The distinct stamps on the clock's period, over 1.04 quanta (a place each, but for
-        // one in 200), within 5 % of the intervals' rate; where the stamps are coarser than
+        // one in 200), within 5 % of the intervals' rate (8 % where the stamps are coarser
+        // than a quarter of the period: a host's catch-ups move it more); where they are coarser than
         // half of it, within less than half its beat with the quantum (the places a clock
         // near the quantum leaves empty fold on every multiple of that beat). Stamps on a
         // grid fold alike on rates mirrored about half its rate (500 Hz at whole ms: 490 and
         // 510 Hz): on the reading's side of that, half way to it at most, and not within 2 %
         // of it.
-        let (mut lo, mut hi) = (0.95 * hz, 1.05 * hz);
+        let wide = if 4.0 * q * hz > 1.0 { 0.08 } else { 0.05 };
+        let (mut lo, mut hi) = ((1.0 - wide) * hz, (1.0 + wide) * hz);
         if 2.0 * q * hz > 1.0 {
             let beat = 0.45 * (1.0 / q - hz).abs();
             (lo, hi) = (lo.max(hz - beat), hi.min(hz + beat));
@@ -1958,10 +1960,20 @@ impl Timing {
                 // (Folded on the first 32,768 and about 65,536 more picked at random; the
                 // line through about 65,536 picked at random.)
                 let distinct = t.len() - self.repeats as usize;
-                let f = fold::fold(&fold::times(t, distinct, 1 << 15, 1 << 16), lo, hi)?;
                 let x = fold::times(t, distinct, 0, 1 << 16);
-                let fit = fold::fit(&x, f, (0.5 * q * f + 0.2).min(0.5))
+                let window = |f: f64| (0.5 * q * f + 0.2).min(0.5);
+                let Some(f) = fold::fold(&fold::times(t, distinct, 1 << 15, 1 << 16), lo, hi)
+                else {
+                    return self.drifting(x, (lo, hi), window);
+                };
+                let fit = fold::fit(&x, f, window(f))
                     .filter(|fit| fit.coherent < 0.9 || fit.crowded <= 0.005)?;
+                if fit.coherent < 0.9 {
+                    // A drifting clock's, or two rates (see below).
+                    if let Some(drifting) = self.drifting(x.clone(), (lo, hi), window) {
+                        return Some(drifting);
+                    }
+                }
                 Some((fit, 1.0 / fit.period, fit.sigma / fit.period, x))
             })
             .flatten();
@@ -2000,9 +2012,13 @@ impl Timing {
                 _ => Ok(()),
             };
         }
-        // Fine stamps without catch-ups: the intervals tell the rate.
+        // Fine stamps without gaps or catch-ups: the intervals tell the rate.
+        // Fine stamps with gaps: where all but one in 20 lie within the quantum's share of a
+        // period and a fifth of one of their place (a pattern of intervals that repeats folds
+        // on its mean rate too).
         let coarse = 4.0 * q * hz > 1.0 || self.repeats > 0;
-        if !coarse && summary.short_intervals == 0 {
+        let held = || fit.cover(&x, (0.5 * q / fit.period + 0.2).min(0.5)).0 >= 0.95;
+        if !coarse && summary.short_intervals == 0 && (summary.gaps == 0 || !held()) {
             return Ok(());
         }
         // The fold's rate where it differs; the samples missing, the span's room at the
@@ -2029,6 +2045,40 @@ impl Timing {
             summary.unexplained_repeat = None;
         }
         Ok(())
+    }
+
+    /// Where the stamps fold on no one rate over the whole record: a clock drifting, whose
+    /// phase a lattice at one rate loses. The first and the last third of the times `x` (s)
+    /// each fold on a rate of their own, searched between `lo` and `hi` Hz (each a lattice
+    /// in every stretch, a place each); within 0.2 % of each other, the record's rate is
+    /// their mean (a linear drift's over the record), its error a tenth of their
+    /// difference.
+    fn drifting(
+        &self,
+        x: Vec<f64>,
+        (lo, hi): (f64, f64),
+        window: impl Fn(f64) -> f64,
+    ) -> Option<Lattice> {
+        let third = x.len() / 3;
+        let rate = |part: &[f64]| {
+            let f = fold::fold(part, lo, hi)?;
+            let fit = fold::fit(part, f, window(f))?;
+            (fit.coherent >= 0.9 && fit.crowded <= 0.005).then_some(1.0 / fit.period)
+        };
+        let (a, b) = (rate(&x[..third])?, rate(&x[x.len() - third..])?);
+        if (a / b - 1.0).abs() > 2e-3 {
+            return None;
+        }
+        let mean = 0.5 * (a + b);
+        let fit = fold::Fit {
+            period: 1.0 / mean,
+            origin: f64::NAN,
+            sigma: 0.1 * (a - b).abs() / (mean * mean),
+            coherent: 1.0,
+            off: None,
+            crowded: 0.0,
+        };
+        Some((fit, mean, 0.1 * (a / b - 1.0).abs(), x))
     }
 
     /// The clock's rate from its beat with the stamps' quantum `q` (s), where they step by
@@ -4432,5 +4482,57 @@ mod tests {
         let mut t: Vec<i64> = (0..100_000).map(|k| k * 1_000_000).collect();
         t.insert(5_000, 4_999_000_000);
         assert!(summary_keeping_repeats(&t).repeat_refusal().is_some());
+    }
+
+    #[test]
+    fn catch_ups_a_quantum_apart_drift_and_fine_stamps_with_gaps_keep_the_clocks_rate() {
+        // 400 and 600 Hz to whole ms, 20 stalls of 50 ms each caught up one sample a ms:
+        // 416.19 and 637.68 Hz before, with 406 and 634 missing of none.
+        for rate in [400.0, 600.0] {
+            let (t, _) = logger(
+                (rate, 10_000),
+                (7, 500, 0.05, 1_000_000),
+                (1_000_000, false, false),
+                |_| false,
+            );
+            // (The last caught-up stamps pass the clock's own: written in order.)
+            let t: Vec<i64> = t
+                .iter()
+                .scan(i64::MIN, |last, &s| {
+                    *last = (*last).max(s);
+                    Some(*last)
+                })
+                .collect();
+            let s = summary_keeping_repeats(&t);
+            assert!((s.rate_hz / rate - 1.0).abs() < 1e-5, "{rate} Hz: {s:?}");
+            assert_eq!(s.missing_samples, 0, "{rate} Hz: {s:?}");
+        }
+        // 240 Hz to the nearest ms with 3 % lost: 240.082 Hz before (from the intervals
+        // without gaps alone).
+        let (t, lost) = logger(
+            (240.0, 3_000),
+            (0, 1, 0.0, 0),
+            (1_000_000, true, false),
+            random(11, 33),
+        );
+        let s = summary_keeping_repeats(&t);
+        assert!((s.rate_hz / 240.0 - 1.0).abs() < 2e-5, "{s:?}");
+        assert!(s.missing_samples.abs_diff(lost) <= 1, "{lost} lost: {s:?}");
+        // 800 Hz drifting by 1e-4 over 75 s (a clock warming), floored to whole ms, 1 % lost:
+        // 797.59 Hz with 327 missing before; the mean rate now.
+        let mut lose = random(12, 100);
+        let (n, mut time, mut stamps, mut kept) = (60_000, 0.0f64, Vec::new(), Vec::new());
+        for k in 0..n {
+            if k == 0 || k + 1 == n || !lose(k) {
+                stamps.push((time * 1e3).floor() as i64 * 1_000_000);
+                kept.push(k);
+            }
+            time += 1.0 / (800.0 * (1.0 + 1e-4 * k as f64 / n as f64));
+        }
+        let lost = (kept[kept.len() - 1] - kept[0] + 1 - kept.len() as i64) as u64;
+        let mean = (n - 1) as f64 / time;
+        let s = summary_keeping_repeats(&stamps);
+        assert!((s.rate_hz / mean - 1.0).abs() < 2e-5, "{mean} Hz: {s:?}");
+        assert!(s.missing_samples.abs_diff(lost) <= 2, "{lost} lost: {s:?}");
     }
 }

@@ -361,11 +361,14 @@ pub(super) fn fit(t: &[f64], hz: f64, window: f64) -> Option<Fit> {
         }
     }
     let place = |x: f64| ((x - origin) / period).round();
-    // (A host's late stamp, caught up on after a stall's gap, may share the place of the
-    // sample after it.)
+    // (A host's late stamps, caught up on after a stall's gap, come closer than the period
+    // and may share the place of the sample after them.)
     let crowded = t
         .windows(3)
-        .filter(|w| w[1] - w[0] < 1.5 * period && place(w[1]) == place(w[2]))
+        .filter(|w| {
+            let regular = |iv: f64| (0.75 * period..1.5 * period).contains(&iv);
+            regular(w[1] - w[0]) && regular(w[2] - w[1]) && place(w[1]) == place(w[2])
+        })
         .count() as f64
         / n as f64;
     Some(Fit {
