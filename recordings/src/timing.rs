@@ -1908,7 +1908,8 @@ impl Timing {
             return Err(stretch);
         }
         let mut summary = summary;
-        self.refold(&mut summary, resolution, median)?;
+        let rounded = matches!(window, Window::Quantum { .. });
+        self.refold(&mut summary, resolution, median, rounded)?;
         Ok(summary)
     }
 
@@ -1927,11 +1928,17 @@ impl Timing {
         summary: &mut TimingSummary,
         resolution: Option<i64>,
         median: f64,
+        rounded: bool,
     ) -> Result<(), String> {
         let t = &self.stamps;
         if t.len() < 64 {
             return Ok(());
         }
+        // Where the rate stays the intervals' (read as a clock rounded to its quantum): a
+        // lost sample's interval rounds like the clock's own where the period is within a
+        // quarter of the quantum, so places left empty are a slower clock's or samples lost
+        // and only the stamps' phase tells which.
+        let unresolved = || self.unresolved(summary, resolution, rounded);
         let q = resolution.map_or(0.0, |q| q as f64 * 1e-9);
         let (hz, span) = (summary.rate_hz, summary.span_s);
         // The distinct stamps on the clock's period, over 1.04 quanta (a place each, but for
@@ -1955,6 +1962,29 @@ impl Timing {
             hi = hi.min(0.5 * (hz + mirror));
         }
         let mirrored = (hz / mirror - 1.0).abs() < 0.02;
+        // A host's catch-ups a quantum or so apart (a gap, then two intervals or more short
+        // of the median but not empty: its late samples) move the intervals' rate, even
+        // across that half (500 Hz to whole ms read 512.5 Hz): where the search would reach
+        // it, neither the fold nor the intervals tell the rate.
+        let caught = || {
+            t.windows(4)
+                .filter(|w| {
+                    let iv = |a: i64, b: i64| (i128::from(b) - i128::from(a)) as f64;
+                    let short = |iv: f64| iv > 0.0 && iv < 0.75 * median;
+                    iv(w[0], w[1]) > 2.5 * median && short(iv(w[1], w[2])) && short(iv(w[2], w[3]))
+                })
+                .count()
+        };
+        if (hz / mirror - 1.0).abs() < wide && 4.0 * q * hz > 1.0 && caught() >= 2 {
+            return Err(format!(
+                "the timestamps, stamped to {q:e} s, give {} Hz, near half the stamps' rate, \
+                 where stamps fold alike on rates either side of it, with {} \
+                 gaps followed by intervals short of the median (a host's late samples caught \
+                 up on, which move the intervals' rate): the rate is not told; give --rate",
+                short(hz),
+                caught()
+            ));
+        }
         let on_period = (1.04 * q * hz <= 1.0 && !mirrored)
             .then(|| {
                 // (Folded on the first 32,768 and about 65,536 more picked at random; the
@@ -1980,18 +2010,21 @@ impl Timing {
         let lattice = match on_period {
             Some(l) => Some(l),
             None if q > 0.0 && 1e-9 * median == q && (0.55..1.45).contains(&(q * hz)) => {
-                self.beat(q, span)?
+                match Self::beat(t, q, span)? {
+                    Some(beat) => Some(beat),
+                    None => Self::drifting_beat(t, q),
+                }
             }
             None => None,
         };
         let Some((fit, rate, sigma, x)) = lattice else {
-            return Ok(());
+            return unresolved();
         };
         if fit.coherent < 0.9 {
             // The stretch that does not keep the phase, where it keeps one of its own at
             // another rate.
             let Some((from, to)) = fit.off.filter(|_| fit.coherent >= 0.25) else {
-                return Ok(());
+                return unresolved();
             };
             // (Its middle half: the stretches at its ends may hold the switch.)
             let part = &x[from + (to - from) / 4..to - (to - from) / 4];
@@ -2009,7 +2042,7 @@ impl Timing {
                     100 * from / x.len(),
                     100 * to / x.len()
                 )),
-                _ => Ok(()),
+                _ => unresolved(),
             };
         }
         // Fine stamps without gaps or catch-ups: the intervals tell the rate.
@@ -2045,6 +2078,78 @@ impl Timing {
             summary.unexplained_repeat = None;
         }
         Ok(())
+    }
+
+    /// Where the stamps' beat with their quantum `q` (s) keeps no one phase over the whole
+    /// record: a clock drifting. The first and the last third of the stamps each beat on a
+    /// rate of their own; within 0.2 % of each other, the record's rate is their mean (a
+    /// linear drift's over the record), its error a tenth of their difference.
+    fn drifting_beat(t: &[i64], q: f64) -> Option<Lattice> {
+        let third = t.len() / 3;
+        let rate = |part: &[i64]| {
+            let span = (i128::from(part[part.len() - 1]) - i128::from(part[0])) as f64 * 1e-9;
+            Self::beat(part, q, span)
+                .ok()
+                .flatten()
+                .map(|(.., rate, _, _)| rate)
+        };
+        let (a, b) = (rate(&t[..third])?, rate(&t[t.len() - third..])?);
+        if (a / b - 1.0).abs() > 2e-3 {
+            return None;
+        }
+        let mean = 0.5 * (a + b);
+        let fit = fold::Fit {
+            period: 1.0 / mean,
+            origin: f64::NAN,
+            sigma: 0.1 * (a - b).abs() / (mean * mean),
+            coherent: 1.0,
+            off: None,
+            crowded: 0.0,
+        };
+        Some((fit, mean, 0.1 * (a / b - 1.0).abs(), Vec::new()))
+    }
+
+    /// Where the rate is read from intervals rounded to the stamps' quantum (`rounded`) and
+    /// the period is within a quarter of the quantum either way, the places left empty are
+    /// a slower clock's own, jitter's across a quantum's edge or samples lost, which the
+    /// intervals count alike (a fold on the stamps' phase or their beat tells them apart,
+    /// where it finds one): more than
+    /// one in 100,000 (and two) and the rate is not told from them, refused with the rates
+    /// they allow.
+    fn unresolved(
+        &self,
+        summary: &TimingSummary,
+        resolution: Option<i64>,
+        rounded: bool,
+    ) -> Result<(), String> {
+        let Some(quantum) = resolution.filter(|_| rounded) else {
+            return Ok(());
+        };
+        let q = quantum as f64 * 1e-9;
+        if !(0.8..1.45).contains(&(q * summary.rate_hz)) {
+            return Ok(());
+        }
+        // The places left empty (gaps of five quanta or more are counted as samples
+        // missing).
+        let empty: u64 = self
+            .stamps
+            .windows(2)
+            .map(|w| ((i128::from(w[1]) - i128::from(w[0])) / i128::from(quantum)) as u64)
+            .filter(|places| (2..=4).contains(places))
+            .map(|places| places - 1)
+            .sum();
+        if empty as f64 <= 2.0 + 1e-5 * self.kept as f64 {
+            return Ok(());
+        }
+        let samples = summary.span_s * summary.rate_hz + 1.0 + summary.missing_samples as f64;
+        let most = summary.rate_hz * (1.0 + empty as f64 / samples);
+        Err(format!(
+            "the timestamps, stamped to {q:e} s near the clock's period, leave {empty} places \
+             empty that a clock slower than its stamps leaves and samples lost leave alike, \
+             and their phase tells neither: the rate lies between {} Hz and {} Hz; give --rate",
+            short(summary.rate_hz),
+            short(most)
+        ))
     }
 
     /// Where the stamps fold on no one rate over the whole record: a clock drifting, whose
@@ -2090,8 +2195,7 @@ impl Timing {
     /// rate is the quantum's and the beat's: its lattice on the beat, the rate, its relative
     /// error, and the times folded. A beat that comes only in part of the record is two
     /// rates: refused, named.
-    fn beat(&self, q: f64, span: f64) -> Result<Option<Lattice>, String> {
-        let t = &self.stamps;
+    fn beat(t: &[i64], q: f64, span: f64) -> Result<Option<Lattice>, String> {
         let secs = |x: i64| (i128::from(x) - i128::from(t[0])) as f64 * 1e-9;
         let quantum = q * 1e9;
         let mut quiet = i64::MIN;
@@ -4534,5 +4638,129 @@ mod tests {
         let s = summary_keeping_repeats(&stamps);
         assert!((s.rate_hz / mean - 1.0).abs() < 2e-5, "{mean} Hz: {s:?}");
         assert!(s.missing_samples.abs_diff(lost) <= 2, "{lost} lost: {s:?}");
+    }
+
+    /// Stamps (ns) of `n` samples of a clock at `rate` Hz drifting linearly by `drift` over
+    /// the record, jittered by `jitter` periods (Gaussian), floored to whole ms, each lost
+    /// one time in `one_in` (none at 0); with the samples lost and the mean rate.
+    fn drifting(
+        (rate, drift, jitter): (f64, f64, f64),
+        n: i64,
+        one_in: u64,
+        seed: u64,
+    ) -> (Vec<i64>, u64, f64) {
+        let mut lose = random(seed, one_in.max(1));
+        let mut next = crate::xorshift(seed + 1);
+        let mut gauss = move || {
+            (0..12)
+                .map(|_| (next() >> 11) as f64 / (1u64 << 53) as f64)
+                .sum::<f64>()
+                - 6.0
+        };
+        let (mut time, mut stamps, mut kept) = (0.37 / rate, Vec::new(), Vec::new());
+        for k in 0..n {
+            let stamp = (time + jitter * gauss() / rate) * 1e3;
+            if one_in == 0 || k == 0 || k + 1 == n || !lose(k) {
+                stamps.push(stamp.floor() as i64 * 1_000_000);
+                kept.push(k);
+            }
+            time += 1.0 / (rate * (1.0 + drift * k as f64 / n as f64));
+        }
+        let t: Vec<i64> = stamps
+            .iter()
+            .scan(i64::MIN, |last, &s| {
+                *last = (*last).max(s);
+                Some(*last)
+            })
+            .collect();
+        let lost = (kept[kept.len() - 1] - kept[0] + 1 - kept.len() as i64) as u64;
+        (t, lost, rate * (1.0 + 0.5 * drift))
+    }
+
+    #[test]
+    fn a_drifting_clocks_beat_is_read_in_thirds_and_losses_no_phase_tells_are_refused() {
+        // 1030 and 1227 Hz drifting by 2e-4 (jittered by 2 % of a period) and 950 Hz by
+        // 1e-4, to whole ms with 1 % lost: 1019.75, 1214.65 and 942.78 Hz with exit 0 before.
+        for (rate, drift, jitter) in [
+            (1030.0, 2e-4, 0.02),
+            (1227.0, 2e-4, 0.02),
+            (950.0, 1e-4, 0.0),
+        ] {
+            let (t, lost, mean) = drifting((rate, drift, jitter), 60_000, 100, 21);
+            let s = summary_keeping_repeats(&t);
+            assert!((s.rate_hz / mean - 1.0).abs() < 2e-6, "{mean} Hz: {s:?}");
+            assert!(s.missing_samples.abs_diff(lost) <= 2, "{lost} lost: {s:?}");
+        }
+        // 1001 Hz over 20 s with 1 % lost (its beat 20 times round, too few to tell from
+        // the places lost samples leave), and clocks drifting by 1e-3 with 1 % lost (a beat
+        // no third holds): 991.19, 1056.64 and 933.39 Hz with exit 0 before; refused,
+        // naming the rates the stamps allow.
+        for (rate, drift, n) in [
+            (1001.0, 0.0, 20_000),
+            (1066.0, 1e-3, 40_000),
+            (940.0, 1e-3, 40_000),
+        ] {
+            let (t, ..) = drifting((rate, drift, 0.0), n, 100, 22);
+            let e = pushed(&t, true).summary(TimeUnit::Nanoseconds).unwrap_err();
+            assert!(
+                e.contains("samples lost leave alike") && e.contains("give --rate"),
+                "{rate} Hz: {e}"
+            );
+        }
+        // The same clocks with no sample lost: read (a drifting clock) or refused, never
+        // another rate.
+        for (rate, drift) in [(1001.0, 0.0), (1030.0, 2e-4), (940.0, 1e-3), (1066.0, 1e-3)] {
+            let (t, lost, mean) = drifting((rate, drift, 0.0), 40_000, 0, 23);
+            if let Ok(s) = pushed(&t, true).summary(TimeUnit::Nanoseconds) {
+                assert!((s.rate_hz / mean - 1.0).abs() < 2e-5, "{mean} Hz: {s:?}");
+                assert!(s.missing_samples.abs_diff(lost) <= 2, "{lost} lost: {s:?}");
+            }
+        }
+    }
+
+    /// Stamps (ns) of 40,000 samples at `rate` Hz, to whole ms, of a host that stalls
+    /// `length` s every `every` samples and catches up on the samples due meanwhile one a
+    /// ms until it meets the clock.
+    fn caught_up_a_ms_apart(rate: f64, every: i64, length: f64) -> Vec<i64> {
+        let period = 1e9 / rate;
+        let mut caught: Option<f64> = None;
+        (0..40_000i64)
+            .map(|k| {
+                let due = k as f64 * period;
+                let t = match caught {
+                    _ if k > 0 && k % every == 0 => due + length * 1e9,
+                    Some(c) if c + 1e6 > due => c + 1e6,
+                    _ => due,
+                };
+                caught = (t > due).then_some(t);
+                (t / 1e6).floor() as i64 * 1_000_000
+            })
+            .collect()
+    }
+
+    #[test]
+    fn catch_ups_a_quantum_apart_near_half_the_stamps_rate_are_refused() {
+        // 490, 500 and 505 Hz to whole ms, stalls of 20 or 50 ms caught up one sample a ms
+        // until the host meets the clock: 509.95, 512.50 and 515.00 Hz with exit 0 before
+        // (where rates either side of 500 Hz fold alike, no fold reads them again).
+        for (rate, every, length) in [
+            (490.0, 250, 0.02),
+            (500.0, 1_000, 0.05),
+            (505.0, 1_000, 0.05),
+        ] {
+            let stamps = caught_up_a_ms_apart(rate, every, length);
+            let e = match pushed(&stamps, true).summary(TimeUnit::Nanoseconds) {
+                Ok(s) => panic!("{rate} {s:?}"),
+                Err(e) => e,
+            };
+            assert!(e.contains("near half the stamps' rate"), "{rate} Hz: {e}");
+        }
+        // 500 Hz to whole ms with 1 % lost, jittered or not: read.
+        for jitter in [0.0, 0.05] {
+            let (t, lost, _) = drifting((500.0, 0.0, jitter), 40_000, 100, 24);
+            let s = summary_keeping_repeats(&t);
+            assert!((s.rate_hz / 500.0 - 1.0).abs() < 5e-5, "{s:?}");
+            assert!(s.missing_samples.abs_diff(lost) <= 2, "{lost} lost: {s:?}");
+        }
     }
 }
