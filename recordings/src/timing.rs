@@ -1770,7 +1770,10 @@ impl Timing {
             }
             _ => (period, room),
         };
+        let (per_stamp, jittered_repeats) = self.shared_stamps(1e9 / period);
         let summary = TimingSummary {
+            per_stamp,
+            jittered_repeats,
             unit: unit.name(),
             header_stamps: unit == TimeUnit::HeaderStamps,
             rate_hz: 1e9 / period,
@@ -1911,6 +1914,35 @@ impl Timing {
         let rounded = matches!(window, Window::Quantum { .. });
         self.refold(&mut summary, resolution, median, rounded)?;
         Ok(summary)
+    }
+
+    /// How many samples nearly every stamp holds, where nine in ten distinct stamps or more
+    /// hold the same number, two or more; and the stamps held by two samples whose stamps
+    /// either side lie two and a half periods (of the rate `hz`) apart or more.
+    fn shared_stamps(&self, hz: f64) -> (Option<u64>, u64) {
+        let t = &self.stamps;
+        if self.repeats == 0 || t.is_empty() {
+            return (None, 0);
+        }
+        let mut held = std::collections::BTreeMap::<u64, u64>::new();
+        let (mut jittered, mut distinct) = (0, 0u64);
+        let mut start = 0;
+        while start < t.len() {
+            let end = start + t[start..].iter().take_while(|&&x| x == t[start]).count();
+            *held.entry((end - start) as u64).or_default() += 1;
+            distinct += 1;
+            if end - start == 2 && start > 0 && end < t.len() {
+                let across = (i128::from(t[end]) - i128::from(t[start - 1])) as f64 * 1e-9;
+                jittered += u64::from(across * hz >= 2.5);
+            }
+            start = end;
+        }
+        let per_stamp = held
+            .iter()
+            .max_by_key(|&(_, &n)| n)
+            .filter(|&(&k, &n)| k >= 2 && n * 10 >= distinct * 9)
+            .map(|(&k, _)| k);
+        (per_stamp, jittered)
     }
 
     /// The rate read again from the stamps' phase ([`fold`]), where they fold on one clock
@@ -2735,6 +2767,15 @@ pub struct TimingSummary {
     /// stamps, the stamp (ns), and how many such repeats there are.
     #[serde(skip)]
     pub unexplained_repeat: Option<(u64, i64, u64)>,
+    /// How many samples nearly every stamp holds (nine in ten stamps or more, two samples or
+    /// more each): a FIFO or a packet read at once and stamped once.
+    #[serde(skip)]
+    pub per_stamp: Option<u64>,
+    /// Repeats (two samples on a stamp) whose stamps either side lie two and a half periods
+    /// apart or more: three periods across the four samples, as a clock jittered across its
+    /// stamps' quantum leaves them (a sample written twice leaves two).
+    #[serde(skip)]
+    pub jittered_repeats: u64,
 }
 
 impl TimingSummary {
@@ -2743,7 +2784,23 @@ impl TimingSummary {
     pub fn repeat_refusal(&self) -> Option<String> {
         let (at, stamp, left) = self.unexplained_repeat?;
         let (q, interval) = (self.resolution_s.unwrap_or(1e-9), self.median_interval_s);
-        Some(if left == self.repeated {
+        Some(if let Some(k) = self.per_stamp {
+            format!(
+                "{} timestamps equal the one before (the first: sample {at}, {stamp} ns): nearly \
+                 every stamp holds {k} samples, as a FIFO or a packet read at once and \
+                 stamped once leaves them; the stamps' rate, {} Hz, is the reads', the \
+                 samples' may be {k} times it: give --rate",
+                self.repeated,
+                short(self.rate_hz)
+            )
+        } else if left == self.repeated && self.jittered_repeats == left {
+            format!(
+                "{left} timestamps equal the one before (the first: sample {at}, {stamp} ns), \
+                 each between stamps three periods apart, as a clock jittered across its \
+                 stamps' quantum ({q:e} s) leaves them, not as a sample written twice does: \
+                 give --rate (the samples are read in order)"
+            )
+        } else if left == self.repeated {
             format!(
                 "{left} timestamps equal the one before (the first: sample {at}, {stamp} ns), \
                  and the stamps, to {q:e} s, resolve the interval {interval:e} s: samples \
@@ -4638,6 +4695,49 @@ mod tests {
         let s = summary_keeping_repeats(&stamps);
         assert!((s.rate_hz / mean - 1.0).abs() < 2e-5, "{mean} Hz: {s:?}");
         assert!(s.missing_samples.abs_diff(lost) <= 2, "{lost} lost: {s:?}");
+    }
+
+    #[test]
+    fn stamps_shared_by_a_packet_or_jittered_past_each_other_are_named_for_it() {
+        // 1 kHz read eight samples at a time, stamped once to the microsecond: refused as
+        // samples repeated before; the stamps' rate and the packet named now.
+        let t: Vec<i64> = (0..64_000i64)
+            .map(|k| (k / 8 * 8 + 7) * 1_000_000)
+            .collect();
+        let e = summary_keeping_repeats(&t).repeat_refusal().unwrap();
+        assert!(
+            e.contains("nearly every stamp holds 8 samples") && e.contains("125 Hz"),
+            "{e}"
+        );
+        // 550 Hz jittered by a tenth of a period, to whole ms (a sample late lands on the
+        // next one's stamp): refused as samples repeated before; named jitter now. The same
+        // clock with six rows written twice: samples repeated, as before.
+        let jittered = |twice: &[usize]| {
+            let mut t = clock(
+                (550.0, 550.0, 0),
+                60_000,
+                (1_000_000, false),
+                (0.0, 0.1e9 / 550.0),
+            );
+            for (i, &at) in twice.iter().enumerate() {
+                t.insert(at + i, t[at + i]);
+            }
+            t.iter()
+                .scan(i64::MIN, |last, &s| {
+                    *last = (*last).max(s);
+                    Some(*last)
+                })
+                .collect::<Vec<_>>()
+        };
+        let s = summary_keeping_repeats(&jittered(&[]));
+        let e = s.repeat_refusal().unwrap();
+        assert!(e.contains("jittered across its stamps' quantum"), "{e}");
+        let s = summary_keeping_repeats(&jittered(&[100, 9_000, 20_000, 33_000, 41_000, 59_000]));
+        let e = s.repeat_refusal().unwrap();
+        assert!(
+            e.contains("samples repeated?") && !e.contains("jittered"),
+            "{e}"
+        );
     }
 
     /// Stamps (ns) of `n` samples of a clock at `rate` Hz drifting linearly by `drift` over
