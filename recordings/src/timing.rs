@@ -2042,9 +2042,15 @@ impl Timing {
         let lattice = match on_period {
             Some(l) => Some(l),
             None if q > 0.0 && 1e-9 * median == q && (0.55..1.45).contains(&(q * hz)) => {
-                match Self::beat(t, q, span)? {
+                let mut unsure = None;
+                match Self::beat(t, q, span, &mut unsure)? {
                     Some(beat) => Some(beat),
-                    None => Self::drifting_beat(t, q),
+                    None => match (Self::drifting_beat(t, q), unsure) {
+                        (Some(beat), _) => Some(beat),
+                        // Read as the quantum's rate, every place left empty a sample lost.
+                        (None, Some(unsure)) if q * hz == 1.0 => return Err(unsure),
+                        (None, _) => None,
+                    },
                 }
             }
             None => None,
@@ -2120,7 +2126,7 @@ impl Timing {
         let third = t.len() / 3;
         let rate = |part: &[i64]| {
             let span = (i128::from(part[part.len() - 1]) - i128::from(part[0])) as f64 * 1e-9;
-            Self::beat(part, q, span)
+            Self::beat(part, q, span, &mut None)
                 .ok()
                 .flatten()
                 .map(|(.., rate, _, _)| rate)
@@ -2227,7 +2233,12 @@ impl Timing {
     /// rate is the quantum's and the beat's: its lattice on the beat, the rate, its relative
     /// error, and the times folded. A beat that comes only in part of the record is two
     /// rates: refused, named.
-    fn beat(t: &[i64], q: f64, span: f64) -> Result<Option<Lattice>, String> {
+    fn beat(
+        t: &[i64],
+        q: f64,
+        span: f64,
+        unsure: &mut Option<String>,
+    ) -> Result<Option<Lattice>, String> {
         let secs = |x: i64| (i128::from(x) - i128::from(t[0])) as f64 * 1e-9;
         let quantum = q * 1e9;
         let mut quiet = i64::MIN;
@@ -2329,6 +2340,40 @@ impl Timing {
                 }
                 let sigma = fit.sigma / (fit.period * fit.period * rate);
                 found.push((fit, rate, sigma, x.clone()));
+            }
+        }
+        // Places left empty with no repeat within 32 quanta (stamps a quantum early or late,
+        // a float's floor for up to 21 in a row; jitter across an edge) that fold on a beat
+        // no lattice holds: a slower clock's beat among samples lost, which the intervals
+        // read as the quantum's rate.
+        if found.is_empty() {
+            let mut r = repeated.iter().peekable();
+            let lone: Vec<f64> = empty
+                .iter()
+                .copied()
+                .filter(|&e| {
+                    while r.next_if(|&&x| x < e - 32.5 * q).is_some() {}
+                    r.peek().is_none_or(|&&x| x > e + 32.5 * q)
+                })
+                .collect();
+            let most = 0.45 / q;
+            // (Where repeats are fewer than a tenth of them: a float's floor repeats stamps
+            // by the thousand, and the samples lost within its runs leave places on its
+            // pattern.)
+            if let Some(f) = (lone.len() >= 16 && 10 * extra.len() <= lone.len())
+                .then(|| fold::fold(&lone, 16.0 / span, most))
+                .flatten()
+            {
+                *unsure = Some(format!(
+                    "the timestamps, stamped to {q:e} s, leave {} places empty with no repeat \
+                     nearby, which fold on a beat of {} Hz (or a fraction of it) as a clock \
+                     slower than its stamps leaves them, among others at random as samples \
+                     lost leave them: the rate is not told (the quantum's rate, {} Hz, takes \
+                     them all for samples lost); give --rate",
+                    lone.len(),
+                    short(f),
+                    short(1.0 / q)
+                ));
             }
         }
         // Both a faster and a slower clock's beat: neither told.
@@ -4816,6 +4861,43 @@ mod tests {
                 assert!(s.missing_samples.abs_diff(lost) <= 2, "{lost} lost: {s:?}");
             }
         }
+    }
+
+    #[test]
+    fn a_slower_clocks_beat_among_samples_lost_is_not_the_quantums_rate() {
+        // 997 and 998 Hz to whole ms with 1 % lost: the places left empty fold on the
+        // clock's beat with the quantum among those lost at random, which no lattice holds:
+        // read as 1000 Hz before, every place a sample lost.
+        for (rate, seeds) in [(997.0, 25..31), (998.0, 25..28)] {
+            for seed in seeds {
+                let (t, ..) = drifting((rate, 0.0, 0.0), 40_000, 100, seed);
+                let e = pushed(&t, true).summary(TimeUnit::Nanoseconds).unwrap_err();
+                assert!(e.contains("which fold on a beat"), "{rate} Hz, {seed}: {e}");
+            }
+        }
+        // 995 Hz: the beat stands out and holds a lattice (read), or refused.
+        for seed in 25..31 {
+            let (t, lost, _) = drifting((995.0, 0.0, 0.0), 40_000, 100, seed);
+            if let Ok(s) = pushed(&t, true).summary(TimeUnit::Nanoseconds) {
+                assert!((s.rate_hz / 995.0 - 1.0).abs() < 2e-6, "{seed}: {s:?}");
+                assert_eq!(s.missing_samples, lost, "{seed}: {s:?}");
+            }
+        }
+        // 999 Hz over 40 s: its 40 places left empty do not stand out among 360 lost (a
+        // beat needs about the square root of 20 times the places lost): the quantum's rate,
+        // 40 more missing, as documented.
+        let (t, lost, _) = drifting((999.0, 0.0, 0.0), 40_000, 100, 25);
+        let s = summary_keeping_repeats(&t);
+        assert_eq!(
+            (s.rate_hz, s.missing_samples, lost),
+            (1000.0, 403, 363),
+            "{s:?}"
+        );
+        // 1000 Hz with 1 % lost: the quantum's rate, the samples lost missing.
+        let (t, lost, _) = drifting((1000.0, 0.0, 0.0), 40_000, 100, 25);
+        let s = summary_keeping_repeats(&t);
+        assert_eq!(s.rate_hz, 1000.0, "{s:?}");
+        assert!(s.missing_samples.abs_diff(lost) <= 1, "{lost} lost: {s:?}");
     }
 
     /// Stamps (ns) of 40,000 samples at `rate` Hz, to whole ms, of a host that stalls
