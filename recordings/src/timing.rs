@@ -2056,11 +2056,19 @@ impl Timing {
             .flatten();
         let lattice = match on_period {
             Some(l) => Some(l),
-            None if q > 0.0 && 1e-9 * median == q && (0.55..1.45).contains(&(q * hz)) => {
+            // (Several samples a stamp, within 0.45 of a whole number of them: the places
+            // that hold one more, or one fewer, beat alike.)
+            None if q > 0.0
+                && 1e-9 * median == q
+                && q * hz >= 0.55
+                && (q * hz).round() <= 3.0
+                && (q * hz - (q * hz).round()).abs() < 0.45 =>
+            {
+                let share = (q * hz).round() as u64;
                 let mut unsure = None;
-                match Self::beat(t, q, span, &mut unsure)? {
+                match Self::beat(t, (q, share), span, &mut unsure)? {
                     Some(beat) => Some(beat),
-                    None => match (Self::drifting_beat(t, q), unsure) {
+                    None => match (Self::drifting_beat(t, (q, share)), unsure) {
                         (Some(beat), _) => Some(beat),
                         // Read as the quantum's rate, every place left empty a sample lost.
                         (None, Some(unsure)) if q * hz == 1.0 => return Err(unsure),
@@ -2137,7 +2145,7 @@ impl Timing {
     /// record: a clock drifting. The first and the last third of the stamps each beat on a
     /// rate of their own; within 0.2 % of each other, the record's rate is their mean (a
     /// linear drift's over the record), its error a tenth of their difference.
-    fn drifting_beat(t: &[i64], q: f64) -> Option<Lattice> {
+    fn drifting_beat(t: &[i64], q: (f64, u64)) -> Option<Lattice> {
         let third = t.len() / 3;
         let rate = |part: &[i64]| {
             let span = (i128::from(part[part.len() - 1]) - i128::from(part[0])) as f64 * 1e-9;
@@ -2306,37 +2314,55 @@ impl Timing {
     /// caught up on); where one of them keeps the beat's phase and the other does not, the
     /// rate is the quantum's and the beat's: its lattice on the beat, the rate, its relative
     /// error, and the times folded. A beat that comes only in part of the record is two
-    /// rates: refused, named.
+    /// rates: refused, named. Where `share` samples a stamp is the whole number nearest
+    /// the clock's (a clock near twice the quantum's rate), the places that hold one more
+    /// or one fewer beat alike, and the rate is `share` quanta's and the beat's. Places
+    /// left empty that fold on a beat no lattice holds (none repeated near them) set
+    /// `unsure` to their refusal.
     fn beat(
         t: &[i64],
-        q: f64,
+        (q, share): (f64, u64),
         span: f64,
         unsure: &mut Option<String>,
     ) -> Result<Option<Lattice>, String> {
         let secs = |x: i64| (i128::from(x) - i128::from(t[0])) as f64 * 1e-9;
         let quantum = q * 1e9;
         let mut quiet = i64::MIN;
-        let (mut repeated, mut extra, mut empty) = (Vec::new(), Vec::new(), Vec::new());
-        for w in t.windows(2) {
-            let iv = (i128::from(w[1]) - i128::from(w[0])) as f64;
-            if iv > 4.5 * quantum {
-                quiet = w[1].saturating_add(iv as i64);
-            } else if w[1] > quiet {
-                for j in 1..(iv / quantum).round() as i64 {
-                    empty.push(secs(w[0]) + j as f64 * q);
+        // The places that hold more than the share (once each, and once for each sample
+        // more) and those that hold fewer (once each, and once for each sample fewer).
+        let (mut repeated, mut extra, mut empty, mut fewer) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let mut place = |x: f64, held: u64| {
+            if held > share {
+                repeated.push(x);
+                extra.extend((share..held).map(|_| x));
+            } else if held < share {
+                empty.push(x);
+                fewer.extend((held..share).map(|_| x));
+            }
+        };
+        let mut i = 0;
+        while i < t.len() {
+            let held = t[i..].iter().take_while(|&&x| x == t[i]).count();
+            if i > 0 {
+                let iv = (i128::from(t[i]) - i128::from(t[i - 1])) as f64;
+                if iv > 4.5 * quantum {
+                    quiet = t[i].saturating_add(iv as i64);
+                } else if t[i] > quiet {
+                    for j in 1..(iv / quantum).round() as i64 {
+                        place(secs(t[i - 1]) + j as f64 * q, 0);
+                    }
                 }
             }
-            if w[0] == w[1] && w[1] > quiet {
-                extra.push(secs(w[1]));
-                if repeated.last() != Some(&secs(w[1])) {
-                    repeated.push(secs(w[1]));
-                }
+            if t[i] > quiet {
+                place(secs(t[i]), held as u64);
             }
+            i += held;
         }
         let mut found = Vec::new();
         for (x, more, less, sign) in [
-            (&repeated, &extra, &empty, 1.0),
-            (&empty, &empty, &extra, -1.0),
+            (&repeated, &extra, &fewer, 1.0),
+            (&empty, &fewer, &extra, -1.0),
         ] {
             if x.len() < 16 {
                 continue;
@@ -2396,7 +2422,7 @@ impl Timing {
                 .filter(|b| !b.0.is_nan())
                 .min_by(|a, b| a.0.total_cmp(&b.0));
             if let Some((_, fit, true)) = beat {
-                let rate = 1.0 / q + sign / fit.period;
+                let rate = share as f64 / q + sign / fit.period;
                 // A beat runs from the record's start to its end.
                 let edge = 4.0 * fit.period + 0.02 * span;
                 if first > edge || span - last > edge {
@@ -5025,6 +5051,26 @@ mod tests {
         let s = summary_keeping_repeats(&t);
         assert!((s.rate_hz / mean - 1.0).abs() < 1e-5, "{mean} Hz: {s:?}");
         assert_eq!(s.missing_samples, 0, "{s:?}");
+    }
+
+    #[test]
+    fn several_samples_a_stamp_beat_on_their_whole_share() {
+        // 1705, 2300 and 3300 Hz to whole ms, and 1910 and 2620 Hz jittered by 3 % of a
+        // period, with 0.5 % lost: the places that hold one sample more (or fewer) than the
+        // whole share nearest beat as a clock near the quantum's rate repeats its stamps.
+        // 1698.99, 2289.31, 3284.49 and 2607.76 Hz before (the span's rate), 1910 Hz refused.
+        for (rate, jitter) in [
+            (1705.0, 0.0),
+            (1910.0, 0.03),
+            (2300.0, 0.0),
+            (2620.0, 0.03),
+            (3300.0, 0.0),
+        ] {
+            let (t, lost, _) = drifting((rate, 0.0, jitter), 40_000, 200, 28);
+            let s = summary_keeping_repeats(&t);
+            assert!((s.rate_hz / rate - 1.0).abs() < 1e-6, "{rate} Hz: {s:?}");
+            assert!(s.missing_samples.abs_diff(lost) <= 2, "{lost} lost: {s:?}");
+        }
     }
 
     /// Stamps (ns) of 40,000 samples at `rate` Hz, to whole ms, of a host that stalls
