@@ -1771,6 +1771,28 @@ impl Timing {
             _ => (period, room),
         };
         let (per_stamp, jittered_repeats) = self.shared_stamps(1e9 / period);
+        // Nearly every stamp holding the same number of samples, and one interval in a
+        // hundred or more between distinct stamps of two quanta or more: packets stamped
+        // once, read fewer times than the quantum's rate (a clock of that many samples a
+        // quantum fills each place), whose samples' times the stamps do not tell.
+        if let (Some(k), Some(quantum)) = (per_stamp, resolution) {
+            let (apart, all) = self.stamps.windows(2).filter(|w| w[1] > w[0]).fold(
+                (0u64, 0u64),
+                |(apart, all), w| {
+                    let wide = i128::from(w[1]) - i128::from(w[0]) >= 2 * i128::from(quantum);
+                    (apart + u64::from(wide), all + 1)
+                },
+            );
+            if all > 0 && 100 * apart >= all {
+                return Err(format!(
+                    "nearly every timestamp holds {k} samples, and {apart} of the {all} \
+                     intervals between distinct stamps span two quanta ({:e} s) or more: a FIFO \
+                     or a packet read {k} samples at a time and stamped once, whose samples' \
+                     times the stamps do not tell; give --rate",
+                    quantum as f64 * 1e-9
+                ));
+            }
+        }
         let summary = TimingSummary {
             per_stamp,
             jittered_repeats,
@@ -1916,7 +1938,7 @@ impl Timing {
         Ok(summary)
     }
 
-    /// How many samples nearly every stamp holds, where nine in ten distinct stamps or more
+    /// How many samples nearly every stamp holds, where eight in ten distinct stamps or more
     /// hold the same number, two or more; and the stamps held by two samples whose stamps
     /// either side lie two and a half periods (of the rate `hz`) apart or more.
     fn shared_stamps(&self, hz: f64) -> (Option<u64>, u64) {
@@ -1940,7 +1962,7 @@ impl Timing {
         let per_stamp = held
             .iter()
             .max_by_key(|&(_, &n)| n)
-            .filter(|&(&k, &n)| k >= 2 && n * 10 >= distinct * 9)
+            .filter(|&(&k, &n)| k >= 2 && n * 10 >= distinct * 8)
             .map(|(&k, _)| k);
         (per_stamp, jittered)
     }
@@ -2460,9 +2482,20 @@ impl Timing {
             // (Where repeats are fewer than a tenth of them: a float's floor repeats stamps
             // by the thousand, and the samples lost within its runs leave places on its
             // pattern.)
+            // Too few to fold (4 to 15), where they come evenly (spaced within a quarter of
+            // their mean spacing, as losses at random are not): a beat as well.
+            let even = || {
+                let gaps: Vec<f64> = lone.windows(2).map(|w| w[1] - w[0]).collect();
+                let mean = gaps.iter().sum::<f64>() / gaps.len() as f64;
+                let sd = (gaps.iter().map(|g| (g - mean).powi(2)).sum::<f64>() / gaps.len() as f64)
+                    .sqrt();
+                (sd < 0.25 * mean).then_some(1.0 / mean)
+            };
+            let marks = extra.is_empty() && (4..16).contains(&lone.len());
             if let Some(f) = (lone.len() >= 16 && 10 * extra.len() <= lone.len())
                 .then(|| fold::fold(&lone, 16.0 / span, most))
                 .flatten()
+                .or_else(|| marks.then(even).flatten())
             {
                 *unsure = Some(format!(
                     "the timestamps, stamped to {q:e} s, leave {} places empty with no repeat \
@@ -2912,8 +2945,8 @@ pub struct TimingSummary {
     /// stamps, the stamp (ns), and how many such repeats there are.
     #[serde(skip)]
     pub unexplained_repeat: Option<(u64, i64, u64)>,
-    /// How many samples nearly every stamp holds (nine in ten stamps or more, two samples or
-    /// more each): a FIFO or a packet read at once and stamped once.
+    /// How many samples nearly every stamp holds (eight in ten stamps or more, two samples
+    /// or more each): a FIFO or a packet read at once and stamped once.
     #[serde(skip)]
     pub per_stamp: Option<u64>,
     /// Repeats (two samples on a stamp) whose stamps either side lie two and a half periods
@@ -4851,16 +4884,24 @@ mod tests {
 
     #[test]
     fn stamps_shared_by_a_packet_or_jittered_past_each_other_are_named_for_it() {
-        // 1 kHz read eight samples at a time, stamped once to the microsecond: refused as
-        // samples repeated before; the stamps' rate and the packet named now.
+        // 1 kHz read eight samples at a time, stamped once to the microsecond, and 1800 Hz
+        // read two at a time to whole ms (read as 2000 Hz with 5556 samples missing before):
+        // refused, the packets named.
         let t: Vec<i64> = (0..64_000i64)
             .map(|k| (k / 8 * 8 + 7) * 1_000_000)
             .collect();
-        let e = summary_keeping_repeats(&t).repeat_refusal().unwrap();
-        assert!(
-            e.contains("nearly every stamp holds 8 samples") && e.contains("125 Hz"),
-            "{e}"
-        );
+        let e = pushed(&t, true).summary(TimeUnit::Nanoseconds).unwrap_err();
+        assert!(e.contains("a FIFO or a packet read 8 samples"), "{e}");
+        let t: Vec<i64> = (0..50_000i64)
+            .map(|k| ((k / 2 * 2 + 1) as f64 / 1800.0 * 1e3).floor() as i64 * 1_000_000)
+            .collect();
+        let e = pushed(&t, true).summary(TimeUnit::Nanoseconds).unwrap_err();
+        assert!(e.contains("a FIFO or a packet read 2 samples"), "{e}");
+        // 2 kHz to whole ms, two samples a stamp, every place filled: read.
+        let t: Vec<i64> = (0..50_000i64)
+            .map(|k| ((k as f64 + 0.3) / 2000.0 * 1e3).floor() as i64 * 1_000_000)
+            .collect();
+        assert_eq!(summary_keeping_repeats(&t).rate_hz, 2000.0);
         // 550 Hz jittered by a tenth of a period, to whole ms (a sample late lands on the
         // next one's stamp): refused as samples repeated before; named jitter now. The same
         // clock with six rows written twice: samples repeated, as before.
@@ -4990,6 +5031,13 @@ mod tests {
                 assert_eq!(s.missing_samples, lost, "{seed}: {s:?}");
             }
         }
+        // 999.718 Hz rounded to whole ms, nothing lost: 12 places left empty, evenly, too few
+        // to fold (read as 1000 Hz with 13 missing before).
+        let t: Vec<i64> = (0..45_534i64)
+            .map(|k| ((k as f64 + 0.4) / 999.718 * 1e3).round() as i64 * 1_000_000)
+            .collect();
+        let e = pushed(&t, true).summary(TimeUnit::Nanoseconds).unwrap_err();
+        assert!(e.contains("which fold on a beat"), "{e}");
         // 999 Hz over 40 s: its 40 places left empty do not stand out among 360 lost (a
         // beat needs about the square root of 20 times the places lost): the quantum's rate,
         // 40 more missing, as documented.
