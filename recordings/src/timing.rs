@@ -2168,7 +2168,6 @@ impl Timing {
     /// rate of their own; within 0.2 % of each other, the record's rate is their mean (a
     /// linear drift's over the record), its error a tenth of their difference.
     fn drifting_beat(t: &[i64], q: (f64, u64)) -> Option<Lattice> {
-        let third = t.len() / 3;
         let rate = |part: &[i64]| {
             let span = (i128::from(part[part.len() - 1]) - i128::from(part[0])) as f64 * 1e-9;
             Self::beat(part, q, span, &mut None)
@@ -2176,20 +2175,8 @@ impl Timing {
                 .flatten()
                 .map(|(.., rate, _, _)| rate)
         };
-        let (a, b) = (rate(&t[..third])?, rate(&t[t.len() - third..])?);
-        if (a / b - 1.0).abs() > 2e-3 {
-            return None;
-        }
-        let mean = 0.5 * (a + b);
-        let fit = fold::Fit {
-            period: 1.0 / mean,
-            origin: f64::NAN,
-            sigma: 0.1 * (a - b).abs() / (mean * mean),
-            coherent: 1.0,
-            off: None,
-            crowded: 0.0,
-        };
-        Some((fit, mean, 0.1 * (a / b - 1.0).abs(), Vec::new()))
+        let (fit, mean, error) = thirds(t, rate)?;
+        Some((fit, mean, error, Vec::new()))
     }
 
     /// Where the rate is read from intervals rounded to the stamps' quantum (`rounded`) and
@@ -2306,26 +2293,13 @@ impl Timing {
         (lo, hi): (f64, f64),
         window: impl Fn(f64) -> f64,
     ) -> Option<Lattice> {
-        let third = x.len() / 3;
         let rate = |part: &[f64]| {
             let f = fold::fold(part, lo, hi)?;
             let fit = fold::fit(part, f, window(f))?;
             (fit.coherent >= 0.9 && fit.crowded <= 0.005).then_some(1.0 / fit.period)
         };
-        let (a, b) = (rate(&x[..third])?, rate(&x[x.len() - third..])?);
-        if (a / b - 1.0).abs() > 2e-3 {
-            return None;
-        }
-        let mean = 0.5 * (a + b);
-        let fit = fold::Fit {
-            period: 1.0 / mean,
-            origin: f64::NAN,
-            sigma: 0.1 * (a - b).abs() / (mean * mean),
-            coherent: 1.0,
-            off: None,
-            crowded: 0.0,
-        };
-        Some((fit, mean, 0.1 * (a / b - 1.0).abs(), x))
+        let (fit, mean, error) = thirds(&x, rate)?;
+        Some((fit, mean, error, x))
     }
 
     /// The clock's rate from its beat with the stamps' quantum `q` (s), where they step by
@@ -2571,6 +2545,28 @@ impl Timing {
             })
         ))
     }
+}
+
+/// A drifting clock's mean rate: the first and the last third of `all` each read on a
+/// rate of their own (`rate`, Hz); within 0.2 % of each other, their mean (a linear drift's
+/// over the record) as a lattice, the rate, and its relative error, a tenth of their
+/// difference.
+fn thirds<T>(all: &[T], rate: impl Fn(&[T]) -> Option<f64>) -> Option<(fold::Fit, f64, f64)> {
+    let third = all.len() / 3;
+    let (a, b) = (rate(&all[..third])?, rate(&all[all.len() - third..])?);
+    if (a / b - 1.0).abs() > 2e-3 {
+        return None;
+    }
+    let mean = 0.5 * (a + b);
+    let fit = fold::Fit {
+        period: 1.0 / mean,
+        origin: f64::NAN,
+        sigma: 0.1 * (a - b).abs() / (mean * mean),
+        coherent: 1.0,
+        off: None,
+        crowded: 0.0,
+    };
+    Some((fit, mean, 0.1 * (a / b - 1.0).abs()))
 }
 
 /// Which intervals are a clock's own (regular), the others short or gaps.
