@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use crate::csv::{self, DataError, position, split_unit};
 use crate::error::{Fail, escaped, with_file};
 use crate::frame::{Frame, Select, Skipped};
-use crate::timing::{Step, TimeUnit, Timing};
+use crate::timing::{Call, Order, Step, TimeUnit, Timing};
 use crate::units::Unit;
 use crate::{bag, dataflash, mcap, rosbag2, ulog};
 
@@ -880,7 +880,15 @@ fn csv_stream(
     // The time column's index and unit (when the column does not say: by its first value).
     let time: Cell<Option<(usize, Option<TimeUnit>)>> = Cell::new(None);
     let strict = request.want_time;
-    let mut timing = Timing::new();
+    // The stamps' statistics are kept on a thread of their own, beside the parsing: each
+    // sample's step (forward, repeated, backward) is told here at once from the stamps'
+    // order, and the calls on the statistics sent over in batches.
+    let (send, receive) = std::sync::mpsc::sync_channel::<Vec<Call>>(16);
+    let mut timing = Beside {
+        order: Order::default(),
+        calls: Vec::with_capacity(CALLS),
+        send,
+    };
     let mut values = vec![0.0; request.columns.len()];
     let mut select = |header: &[String]| -> Result<Vec<usize>, String> {
         let mut picks = request
@@ -1005,7 +1013,19 @@ fn csv_stream(
         }
         row_values(&mut values, cells, request, stamp, &mut *each)
     };
-    csv::read_rows(files, &mut select, &mut row).map_err(|e: DataError| Fail(e.to_string()))?;
+    let keeper = std::thread::spawn(move || {
+        let mut timing = Timing::new();
+        for calls in receive {
+            timing.replay(&calls);
+        }
+        timing
+    });
+    let read = csv::read_rows(files, &mut select, &mut row);
+    timing.finish();
+    let timing = keeper
+        .join()
+        .map_err(|_| Fail("the timestamps' thread stopped".into()))?;
+    read.map_err(|e: DataError| Fail(e.to_string()))?;
     Ok(Read {
         unknown,
         units: units.unwrap_or_default(),
@@ -1014,4 +1034,52 @@ fn csv_stream(
             .map(|(_, u)| (timing, u.unwrap_or(TimeUnit::Seconds))),
         skipped: Skipped::default(),
     })
+}
+
+/// The calls on a [`Timing`] sent at once.
+const CALLS: usize = 8192;
+
+/// A [`Timing`] kept on another thread: the steps told here, the calls sent there.
+struct Beside {
+    order: Order,
+    calls: Vec<Call>,
+    send: std::sync::mpsc::SyncSender<Vec<Call>>,
+}
+
+impl Beside {
+    /// [`Timing::push`].
+    fn push(&mut self, t: i64) -> Step {
+        self.call(Call::Push(t));
+        self.order.step(t)
+    }
+
+    fn keep_repeat(&mut self) {
+        self.call(Call::KeepRepeat);
+    }
+
+    fn drop_repeat(&mut self) {
+        self.call(Call::DropRepeat);
+    }
+
+    fn drop_one(&mut self) {
+        self.call(Call::DropOne);
+    }
+
+    fn call(&mut self, call: Call) {
+        self.calls.push(call);
+        if self.calls.len() == CALLS {
+            // A closed channel means the thread is gone; its join says why.
+            let _ = self.send.send(std::mem::replace(
+                &mut self.calls,
+                Vec::with_capacity(CALLS),
+            ));
+        }
+    }
+
+    /// Sends the calls left; the thread then ends.
+    fn finish(self) {
+        if !self.calls.is_empty() {
+            let _ = self.send.send(self.calls);
+        }
+    }
 }

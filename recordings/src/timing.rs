@@ -200,6 +200,42 @@ pub enum Step {
     Repeat,
 }
 
+/// The order of stamps alone, told as [`Timing::push`] tells it: a reader that keeps its
+/// [`Timing`] on another thread learns each sample's [`Step`] here at once, and sends the
+/// [`Call`]s over.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Order {
+    /// The last stamp that moved forward, ns.
+    last: Option<i64>,
+}
+
+impl Order {
+    /// The step of the stamp `t` (ns), as [`Timing::push`] would return it.
+    pub fn step(&mut self, t: i64) -> Step {
+        match self.last {
+            Some(last) if t == last => Step::Repeat,
+            Some(last) if t < last => Step::Backward { last },
+            _ => {
+                self.last = Some(t);
+                Step::Forward
+            }
+        }
+    }
+}
+
+/// A call on a [`Timing`], made later ([`Timing::replay`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Call {
+    /// [`Timing::push`] of the stamp, ns.
+    Push(i64),
+    /// [`Timing::keep_repeat`].
+    KeepRepeat,
+    /// [`Timing::drop_repeat`].
+    DropRepeat,
+    /// [`Timing::drop_one`].
+    DropOne,
+}
+
 /// The most marks held: past them, every other one is let go and the blocks between them
 /// double.
 const MARKS: usize = 512;
@@ -1068,6 +1104,20 @@ impl Timing {
             bits: 64,
             block: BLOCK,
             ..Self::default()
+        }
+    }
+
+    /// Makes the `calls` in order.
+    pub fn replay(&mut self, calls: &[Call]) {
+        for &call in calls {
+            match call {
+                Call::Push(t) => {
+                    self.push(t);
+                }
+                Call::KeepRepeat => self.keep_repeat(),
+                Call::DropRepeat => self.drop_repeat(),
+                Call::DropOne => self.drop_one(),
+            }
         }
     }
 
@@ -3045,6 +3095,57 @@ mod tests {
                 t
             })
             .collect()
+    }
+
+    /// [`Order::step`] tells each stamp's step as [`Timing::push`] does, and a [`Timing`] fed
+    /// the [`Call`]s later sums up as one fed directly: stamps forward, repeated (kept and
+    /// dropped), backward and dropped, in runs and at random, with and without a first stamp.
+    #[test]
+    fn a_timing_replayed_is_the_timing_fed_directly() {
+        let mut next = crate::xorshift(0x05ee_d0f0_dde5);
+        for case in 0..300u64 {
+            let n = (next() % 20_000) as usize;
+            let mut t = 1_700_000_000_000_000_000 + (next() % 1_000_000_000) as i64;
+            let (mut direct, mut later, mut order) =
+                (Timing::new(), Timing::new(), Order::default());
+            let mut calls = Vec::new();
+            let keep_repeats = case % 3 != 0;
+            for _ in 0..n {
+                t += match next() % 100 {
+                    0..=79 => 2_500_000 + (next() % 1_000) as i64 * (case % 2) as i64,
+                    80..=89 => 0,
+                    90..=94 => -((next() % 10_000_000) as i64),
+                    _ => 5_000_000 + (next() % 100_000_000) as i64,
+                };
+                let step = order.step(t);
+                assert_eq!(step, direct.push(t), "case {case}");
+                calls.push(Call::Push(t));
+                match step {
+                    Step::Forward => {}
+                    Step::Repeat if keep_repeats => {
+                        direct.keep_repeat();
+                        calls.push(Call::KeepRepeat);
+                    }
+                    Step::Repeat => {
+                        direct.drop_repeat();
+                        calls.push(Call::DropRepeat);
+                    }
+                    Step::Backward { .. } => {
+                        direct.drop_one();
+                        calls.push(Call::DropOne);
+                    }
+                }
+            }
+            for chunk in calls.chunks(1 + (next() % 5_000) as usize) {
+                later.replay(chunk);
+            }
+            assert_eq!(direct.dropped(), later.dropped(), "case {case}");
+            assert_eq!(
+                direct.summary(TimeUnit::Nanoseconds),
+                later.summary(TimeUnit::Nanoseconds),
+                "case {case}"
+            );
+        }
     }
 
     /// Intervals sorted by counting are those sorted by comparing: clustered about a period,

@@ -153,10 +153,12 @@ pub(super) fn fold(t: &[f64], lo: f64, hi: f64) -> Option<f64> {
         }
         k = n.min(4 * k);
     };
-    // Around the peak, on four times as many stamps at a time.
+    // Around the peak, on the stamps within four times the span at a time: the band
+    // searched is some 33 bins whatever the record's length.
     while k < n {
-        let half = 1.0 / (t[k - 1] - t[0]);
-        k = n.min(4 * k);
+        let span = t[k - 1] - t[0];
+        let half = 1.0 / span;
+        k = (k + t[k..].partition_point(|&x| x - t[0] <= 4.0 * span)).clamp(k + 1, n);
         let step = 0.25 / (t[k - 1] - t[0]);
         let bins = (2.0 * half / step).ceil() as usize + 1;
         let x = first(k);
