@@ -312,7 +312,7 @@ fn not_a_bag(head: &[u8]) -> String {
 
 /// The frame of one serialized `sensor_msgs/Imu` and its header's frame_id: `None` when its
 /// length is not that of the message (the header's frame_id length included).
-fn decode(b: &[u8]) -> Option<(Frame, &[u8])> {
+pub(crate) fn decode(b: &[u8]) -> Option<(Frame, &[u8])> {
     let secs = u32_at(b, 4, false)?;
     let nsecs = u32_at(b, 8, false)?;
     let frame_id = usize::try_from(u32_at(b, 12, false)?).ok()?;

@@ -513,6 +513,23 @@ fn read_source_in(
     if header.is_empty() {
         return Err(error(path, None, "empty file (no header row)"));
     }
+    if let [only] = header.as_slice()
+        && let Some((name, symbol)) = [("tabs", '\t'), ("semicolons", ';')]
+            .into_iter()
+            .find(|&(_, c)| only.contains(c))
+    {
+        return Err(error(
+            path,
+            None,
+            format!(
+                "the header is one field holding {name} ('{}'): the values are separated by \
+                 {name}, not commas; the files read are comma-separated (replace the {name} by \
+                 commas, e.g. tr '{}' ',')",
+                shown(only),
+                symbol.escape_default()
+            ),
+        ));
+    }
     if header.len() > 1 && all_numbers(&::csv::StringRecord::from(header.clone())) {
         return Err(error(
             path,

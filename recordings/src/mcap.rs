@@ -17,7 +17,9 @@
 //! (int32 sec, uint32 nanosec), string frame_id (uint32 length counting its NUL, then the bytes),
 //! then 37 float64 (orientation, its covariance, angular_velocity, its covariance,
 //! linear_acceleration, its covariance), the first aligned to 8 bytes counted from the end of
-//! the encapsulation header.
+//! the encapsulation header. A channel of ROS 1 messages (schema `sensor_msgs/Imu` in
+//! `ros1msg`, message encoding `ros1`: what `mcap convert` writes of a ROS 1 bag) is decoded
+//! as a bag's message is.
 
 use crate::frame::open_head;
 use std::collections::HashMap;
@@ -37,6 +39,12 @@ pub const IMU_SCHEMA: &str = "sensor_msgs/msg/Imu";
 
 /// The one message encoding read.
 const CDR: &str = "cdr";
+/// The IMU's ROS 1 type, as an MCAP file converted from a ROS 1 bag names its schema.
+const ROS1_IMU_SCHEMA: &str = "sensor_msgs/Imu";
+/// That schema's encoding.
+const ROS1_SCHEMA_ENCODING: &str = "ros1msg";
+/// The message encoding of ROS 1 messages (their ROS 1 serialization, as in a bag).
+const ROS1: &str = "ros1";
 
 /// The schema encodings of ROS 2 message definitions.
 const SCHEMA_ENCODINGS: [&str; 2] = ["ros2msg", "ros2idl"];
@@ -69,6 +77,27 @@ pub fn read_selected(
     select: &Select,
     each: &mut dyn FnMut(Frame),
 ) -> Result<Skipped, DataError> {
+    read_compressed(path, select, each, false)
+}
+
+/// The most bytes one message decompresses to: an IMU message is some 330 bytes and its
+/// frame_id.
+const MESSAGE_LIMIT: usize = 1 << 20;
+
+/// A message's data compressed as one zstd frame (a rosbag2 folder recorded with
+/// `--compression-mode message`), decompressed; `None` when it is no such frame or holds
+/// more than [`MESSAGE_LIMIT`] bytes.
+pub(crate) fn unzstd_message(data: &[u8]) -> Option<Vec<u8>> {
+    zstd::bulk::decompress(data, MESSAGE_LIMIT).ok()
+}
+
+/// [`read_selected`], each message's data a zstd frame where `zstd_messages`.
+pub(crate) fn read_compressed(
+    path: &Path,
+    select: &Select,
+    each: &mut dyn FnMut(Frame),
+    zstd_messages: bool,
+) -> Result<Skipped, DataError> {
     let topic = select.topic;
     let fail = |problem: String| data_error(path, problem);
     let (mut file, len, head) = open_head(path, ::mcap::MAGIC.len() as u64)?;
@@ -95,6 +124,7 @@ pub fn read_selected(
         found: 0,
         messages: 0,
         tally: Tally::new(select, each),
+        zstd_messages,
     };
     let corrupt = |what: &dyn std::fmt::Display, messages: u64| {
         fail(format!(
@@ -199,6 +229,8 @@ struct State<'a> {
     /// Messages found on every channel.
     messages: u64,
     tally: Tally<'a>,
+    /// Whether each message's data is a zstd frame.
+    zstd_messages: bool,
 }
 
 /// Why a record was not taken: the file is damaged, or a channel on the topic cannot be read.
@@ -263,8 +295,20 @@ impl State<'_> {
                 }
                 if self.channels.wanted.contains(&channel) {
                     self.found += 1;
-                    self.tally
-                        .offer(u32::from(channel), data.get(22..).and_then(decode));
+                    let plain;
+                    let body = match data.get(22..) {
+                        Some(b) if self.zstd_messages => {
+                            plain = unzstd_message(b);
+                            plain.as_deref()
+                        }
+                        b => b,
+                    };
+                    let decode = if self.channels.ros1.contains(&channel) {
+                        crate::bag::decode
+                    } else {
+                        decode
+                    };
+                    self.tally.offer(u32::from(channel), body.and_then(decode));
                 }
                 Ok(())
             }
@@ -395,6 +439,9 @@ struct Channels {
     known: HashMap<u16, (String, u16)>,
     /// The channels on the topic of another schema: its name, and the channel's ID.
     others: Vec<(String, u16)>,
+    /// The IDs of the channels on the topic whose messages are ROS 1's (`mcap convert` of a
+    /// ROS 1 bag).
+    ros1: Vec<u16>,
 }
 
 impl Channels {
@@ -430,17 +477,21 @@ impl Channels {
             Record::Channel(c) => {
                 let schema = self.schemas.get(&c.schema_id);
                 let name = schema.map_or("", |s| s.0.as_str());
-                if c.topic == topic && schema.is_some() && name != IMU_SCHEMA {
+                let imu = name == IMU_SCHEMA || name == ROS1_IMU_SCHEMA;
+                if c.topic == topic && schema.is_some() && !imu {
                     if !self.others.iter().any(|o| o.1 == c.id) {
                         self.others.push((name.to_string(), c.id));
                     }
                 } else if c.topic == topic {
-                    check_channel(topic, c.schema_id, schema, &c.message_encoding)?;
+                    let ros1 = check_channel(topic, c.schema_id, schema, &c.message_encoding)?;
                     if !self.wanted.contains(&c.id) {
                         self.wanted.push(c.id);
                     }
+                    if ros1 && !self.ros1.contains(&c.id) {
+                        self.ros1.push(c.id);
+                    }
                 }
-                if name == IMU_SCHEMA && !self.imu_topics.contains(&c.topic) {
+                if imu && !self.imu_topics.contains(&c.topic) {
                     self.imu_topics.push(c.topic.clone());
                 }
                 if !self.all_topics.contains(&c.topic) {
@@ -453,13 +504,14 @@ impl Channels {
     }
 }
 
-/// A channel on `topic` (its schema, and its message encoding) that this reader can decode.
+/// A channel on `topic` (its schema, and its message encoding) that this reader can decode:
+/// whether its messages are ROS 1's.
 fn check_channel(
     topic: &str,
     schema_id: u16,
     schema: Option<&(String, String)>,
     message_encoding: &str,
-) -> Result<(), String> {
+) -> Result<bool, String> {
     let Some((name, encoding)) = schema else {
         return Err(if schema_id == 0 {
             format!("topic '{topic}' has no schema, not {IMU_SCHEMA}")
@@ -467,6 +519,16 @@ fn check_channel(
             format!("topic '{topic}' names schema {schema_id}, which the file does not define")
         });
     };
+    if name == ROS1_IMU_SCHEMA {
+        return if encoding == ROS1_SCHEMA_ENCODING && message_encoding == ROS1 {
+            Ok(true)
+        } else {
+            Err(format!(
+                "topic '{topic}' has the ROS 1 type {name} in schema encoding '{encoding}' and \
+                 message encoding '{message_encoding}' (read: {ROS1_SCHEMA_ENCODING} and {ROS1})"
+            ))
+        };
+    }
     if name != IMU_SCHEMA {
         return Err(format!("topic '{topic}' has type {name}, not {IMU_SCHEMA}"));
     }
@@ -481,7 +543,7 @@ fn check_channel(
             "unknown encoding '{message_encoding}' on topic '{topic}' (supported: {CDR})"
         ));
     }
-    Ok(())
+    Ok(false)
 }
 
 /// Why a file that does not start with the MCAP magic is not read.

@@ -4,7 +4,11 @@
 //! A folder is read through its `metadata.yaml`: `storage_identifier` (`mcap` or `sqlite3`)
 //! and `relative_file_paths`, the storage files in recording order, each read in turn by the
 //! MCAP reader ([`super::mcap`]) or by [`read_db3`]. A folder compressed file by file
-//! (`compression_mode: FILE`) is refused with what to run (`ros2 bag decompress`).
+//! (`compression_mode: FILE`) is refused with what to run (`ros2 bag decompress`); one
+//! compressed message by message in zstd (`compression_mode: MESSAGE`) is read, each
+//! message's data decompressed. Up to metadata version 3 (ROS 2 Dashing and Eloquent) the
+//! files' paths start with the folder's name, which is left out. A folder's `metadata.yaml`
+//! given for the folder reads the folder.
 //!
 //! A `.db3` file is the rosbag2 SQLite storage (`rosbag2_storage_default_plugins`, the default
 //! of ROS 2 before Iron): a table `topics` (`id`, `name`, `type`, `serialization_format`) and a
@@ -34,6 +38,9 @@ pub struct Metadata {
     pub compression_mode: String,
     /// `compression_format` (`zstd` or empty).
     pub compression_format: String,
+    /// `version`: the metadata's layout (up to 3, the storage files' paths start with the
+    /// folder's name).
+    pub version: Option<u64>,
 }
 
 impl Metadata {
@@ -45,6 +52,7 @@ impl Metadata {
             files: Vec::new(),
             compression_mode: String::new(),
             compression_format: String::new(),
+            version: None,
         };
         let mut in_files = false;
         let mut seen_files = false;
@@ -66,6 +74,7 @@ impl Metadata {
                 "storage_identifier" => meta.storage = value.to_string(),
                 "compression_mode" => meta.compression_mode = value.to_string(),
                 "compression_format" => meta.compression_format = value.to_string(),
+                "version" if meta.version.is_none() => meta.version = value.parse().ok(),
                 "relative_file_paths" => {
                     seen_files = true;
                     if let Some(list) = value.strip_prefix('[').and_then(|v| v.strip_suffix(']')) {
@@ -105,6 +114,34 @@ fn unquoted(v: &str) -> &str {
 /// (else SQLite). An error when the metadata cannot be read, names a storage this tool does
 /// not read, is compressed file by file, or names a file that is not in the folder.
 pub fn storage_files(dir: &Path) -> Result<(Vec<PathBuf>, bool), DataError> {
+    Ok(storage(dir)?.files_and_kind())
+}
+
+/// A rosbag2 folder's storage: its files in order, whether they are MCAP, and whether each
+/// message is compressed by zstd (`compression_mode: MESSAGE`).
+struct Storage {
+    files: Vec<PathBuf>,
+    mcap: bool,
+    zstd_messages: bool,
+}
+
+impl Storage {
+    fn files_and_kind(self) -> (Vec<PathBuf>, bool) {
+        (self.files, self.mcap)
+    }
+}
+
+/// The folder `path` names: itself, or the folder of its `metadata.yaml`.
+pub fn folder(path: &Path) -> &Path {
+    match path.parent() {
+        Some(parent) if path.file_name() == Some(METADATA.as_ref()) && path.is_file() => parent,
+        _ => path,
+    }
+}
+
+/// [`storage_files`], and whether the messages are compressed one by one.
+fn storage(dir: &Path) -> Result<Storage, DataError> {
+    let dir = folder(dir);
     let path = dir.join(METADATA);
     let fail = |p: String| data_error(&path, p);
     let text = std::fs::read_to_string(&path).map_err(|e| fail(format!("cannot read: {e}")))?;
@@ -130,11 +167,22 @@ pub fn storage_files(dir: &Path) -> Result<(Vec<PathBuf>, bool), DataError> {
             }
         )));
     }
+    // Compressed message by message: each message's data a zstd frame.
+    let zstd_messages = meta.compression_mode.eq_ignore_ascii_case("message");
+    if zstd_messages && !meta.compression_format.eq_ignore_ascii_case("zstd") {
+        return Err(fail(format!(
+            "the bag's messages are compressed one by one in '{}', which is not read (zstd is)",
+            crate::error::escaped(&meta.compression_format)
+        )));
+    }
     if meta.files.is_empty() {
         return Err(fail(
             "it names no storage file (relative_file_paths is empty)".into(),
         ));
     }
+    // Up to version 3, each path starts with the folder's name (as it was when recorded;
+    // rosbag2 reads it from the folder's parent): the folder is where the rest lies.
+    let prefixed = meta.version.is_some_and(|v| v <= 3);
     let mut files = Vec::with_capacity(meta.files.len());
     for f in &meta.files {
         let rel = Path::new(f);
@@ -148,7 +196,11 @@ pub fn storage_files(dir: &Path) -> Result<(Vec<PathBuf>, bool), DataError> {
                 crate::error::escaped(f)
             )));
         }
-        let file = dir.join(rel);
+        let mut parts = rel.components();
+        let file = match (prefixed, parts.next(), parts.as_path()) {
+            (true, Some(_), rest) if !rest.as_os_str().is_empty() => dir.join(rest),
+            _ => dir.join(rel),
+        };
         let problem = match std::fs::metadata(&file) {
             Ok(m) if m.is_file() => None,
             Ok(_) => Some("is not a regular file"),
@@ -165,7 +217,11 @@ pub fn storage_files(dir: &Path) -> Result<(Vec<PathBuf>, bool), DataError> {
         }
         files.push(file);
     }
-    Ok((files, mcap))
+    Ok(Storage {
+        files,
+        mcap,
+        zstd_messages,
+    })
 }
 
 /// Calls `each` with every finite `sensor_msgs/msg/Imu` message on `select`'s topic (and
@@ -176,15 +232,19 @@ pub fn read_folder(
     select: &Select,
     each: &mut dyn FnMut(Frame),
 ) -> Result<Skipped, DataError> {
-    let (files, is_mcap) = storage_files(dir)?;
+    let Storage {
+        files,
+        mcap: is_mcap,
+        zstd_messages,
+    } = storage(dir)?;
     let mut skipped = Skipped::default();
     let mut found = false;
     let mut last_err = None;
     for file in &files {
         let read = if is_mcap {
-            mcap::read_selected(file, select, each)
+            mcap::read_compressed(file, select, each, zstd_messages)
         } else {
-            read_db3(file, select, each)
+            read_db3_compressed(file, select, each, zstd_messages)
         };
         match read {
             Ok(s) => {
@@ -215,6 +275,16 @@ pub fn read_db3(
     path: &Path,
     select: &Select,
     each: &mut dyn FnMut(Frame),
+) -> Result<Skipped, DataError> {
+    read_db3_compressed(path, select, each, false)
+}
+
+/// [`read_db3`], each message's data a zstd frame where `zstd_messages`.
+fn read_db3_compressed(
+    path: &Path,
+    select: &Select,
+    each: &mut dyn FnMut(Frame),
+    zstd_messages: bool,
 ) -> Result<Skipped, DataError> {
     let topic = select.topic;
     let fail = |p: String| data_error(path, p);
@@ -319,9 +389,17 @@ pub fn read_db3(
     while let Some(row) = rows.next().map_err(sql)? {
         let source = row.get::<_, i64>(0).map_err(sql)?;
         let data = row.get_ref(1).map_err(sql)?;
+        let plain;
+        let data = match data.as_blob().ok() {
+            Some(b) if zstd_messages => {
+                plain = mcap::unzstd_message(b);
+                plain.as_deref()
+            }
+            b => b,
+        };
         tally.offer(
             u32::try_from(source).unwrap_or(u32::MAX),
-            data.as_blob().ok().and_then(mcap::decode),
+            data.and_then(mcap::decode),
         );
     }
     tally.finish(path, topic, &|id| format!("topic row {id}"))

@@ -37,9 +37,13 @@ pub enum Kind {
 }
 
 impl Kind {
-    /// The kind of `path`: a folder holding `metadata.yaml` is a rosbag2 folder; a file is
-    /// known by its first bytes (standard input, a pipe and a short text file are CSV).
+    /// The kind of `path`: a folder holding `metadata.yaml` (or that file) is a rosbag2 folder;
+    /// a file is known by its first bytes (standard input, a pipe and a short text file are
+    /// CSV).
     pub fn of(path: &Path) -> Kind {
+        if rosbag2::folder(path) != path {
+            return Kind::Rosbag2;
+        }
         if path.is_dir() {
             return if path.join(rosbag2::METADATA).is_file() {
                 Kind::Rosbag2

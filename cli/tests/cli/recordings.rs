@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use common::{assert_one_line_failure, imu_ar, json, stderr};
 use imu_ar_cli::input::frame::{Frame, Select};
 use imu_ar_cli::input::{bag, mcap, rosbag2};
-use ros::{assert_bits, fixture, noise, temp_dir};
+use ros::{assert_bits, fixture, fixture_dir, noise, noise_frames, temp_dir};
 
 fn path(p: &Path) -> &str {
     p.to_str().unwrap()
@@ -1071,4 +1071,227 @@ fn a_repeated_stamp_of_a_fine_clock_is_refused_after_the_file_is_read() {
         "{}",
         stderr(&out)
     );
+}
+
+/// A copy of the committed rosbag2 folder `name` in `dir` as `to`, its metadata edited by
+/// `edit`.
+fn copied_folder(dir: &Path, name: &str, to: &str, edit: impl Fn(String) -> String) -> PathBuf {
+    let from = fixture_dir(name);
+    let folder = dir.join(to);
+    std::fs::create_dir_all(&folder).unwrap();
+    for entry in std::fs::read_dir(&from).unwrap() {
+        let entry = entry.unwrap();
+        std::fs::copy(entry.path(), folder.join(entry.file_name())).unwrap();
+    }
+    let meta = folder.join("metadata.yaml");
+    let text = std::fs::read_to_string(&meta).unwrap();
+    std::fs::write(&meta, edit(text)).unwrap();
+    folder
+}
+
+#[test]
+fn old_rosbag2_folders_name_their_files_from_the_folders_parent() {
+    // Up to metadata version 3 (Dashing, Eloquent), each path starts with the folder's name:
+    // as recorded, and after the folder was renamed.
+    let dir = temp_dir("rosbag2-v3");
+    for (to, prefix) in [("old_bag", "old_bag"), ("renamed", "rosbag2_2019_11_05")] {
+        let folder = copied_folder(&dir, "rosbag2-sqlite3", to, |t| {
+            t.replace("version: 9", "version: 3").replace(
+                "  - rosbag2-sqlite3.db3",
+                &format!("  - {prefix}/rosbag2-sqlite3.db3"),
+            )
+        });
+        let (got, result) = read(&folder, None);
+        assert_eq!(result, Ok(0), "{to}");
+        assert_bits(&got, &noise_frames(), to);
+    }
+    // From version 4 on, the path is the folder's own: a prefix is a file missing.
+    let folder = copied_folder(&dir, "rosbag2-sqlite3", "v4", |t| {
+        t.replace("version: 9", "version: 4")
+            .replace("  - rosbag2-sqlite3.db3", "  - v4/rosbag2-sqlite3.db3")
+    });
+    let (_, result) = read(&folder, None);
+    assert!(
+        result
+            .unwrap_err()
+            .contains("'v4/rosbag2-sqlite3.db3' is missing"),
+        "v4"
+    );
+}
+
+#[test]
+fn a_rosbag2_folder_compressed_message_by_message_is_read() {
+    // `ros2 bag record --compression-mode message --compression-format zstd`: each message's
+    // data one zstd frame, the metadata saying so.
+    let dir = temp_dir("rosbag2-message-zstd");
+    let folder = copied_folder(&dir, "rosbag2-sqlite3", "zstd", |t| {
+        t.replace("compression_format: ''", "compression_format: zstd")
+            .replace("compression_mode: ''", "compression_mode: MESSAGE")
+    });
+    let db = rusqlite::Connection::open(folder.join("rosbag2-sqlite3.db3")).unwrap();
+    let rows: Vec<(i64, Vec<u8>)> = db
+        .prepare("SELECT id, data FROM messages")
+        .unwrap()
+        .query_map([], |r| Ok((r.get(0)?, r.get(1)?)))
+        .unwrap()
+        .map(Result::unwrap)
+        .collect();
+    assert_eq!(rows.len(), 1200);
+    for (id, data) in rows {
+        let packed = zstd::bulk::compress(&data, 3).unwrap();
+        db.execute(
+            "UPDATE messages SET data = ?1 WHERE id = ?2",
+            rusqlite::params![packed, id],
+        )
+        .unwrap();
+    }
+    drop(db);
+    let (got, result) = read(&folder, None);
+    assert_eq!(result, Ok(0));
+    assert_bits(&got, &noise_frames(), "zstd messages");
+    // Another format is named, not counted undecodable.
+    let lz4 = copied_folder(&dir, "rosbag2-sqlite3", "lz4", |t| {
+        t.replace("compression_format: ''", "compression_format: lz4")
+            .replace("compression_mode: ''", "compression_mode: MESSAGE")
+    });
+    let e = read(&lz4, None).1.unwrap_err();
+    assert!(
+        e.contains("compressed one by one in 'lz4', which is not read (zstd is)"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_rosbag2_folders_metadata_file_reads_its_folder() {
+    let folder = fixture_dir("rosbag2-mcap");
+    let meta = folder.join("metadata.yaml");
+    let (got, result) = read(&meta, None);
+    assert_eq!(result, Ok(0));
+    assert_bits(&got, &noise_frames(), "metadata.yaml");
+    let of_folder = json(&imu_ar(&[
+        "noise",
+        path(&folder),
+        "--topic",
+        "/imu0",
+        "--column",
+        "gx",
+        "--json",
+    ]));
+    let of_meta = json(&imu_ar(&[
+        "noise",
+        path(&meta),
+        "--topic",
+        "/imu0",
+        "--column",
+        "gx",
+        "--json",
+    ]));
+    assert_eq!(of_meta["white_noise"], of_folder["white_noise"]);
+    assert_eq!(of_meta["n"], 1200);
+}
+
+/// A ROS 1 `sensor_msgs/Imu` of `frame` (seq, stamp, frame_id `imu_link`, 37 float64), as a
+/// bag holds it.
+fn ros1(frame: &Frame, seq: u32) -> Vec<u8> {
+    let mut b = seq.to_le_bytes().to_vec();
+    b.extend((frame.stamp_ns.div_euclid(1_000_000_000) as u32).to_le_bytes());
+    b.extend((frame.stamp_ns.rem_euclid(1_000_000_000) as u32).to_le_bytes());
+    b.extend(8u32.to_le_bytes());
+    b.extend(b"imu_link");
+    let mut values = [0.0; 37];
+    values[13..16].copy_from_slice(&frame.axes[..3]);
+    values[25..28].copy_from_slice(&frame.axes[3..]);
+    values.iter().for_each(|v| b.extend(v.to_le_bytes()));
+    b
+}
+
+#[test]
+fn an_mcap_file_of_ros1_messages_is_read_as_a_bag_is() {
+    // What `mcap convert x.bag x.mcap` writes: schema sensor_msgs/Imu in ros1msg, message
+    // encoding ros1, each message's data the bag's.
+    let dir = temp_dir("mcap-ros1");
+    let frames = noise(300, 2);
+    let file = |schema: (&str, &str), encoding: &str| {
+        let mut out = b"\x89MCAP0\r\n".to_vec();
+        let mut body = Vec::new();
+        string(&mut body, "ros1");
+        string(&mut body, "hand");
+        record(&mut out, 0x01, &body);
+        let mut s = 1u16.to_le_bytes().to_vec();
+        string(&mut s, schema.0);
+        string(&mut s, schema.1);
+        s.extend(0u32.to_le_bytes());
+        record(&mut out, 0x03, &s);
+        let mut c = 1u16.to_le_bytes().to_vec();
+        c.extend(1u16.to_le_bytes());
+        string(&mut c, "/imu0");
+        string(&mut c, encoding);
+        c.extend(0u32.to_le_bytes());
+        record(&mut out, 0x04, &c);
+        for (i, f) in frames.iter().enumerate() {
+            let mut m = 1u16.to_le_bytes().to_vec();
+            m.extend((i as u32).to_le_bytes());
+            m.extend((f.stamp_ns as u64).to_le_bytes());
+            m.extend((f.stamp_ns as u64).to_le_bytes());
+            m.extend(ros1(f, i as u32));
+            record(&mut out, 0x05, &m);
+        }
+        record(&mut out, 0x0f, &0u32.to_le_bytes());
+        let mut footer = 0u64.to_le_bytes().to_vec();
+        footer.extend(0u64.to_le_bytes());
+        footer.extend(0u32.to_le_bytes());
+        record(&mut out, 0x02, &footer);
+        out.extend(b"\x89MCAP0\r\n");
+        out
+    };
+    let good = dir.join("ros1.mcap");
+    std::fs::write(&good, file(("sensor_msgs/Imu", "ros1msg"), "ros1")).unwrap();
+    let (got, result) = read(&good, None);
+    assert_eq!(result, Ok(0));
+    assert_bits(&got, &frames, "ros1.mcap");
+    // The ROS 1 type in another encoding is named with its encodings.
+    let cdr = dir.join("ros1-cdr.mcap");
+    std::fs::write(&cdr, file(("sensor_msgs/Imu", "ros1msg"), "cdr")).unwrap();
+    let e = read(&cdr, None).1.unwrap_err();
+    assert!(
+        e.contains("has the ROS 1 type sensor_msgs/Imu in schema encoding 'ros1msg' and message encoding 'cdr'"),
+        "{e}"
+    );
+}
+
+#[test]
+fn values_separated_by_tabs_or_semicolons_are_named_for_it() {
+    let dir = temp_dir("separators");
+    let frames = noise(400, 2);
+    for (name, sep, comment) in [
+        ("tabs", '\t', ""),
+        ("semicolons", ';', ""),
+        ("tabs", '\t', "#"),
+    ] {
+        let mut text =
+            format!("{comment}timestamp [ns]{sep}gx [rad/s]{sep}gy [rad/s]{sep}gz [rad/s]\n");
+        for f in &frames {
+            writeln!(
+                text,
+                "{}{sep}{:?}{sep}{:?}{sep}{:?}",
+                f.stamp_ns, f.axes[0], f.axes[1], f.axes[2]
+            )
+            .unwrap();
+        }
+        let file = dir.join(format!("{name}{comment}.txt"));
+        std::fs::write(&file, text).unwrap();
+        for args in [
+            vec!["noise", path(&file), "--column", "gx"],
+            vec!["characterise", path(&file), "--out", path(&dir)],
+        ] {
+            let out = imu_ar(&args);
+            assert_one_line_failure(&out);
+            assert!(
+                stderr(&out).contains(&format!("the values are separated by {name}, not commas")),
+                "{name}{comment} {}: {}",
+                args[0],
+                stderr(&out)
+            );
+        }
+    }
 }
