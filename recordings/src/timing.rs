@@ -1507,10 +1507,22 @@ impl Timing {
         let (a, b) = (&marks[i], &marks[j]);
         let first = self.first.unwrap_or(a.t);
         let since = |t: i64| (i128::from(t) - i128::from(first)) as f64 * 1e-9;
+        // A stretch that runs fast with a gap in or just before it: a host's stall, its
+        // samples stamped late and then faster than the clock, is as likely as a second rate.
+        let gap = marks[i..=j].iter().map(|m| m.longest).max().unwrap_or(0) as f64;
+        let stall = if gap > 2.5 * period {
+            format!(
+                " (with a gap of {} s: a host's stall caught up on faster than the clock, its \
+                 late samples stamped as they were read, or a second clock)",
+                short(gap * 1e-9)
+            )
+        } else {
+            String::new()
+        };
         Some(format!(
             "the timestamps show mixed rates: samples {} to {} ({} s to {} s after the first \
              stamp) run at {} Hz, the record at {} Hz, more than their stamps' rounding and \
-             jitter explain; one record must have one rate (or give --rate)",
+             jitter explain{stall}; one record must have one rate (or give --rate)",
             a.kept + 1,
             b.kept + 1,
             short(since(a.t)),
@@ -5236,6 +5248,51 @@ mod tests {
                 (t / 1e6).floor() as i64 * 1_000_000
             })
             .collect()
+    }
+
+    /// Stamps (ns) of `n` samples at `rate` Hz, floored to whole ms, of a host that stalls
+    /// `length` s at each sample of `stalls` in turn (from that sample's stamp, a catch-up's
+    /// too) and then stamps the samples due meanwhile `per` a ms until it meets the clock.
+    fn stalled(rate: f64, n: usize, stalls: &[usize], length: f64, per: usize) -> Vec<i64> {
+        let mut t: Vec<f64> = (0..n).map(|k| k as f64 / rate).collect();
+        for &at in stalls {
+            let end = t[at] + length;
+            for (k, m) in (at..n).enumerate() {
+                let c = end + (k / per) as f64 * 1e-3;
+                if t[m] >= c {
+                    break;
+                }
+                t[m] = c;
+            }
+        }
+        t.iter()
+            .map(|x| (x * 1e3 + 1e-9).floor() as i64 * 1_000_000)
+            .collect()
+    }
+
+    #[test]
+    fn a_fast_stretch_after_a_gap_names_a_hosts_stall_as_well_as_a_second_rate() {
+        // 965.606 Hz to whole ms, stalls of 139 ms caught up three samples a ms, the second
+        // starting during the first's catch-up: the refusal named only a second rate ("run at
+        // 2969.69697 Hz").
+        let stamps = stalled(965.606, 32_304, &[3_682, 16_343, 26_550, 26_642], 0.139, 3);
+        let e = match pushed(&stamps, true).summary(TimeUnit::Nanoseconds) {
+            Ok(s) => panic!("{s:?}"),
+            Err(e) => e,
+        };
+        assert!(
+            e.contains("mixed rates") && e.contains("a host's stall caught up on"),
+            "{e}"
+        );
+        // A second rate with no gap is named as one alone.
+        let mut t: Vec<i64> = (0..20_000i64).map(|k| k * 1_000_000).collect();
+        let end = t[t.len() - 1];
+        t.extend((1..2_000i64).map(|k| end + k * 800_000));
+        let e = match pushed(&t, true).summary(TimeUnit::Nanoseconds) {
+            Ok(s) => panic!("{s:?}"),
+            Err(e) => e,
+        };
+        assert!(e.contains("mixed rates") && !e.contains("stall"), "{e}");
     }
 
     #[test]
