@@ -17,6 +17,11 @@
 //! Bytes that do not start a message (not `A3 95`, or a type no `FMT` defines, or a `FMT`
 //! that contradicts itself) are skipped one by one until a message head is found again, as
 //! DFReader does, and counted; a last message cut short by the end of the file is reported.
+//! An `IMU` message whose TimeUS no clock since boot reaches (past [`MAX_TIME_US`]) or whose
+//! `I` names no IMU an INS holds (not below [`MAX_IMUS`]) is corrupt, as an SD card's write
+//! error leaves one: it is skipped and counted ([`Survey::corrupt`], [`Report::corrupt`]),
+//! neither a sample nor an instance of its own. A batch header whose sample times do so is
+//! an undecodable batch.
 //!
 //! `IMU` ("QBffffffIIfBBHH": TimeUS, I, GyrX..GyrZ rad/s, AccX..AccZ m/s^2, EG, EA, T °C, ...;
 //! older logs: `IMU`, `IMU2`, `IMU3` without `I`) holds the filtered, fully corrected samples
@@ -66,6 +71,18 @@ const KEPT_CHANGES: usize = 16;
 const MAX_OPEN: usize = 16;
 /// Samples per `ISBD` block.
 const BLOCK: usize = 32;
+
+/// The latest sample time (µs since boot) a message can carry: 2^53 µs (285 years), the
+/// largest whole number of microseconds a double holds exactly, whose nanoseconds (9.0e18) an
+/// i64 also holds. A later TimeUS is the garbage of a corrupt message (14047262688061562948 µs,
+/// year 447110, from an SD card's write error), no time of any clock.
+pub const MAX_TIME_US: u64 = 1 << 53;
+
+/// The most IMUs an ArduPilot INS holds: `INS_MAX_INSTANCES` is 3 + `INS_AUX_INSTANCES`
+/// (`libraries/AP_InertialSensor/AP_InertialSensor_config.h`), and its parameters go up to
+/// the fifth IMU (`INS4_`, `INS5_` in `AP_InertialSensor.cpp`). An `IMU` message's `I` is
+/// below it; one that is not is a corrupt message.
+pub const MAX_IMUS: u8 = 5;
 
 /// The IMU data read.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -214,6 +231,9 @@ pub struct Survey {
     pub resyncs: u64,
     /// The byte offset of the last message when it is cut short by the end of the file.
     pub truncated: Option<u64>,
+    /// Corrupt `IMU` messages (of every instance): a TimeUS past [`MAX_TIME_US`], or an `I`
+    /// not below [`MAX_IMUS`]. They are in no source.
+    pub corrupt: u64,
 }
 
 impl Survey {
@@ -354,6 +374,9 @@ pub struct Report {
     pub resyncs: u64,
     /// The byte offset of the last message when it is cut short by the end of the file.
     pub truncated: Option<u64>,
+    /// Corrupt `IMU` messages of the log (of every instance: the `I` of one may be the
+    /// garbage), skipped: a TimeUS past [`MAX_TIME_US`], or an `I` not below [`MAX_IMUS`].
+    pub corrupt: u64,
 }
 
 /// What the log holds of IMU data and its parameters, read in one pass without delivering
@@ -462,6 +485,7 @@ pub fn survey(path: &Path) -> Result<Survey, DataError> {
         skipped_bytes: log.skipped_bytes,
         resyncs: log.resyncs,
         truncated: log.truncated,
+        corrupt: log.corrupt,
     })
 }
 
@@ -593,6 +617,7 @@ pub fn read_surveyed(
         skipped_bytes: log.skipped_bytes,
         resyncs: log.resyncs,
         truncated: log.truncated,
+        corrupt: log.corrupt,
     })
 }
 
@@ -685,6 +710,12 @@ impl Field {
     /// Its u64 in payload `p` (a `Q` field).
     fn u64(self, p: &[u8]) -> Option<u64> {
         bytes_at::<8>(p, self.at).map(u64::from_le_bytes)
+    }
+
+    /// Its time in µs in payload `p` (a `Q` field of µs since boot): `None` past
+    /// [`MAX_TIME_US`], where no clock since boot reaches.
+    fn time_us(self, p: &[u8]) -> Option<u64> {
+        self.u64(p).filter(|&t| t <= MAX_TIME_US)
     }
 
     /// Its text in payload `p` (an `n`, `N` or `Z` field), up to the first NUL.
@@ -969,13 +1000,15 @@ struct Header {
 }
 
 impl Header {
-    /// Whether its samples can be rebuilt.
+    /// Whether its samples can be rebuilt: a sensor type, a multiplier and a sample rate that
+    /// are positive numbers, and sample times up to [`MAX_TIME_US`].
     fn valid(&self) -> bool {
         self.kind.is_some()
             && self.mul > 0.0
             && self.mul.is_finite()
             && self.rate > 0.0
             && self.rate.is_finite()
+            && self.sample_us + self.count as f64 * 1e6 / self.rate <= MAX_TIME_US as f64
     }
 }
 
@@ -1134,6 +1167,8 @@ impl Batches {
 /// What a pass found besides the IMU messages.
 struct Log {
     messages: u64,
+    /// Corrupt `IMU` messages, not passed on.
+    corrupt: u64,
     parameters: Vec<Parameter>,
     unreadable: Vec<String>,
     skipped_bytes: u64,
@@ -1278,7 +1313,7 @@ fn scan(path: &Path, visit: &mut dyn FnMut(Event)) -> Result<Log, DataError> {
     let io = |e: std::io::Error| data_error(path, format!("cannot read: {e}"));
     let mut win = Window::open(path).map_err(|e| fail(format!("cannot open: {e}")))?;
     let mut state = State::new();
-    let (mut messages, mut skipped, mut resyncs) = (0u64, 0u64, 0u64);
+    let (mut messages, mut skipped, mut resyncs, mut corrupt) = (0u64, 0u64, 0u64, 0u64);
     let mut skipping = false;
     let mut truncated = None;
     let mut unreadable: Vec<String> = Vec::new();
@@ -1383,12 +1418,16 @@ fn scan(path: &Path, visit: &mut dyn FnMut(Event)) -> Result<Log, DataError> {
                 }
             }
             Role::Imu(f) => {
+                // An instance no INS holds, or a time no clock reaches: a corrupt message.
                 let instance = match f.instance {
-                    Ok(i) => i.num(p).map(|i| i as u8),
+                    Ok(i) => i
+                        .num(p)
+                        .filter(|i| (0.0..f64::from(MAX_IMUS)).contains(i))
+                        .map(|i| i as u8),
                     Err(i) => Some(i),
                 };
                 let num = |f: Field| f.num(p).unwrap_or(f64::NAN);
-                if let (Some(time), Some(instance)) = (f.time.u64(p), instance) {
+                if let (Some(time), Some(instance)) = (f.time.time_us(p), instance) {
                     visit(Event::Imu(ImuMessage {
                         time_us: time as f64,
                         instance,
@@ -1396,6 +1435,8 @@ fn scan(path: &Path, visit: &mut dyn FnMut(Event)) -> Result<Log, DataError> {
                         accel: f.accel.map(num),
                         temperature: f.temperature.map(num),
                     }));
+                } else {
+                    corrupt += 1;
                 }
             }
             Role::Isbh(f) => {
@@ -1410,7 +1451,7 @@ fn scan(path: &Path, visit: &mut dyn FnMut(Event)) -> Result<Log, DataError> {
                     instance: num(f.instance) as u8,
                     mul: num(f.mul),
                     count: num(f.count) as usize,
-                    sample_us: f.sample_us.u64(p).map_or(f64::NAN, |t| t as f64),
+                    sample_us: f.sample_us.time_us(p).map_or(f64::NAN, |t| t as f64),
                     rate: num(f.rate),
                 }));
             }
@@ -1451,6 +1492,7 @@ fn scan(path: &Path, visit: &mut dyn FnMut(Event)) -> Result<Log, DataError> {
     parameters.sort_by(|a, b| a.name.cmp(&b.name));
     Ok(Log {
         messages,
+        corrupt,
         parameters,
         unreadable,
         skipped_bytes: skipped,
@@ -1502,5 +1544,205 @@ mod tests {
             fmt(128, 89, "FMT", "BBnNZ", "Type,Length,Name,Format,Columns"),
             Some((128, 89, 5))
         );
+    }
+
+    /// The `IMU` message type of the logs [`imu_log`] writes.
+    const IMU_TYPE: u8 = 150;
+
+    /// An `FMT` message defining type `ty`, as ArduPilot writes it.
+    fn fmt_message(bytes: &mut Vec<u8>, ty: u8, name: &str, chars: &str, columns: &str) {
+        let len = 3 + chars
+            .bytes()
+            .map(|c| char_size(c).unwrap_or(0))
+            .sum::<usize>();
+        bytes.extend_from_slice(&[HEAD[0], HEAD[1], FMT_TYPE, ty, len as u8]);
+        for (text, n) in [(name, 4), (chars, 16), (columns, 64)] {
+            let mut b = text.as_bytes().to_vec();
+            b.resize(n, 0);
+            bytes.extend_from_slice(&b);
+        }
+    }
+
+    /// A DataFlash log as ArduPilot writes it (the `FMT` of `FMT`, the `FMT` of `IMU` with its
+    /// real format string), then one `IMU` message for each (TimeUS, I) of `imus`, with
+    /// plausible axes and temperature.
+    fn imu_log(imus: &[(u64, u8)]) -> Vec<u8> {
+        let mut bytes = Vec::new();
+        fmt_message(
+            &mut bytes,
+            FMT_TYPE,
+            "FMT",
+            "BBnNZ",
+            "Type,Length,Name,Format,Columns",
+        );
+        fmt_message(
+            &mut bytes,
+            IMU_TYPE,
+            "IMU",
+            "QBffffffIIfBBHH",
+            "TimeUS,I,GyrX,GyrY,GyrZ,AccX,AccY,AccZ,EG,EA,T,GH,AH,GHz,AHz",
+        );
+        for (k, &(time, instance)) in imus.iter().enumerate() {
+            bytes.extend_from_slice(&[HEAD[0], HEAD[1], IMU_TYPE]);
+            bytes.extend_from_slice(&time.to_le_bytes());
+            bytes.push(instance);
+            let wobble = (k % 7) as f32 * 1e-3;
+            for v in [0.01 + wobble, -0.02, 0.005, 0.1, -0.2 + wobble, 9.81] {
+                bytes.extend_from_slice(&f32::to_le_bytes(v));
+            }
+            bytes.extend_from_slice(&[0; 8]);
+            bytes.extend_from_slice(&30f32.to_le_bytes());
+            bytes.extend_from_slice(&[1, 1]);
+            bytes.extend_from_slice(&400u16.to_le_bytes());
+            bytes.extend_from_slice(&400u16.to_le_bytes());
+        }
+        bytes
+    }
+
+    /// A scratch file of its own (tests run on several threads), removed when dropped.
+    struct Scratch(std::path::PathBuf);
+
+    impl Scratch {
+        /// `bytes` in a new scratch file.
+        fn new(bytes: &[u8]) -> Self {
+            use std::sync::atomic::{AtomicU64, Ordering};
+            static CALLS: AtomicU64 = AtomicU64::new(0);
+            let call = CALLS.fetch_add(1, Ordering::Relaxed);
+            let name = format!("imu-ar-dataflash-{}-{call}.bin", std::process::id());
+            let path = std::env::temp_dir().join(name);
+            std::fs::write(&path, bytes).expect("a scratch file");
+            Scratch(path)
+        }
+    }
+
+    impl Drop for Scratch {
+        fn drop(&mut self) {
+            let _ = std::fs::remove_file(&self.0);
+        }
+    }
+
+    /// The `IMU` samples of `path`'s one instance (none named), or the read's error.
+    fn imu_samples(path: &Path) -> Result<(Vec<Sample>, Report), String> {
+        let select = Select {
+            kind: Kind::Imu,
+            instance: None,
+        };
+        let mut samples = Vec::new();
+        let report =
+            read(path, &select, &mut |s| samples.push(s)).map_err(|e| e.problem.clone())?;
+        Ok((samples, report))
+    }
+
+    /// 400 Hz from 5 s since boot: the times of `n` good `IMU` messages of instance 0.
+    fn good(n: u64) -> Vec<(u64, u8)> {
+        (0..n).map(|k| (5_000_000 + 2_500 * k, 0)).collect()
+    }
+
+    #[test]
+    fn an_imu_message_whose_time_no_clock_reaches_is_corrupt_and_skipped() {
+        // One message of an SD card's write error in the middle of 400 good ones: TimeUS
+        // 14047262688061562948 µs (year 447110), past what i64 nanoseconds hold; and one just
+        // past 2^53 µs, which a double no longer holds exactly.
+        for bad in [14_047_262_688_061_562_948, u64::MAX, (1 << 53) + 1] {
+            let mut imus = good(400);
+            imus.insert(200, (bad, 0));
+            let file = Scratch::new(&imu_log(&imus));
+            let survey = survey(&file.0).expect("a survey");
+            let found = survey.instances(Kind::Imu);
+            assert_eq!(found.len(), 1, "{bad}");
+            assert_eq!(found[0].messages, 400, "{bad}");
+            assert_eq!(
+                found[0].span_us,
+                Some((5e6, 5e6 + 2_500.0 * 399.0)),
+                "{bad}"
+            );
+            assert_eq!(survey.corrupt, 1, "{bad}");
+            let (samples, report) = imu_samples(&file.0).expect("the good samples");
+            assert_eq!(report.delivered, 400, "{bad}");
+            assert_eq!(report.corrupt, 1, "{bad}");
+            assert!(
+                samples
+                    .windows(2)
+                    .all(|w| w[1].time_us - w[0].time_us == 2_500.0),
+                "{bad}: one clock, one sample missing"
+            );
+        }
+        // The latest time a message can carry is read.
+        let file = Scratch::new(&imu_log(&[(1 << 53, 0)]));
+        let (samples, report) = imu_samples(&file.0).expect("a sample");
+        assert_eq!(samples[0].time_us, 2f64.powi(53));
+        assert_eq!(report.corrupt, 0);
+    }
+
+    #[test]
+    fn a_batch_whose_sample_times_no_clock_reaches_is_undecodable() {
+        // Two gyro batches of 32 samples at 1 kHz (ISBH, one ISBD block each): the first good,
+        // the second's SampleUS the garbage of a corrupt header.
+        let mut bytes = imu_log(&[]);
+        fmt_message(
+            &mut bytes,
+            151,
+            "ISBH",
+            "QHBBHHQf",
+            "TimeUS,N,type,instance,mul,smp_cnt,SampleUS,smp_rate",
+        );
+        fmt_message(&mut bytes, 152, "ISBD", "QHHaaa", "TimeUS,N,seqno,x,y,z");
+        for (n, sample_us) in [(1u16, 5_000_000u64), (2, 14_047_262_688_061_562_948)] {
+            bytes.extend_from_slice(&[HEAD[0], HEAD[1], 151]);
+            bytes.extend_from_slice(&5_100_000u64.to_le_bytes());
+            bytes.extend_from_slice(&n.to_le_bytes());
+            bytes.extend_from_slice(&[1, 0]);
+            bytes.extend_from_slice(&1u16.to_le_bytes());
+            bytes.extend_from_slice(&32u16.to_le_bytes());
+            bytes.extend_from_slice(&sample_us.to_le_bytes());
+            bytes.extend_from_slice(&1000f32.to_le_bytes());
+            bytes.extend_from_slice(&[HEAD[0], HEAD[1], 152]);
+            bytes.extend_from_slice(&5_100_000u64.to_le_bytes());
+            bytes.extend_from_slice(&n.to_le_bytes());
+            bytes.extend_from_slice(&0u16.to_le_bytes());
+            for v in 0..96i16 {
+                bytes.extend_from_slice(&(v % 13 - 6).to_le_bytes());
+            }
+        }
+        let file = Scratch::new(&bytes);
+        let select = Select {
+            kind: Kind::BatchGyro,
+            instance: Some(0),
+        };
+        let mut times = Vec::new();
+        let report = read(&file.0, &select, &mut |s| times.push(s.time_us)).expect("a batch");
+        assert_eq!((report.delivered, report.undecodable_batches), (32, 1));
+        assert_eq!(times.last(), Some(&(5e6 + 31_000.0)));
+    }
+
+    #[test]
+    fn an_imu_instance_past_ardupilots_five_imus_is_corrupt_and_skipped() {
+        // One message whose I byte reads 107 (and one 5, the sixth IMU no INS holds) among 400
+        // of instance 0: one IMU, read without --instance.
+        let mut imus = good(400);
+        imus.insert(200, (5_000_000 + 2_500 * 200 + 1_000, 107));
+        imus.insert(300, (5_000_000 + 2_500 * 300 + 1_000, 5));
+        let file = Scratch::new(&imu_log(&imus));
+        let survey = survey(&file.0).expect("a survey");
+        let found: Vec<(u8, u64)> = survey
+            .instances(Kind::Imu)
+            .iter()
+            .map(|s| (s.instance, s.messages))
+            .collect();
+        assert_eq!(found, vec![(0, 400)]);
+        assert_eq!(survey.corrupt, 2);
+        let (samples, report) = imu_samples(&file.0).expect("instance 0, the only one");
+        assert_eq!((samples.len(), report.corrupt), (400, 2));
+        // Five IMUs (instances 0 to 4) are ArduPilot's most: each is one, and without
+        // --instance the refusal gives each one's messages.
+        let imus: Vec<(u64, u8)> = (0..50u64)
+            .flat_map(|k| (0..5).map(move |i| (5_000_000 + 2_500 * k, i)))
+            .collect();
+        let file = Scratch::new(&imu_log(&imus));
+        let survey = super::survey(&file.0).expect("a survey");
+        assert_eq!(survey.instances(Kind::Imu).len(), 5);
+        assert_eq!(survey.corrupt, 0);
+        let e = imu_samples(&file.0).expect_err("five instances");
+        assert!(e.contains("instance 4 (50 messages)"), "{e}");
     }
 }

@@ -393,17 +393,23 @@ fn autopilot_stream(
         // The instances of the IMU messages and of the batches of the picked sensor; of the two,
         // the one with more samples of the instance chosen.
         let batch = batch_kind(&picks);
-        let mut found: Vec<(u8, String)> = Vec::new();
+        // Each with its messages, so that a stray one shows as such.
+        let mut counts: Vec<(u8, u64)> = Vec::new();
         for s in survey
             .instances(dataflash::Kind::Imu)
             .into_iter()
             .chain(batch.map(|b| survey.instances(b)).unwrap_or_default())
         {
-            if found.iter().all(|(i, _)| *i != s.instance) {
-                found.push((s.instance, s.instance.to_string()));
+            match counts.iter_mut().find(|(i, _)| *i == s.instance) {
+                Some((_, n)) => *n += s.messages,
+                None => counts.push((s.instance, s.messages)),
             }
         }
-        found.sort_by_key(|(i, _)| *i);
+        counts.sort_by_key(|(i, _)| *i);
+        let found: Vec<(u8, String)> = counts
+            .into_iter()
+            .map(|(i, n)| (i, format!("{i} ({n} messages)")))
+            .collect();
         if found.is_empty() && !survey.unreadable.is_empty() {
             return Err(with_file(
                 files,
@@ -432,7 +438,8 @@ fn autopilot_stream(
         })
         .map_err(|e| Fail(e.to_string()))?;
         skipped.non_finite = report.non_finite;
-        skipped.undecodable = report.dropped_batches + report.undecodable_batches;
+        // Corrupt IMU messages (a TimeUS or an instance no IMU has) are undecodable ones.
+        skipped.undecodable = report.dropped_batches + report.undecodable_batches + report.corrupt;
         skipped.cut_short = u64::from(survey.truncated.is_some());
     } else {
         skipped = ulog_stream(files, request, &picks, &mut take)?;
@@ -503,7 +510,8 @@ pub fn fuller(
 /// The samples of a ULog file's gyro or accelerometer, or both (`picks`), to `take` (time in
 /// microseconds, the six axes): of the sensor topic and its FIFO topic, the [`fuller`]. Gyro and accelerometer are separate topics: read together (on two threads), they are
 /// paired by equal sample times, as PX4's drivers publish the two halves of one FIFO read;
-/// samples without a partner are counted, and more than 1 % of them refused.
+/// samples without a partner are counted, and more than 1 % of them refused, naming why
+/// ([`Pairing`]): one topic's lost messages, or times of their own.
 fn ulog_stream(
     files: &[PathBuf],
     request: &Request,
@@ -583,8 +591,9 @@ fn ulog_stream(
         return Ok(skipped);
     };
     type Batch = Vec<(f64, [f64; 3])>;
+    let dropouts = survey.dropouts;
     let survey = &survey;
-    let (reports, paired, unpaired) = std::thread::scope(|scope| {
+    let (reports, pairing) = std::thread::scope(|scope| {
         let reader = |select: ulog::Select, send: std::sync::mpsc::SyncSender<Batch>| {
             move || {
                 let mut batch = Vec::with_capacity(4096);
@@ -607,24 +616,31 @@ fn ulog_stream(
         let x = scope.spawn(reader(b, accel_send));
         let (mut gyro, mut accel) = (gyro.iter().flatten(), accel.iter().flatten());
         let (mut next_gyro, mut next_accel) = (gyro.next(), accel.next());
-        let (mut paired, mut unpaired) = (0u64, 0u64);
+        let mut pairing = Pairing::default();
         while let (Some((tg, wg)), Some((ta, wa))) = (next_gyro, next_accel) {
             // Equal sample times, to the microsecond's rounding.
             if (tg - ta).abs() < 0.5 {
                 take(tg, [wg[0], wg[1], wg[2], wa[0], wa[1], wa[2]]);
-                paired += 1;
+                pairing.pair();
                 (next_gyro, next_accel) = (gyro.next(), accel.next());
             } else if tg < ta {
-                unpaired += 1;
+                pairing.alone(Sensor::Gyro, 1);
                 next_gyro = gyro.next();
             } else {
-                unpaired += 1;
+                pairing.alone(Sensor::Accel, 1);
                 next_accel = accel.next();
             }
         }
-        let rest =
-            next_gyro.iter().count() + next_accel.iter().count() + gyro.count() + accel.count();
-        unpaired += rest as u64;
+        // The samples after the other sensor's last.
+        pairing.alone(
+            Sensor::Gyro,
+            (next_gyro.iter().count() + gyro.count()) as u64,
+        );
+        pairing.alone(
+            Sensor::Accel,
+            (next_accel.iter().count() + accel.count()) as u64,
+        );
+        pairing.finish();
         let join = |h: std::thread::ScopedJoinHandle<'_, Result<ulog::Report, DataError>>| {
             h.join().unwrap_or_else(|_| {
                 Err(DataError {
@@ -634,22 +650,48 @@ fn ulog_stream(
                 })
             })
         };
-        ((join(g), join(x)), paired, unpaired)
+        ((join(g), join(x)), pairing)
     });
     let (g, x) = (reports.0.map_err(fail)?, reports.1.map_err(fail)?);
     // A sample that is not finite is not delivered, and leaves its partner without one: the
     // row is counted once, as not finite, as a CSV row with a NaN is.
     let non_finite = g.non_finite + x.non_finite;
-    let unpaired = unpaired.saturating_sub(non_finite);
+    let paired = pairing.paired;
+    let unpaired = (pairing.gyro.samples + pairing.accel.samples).saturating_sub(non_finite);
     if unpaired.saturating_mul(100) > paired.saturating_add(unpaired) {
+        let (gyro, accel) = (a.topic.name(), b.topic.name());
+        let Some(lost) = pairing.lost(
+            [
+                pairing.gyro.samples.saturating_sub(x.non_finite),
+                pairing.accel.samples.saturating_sub(g.non_finite),
+            ],
+            [gyro, accel],
+        ) else {
+            return Err(with_file(
+                files,
+                format!(
+                    "{gyro} and {accel} share {paired} sample times; {unpaired} samples of one or \
+                     the other have no partner (more than 1 %): the two are published at times \
+                     of their own here, so read the gyro axes and the accelerometer axes apart"
+                ),
+            ));
+        };
+        let logger = match dropouts {
+            (0, _) => String::new(),
+            (n, ms) => format!(" (the log records {n} dropouts of the logger, {ms} ms in all)"),
+        };
+        let again = if pairing.gyro.gaps + pairing.accel.gaps > 0 {
+            ", or record again with a logger that keeps up (a faster SD card, fewer topics \
+             logged)"
+        } else {
+            ""
+        };
         return Err(with_file(
             files,
             format!(
-                "{} and {} share {paired} sample times; {unpaired} samples of one or the other \
-                 have no partner (more than 1 %): the two are published at times of their own \
-                 here, so read the gyro axes and the accelerometer axes apart",
-                a.topic.name(),
-                b.topic.name()
+                "{gyro} and {accel} share {paired} sample times, but {lost}{logger}; the \
+                 {unpaired} samples without a partner are more than 1 %: read the gyro axes and \
+                 the accelerometer axes apart (each is then read with its gaps counted){again}"
             ),
         ));
     }
@@ -657,6 +699,133 @@ fn ulog_stream(
     skipped.non_finite = non_finite;
     skipped.unpaired = unpaired;
     Ok(skipped)
+}
+
+/// The sensor of a sample the pairing of gyro and accelerometer met.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Sensor {
+    /// The gyro.
+    Gyro,
+    /// The accelerometer.
+    Accel,
+}
+
+/// The samples of one sensor without a partner of the same time in the other sensor's topic,
+/// by where they lie in that topic.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct Alone {
+    /// All of them.
+    samples: u64,
+    /// Runs of them between two paired samples, with no sample of the other sensor alone among
+    /// them: each a gap of the other topic (messages it lost).
+    gaps: u64,
+    /// Those before the first paired sample: the other topic starts after them.
+    before: u64,
+    /// Those after the last paired sample: the other topic ends before them.
+    after: u64,
+}
+
+/// The tally of gyro and accelerometer samples paired by their times, met in time order: how
+/// many pair, and where those without a partner lie.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct Pairing {
+    /// Samples paired.
+    paired: u64,
+    /// The gyro samples alone.
+    gyro: Alone,
+    /// The accelerometer samples alone.
+    accel: Alone,
+    /// Samples alone between two paired samples that hold some of both sensors: scattered,
+    /// as two clocks leave them.
+    mixed: u64,
+    /// The gyro and accelerometer samples alone since the last paired sample.
+    open: (u64, u64),
+}
+
+impl Pairing {
+    /// A paired sample: closes the run of samples alone before it.
+    fn pair(&mut self) {
+        let (g, a) = std::mem::take(&mut self.open);
+        if self.paired == 0 {
+            self.gyro.before += g;
+            self.accel.before += a;
+        } else {
+            match (g, a) {
+                (0, 0) => {}
+                (_, 0) => self.gyro.gaps += 1,
+                (0, _) => self.accel.gaps += 1,
+                (g, a) => self.mixed += g + a,
+            }
+        }
+        self.paired += 1;
+    }
+
+    /// `n` samples of `sensor` without a partner.
+    fn alone(&mut self, sensor: Sensor, n: u64) {
+        match sensor {
+            Sensor::Gyro => {
+                self.gyro.samples += n;
+                self.open.0 += n;
+            }
+            Sensor::Accel => {
+                self.accel.samples += n;
+                self.open.1 += n;
+            }
+        }
+    }
+
+    /// The samples alone after the last paired sample.
+    fn finish(&mut self) {
+        let (g, a) = std::mem::take(&mut self.open);
+        if self.paired == 0 {
+            self.gyro.before += g;
+            self.accel.before += a;
+        } else {
+            self.gyro.after += g;
+            self.accel.after += a;
+        }
+    }
+
+    /// Why the samples without a partner have none, when a topic lost messages or spans less
+    /// time than the other: for each sensor with `alone` (gyro, accelerometer) samples, where
+    /// they lie in the other's topic (`topics`, gyro then accelerometer). `None` when they lie
+    /// otherwise: scattered among both sensors' (two clocks), or one in most of the other
+    /// topic's steps (two rates), the times of their own of each topic.
+    fn lost(&self, alone: [u64; 2], topics: [&str; 2]) -> Option<String> {
+        let total = self.paired + self.gyro.samples + self.accel.samples;
+        // A topic's usual step is the other's when most of the steps between paired samples
+        // hold no sample alone: the few that do are its gaps. Samples alone of both sensors
+        // between the same two pairs are no gap; a few (1 %) are borne.
+        let gaps = self.gyro.gaps + self.accel.gaps;
+        if self.paired == 0 || gaps.saturating_mul(2) > self.paired || self.mixed * 100 > total {
+            return None;
+        }
+        let sensors = [("gyro", &self.gyro), ("accelerometer", &self.accel)];
+        let mut causes = Vec::new();
+        for (k, n) in alone.into_iter().enumerate() {
+            let (what, side) = sensors[k];
+            let (other, _) = sensors[1 - k];
+            let (mine, theirs) = (topics[k], topics[1 - k]);
+            let mut how = Vec::new();
+            if side.gaps > 0 {
+                how.push(format!("lost messages ({} gaps)", side.gaps));
+            }
+            if side.before > 0 {
+                how.push(format!("starts {} samples after {mine}", side.before));
+            }
+            if side.after > 0 {
+                how.push(format!("ends {} samples before {mine}", side.after));
+            }
+            if n == 0 || how.is_empty() {
+                continue;
+            }
+            causes.push(format!(
+                "{n} {what} samples ({mine}) have no {other} sample at their times: {theirs} {}",
+                how.join(" and ")
+            ));
+        }
+        (!causes.is_empty()).then(|| causes.join("; "))
+    }
 }
 
 /// The axes (of [`AXES`]) that `request.columns` name; an error naming the column that is none,
@@ -1085,5 +1254,164 @@ impl Beside {
         if !self.calls.is_empty() {
             let _ = self.send.send(self.calls);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The format PX4 writes for `sensor_gyro_fifo` and `sensor_accel_fifo` (after `name:`).
+    const FIFO: &str = concat!(
+        "uint64_t timestamp;uint64_t timestamp_sample;uint32_t device_id;float dt;",
+        "float scale;int16_t[32] x;int16_t[32] y;int16_t[32] z;uint8_t samples;",
+        "uint8_t[3] _padding0;",
+    );
+
+    /// A message of type `ty` and `payload`, as ULog frames it.
+    fn message(bytes: &mut Vec<u8>, ty: u8, payload: &[u8]) {
+        bytes.extend_from_slice(&(payload.len() as u16).to_le_bytes());
+        bytes.push(ty);
+        bytes.extend_from_slice(payload);
+    }
+
+    /// A PX4 ULog file of one IMU's `sensor_gyro_fifo` and `sensor_accel_fifo`, 10 samples a
+    /// message: for each, the times (µs) of its messages' last samples and its samples'
+    /// spacing (µs).
+    fn fifo_log(gyro: (&[u64], u64), accel: (&[u64], u64)) -> Vec<u8> {
+        let mut bytes = crate::ulog::MAGIC.to_vec();
+        bytes.push(1);
+        bytes.extend_from_slice(&0u64.to_le_bytes());
+        message(&mut bytes, b'B', &[0; 40]);
+        for (id, topic) in [(0u16, "sensor_gyro_fifo"), (1, "sensor_accel_fifo")] {
+            message(&mut bytes, b'F', format!("{topic}:{FIFO}").as_bytes());
+            let mut p = vec![0];
+            p.extend_from_slice(&id.to_le_bytes());
+            p.extend_from_slice(topic.as_bytes());
+            message(&mut bytes, b'A', &p);
+        }
+        let mut data: Vec<(u64, u16, u64)> = gyro.0.iter().map(|&t| (t, 0, gyro.1)).collect();
+        data.extend(accel.0.iter().map(|&t| (t, 1, accel.1)));
+        data.sort_unstable();
+        for (t, id, dt) in data {
+            let mut p = id.to_le_bytes().to_vec();
+            p.extend_from_slice(&(t + 40).to_le_bytes());
+            p.extend_from_slice(&t.to_le_bytes());
+            p.extend_from_slice(&(7 + u32::from(id)).to_le_bytes());
+            p.extend_from_slice(&(dt as f32).to_le_bytes());
+            p.extend_from_slice(&1e-3f32.to_le_bytes());
+            for axis in 0..3u64 {
+                for i in 0..32u64 {
+                    // Noise-like values, different for each sample and axis.
+                    let v = ((t / 50 + i) * 7_919 + axis * 104_729) % 201;
+                    p.extend_from_slice(&(v as i16 - 100).to_le_bytes());
+                }
+            }
+            p.push(10);
+            message(&mut bytes, b'D', &p);
+        }
+        bytes
+    }
+
+    /// `bytes` in a scratch file of its own (tests run on several threads), removed when
+    /// dropped.
+    struct Scratch(PathBuf);
+
+    impl Scratch {
+        /// `bytes` in a new scratch file.
+        fn new(bytes: &[u8]) -> Self {
+            use std::sync::atomic::{AtomicU64, Ordering};
+            static CALLS: AtomicU64 = AtomicU64::new(0);
+            let call = CALLS.fetch_add(1, Ordering::Relaxed);
+            let name = format!("imu-ar-source-{}-{call}.ulg", std::process::id());
+            let path = std::env::temp_dir().join(name);
+            std::fs::write(&path, bytes).expect("a scratch file");
+            Scratch(path)
+        }
+    }
+
+    impl Drop for Scratch {
+        fn drop(&mut self) {
+            let _ = std::fs::remove_file(&self.0);
+        }
+    }
+
+    /// The refusal of the six axes of the ULog file `bytes`.
+    fn six_axis_refusal(bytes: &[u8]) -> String {
+        let file = Scratch::new(bytes);
+        let columns: Vec<String> = AXES.iter().map(|a| a.to_string()).collect();
+        let request = Request {
+            columns: &columns,
+            topic: None,
+            frame_id: None,
+            time_column: None,
+            want_time: true,
+            drop_backward: false,
+            instance: None,
+        };
+        match stream(std::slice::from_ref(&file.0), &request, &mut |_| {}) {
+            Ok(_) => panic!("six axes read"),
+            Err(e) => e.0,
+        }
+    }
+
+    /// The times of the last samples of `n` messages of 10 samples `dt` µs apart from 1 s
+    /// on, but those `k` for which `lost(k)`.
+    fn messages(n: u64, dt: u64, lost: impl Fn(u64) -> bool) -> Vec<u64> {
+        (0..n)
+            .filter(|&k| !lost(k))
+            .map(|k| 1_000_000 + 9 * dt + 10 * dt * k)
+            .collect()
+    }
+
+    #[test]
+    fn a_topic_that_lost_messages_is_named_with_its_gaps_not_called_a_clock_of_its_own() {
+        // 2 kHz. The logger lost every 50th gyro message (2 % of the gyro, the last message
+        // one of them); the accelerometer is whole. 98 % of the samples pair exactly.
+        let e = six_axis_refusal(&fifo_log(
+            (&messages(1_000, 500, |k| k % 50 == 49), 500),
+            (&messages(1_000, 500, |_| false), 500),
+        ));
+        assert!(
+            e.contains(
+                "200 accelerometer samples (sensor_accel_fifo) have no gyro sample at their \
+                 times: sensor_gyro_fifo lost messages (19 gaps) and ends 10 samples before \
+                 sensor_accel_fifo"
+            ),
+            "{e}"
+        );
+        assert!(e.contains("share 9800 sample times"), "{e}");
+        assert!(!e.contains("times of their own"), "{e}");
+        // Both lost messages, and the accelerometer's first three: each topic is named.
+        let e = six_axis_refusal(&fifo_log(
+            (&messages(1_000, 500, |k| k % 50 == 20), 500),
+            (&messages(1_000, 500, |k| k % 40 == 7 || k < 3), 500),
+        ));
+        assert!(
+            e.contains(
+                "280 gyro samples (sensor_gyro_fifo) have no accelerometer sample at their \
+                 times: sensor_accel_fifo lost messages (25 gaps) and starts 30 samples after \
+                 sensor_gyro_fifo; 200 accelerometer samples (sensor_accel_fifo) have no gyro \
+                 sample at their times: sensor_gyro_fifo lost messages (20 gaps)"
+            ),
+            "{e}"
+        );
+        assert!(!e.contains("times of their own"), "{e}");
+    }
+
+    #[test]
+    fn samples_of_two_clocks_or_rates_are_still_called_times_of_their_own() {
+        // The accelerometer's samples half a step after the gyro's: none pairs.
+        let gyro = messages(1_000, 500, |_| false);
+        let late: Vec<u64> = gyro.iter().map(|t| t + 250).collect();
+        let e = six_axis_refusal(&fifo_log((&gyro, 500), (&late, 500)));
+        assert!(e.contains("published at times of their own"), "{e}");
+        // The accelerometer at half the gyro's rate: every other gyro sample has no partner,
+        // one in each of the accelerometer's steps, which are no gaps.
+        let e = six_axis_refusal(&fifo_log(
+            (&gyro, 500),
+            (&messages(500, 1_000, |_| false), 1_000),
+        ));
+        assert!(e.contains("published at times of their own"), "{e}");
     }
 }
