@@ -67,7 +67,8 @@ fn scratch(extension: &str) -> PathBuf {
 }
 
 /// The ROS readers (ROS 1 bag, MCAP, rosbag2 SQLite database) on arbitrary bytes: the first
-/// byte picks the reader, the rest is the file, read with and without a frame_id. Every
+/// byte picks the reader (240 and up: a rosbag2 folder compressed message by message, of MCAP
+/// or SQLite storage), the rest is the file, read with and without a frame_id. Every
 /// delivered frame is finite, a success delivered at least one, an error names the file, and
 /// nothing panics.
 pub fn ros_read(data: &[u8]) {
@@ -75,6 +76,9 @@ pub fn ros_read(data: &[u8]) {
         return;
     };
     type Read = fn(&Path, &Select, &mut dyn FnMut(Frame)) -> Result<Skipped, DataError>;
+    if which >= 240 {
+        return compressed_folder(which % 2 == 0, bytes);
+    }
     let (extension, read): (&str, Read) = match which % 3 {
         0 => ("bag", bag::read_selected),
         1 => ("mcap", mcap::read_selected),
@@ -101,6 +105,31 @@ pub fn ros_read(data: &[u8]) {
         }
     }
     let _ = std::fs::remove_file(&path);
+}
+
+/// [`ros_read`]'s rosbag2 folder compressed message by message in zstd: `bytes` its one
+/// storage file (MCAP or SQLite), each message's data decompressed before it is decoded.
+fn compressed_folder(is_mcap: bool, bytes: &[u8]) {
+    let folder = scratch("bag");
+    std::fs::create_dir_all(&folder).expect("a scratch folder in the temporary folder");
+    let file = if is_mcap { "a_0.mcap" } else { "a_0.db3" };
+    let meta = format!(
+        "rosbag2_bagfile_information:\n  version: 9\n  storage_identifier: {}\n  \
+         relative_file_paths:\n  - {file}\n  compression_format: zstd\n  \
+         compression_mode: MESSAGE\n",
+        if is_mcap { "mcap" } else { "sqlite3" }
+    );
+    std::fs::write(folder.join(rosbag2::METADATA), meta).expect("the folder's metadata");
+    std::fs::write(folder.join(file), bytes).expect("the folder's storage file");
+    let mut frames = 0u64;
+    match rosbag2::read_folder(&folder, &Select::topic("/imu0"), &mut |f: Frame| {
+        assert!(f.axes.iter().all(|v| v.is_finite()));
+        frames += 1;
+    }) {
+        Ok(_) => assert!(frames > 0),
+        Err(e) => assert!(e.file.starts_with(&folder)),
+    }
+    let _ = std::fs::remove_dir_all(&folder);
 }
 
 /// The rosbag2 `metadata.yaml` reader on arbitrary text: a storage and a list of files, or an

@@ -374,8 +374,9 @@ pub struct Report {
     pub resyncs: u64,
     /// The byte offset of the last message when it is cut short by the end of the file.
     pub truncated: Option<u64>,
-    /// Corrupt `IMU` messages of the log (of every instance: the `I` of one may be the
-    /// garbage), skipped: a TimeUS past [`MAX_TIME_US`], or an `I` not below [`MAX_IMUS`].
+    /// Corrupt `IMU` messages skipped: the instance's own with a TimeUS past
+    /// [`MAX_TIME_US`], and those whose `I` is not below [`MAX_IMUS`] (whose instance the
+    /// garbage hides).
     pub corrupt: u64,
 }
 
@@ -617,7 +618,13 @@ pub fn read_surveyed(
         skipped_bytes: log.skipped_bytes,
         resyncs: log.resyncs,
         truncated: log.truncated,
-        corrupt: log.corrupt,
+        // Its own, and those that name no IMU (any instance's).
+        corrupt: log
+            .corrupt_of
+            .get(usize::from(instance))
+            .copied()
+            .unwrap_or(0)
+            + (log.corrupt - log.corrupt_of.iter().sum::<u64>()),
     })
 }
 
@@ -1169,6 +1176,8 @@ struct Log {
     messages: u64,
     /// Corrupt `IMU` messages, not passed on.
     corrupt: u64,
+    /// Of them, those of each instance (a time no clock reaches; the others name no IMU).
+    corrupt_of: [u64; MAX_IMUS as usize],
     parameters: Vec<Parameter>,
     unreadable: Vec<String>,
     skipped_bytes: u64,
@@ -1314,6 +1323,7 @@ fn scan(path: &Path, visit: &mut dyn FnMut(Event)) -> Result<Log, DataError> {
     let mut win = Window::open(path).map_err(|e| fail(format!("cannot open: {e}")))?;
     let mut state = State::new();
     let (mut messages, mut skipped, mut resyncs, mut corrupt) = (0u64, 0u64, 0u64, 0u64);
+    let mut corrupt_of = [0u64; MAX_IMUS as usize];
     let mut skipping = false;
     let mut truncated = None;
     let mut unreadable: Vec<String> = Vec::new();
@@ -1437,6 +1447,9 @@ fn scan(path: &Path, visit: &mut dyn FnMut(Event)) -> Result<Log, DataError> {
                     }));
                 } else {
                     corrupt += 1;
+                    if let Some(i) = instance {
+                        corrupt_of[usize::from(i)] += 1;
+                    }
                 }
             }
             Role::Isbh(f) => {
@@ -1493,6 +1506,7 @@ fn scan(path: &Path, visit: &mut dyn FnMut(Event)) -> Result<Log, DataError> {
     Ok(Log {
         messages,
         corrupt,
+        corrupt_of,
         parameters,
         unreadable,
         skipped_bytes: skipped,
@@ -1713,6 +1727,36 @@ mod tests {
         let report = read(&file.0, &select, &mut |s| times.push(s.time_us)).expect("a batch");
         assert_eq!((report.delivered, report.undecodable_batches), (32, 1));
         assert_eq!(times.last(), Some(&(5e6 + 31_000.0)));
+    }
+
+    #[test]
+    fn an_instance_counts_its_own_corrupt_messages_and_those_that_name_none() {
+        // Three IMUs, 100 messages each, every tenth of each with a TimeUS no clock reaches,
+        // and one whose I byte reads 107: instance 0 lost 10 (and perhaps the stray one), not
+        // the log's 31 (30 before).
+        let mut imus: Vec<(u64, u8)> = (0..100u64)
+            .flat_map(|k| {
+                (0..3).map(move |i| {
+                    let t = if k % 10 == 5 {
+                        u64::MAX
+                    } else {
+                        5_000_000 + 2_500 * k
+                    };
+                    (t, i)
+                })
+            })
+            .collect();
+        imus.push((5_000_000 + 2_500 * 100, 107));
+        let file = Scratch::new(&imu_log(&imus));
+        assert_eq!(survey(&file.0).expect("a survey").corrupt, 31);
+        for instance in 0..3 {
+            let select = Select {
+                kind: Kind::Imu,
+                instance: Some(instance),
+            };
+            let report = read(&file.0, &select, &mut |_| {}).expect("an instance");
+            assert_eq!((report.delivered, report.corrupt), (90, 11), "{instance}");
+        }
     }
 
     #[test]

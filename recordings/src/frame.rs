@@ -169,7 +169,16 @@ pub(crate) struct Tally<'a> {
     /// Each frame_id seen, with its messages and whether it is the one chosen.
     frame_ids: Vec<(Vec<u8>, u64, bool)>,
     sources: Vec<Source>,
+    /// Messages not decoded whose data is a zstd frame (a rosbag2 folder's storage file,
+    /// recorded with each message compressed, read without its folder).
+    zstd: u64,
 }
+
+/// A message's decoder: its frame and header frame_id, or `None`.
+pub(crate) type Decode = fn(&[u8]) -> Option<(Frame, &[u8])>;
+
+/// The first bytes of a zstd frame.
+const ZSTD_MAGIC: [u8; 4] = [0x28, 0xb5, 0x2f, 0xfd];
 
 /// The most frame_ids told apart on one topic; more are one error.
 const MAX_FRAME_IDS: usize = 16;
@@ -184,7 +193,22 @@ impl<'a> Tally<'a> {
             skipped: Skipped::default(),
             frame_ids: Vec::new(),
             sources: Vec::new(),
+            zstd: 0,
         }
+    }
+
+    /// [`Tally::offer`] of a message's `data` (none where it is missing), decoded by `decode`.
+    pub(crate) fn offer_data(
+        &mut self,
+        source: u32,
+        data: Option<&[u8]>,
+        decode: Decode,
+    ) {
+        let decoded = data.and_then(decode);
+        if decoded.is_none() && data.is_some_and(|d| d.starts_with(&ZSTD_MAGIC)) {
+            self.zstd += 1;
+        }
+        self.offer(source, decoded);
     }
 
     /// One message on the topic from publisher `source`: its frame and header frame_id when
@@ -340,7 +364,13 @@ impl<'a> Tally<'a> {
             non_finite,
             ..
         } = self.skipped;
-        let problem = if non_finite == 0 {
+        let problem = if non_finite == 0 && self.zstd == undecodable && undecodable > 0 {
+            format!(
+                "no decodable messages on '{topic}' ({undecodable} undecodable): each is a zstd \
+                 frame, as a rosbag2 folder recorded with --compression-mode message stores \
+                 them; give the folder, whose metadata.yaml says so, not its storage file alone"
+            )
+        } else if non_finite == 0 {
             format!("no decodable messages on '{topic}' ({undecodable} undecodable)")
         } else {
             format!(

@@ -308,7 +308,7 @@ impl State<'_> {
                     } else {
                         decode
                     };
-                    self.tally.offer(u32::from(channel), body.and_then(decode));
+                    self.tally.offer_data(u32::from(channel), body, decode);
                 }
                 Ok(())
             }

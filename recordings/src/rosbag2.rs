@@ -397,9 +397,10 @@ fn read_db3_compressed(
             }
             b => b,
         };
-        tally.offer(
+        tally.offer_data(
             u32::try_from(source).unwrap_or(u32::MAX),
-            data.and_then(mcap::decode),
+            data,
+            mcap::decode,
         );
     }
     tally.finish(path, topic, &|id| format!("topic row {id}"))

@@ -1149,6 +1149,14 @@ fn a_rosbag2_folder_compressed_message_by_message_is_read() {
     let (got, result) = read(&folder, None);
     assert_eq!(result, Ok(0));
     assert_bits(&got, &noise_frames(), "zstd messages");
+    // Its storage file alone: the compression is named ("no decodable messages" before).
+    let e = read(&folder.join("rosbag2-sqlite3.db3"), None)
+        .1
+        .unwrap_err();
+    assert!(
+        e.contains("1200 undecodable): each is a zstd frame") && e.contains("give the folder"),
+        "{e}"
+    );
     // Another format is named, not counted undecodable.
     let lz4 = copied_folder(&dir, "rosbag2-sqlite3", "lz4", |t| {
         t.replace("compression_format: ''", "compression_format: lz4")
