@@ -198,12 +198,7 @@ impl<'a> Tally<'a> {
     }
 
     /// [`Tally::offer`] of a message's `data` (none where it is missing), decoded by `decode`.
-    pub(crate) fn offer_data(
-        &mut self,
-        source: u32,
-        data: Option<&[u8]>,
-        decode: Decode,
-    ) {
+    pub(crate) fn offer_data(&mut self, source: u32, data: Option<&[u8]>, decode: Decode) {
         let decoded = data.and_then(decode);
         if decoded.is_none() && data.is_some_and(|d| d.starts_with(&ZSTD_MAGIC)) {
             self.zstd += 1;
