@@ -376,7 +376,7 @@ pub struct Report {
     pub truncated: Option<u64>,
     /// Corrupt `IMU` messages skipped: the instance's own with a TimeUS past
     /// [`MAX_TIME_US`], and those whose `I` is not below [`MAX_IMUS`] (whose instance the
-    /// garbage hides).
+    /// garbage hides); none for a read of batches.
     pub corrupt: u64,
 }
 
@@ -618,13 +618,16 @@ pub fn read_surveyed(
         skipped_bytes: log.skipped_bytes,
         resyncs: log.resyncs,
         truncated: log.truncated,
-        // Its own, and those that name no IMU (any instance's).
-        corrupt: log
-            .corrupt_of
-            .get(usize::from(instance))
-            .copied()
-            .unwrap_or(0)
-            + (log.corrupt - log.corrupt_of.iter().sum::<u64>()),
+        // Its own, and those that name no IMU (any instance's); a batch read reads none.
+        corrupt: if kind == Kind::Imu {
+            log.corrupt_of
+                .get(usize::from(instance))
+                .copied()
+                .unwrap_or(0)
+                + (log.corrupt - log.corrupt_of.iter().sum::<u64>())
+        } else {
+            0
+        },
     })
 }
 
@@ -1691,8 +1694,9 @@ mod tests {
     #[test]
     fn a_batch_whose_sample_times_no_clock_reaches_is_undecodable() {
         // Two gyro batches of 32 samples at 1 kHz (ISBH, one ISBD block each): the first good,
-        // the second's SampleUS the garbage of a corrupt header.
-        let mut bytes = imu_log(&[]);
+        // the second's SampleUS the garbage of a corrupt header. Two corrupt IMU messages
+        // besides, which a batch read does not count (it counted them before).
+        let mut bytes = imu_log(&[(u64::MAX, 0), (5_000_000, 107)]);
         fmt_message(
             &mut bytes,
             151,
@@ -1726,6 +1730,7 @@ mod tests {
         let mut times = Vec::new();
         let report = read(&file.0, &select, &mut |s| times.push(s.time_us)).expect("a batch");
         assert_eq!((report.delivered, report.undecodable_batches), (32, 1));
+        assert_eq!(report.corrupt, 0);
         assert_eq!(times.last(), Some(&(5e6 + 31_000.0)));
     }
 

@@ -362,8 +362,9 @@ impl<'a> Tally<'a> {
         let problem = if non_finite == 0 && self.zstd == undecodable && undecodable > 0 {
             format!(
                 "no decodable messages on '{topic}' ({undecodable} undecodable): each is a zstd \
-                 frame, as a rosbag2 folder recorded with --compression-mode message stores \
-                 them; give the folder, whose metadata.yaml says so, not its storage file alone"
+                 frame, as rosbag2 stores messages recorded with --compression-mode message; \
+                 they are read through the bag's folder, whose metadata.yaml says \
+                 compression_mode: MESSAGE and compression_format: zstd"
             )
         } else if non_finite == 0 {
             format!("no decodable messages on '{topic}' ({undecodable} undecodable)")

@@ -236,11 +236,6 @@ pub enum Call {
     DropOne,
 }
 
-/// The longest stretch after a gap whose stamps may hold a host's late samples caught up on
-/// (the gap's length, at most this), ns: a gap of a minute is a pause in the recording, and
-/// the clock's stamps after it are its own.
-const QUIET_MOST: i64 = 10_000_000_000;
-
 /// The most marks held: past them, every other one is let go and the blocks between them
 /// double.
 const MARKS: usize = 512;
@@ -1171,7 +1166,7 @@ impl Timing {
         // up on: not the samples of the intervals they open.
         let quarters = if 2 * self.repeats >= self.kept { 7 } else { 9 };
         if reach > iv.saturating_mul(quarters) / 4 {
-            self.quiet = Some(self.last.saturating_add(reach.min(QUIET_MOST)));
+            self.quiet = Some(self.last.saturating_add(reach));
         }
         if self.quiet.is_none_or(|end| self.last >= end) {
             self.count_held(iv, self.trailing_repeats + 1);
@@ -2410,7 +2405,7 @@ impl Timing {
             if i > 0 {
                 let iv = (i128::from(t[i]) - i128::from(t[i - 1])) as f64;
                 if iv > 4.5 * quantum {
-                    quiet = t[i].saturating_add((iv as i64).min(QUIET_MOST));
+                    quiet = t[i].saturating_add(iv as i64);
                 } else if t[i] > quiet {
                     for j in 1..(iv / quantum).round() as i64 {
                         place(secs(t[i - 1]) + j as f64 * q, 0);
@@ -5253,26 +5248,6 @@ mod tests {
                 (t / 1e6).floor() as i64 * 1_000_000
             })
             .collect()
-    }
-
-    #[test]
-    fn a_pause_of_a_minute_leaves_the_clocks_stamps_after_it_its_own() {
-        // 1002.6521 Hz floored to whole ms, 112,981 samples of which 60,159 (a minute) are
-        // not recorded, after 2 s or 30 s: read 1002.4606 Hz (1.9e-4 low, 60,138 missing), and
-        // refused as a beat in part of the record, before (the stamps a gap's length after it
-        // were all taken for a host's catch-up). Now the span's rate with the gap's samples
-        // counted within two: within 2 / 112,980 and a quantum over the 113 s span, 3e-5
-        // (1002.6242 Hz, 2.8e-5 low, after 2 s).
-        let rate = 1002.6521;
-        for at in [2_040, 30_000] {
-            let t: Vec<i64> = (0..112_981usize)
-                .filter(|k| !(at..at + 60_159).contains(k))
-                .map(|k| (k as f64 / rate * 1e3 + 1e-9).floor() as i64 * 1_000_000)
-                .collect();
-            let s = summary_keeping_repeats(&t);
-            assert!((s.rate_hz / rate - 1.0).abs() < 3e-5, "{at}: {s:?}");
-            assert!(s.missing_samples.abs_diff(60_159) <= 2, "{at}: {s:?}");
-        }
     }
 
     /// Stamps (ns) of `n` samples at `rate` Hz, floored to whole ms, of a host that stalls

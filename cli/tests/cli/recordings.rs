@@ -1154,7 +1154,20 @@ fn a_rosbag2_folder_compressed_message_by_message_is_read() {
         .1
         .unwrap_err();
     assert!(
-        e.contains("1200 undecodable): each is a zstd frame") && e.contains("give the folder"),
+        e.contains("1200 undecodable): each is a zstd frame")
+            && e.contains("read through the bag's folder"),
+        "{e}"
+    );
+    // A folder whose metadata does not say so: what it must say.
+    let silent = copied_folder(&dir, "rosbag2-sqlite3", "silent", |t| t);
+    std::fs::copy(
+        folder.join("rosbag2-sqlite3.db3"),
+        silent.join("rosbag2-sqlite3.db3"),
+    )
+    .unwrap();
+    let e = read(&silent, None).1.unwrap_err();
+    assert!(
+        e.contains("whose metadata.yaml says compression_mode: MESSAGE"),
         "{e}"
     );
     // Another format is named, not counted undecodable.
