@@ -1521,6 +1521,7 @@ fn scan(path: &Path, visit: &mut dyn FnMut(Event)) -> Result<Log, DataError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Scratch;
 
     #[test]
     fn half_precision_numbers_decode_as_ieee_754_says() {
@@ -1616,28 +1617,6 @@ mod tests {
         bytes
     }
 
-    /// A scratch file of its own (tests run on several threads), removed when dropped.
-    struct Scratch(std::path::PathBuf);
-
-    impl Scratch {
-        /// `bytes` in a new scratch file.
-        fn new(bytes: &[u8]) -> Self {
-            use std::sync::atomic::{AtomicU64, Ordering};
-            static CALLS: AtomicU64 = AtomicU64::new(0);
-            let call = CALLS.fetch_add(1, Ordering::Relaxed);
-            let name = format!("imu-ar-dataflash-{}-{call}.bin", std::process::id());
-            let path = std::env::temp_dir().join(name);
-            std::fs::write(&path, bytes).expect("a scratch file");
-            Scratch(path)
-        }
-    }
-
-    impl Drop for Scratch {
-        fn drop(&mut self) {
-            let _ = std::fs::remove_file(&self.0);
-        }
-    }
-
     /// The `IMU` samples of `path`'s one instance (none named), or the read's error.
     fn imu_samples(path: &Path) -> Result<(Vec<Sample>, Report), String> {
         let select = Select {
@@ -1663,7 +1642,7 @@ mod tests {
         for bad in [14_047_262_688_061_562_948, u64::MAX, (1 << 53) + 1] {
             let mut imus = good(400);
             imus.insert(200, (bad, 0));
-            let file = Scratch::new(&imu_log(&imus));
+            let file = Scratch::new(&imu_log(&imus), "bin");
             let survey = survey(&file.0).expect("a survey");
             let found = survey.instances(Kind::Imu);
             assert_eq!(found.len(), 1, "{bad}");
@@ -1685,7 +1664,7 @@ mod tests {
             );
         }
         // The latest time a message can carry is read.
-        let file = Scratch::new(&imu_log(&[(1 << 53, 0)]));
+        let file = Scratch::new(&imu_log(&[(1 << 53, 0)]), "bin");
         let (samples, report) = imu_samples(&file.0).expect("a sample");
         assert_eq!(samples[0].time_us, 2f64.powi(53));
         assert_eq!(report.corrupt, 0);
@@ -1722,7 +1701,7 @@ mod tests {
                 bytes.extend_from_slice(&(v % 13 - 6).to_le_bytes());
             }
         }
-        let file = Scratch::new(&bytes);
+        let file = Scratch::new(&bytes, "bin");
         let select = Select {
             kind: Kind::BatchGyro,
             instance: Some(0),
@@ -1752,7 +1731,7 @@ mod tests {
             })
             .collect();
         imus.push((5_000_000 + 2_500 * 100, 107));
-        let file = Scratch::new(&imu_log(&imus));
+        let file = Scratch::new(&imu_log(&imus), "bin");
         assert_eq!(survey(&file.0).expect("a survey").corrupt, 31);
         for instance in 0..3 {
             let select = Select {
@@ -1771,7 +1750,7 @@ mod tests {
         let mut imus = good(400);
         imus.insert(200, (5_000_000 + 2_500 * 200 + 1_000, 107));
         imus.insert(300, (5_000_000 + 2_500 * 300 + 1_000, 5));
-        let file = Scratch::new(&imu_log(&imus));
+        let file = Scratch::new(&imu_log(&imus), "bin");
         let survey = survey(&file.0).expect("a survey");
         let found: Vec<(u8, u64)> = survey
             .instances(Kind::Imu)
@@ -1787,7 +1766,7 @@ mod tests {
         let imus: Vec<(u64, u8)> = (0..50u64)
             .flat_map(|k| (0..5).map(move |i| (5_000_000 + 2_500 * k, i)))
             .collect();
-        let file = Scratch::new(&imu_log(&imus));
+        let file = Scratch::new(&imu_log(&imus), "bin");
         let survey = super::survey(&file.0).expect("a survey");
         assert_eq!(survey.instances(Kind::Imu).len(), 5);
         assert_eq!(survey.corrupt, 0);

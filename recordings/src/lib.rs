@@ -24,6 +24,35 @@ pub mod timing;
 pub mod ulog;
 pub mod units;
 
+/// `bytes` in a scratch file of the unit tests' own (they run on several threads), named
+/// with `extension`, removed when dropped.
+#[cfg(test)]
+pub(crate) struct Scratch(pub std::path::PathBuf);
+
+#[cfg(test)]
+impl Scratch {
+    /// `bytes` in a new scratch file.
+    pub(crate) fn new(bytes: &[u8], extension: &str) -> Self {
+        use std::sync::atomic::{AtomicU64, Ordering};
+        static CALLS: AtomicU64 = AtomicU64::new(0);
+        let call = CALLS.fetch_add(1, Ordering::Relaxed);
+        let name = format!(
+            "imu-ar-recordings-{}-{call}.{extension}",
+            std::process::id()
+        );
+        let path = std::env::temp_dir().join(name);
+        std::fs::write(&path, bytes).expect("a scratch file");
+        Scratch(path)
+    }
+}
+
+#[cfg(test)]
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.0);
+    }
+}
+
 /// A fixed generator for the unit tests' random inputs (xorshift64).
 #[cfg(test)]
 pub(crate) fn xorshift(mut state: u64) -> impl FnMut() -> u64 {

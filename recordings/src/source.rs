@@ -745,10 +745,20 @@ struct Pairing {
 impl Pairing {
     /// A paired sample: closes the run of samples alone before it.
     fn pair(&mut self) {
+        self.close(false);
+        self.paired += 1;
+    }
+
+    /// Closes the run of samples alone since the last paired sample: before the first, a gap
+    /// (or samples of both sensors, mixed) between two, or after the `last`.
+    fn close(&mut self, last: bool) {
         let (g, a) = std::mem::take(&mut self.open);
         if self.paired == 0 {
             self.gyro.before += g;
             self.accel.before += a;
+        } else if last {
+            self.gyro.after += g;
+            self.accel.after += a;
         } else {
             match (g, a) {
                 (0, 0) => {}
@@ -757,7 +767,6 @@ impl Pairing {
                 (g, a) => self.mixed += g + a,
             }
         }
-        self.paired += 1;
     }
 
     /// `n` samples of `sensor` without a partner.
@@ -776,14 +785,7 @@ impl Pairing {
 
     /// The samples alone after the last paired sample.
     fn finish(&mut self) {
-        let (g, a) = std::mem::take(&mut self.open);
-        if self.paired == 0 {
-            self.gyro.before += g;
-            self.accel.before += a;
-        } else {
-            self.gyro.after += g;
-            self.accel.after += a;
-        }
+        self.close(true);
     }
 
     /// Why the samples without a partner have none, when a topic lost messages or spans less
@@ -1260,6 +1262,7 @@ impl Beside {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Scratch;
 
     /// The format PX4 writes for `sensor_gyro_fifo` and `sensor_accel_fifo` (after `name:`).
     const FIFO: &str = concat!(
@@ -1313,32 +1316,9 @@ mod tests {
         bytes
     }
 
-    /// `bytes` in a scratch file of its own (tests run on several threads), removed when
-    /// dropped.
-    struct Scratch(PathBuf);
-
-    impl Scratch {
-        /// `bytes` in a new scratch file.
-        fn new(bytes: &[u8]) -> Self {
-            use std::sync::atomic::{AtomicU64, Ordering};
-            static CALLS: AtomicU64 = AtomicU64::new(0);
-            let call = CALLS.fetch_add(1, Ordering::Relaxed);
-            let name = format!("imu-ar-source-{}-{call}.ulg", std::process::id());
-            let path = std::env::temp_dir().join(name);
-            std::fs::write(&path, bytes).expect("a scratch file");
-            Scratch(path)
-        }
-    }
-
-    impl Drop for Scratch {
-        fn drop(&mut self) {
-            let _ = std::fs::remove_file(&self.0);
-        }
-    }
-
     /// The refusal of the six axes of the ULog file `bytes`.
     fn six_axis_refusal(bytes: &[u8]) -> String {
-        let file = Scratch::new(bytes);
+        let file = Scratch::new(bytes, "ulg");
         let columns: Vec<String> = AXES.iter().map(|a| a.to_string()).collect();
         let request = Request {
             columns: &columns,

@@ -871,21 +871,44 @@ fn hand_mcap(
     frames: &[Frame],
     channel_of: impl Fn(usize) -> u16,
 ) -> Vec<u8> {
+    let messages = MessagesOf {
+        schema: ("sensor_msgs/msg/Imu", "ros2msg"),
+        encoding: "cdr",
+        data: |f: &Frame, _| cdr(f),
+    };
+    hand_mcap_of(&messages, channels, frames, channel_of)
+}
+
+/// How an MCAP file's IMU messages are written: the schema (name, encoding), the channels'
+/// message encoding, and each frame's data (the frame, its number).
+struct MessagesOf<'a, D: Fn(&Frame, usize) -> Vec<u8>> {
+    schema: (&'a str, &'a str),
+    encoding: &'a str,
+    data: D,
+}
+
+/// [`hand_mcap`] of `messages`.
+fn hand_mcap_of<D: Fn(&Frame, usize) -> Vec<u8>>(
+    messages: &MessagesOf<'_, D>,
+    channels: &[(u16, &str)],
+    frames: &[Frame],
+    channel_of: impl Fn(usize) -> u16,
+) -> Vec<u8> {
     let mut out = b"\x89MCAP0\r\n".to_vec();
     let mut body = Vec::new();
     string(&mut body, "ros2");
     string(&mut body, "hand");
     record(&mut out, 0x01, &body);
     let mut schema = 1u16.to_le_bytes().to_vec();
-    string(&mut schema, "sensor_msgs/msg/Imu");
-    string(&mut schema, "ros2msg");
+    string(&mut schema, messages.schema.0);
+    string(&mut schema, messages.schema.1);
     schema.extend(0u32.to_le_bytes());
     record(&mut out, 0x03, &schema);
     for &(id, topic) in channels {
         let mut c = id.to_le_bytes().to_vec();
         c.extend(1u16.to_le_bytes());
         string(&mut c, topic);
-        string(&mut c, "cdr");
+        string(&mut c, messages.encoding);
         c.extend(0u32.to_le_bytes());
         record(&mut out, 0x04, &c);
     }
@@ -894,7 +917,7 @@ fn hand_mcap(
         m.extend((i as u32).to_le_bytes());
         m.extend((f.stamp_ns as u64).to_le_bytes());
         m.extend((f.stamp_ns as u64).to_le_bytes());
-        m.extend(cdr(f));
+        m.extend((messages.data)(f, i));
         record(&mut out, 0x05, &m);
     }
     record(&mut out, 0x0f, &0u32.to_le_bytes());
@@ -1233,37 +1256,12 @@ fn an_mcap_file_of_ros1_messages_is_read_as_a_bag_is() {
     let dir = temp_dir("mcap-ros1");
     let frames = noise(300, 2);
     let file = |schema: (&str, &str), encoding: &str| {
-        let mut out = b"\x89MCAP0\r\n".to_vec();
-        let mut body = Vec::new();
-        string(&mut body, "ros1");
-        string(&mut body, "hand");
-        record(&mut out, 0x01, &body);
-        let mut s = 1u16.to_le_bytes().to_vec();
-        string(&mut s, schema.0);
-        string(&mut s, schema.1);
-        s.extend(0u32.to_le_bytes());
-        record(&mut out, 0x03, &s);
-        let mut c = 1u16.to_le_bytes().to_vec();
-        c.extend(1u16.to_le_bytes());
-        string(&mut c, "/imu0");
-        string(&mut c, encoding);
-        c.extend(0u32.to_le_bytes());
-        record(&mut out, 0x04, &c);
-        for (i, f) in frames.iter().enumerate() {
-            let mut m = 1u16.to_le_bytes().to_vec();
-            m.extend((i as u32).to_le_bytes());
-            m.extend((f.stamp_ns as u64).to_le_bytes());
-            m.extend((f.stamp_ns as u64).to_le_bytes());
-            m.extend(ros1(f, i as u32));
-            record(&mut out, 0x05, &m);
-        }
-        record(&mut out, 0x0f, &0u32.to_le_bytes());
-        let mut footer = 0u64.to_le_bytes().to_vec();
-        footer.extend(0u64.to_le_bytes());
-        footer.extend(0u32.to_le_bytes());
-        record(&mut out, 0x02, &footer);
-        out.extend(b"\x89MCAP0\r\n");
-        out
+        let messages = MessagesOf {
+            schema,
+            encoding,
+            data: |f: &Frame, i| ros1(f, i as u32),
+        };
+        hand_mcap_of(&messages, &[(1, "/imu0")], &frames, |_| 1)
     };
     let good = dir.join("ros1.mcap");
     std::fs::write(&good, file(("sensor_msgs/Imu", "ros1msg"), "ros1")).unwrap();
