@@ -195,8 +195,9 @@ pub(super) struct Fit {
 impl Fit {
     /// The share of the times `t` (s, in order) within `window` cycles of their place, the
     /// share of the places from the first time's to the last's with a time so near, and
-    /// how many places that is.
-    pub fn cover(&self, t: &[f64], window: f64) -> (f64, f64, f64) {
+    /// how many places that is; the places within the stretches `hidden` (s, in order, apart:
+    /// where no time can be) left out.
+    pub fn cover(&self, t: &[f64], window: f64, hidden: &[(f64, f64)]) -> (f64, f64, f64) {
         let (mut near, mut places, mut last) = (0usize, 0usize, f64::NEG_INFINITY);
         for &x in t {
             let r = (x - self.origin) / self.period;
@@ -210,7 +211,13 @@ impl Fit {
         }
         let ends = |x: f64| ((x - self.origin) / self.period).round();
         let all = match (t.first(), t.last()) {
-            (Some(&a), Some(&b)) => ends(b) - ends(a) + 1.0,
+            (Some(&a), Some(&b)) => {
+                let unseen: f64 = hidden
+                    .iter()
+                    .map(|&(from, to)| ((to.min(b) - from.max(a)) / self.period).floor().max(0.0))
+                    .sum();
+                (ends(b) - ends(a) + 1.0 - unseen).max(1.0)
+            }
             _ => 1.0,
         };
         (
