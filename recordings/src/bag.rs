@@ -24,7 +24,8 @@ use rosbag::{ChunkRecord, IndexRecord, MessageRecord, RosBag};
 use crate::csv::DataError;
 use crate::error::escaped;
 use crate::frame::{
-    Frame, IMU_F64S, Select, Skipped, Tally, absent_topic, data_error, imu_axes, stamp_ns, u32_at,
+    Decoded, Frame, IMU_F64S, NotProvided, Select, Skipped, Tally, absent_topic, data_error,
+    imu_axes, stamp_ns, u32_at,
 };
 
 /// The message type of the IMU connections.
@@ -45,7 +46,8 @@ const MAGIC: &[u8] = b"#ROSBAG V2.0\n";
 /// messages on the topic sorted (56 bytes each held).
 ///
 /// Messages that cannot be decoded, and those with a NaN or an infinite axis, are counted and
-/// not delivered. An error (after the frames already delivered, when the damage is found
+/// not delivered; those that mark their gyro or accelerometer as not provided (the first
+/// element of its covariance -1) are delivered and counted ([`Skipped::not_provided`]). An error (after the frames already delivered, when the damage is found
 /// midway) when the file is not a bag of format 2.0, is truncated or corrupt, has no
 /// connection on `topic`, has one of another type (or another definition of `sensor_msgs/Imu`),
 /// or has no finite message on it.
@@ -184,12 +186,12 @@ pub fn read_selected(
                 continue;
             }
             found += 1;
-            let frame = decode(m.data).map(|(f, id)| {
+            let frame = decode(m.data).map(|(f, marks, id)| {
                 let k = frame_ids.iter().position(|i| i == id).unwrap_or_else(|| {
                     frame_ids.push(id.to_vec());
                     frame_ids.len() - 1
                 });
-                (f, u16::try_from(k).unwrap_or(u16::MAX))
+                (f, marks, u16::try_from(k).unwrap_or(u16::MAX))
             });
             sorted.push((m.time, m.conn_id, frame));
         }
@@ -223,13 +225,13 @@ fn deliver(held: &mut Vec<Held>, frame_ids: &[Vec<u8>], tally: &mut Tally) {
     held.sort_by_key(|&(time, _, _)| time);
     for (_, conn, frame) in held.drain(..) {
         let id = |k: u16| frame_ids.get(usize::from(k)).map_or(&[][..], Vec::as_slice);
-        tally.offer(conn, frame.map(|(f, k)| (f, id(k))));
+        tally.offer(conn, frame.map(|(f, marks, k)| (f, marks, id(k))));
     }
 }
 
-/// A message held to be sorted: its receive time, connection, and frame with the index of its
-/// frame_id (`None` when it did not decode).
-type Held = (u64, u32, Option<(Frame, u16)>);
+/// A message held to be sorted: its receive time, connection, and frame with the sensors it
+/// marks as not provided and the index of its frame_id (`None` when it did not decode).
+type Held = (u64, u32, Option<(Frame, NotProvided, u16)>);
 
 /// The rosbag crate's error text without its `rosbag::Error: ` prefix.
 fn text(e: &rosbag::Error) -> String {
@@ -310,9 +312,10 @@ fn not_a_bag(head: &[u8]) -> String {
     }
 }
 
-/// The frame of one serialized `sensor_msgs/Imu` and its header's frame_id: `None` when its
-/// length is not that of the message (the header's frame_id length included).
-pub(crate) fn decode(b: &[u8]) -> Option<(Frame, &[u8])> {
+/// The frame of one serialized `sensor_msgs/Imu`, the sensors it marks as not provided, and
+/// its header's frame_id: `None` when its length is not that of the message (the header's
+/// frame_id length included).
+pub(crate) fn decode(b: &[u8]) -> Option<Decoded<'_>> {
     let secs = u32_at(b, 4, false)?;
     let nsecs = u32_at(b, 8, false)?;
     let frame_id = usize::try_from(u32_at(b, 12, false)?).ok()?;
@@ -320,9 +323,10 @@ pub(crate) fn decode(b: &[u8]) -> Option<(Frame, &[u8])> {
     if b.len() != at.checked_add(IMU_F64S * 8)? {
         return None;
     }
+    let (axes, marks) = imu_axes(b, at, false)?;
     let frame = Frame {
         stamp_ns: stamp_ns(i64::from(secs), nsecs),
-        axes: imu_axes(b, at, false)?,
+        axes,
     };
-    Some((frame, b.get(16..at)?))
+    Some((frame, marks, b.get(16..at)?))
 }

@@ -1,6 +1,9 @@
 //! One IMU message as the ROS readers ([`super::bag`], [`super::mcap`]) deliver it, what they
 //! skipped, and what the two readers share: the little-endian and big-endian field access that
-//! cannot panic, and the tally that delivers the finite frames and counts the others.
+//! cannot panic, and the tally that delivers the finite frames and counts the others, and the
+//! messages that mark their gyro or accelerometer as not provided (the first element of its
+//! covariance -1, sensor_msgs/Imu), for [`Skipped::not_provided`] to refuse reading that
+//! sensor.
 
 use std::fs::File;
 use std::io::Read;
@@ -34,6 +37,13 @@ pub struct Skipped {
     /// Logs whose last message the end of the file cuts short (a PX4 ULog file or an
     /// ArduPilot DataFlash log written until the power went): the samples before it are read.
     pub cut_short: u64,
+    /// Delivered messages that mark their gyro as not provided
+    /// (`angular_velocity_covariance[0] = -1`): their angular_velocity is no measurement.
+    pub gyro_not_provided: u64,
+    /// Delivered messages that mark their accelerometer as not provided
+    /// (`linear_acceleration_covariance[0] = -1`): their linear_acceleration is no
+    /// measurement.
+    pub accel_not_provided: u64,
 }
 
 impl Skipped {
@@ -53,6 +63,51 @@ impl Skipped {
         .map(|(n, what)| format!("{n} {what}"))
         .collect();
         (!parts.is_empty()).then(|| format!("messages skipped: {}", parts.join(", ")))
+    }
+
+    /// The refusal of a read of the gyro's axes (`gyro`) or the accelerometer's (`accel`) when
+    /// the messages mark that sensor as not provided: sensor_msgs/Imu says a covariance whose
+    /// first element is -1 means "this estimate is not provided; disregard it". `None` when
+    /// no message marks a sensor read.
+    ///
+    /// ```
+    /// use imu_ar_recordings::frame::Skipped;
+    /// let gyro_only = Skipped { accel_not_provided: 400, ..Skipped::default() };
+    /// assert!(gyro_only.not_provided(true, false).is_none());
+    /// let refusal = gyro_only.not_provided(true, true).unwrap();
+    /// assert!(refusal.starts_with(
+    ///     "the messages mark the accelerometer as not provided: \
+    ///      linear_acceleration_covariance[0] = -1"
+    /// ));
+    /// ```
+    pub fn not_provided(&self, gyro: bool, accel: bool) -> Option<String> {
+        let marked: Vec<String> = [
+            (
+                gyro,
+                self.gyro_not_provided,
+                "gyro",
+                "angular_velocity",
+                "accelerometer's (ax, ay, az)",
+            ),
+            (
+                accel,
+                self.accel_not_provided,
+                "accelerometer",
+                "linear_acceleration",
+                "gyro's (gx, gy, gz)",
+            ),
+        ]
+        .iter()
+        .filter(|(read, n, ..)| *read && *n > 0)
+        .map(|(_, n, sensor, field, other)| {
+            format!(
+                "the messages mark the {sensor} as not provided: {field}_covariance[0] = -1 \
+                 in {n} of them (sensor_msgs/Imu: disregard its values); the {other} axes \
+                 can be read alone"
+            )
+        })
+        .collect();
+        (!marked.is_empty()).then(|| marked.join("; "))
     }
 
     /// The warning for a log cut short, when it is.
@@ -100,27 +155,44 @@ pub(crate) fn f64_at(bytes: &[u8], at: usize, big: bool) -> Option<f64> {
 /// (4), its covariance (9), angular_velocity (3), its covariance (9), linear_acceleration (3),
 /// its covariance (9).
 pub(crate) const IMU_F64S: usize = 37;
-/// Where angular_velocity starts among those float64s.
+/// Where angular_velocity starts among those float64s (its covariance 3 later).
 const ANGULAR: usize = 13;
-/// Where linear_acceleration starts among those float64s.
+/// Where linear_acceleration starts among those float64s (its covariance 3 later).
 const LINEAR: usize = 25;
 
+/// The sensors a `sensor_msgs/Imu` message marks as not provided: the first element of
+/// `angular_velocity_covariance`, of `linear_acceleration_covariance`, is -1 ("this estimate
+/// is not provided; disregard it").
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct NotProvided {
+    /// angular_velocity_covariance[0] is -1.
+    pub(crate) gyro: bool,
+    /// linear_acceleration_covariance[0] is -1.
+    pub(crate) accel: bool,
+}
+
 /// The six axes of the float64 fields of a `sensor_msgs/Imu` that start at byte `at` of
-/// `bytes`: `None` when `bytes` is too short.
-pub(crate) fn imu_axes(bytes: &[u8], at: usize, big: bool) -> Option<[f64; 6]> {
+/// `bytes`, and the sensors their covariances mark as not provided: `None` when `bytes` is
+/// too short.
+pub(crate) fn imu_axes(bytes: &[u8], at: usize, big: bool) -> Option<([f64; 6], NotProvided)> {
     let end = at.checked_add(IMU_F64S * 8)?;
     if bytes.len() < end {
         return None;
     }
     let field = |i: usize| f64_at(bytes, at.checked_add(i * 8)?, big);
-    Some([
+    let axes = [
         field(ANGULAR)?,
         field(ANGULAR + 1)?,
         field(ANGULAR + 2)?,
         field(LINEAR)?,
         field(LINEAR + 1)?,
         field(LINEAR + 2)?,
-    ])
+    ];
+    let not_provided = NotProvided {
+        gyro: field(ANGULAR + 3)? == -1.0,
+        accel: field(LINEAR + 3)? == -1.0,
+    };
+    Some((axes, not_provided))
 }
 
 /// A stamp of `sec` seconds and `nanosec` nanoseconds in nanoseconds (no overflow: `sec` is a
@@ -174,8 +246,12 @@ pub(crate) struct Tally<'a> {
     zstd: u64,
 }
 
-/// A message's decoder: its frame and header frame_id, or `None`.
-pub(crate) type Decode = fn(&[u8]) -> Option<(Frame, &[u8])>;
+/// A decoded message: its frame, the sensors it marks as not provided, and its header's
+/// frame_id.
+pub(crate) type Decoded<'a> = (Frame, NotProvided, &'a [u8]);
+
+/// A message's decoder: the message decoded, or `None`.
+pub(crate) type Decode = fn(&[u8]) -> Option<Decoded<'_>>;
 
 /// The first bytes of a zstd frame.
 const ZSTD_MAGIC: [u8; 4] = [0x28, 0xb5, 0x2f, 0xfd];
@@ -199,17 +275,29 @@ impl<'a> Tally<'a> {
 
     /// [`Tally::offer`] of a message's `data` (none where it is missing), decoded by `decode`.
     pub(crate) fn offer_data(&mut self, source: u32, data: Option<&[u8]>, decode: Decode) {
+        let decoded = self.decode(data, decode);
+        self.offer(source, decoded);
+    }
+
+    /// A message's `data` (none where it is missing) decoded by `decode`, to be offered
+    /// later; one that does not decode and is a zstd frame is counted for [`Tally::finish`].
+    pub(crate) fn decode<'d>(
+        &mut self,
+        data: Option<&'d [u8]>,
+        decode: Decode,
+    ) -> Option<Decoded<'d>> {
         let decoded = data.and_then(decode);
         if decoded.is_none() && data.is_some_and(|d| d.starts_with(&ZSTD_MAGIC)) {
             self.zstd += 1;
         }
-        self.offer(source, decoded);
+        decoded
     }
 
-    /// One message on the topic from publisher `source`: its frame and header frame_id when
-    /// decoded. Delivered when decoded, finite and of the chosen frame_id; counted otherwise.
-    pub(crate) fn offer(&mut self, source: u32, decoded: Option<(Frame, &[u8])>) {
-        let Some((frame, frame_id)) = decoded else {
+    /// One message on the topic from publisher `source`, when decoded. Delivered when decoded,
+    /// finite and of the chosen frame_id (and counted when it marks a sensor as not
+    /// provided); counted otherwise.
+    pub(crate) fn offer(&mut self, source: u32, decoded: Option<Decoded<'_>>) {
+        let Some((frame, not_provided, frame_id)) = decoded else {
             self.skipped.undecodable += 1;
             return;
         };
@@ -259,6 +347,8 @@ impl<'a> Tally<'a> {
             s.span = Some(s.span.map_or((t, t), |(a, b)| (a.min(t), b.max(t))));
         }
         self.delivered += 1;
+        self.skipped.gyro_not_provided += u64::from(not_provided.gyro);
+        self.skipped.accel_not_provided += u64::from(not_provided.accel);
         (self.each)(frame);
     }
 
@@ -452,8 +542,9 @@ mod tests {
             };
             let mut tally = Tally::new(&select, &mut each);
             for t in 0..10 {
-                tally.offer(1, Some((frame(2 * t), text)));
-                tally.offer(2, Some((frame(2 * t + 1), bytes)));
+                let none = NotProvided::default();
+                tally.offer(1, Some((frame(2 * t), none, text)));
+                tally.offer(2, Some((frame(2 * t + 1), none, bytes)));
             }
             let finished = tally.finish(file, "/imu", &|id| format!("connection {id}"));
             match result {

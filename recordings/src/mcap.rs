@@ -3,10 +3,17 @@
 //! zstd or lz4 chunks, through the sans-I/O reader of the [`mcap`] crate.
 //!
 //! The file is read front to back in pieces of 256 KiB and one chunk is decompressed at a
-//! time (its CRC, when it has one, checked before any of its messages is delivered): memory is
-//! bounded by the largest chunk, whatever the length of the file. Messages are delivered in
-//! file order (chunk after chunk, each chunk's messages as stored), not re-sorted by log time.
-//! A channel is checked when its record is read, which is before any of its messages.
+//! time (its CRC, when it has one, checked before any of its messages is delivered). Messages
+//! are delivered in the order of their log times, as the MCAP readers play them: each chunk's
+//! messages on the topic are held and sorted, and those logged before every chunk still to
+//! come (the start times of the chunk index in the file's summary) are delivered. Memory is
+//! bounded by the largest chunk and the topic's messages of one chunk (some 90 bytes each)
+//! when the chunks follow each other in time, as recorders write them; when they do not
+//! (chunks written out of order, or whose times overlap), the messages are held until the
+//! chunks that come before them in time are read. A file without a chunk index (unchunked, or
+//! with no summary) is read in file order: a message logged before the one before it, and
+//! stamped before it too, is refused as the file being out of log-time order. A channel is
+//! checked when its record is read, which is before any of its messages.
 //!
 //! A message is decoded by hand from its CDR serialization (OMG CDR, XCDR version 1: OMG DDS-XTypes
 //! 1.3 section 7.4.3, <https://www.omg.org/spec/DDS-XTypes/1.3>, as the ROS 2 middleware writes
@@ -22,8 +29,11 @@
 //! as a bag's message is.
 
 use crate::frame::open_head;
-use std::collections::HashMap;
-use std::io::{ErrorKind, Read};
+use std::cmp::Ordering;
+use std::collections::binary_heap::PeekMut;
+use std::collections::{BinaryHeap, HashMap};
+use std::fs::File;
+use std::io::{BufReader, ErrorKind, Read, Seek, SeekFrom};
 use std::path::Path;
 
 use ::mcap::records::{Record, op};
@@ -31,7 +41,8 @@ use ::mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
 
 use crate::csv::DataError;
 use crate::frame::{
-    Frame, Select, Skipped, Tally, absent_topic, bytes_at, data_error, imu_axes, stamp_ns, u32_at,
+    Decoded, Frame, NotProvided, Select, Skipped, Tally, absent_topic, bytes_at, data_error,
+    imu_axes, stamp_ns, u32_at,
 };
 
 /// The schema name of the IMU channels.
@@ -49,6 +60,9 @@ const ROS1: &str = "ros1";
 /// The schema encodings of ROS 2 message definitions.
 const SCHEMA_ENCODINGS: [&str; 2] = ["ros2msg", "ros2idl"];
 
+/// The schema encodings read, for a refusal: ROS 2's, and ROS 1's with its type name.
+const READ_ENCODINGS: &str = "ros2msg, ros2idl, or ros1msg for the ROS 1 type sensor_msgs/Imu";
+
 /// How much of the file is asked for at a time, at least.
 const READ_SIZE: usize = 256 * 1024;
 
@@ -57,13 +71,16 @@ const READ_SIZE: usize = 256 * 1024;
 const MIN_RECORD_LIMIT: u64 = 64 * 1024 * 1024;
 
 /// Calls `each` with every finite `sensor_msgs/msg/Imu` message on `topic` of the MCAP file
-/// `path`, in file order, and returns what was skipped.
+/// `path`, in the order of their log times (stable), and returns what was skipped.
 ///
 /// Messages that cannot be decoded, and those with a NaN or an infinite axis, are counted and
-/// not delivered. An error (after the frames already delivered, when the damage is found
+/// not delivered; those that mark their gyro or accelerometer as not provided (the first
+/// element of its covariance -1) are delivered and counted ([`Skipped::not_provided`]). An error (after the frames already delivered, when the damage is found
 /// midway) when the file is not an MCAP file, is truncated or corrupt, has no channel on
-/// `topic`, has one with another schema, another schema encoding than ros2msg or ros2idl, or
-/// another message encoding than cdr, or has no finite message on it.
+/// `topic`, has one with another schema, another schema encoding than ros2msg or ros2idl
+/// (ros1msg with message encoding ros1 for the ROS 1 type), or another message encoding than
+/// cdr, has no finite message on it, or has no chunk index and its messages out of log-time
+/// order (their header stamps too).
 pub fn read(path: &Path, topic: &str, each: &mut dyn FnMut(Frame)) -> Result<Skipped, DataError> {
     read_selected(path, &Select::topic(topic), each)
 }
@@ -110,6 +127,19 @@ pub(crate) fn read_compressed(
         return Err(fail(not_mcap(&head)));
     }
     let limit = usize::try_from(len.max(MIN_RECORD_LIMIT)).unwrap_or(usize::MAX);
+    let starts = chunk_starts(&mut file, len);
+    let indexed = !starts.is_empty();
+    // The earliest start time of the chunks from the k-th on (in file order): the messages
+    // logged before it are all read once k chunks are.
+    let mut later = starts;
+    let mut earliest = u64::MAX;
+    for t in later.iter_mut().rev() {
+        earliest = earliest.min(*t);
+        *t = earliest;
+    }
+    later.push(u64::MAX);
+    file.seek(SeekFrom::Start(::mcap::MAGIC.len() as u64))
+        .map_err(|e| fail(format!("cannot read: {e}")))?;
     // Chunks are handed over whole and opened here: the reader trusts the lengths of the
     // records inside an uncompressed chunk.
     let mut reader = LinearReader::new_with_options(
@@ -125,7 +155,13 @@ pub(crate) fn read_compressed(
         messages: 0,
         tally: Tally::new(select, each),
         zstd_messages,
+        held: BinaryHeap::new(),
+        frame_ids: Vec::new(),
+        last: Vec::new(),
+        indexed,
     };
+    // The chunks read so far.
+    let mut chunks = 0usize;
     let corrupt = |what: &dyn std::fmt::Display, messages: u64| {
         fail(format!(
             "truncated or corrupt MCAP file: {what} (after {messages} messages)"
@@ -168,15 +204,21 @@ pub(crate) fn read_compressed(
                         .map_err(|r| refused(r, messages))?;
                     rest = after;
                 }
+                chunks = chunks.saturating_add(1);
+                let before = later.get(chunks).copied().unwrap_or(u64::MAX);
+                state.release(before, topic).map_err(fail)?;
             }
             LinearReadEvent::Record { opcode, data } => {
                 let messages = state.messages;
                 state
                     .record(opcode, data, topic)
                     .map_err(|r| refused(r, messages))?;
+                let before = later.get(chunks).copied().unwrap_or(u64::MAX);
+                state.release(before, topic).map_err(fail)?;
             }
         }
     }
+    state.release(u64::MAX, topic).map_err(fail)?;
     let State {
         channels,
         counted,
@@ -231,7 +273,50 @@ struct State<'a> {
     tally: Tally<'a>,
     /// Whether each message's data is a zstd frame.
     zstd_messages: bool,
+    /// The topic's messages read and not yet delivered, the earliest logged on top.
+    held: BinaryHeap<Held>,
+    /// The frame_ids of the held messages, which name them by index.
+    frame_ids: Vec<Vec<u8>>,
+    /// The log time and header stamp of the last message delivered of each frame_id (up to
+    /// [`CHECKED_FRAME_IDS`] of them).
+    last: Vec<(Vec<u8>, u64, i64)>,
+    /// Whether the file's summary has a chunk index.
+    indexed: bool,
 }
+
+/// A message held to be sorted: its log time, its number among the topic's messages, its
+/// channel, and its frame with the sensors it marks as not provided and the index of its
+/// frame_id (`None` when it did not decode). Ordered for a max-heap to pop the earliest log
+/// time first, and of equal log times the first read.
+struct Held {
+    log_time: u64,
+    number: u64,
+    channel: u16,
+    decoded: Option<(Frame, NotProvided, u32)>,
+}
+
+impl Ord for Held {
+    fn cmp(&self, other: &Self) -> Ordering {
+        (other.log_time, other.number).cmp(&(self.log_time, self.number))
+    }
+}
+
+impl PartialOrd for Held {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl PartialEq for Held {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other) == Ordering::Equal
+    }
+}
+
+impl Eq for Held {}
+
+/// The most frame_ids whose order of log times is checked.
+const CHECKED_FRAME_IDS: usize = 16;
 
 /// Why a record was not taken: the file is damaged, or a channel on the topic cannot be read.
 enum Refusal {
@@ -295,6 +380,7 @@ impl State<'_> {
                 }
                 if self.channels.wanted.contains(&channel) {
                     self.found += 1;
+                    let log_time = bytes_at::<8>(data, 6).map_or(0, u64::from_le_bytes);
                     let plain;
                     let body = match data.get(22..) {
                         Some(b) if self.zstd_messages => {
@@ -308,13 +394,138 @@ impl State<'_> {
                     } else {
                         decode
                     };
-                    self.tally.offer_data(u32::from(channel), body, decode);
+                    let decoded = self.tally.decode(body, decode).map(|(f, marks, id)| {
+                        let k = match self.frame_ids.iter().position(|i| i == id) {
+                            Some(k) => k,
+                            None => {
+                                self.frame_ids.push(id.to_vec());
+                                self.frame_ids.len() - 1
+                            }
+                        };
+                        (f, marks, u32::try_from(k).unwrap_or(u32::MAX))
+                    });
+                    self.held.push(Held {
+                        log_time,
+                        number: self.found,
+                        channel,
+                        decoded,
+                    });
                 }
                 Ok(())
             }
             _ => Ok(()),
         }
     }
+}
+
+impl State<'_> {
+    /// Delivers the held messages logged before `before`, in the order of their log times
+    /// (stable). An error when the one delivered before a message of its frame_id was logged
+    /// and stamped after it: the file is out of log-time order where its chunk index (or its
+    /// lack of one) could not put it in order.
+    fn release(&mut self, before: u64, topic: &str) -> Result<(), String> {
+        while let Some(top) = self.held.peek_mut()
+            && top.log_time < before
+        {
+            let Held {
+                log_time,
+                channel,
+                decoded,
+                ..
+            } = PeekMut::pop(top);
+            let decoded: Option<Decoded<'_>> = decoded.map(|(f, marks, k)| {
+                let id = usize::try_from(k)
+                    .ok()
+                    .and_then(|k| self.frame_ids.get(k))
+                    .map_or(&[][..], Vec::as_slice);
+                (f, marks, id)
+            });
+            if let Some((frame, _, id)) = decoded {
+                let full = self.last.len() >= CHECKED_FRAME_IDS;
+                match self.last.iter_mut().find(|(i, _, _)| i.as_slice() == id) {
+                    Some((_, t, stamp)) if log_time < *t && frame.stamp_ns < *stamp => {
+                        return Err(format!(
+                            "the file's messages are out of log-time order: a message on \
+                             '{topic}' logged at {log_time} ns (stamped {} ns) follows one \
+                             logged at {t} ns (stamped {stamp} ns), and {}",
+                            frame.stamp_ns,
+                            if self.indexed {
+                                "its chunk index does not match its chunks"
+                            } else {
+                                "the file has no chunk index to read them in order by"
+                            }
+                        ));
+                    }
+                    Some((_, t, stamp)) => (*t, *stamp) = (log_time, frame.stamp_ns),
+                    None if !full => {
+                        self.last.push((id.to_vec(), log_time, frame.stamp_ns));
+                    }
+                    None => {}
+                }
+            }
+            self.tally.offer(u32::from(channel), decoded);
+        }
+        if self.held.is_empty() {
+            self.frame_ids.clear();
+        }
+        Ok(())
+    }
+}
+
+/// The start times of the chunks in the chunk index of the summary of the MCAP file `file`
+/// (`len` bytes), in the order of the chunks in the file; none when it has no summary or no
+/// chunk index, or they cannot be read.
+fn chunk_starts(file: &mut File, len: u64) -> Vec<u64> {
+    chunk_index(file, len).unwrap_or_default()
+}
+
+/// [`chunk_starts`], `None` where it finds none.
+fn chunk_index(file: &mut File, len: u64) -> Option<Vec<u64>> {
+    // The footer record (opcode, length 20, summary_start, summary_offset_start, CRC) and the
+    // closing magic end the file.
+    let magic = ::mcap::MAGIC.len() as u64;
+    let footer = len.checked_sub(magic + 9 + 20)?;
+    file.seek(SeekFrom::Start(footer)).ok()?;
+    let mut record = [0u8; 29];
+    file.read_exact(&mut record).ok()?;
+    if record[0] != op::FOOTER || bytes_at::<8>(&record, 1).map(u64::from_le_bytes) != Some(20) {
+        return None;
+    }
+    let start = bytes_at::<8>(&record, 9).map(u64::from_le_bytes)?;
+    if start < magic || start >= footer {
+        return None;
+    }
+    file.seek(SeekFrom::Start(start)).ok()?;
+    let mut summary = BufReader::new(file);
+    // Chunk start offset and start time of each chunk index record.
+    let mut chunks: Vec<(u64, u64)> = Vec::new();
+    let mut at = start;
+    while at < footer {
+        let mut head = [0u8; 9];
+        summary.read_exact(&mut head).ok()?;
+        let size = bytes_at::<8>(&head, 1).map(u64::from_le_bytes)?;
+        let end = at.checked_add(9)?.checked_add(size)?;
+        if end > footer {
+            return None;
+        }
+        let mut skip = size;
+        if head[0] == op::CHUNK_INDEX {
+            // message_start_time, message_end_time, chunk_start_offset.
+            let mut fields = [0u8; 24];
+            if size < 24 {
+                return None;
+            }
+            summary.read_exact(&mut fields).ok()?;
+            let time = bytes_at::<8>(&fields, 0).map(u64::from_le_bytes)?;
+            let offset = bytes_at::<8>(&fields, 16).map(u64::from_le_bytes)?;
+            chunks.push((offset, time));
+            skip -= 24;
+        }
+        summary.seek_relative(i64::try_from(skip).ok()?).ok()?;
+        at = end;
+    }
+    chunks.sort_unstable();
+    Some(chunks.into_iter().map(|(_, time)| time).collect())
 }
 
 /// The record `data` of kind `opcode`, parsed by the [`mcap`] crate once its strings are
@@ -534,8 +745,8 @@ fn check_channel(
     }
     if !SCHEMA_ENCODINGS.contains(&encoding.as_str()) {
         return Err(format!(
-            "unknown schema encoding '{encoding}' on topic '{topic}' (supported: {})",
-            SCHEMA_ENCODINGS.join(", ")
+            "unknown schema encoding '{encoding}' on topic '{topic}' (supported: \
+             {READ_ENCODINGS})"
         ));
     }
     if message_encoding != CDR {
@@ -557,10 +768,10 @@ fn not_mcap(head: &[u8]) -> String {
     }
 }
 
-/// The frame of one CDR-serialized `sensor_msgs/msg/Imu` and its header's frame_id (without
-/// its NUL): `None` when the encapsulation is not CDR_LE or CDR_BE, or the message is too
-/// short.
-pub(crate) fn decode(b: &[u8]) -> Option<(Frame, &[u8])> {
+/// The frame of one CDR-serialized `sensor_msgs/msg/Imu`, the sensors it marks as not
+/// provided, and its header's frame_id (without its NUL): `None` when the encapsulation is not
+/// CDR_LE or CDR_BE, or the message is too short.
+pub(crate) fn decode(b: &[u8]) -> Option<Decoded<'_>> {
     let big = match b.get(..2)? {
         [0, 1] => false,
         [0, 0] => true,
@@ -573,10 +784,11 @@ pub(crate) fn decode(b: &[u8]) -> Option<(Frame, &[u8])> {
     let frame_id = usize::try_from(u32_at(body, 8, big)?).ok()?;
     let end = 12usize.checked_add(frame_id)?;
     let at = end.checked_add(7)? & !7;
+    let (axes, marks) = imu_axes(body, at, big)?;
     let frame = Frame {
         stamp_ns: stamp_ns(i64::from(sec), nanosec),
-        axes: imu_axes(body, at, big)?,
+        axes,
     };
     let id = body.get(12..end)?;
-    Some((frame, id.strip_suffix(&[0]).unwrap_or(id)))
+    Some((frame, marks, id.strip_suffix(&[0]).unwrap_or(id)))
 }

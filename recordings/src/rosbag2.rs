@@ -15,6 +15,7 @@
 //! table `messages` (`topic_id`, `timestamp`, `data`), each message's `data` the CDR
 //! serialization of the message, decoded as in an MCAP file. Messages are read in the order of
 //! their receive `timestamp` (then of their row), which is the order `ros2 bag play` plays.
+//! The database is opened read-only and immutable: nothing is written, in it or beside it.
 
 use std::path::{Path, PathBuf};
 
@@ -252,6 +253,8 @@ pub fn read_folder(
                 skipped.undecodable += s.undecodable;
                 skipped.non_finite += s.non_finite;
                 skipped.other_frame_id += s.other_frame_id;
+                skipped.gyro_not_provided += s.gyro_not_provided;
+                skipped.accel_not_provided += s.accel_not_provided;
             }
             // A split bag's file may hold none of the topic's messages; the others must.
             Err(e) if files.len() > 1 && e.problem.starts_with("no ") => last_err = Some(e),
@@ -279,6 +282,45 @@ pub fn read_db3(
     read_db3_compressed(path, select, each, false)
 }
 
+/// The SQLite database `path` opened read-only. Opened immutable (a URI with `immutable=1`):
+/// SQLite takes no lock and writes nothing, neither the database nor a `-shm` or `-wal` file
+/// beside it, so a database in WAL mode (rosbag2's `resilient` storage preset) is read where
+/// its reader may not write and leaves its folder as it was. A database with a write-ahead log
+/// beside it that holds changes (`<file>-wal`, not empty: a recording that was not closed) is
+/// opened read-only and not immutable, for SQLite to read them from the log.
+fn open(path: &Path) -> rusqlite::Result<Connection> {
+    let flags = OpenFlags::SQLITE_OPEN_READ_ONLY | OpenFlags::SQLITE_OPEN_NO_MUTEX;
+    let mut wal = path.as_os_str().to_owned();
+    wal.push("-wal");
+    if std::fs::metadata(&wal).is_ok_and(|m| m.len() > 0) {
+        return Connection::open_with_flags(path, flags);
+    }
+    Connection::open_with_flags(immutable_uri(path), flags | OpenFlags::SQLITE_OPEN_URI)
+}
+
+/// The SQLite URI (<https://www.sqlite.org/uri.html>) of the file `path`, immutable: `file:`,
+/// the path with every byte but an ASCII letter, digit, `/`, `-`, `.`, `_` or `~`
+/// percent-escaped (`?`, `#`, `%` and the rest are the file name's), then `?immutable=1`. An
+/// absolute path is given an empty authority (`file:///...`), so that one starting with `//`
+/// is not read as a host.
+fn immutable_uri(path: &Path) -> String {
+    use std::fmt::Write as _;
+    let bytes = path.as_os_str().as_encoded_bytes();
+    let mut uri = String::from("file:");
+    if bytes.starts_with(b"/") {
+        uri.push_str("//");
+    }
+    for &b in bytes {
+        if b.is_ascii_alphanumeric() || b"/-._~".contains(&b) {
+            uri.push(char::from(b));
+        } else {
+            let _ = write!(uri, "%{b:02X}");
+        }
+    }
+    uri.push_str("?immutable=1");
+    uri
+}
+
 /// [`read_db3`], each message's data a zstd frame where `zstd_messages`.
 fn read_db3_compressed(
     path: &Path,
@@ -289,11 +331,7 @@ fn read_db3_compressed(
     let topic = select.topic;
     let fail = |p: String| data_error(path, p);
     let sql = |e: rusqlite::Error| fail(format!("not a readable rosbag2 database: {e}"));
-    let db = Connection::open_with_flags(
-        path,
-        OpenFlags::SQLITE_OPEN_READ_ONLY | OpenFlags::SQLITE_OPEN_NO_MUTEX,
-    )
-    .map_err(sql)?;
+    let db = open(path).map_err(sql)?;
     let mut topics = db
         .prepare("SELECT id, name, type, serialization_format FROM topics")
         .map_err(sql)?;

@@ -930,6 +930,15 @@ fn messages(
         skipped.undecodable += s.undecodable;
         skipped.non_finite += s.non_finite;
         skipped.other_frame_id += s.other_frame_id;
+        skipped.gyro_not_provided += s.gyro_not_provided;
+        skipped.accel_not_provided += s.accel_not_provided;
+    }
+    // A sensor the messages mark as not provided (sensor_msgs/Imu: its covariance's first
+    // element -1) holds no measurement: reading its axes is refused.
+    let gyro = picks.iter().any(|&i| i < 3);
+    let accel = picks.iter().any(|&i| i >= 3);
+    if let Some(refusal) = skipped.not_provided(gyro, accel) {
+        return Err(with_file(files, refusal));
     }
     // Skipped messages leave holes the stamps show only as gaps; uniform ones (every other
     // message) would pass for a lower rate. More than 1 % of the record is refused.
@@ -1065,7 +1074,10 @@ fn csv_stream(
         send,
     };
     let mut values = vec![0.0; request.columns.len()];
+    // The files begun, and whether the one being read has passed a row yet.
+    let begun = std::cell::Cell::new((0usize, false));
     let mut select = |header: &[String]| -> Result<Vec<usize>, String> {
+        begun.set((begun.get().0 + 1, true));
         let mut picks = request
             .columns
             .iter()
@@ -1117,6 +1129,10 @@ fn csv_stream(
         Ok(picks)
     };
     let mut row = |cells: &[&str]| -> Result<(), String> {
+        let (files, first_row) = begun.get();
+        if first_row {
+            begun.set((files, false));
+        }
         let (cells, stamp) = match time.get() {
             Some((i, unit)) => {
                 let (last, cells) = cells.split_last().ok_or("no cells")?;
@@ -1177,6 +1193,13 @@ fn csv_stream(
                 timing.drop_repeat();
             } else {
                 timing.drop_one();
+            }
+            if !request.drop_backward && first_row && files > 1 {
+                return Err(format!(
+                    "the file's first timestamp, {t} ns, is not after the last of the file \
+                     before ({last} ns): the files are out of order; give them in time order \
+                     (a shell's glob puts rec_10 before rec_2)"
+                ));
             }
             if !request.drop_backward {
                 return Err(format!(

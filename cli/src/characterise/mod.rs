@@ -261,6 +261,8 @@ fn characterise(
         summary(read.timing, args.rate.is_none()).map_err(|e| with_file(&args.files, e))?;
     let rate = resolve_rate(args.rate, timing.as_ref()).map_err(|e| with_file(&args.files, e.0))?;
     check_span("--rate", rate, n as usize)?;
+    crate::input::check_gaps(timing.as_ref(), n as usize).map_err(|e| with_file(&args.files, e))?;
+    let kind = Kind::of(&args.files[0]);
     let units: Vec<Unit> = (0..6)
         .map(|i| {
             axis_unit(
@@ -269,11 +271,17 @@ fn characterise(
                 read.unknown.get(i).and_then(Option::as_deref),
                 given[i / 3],
                 &columns[i],
-                args.topic.is_some(),
+                kind,
             )
         })
         .collect::<Result<_, _>>()
         .map_err(|e| with_file(&args.files, e.0))?;
+    if let Some(w) = gravity(
+        std::array::from_fn(|k| axes[3 + k].mean() * units[3 + k].to_si),
+        kind,
+    )? {
+        eprintln!("imu-ar: warning: {}", with_file(&args.files, w).0);
+    }
     let fits: Vec<Fitting> = units
         .iter()
         .map(|u| Fitting {
@@ -298,7 +306,18 @@ fn characterise(
         if axes[i].is_constant() {
             return Err(fail("constant (a stuck sensor?): no noise to model".into()));
         }
-        fit_axis(&fits[i], &axes[i], &octaves[i], units[i].to_si).map_err(|Fail(e)| fail(e))
+        fit_axis(&fits[i], &axes[i], &octaves[i], units[i].to_si).map_err(|Fail(e)| {
+            // Every Allan variance underflowed, though the samples differ.
+            if e == imu_ar::noise::NoiseError::Constant.to_string() {
+                fail(
+                    "the Allan variance underflows f64 (differences of about 1e-160 or less); \
+                     rescale the record"
+                        .into(),
+                )
+            } else {
+                fail(e)
+            }
+        })
     };
     let fitted: Vec<Result<Fitted<'_>, Fail>> = std::thread::scope(|scope| {
         let gyros = scope.spawn(|| (0..3).map(fit).collect::<Vec<_>>());
@@ -477,7 +496,8 @@ pub(crate) fn write_all(
             Ok(paths)
         });
     // The files of the formats not asked for, an earlier run's: set aside with the commit,
-    // so that the folder holds one run's files.
+    // so that the folder holds one run's files (a file of such a name that no export wrote
+    // is left as it is).
     let stale: Vec<&str> = Format::ALL
         .iter()
         .filter(|f| !formats.contains(f))
@@ -499,8 +519,22 @@ pub(crate) fn write_all(
     moved
 }
 
-/// Moves the files `paths` into `out` by `rename`, and the files named `stale` there (of an
-/// earlier run) out of it, all or none. The files of the same names already there are kept
+/// Whether the file at `path` is one an export wrote: its first MiB names the exporter.
+fn exported(path: &Path) -> bool {
+    use std::io::Read;
+    let exporter = crate::export::files::TOOL;
+    let exporter = &exporter[exporter.find('(').unwrap_or(0)..];
+    let mut head = Vec::new();
+    std::fs::File::open(path)
+        .and_then(|f| f.take(1 << 20).read_to_end(&mut head))
+        .is_ok()
+        && head
+            .windows(exporter.len())
+            .any(|w| w == exporter.as_bytes())
+}
+
+/// Moves the files `paths` into `out` by `rename`, and the files named `stale` there that an
+/// export wrote (of an earlier run) out of it, all or none. The files of the same names already there are kept
 /// first (linked, or copied, into the folder `kept`, where the stale ones go too); when a
 /// move fails, the ones before it are undone and the kept files put back, and the error names
 /// the file that could not be replaced.
@@ -545,7 +579,7 @@ fn commit(
     let aside: Vec<(PathBuf, PathBuf)> = stale
         .iter()
         .map(|name| (out.join(name), kept.join(name)))
-        .filter(|(at, _)| at.is_file())
+        .filter(|(at, _)| at.is_file() && exported(at))
         .collect();
     for (k, (at, keep)) in aside.iter().enumerate() {
         if let Err(e) = rename(at, keep) {
@@ -583,6 +617,41 @@ fn commit(
         .iter()
         .map(|(_, to, _)| to.display().to_string())
         .collect())
+}
+
+/// The accelerometers' mean (m/s^2, as read) against gravity's: a record at rest reads
+/// 9.81 m/s^2 in magnitude whatever way the sensor lies. A magnitude within 20 % of 1 or of
+/// 1000 is a record in g or mg read as m/s^2: refused, naming the flag that reads it so;
+/// another outside 7 to 13 m/s^2 (a record not at rest, gravity taken out, or another unit)
+/// is a warning, returned.
+fn gravity(mean: [f64; 3], kind: Kind) -> Result<Option<String>, Fail> {
+    const G: f64 = 9.806_65;
+    let magnitude = mean.iter().map(|a| a * a).sum::<f64>().sqrt();
+    let shown = format!(
+        "the accelerometers read {magnitude:.4} m/s^2 on average (x, y, z: {:.4}, {:.4}, \
+         {:.4}), where a sensor at rest reads gravity's {G} whatever way it lies",
+        mean[0], mean[1], mean[2]
+    );
+    for (unit, scale) in [("g", 1.0), ("mg", 1000.0)] {
+        if (0.8 * scale..=1.25 * scale).contains(&magnitude) {
+            let how = match kind {
+                Kind::Csv => format!(
+                    ": say so in the header's bracket ([{unit}]), or with --accel-unit {unit} \
+                     for columns without one"
+                ),
+                Kind::Bag | Kind::Mcap | Kind::Rosbag2 | Kind::Db3 => format!(
+                    " (a driver that does not keep REP 103): --accel-unit {unit} reads them so"
+                ),
+                _ => String::new(),
+            };
+            return Err(Fail(format!(
+                "{shown}: the values are in {unit}, not m/s^2{how}"
+            )));
+        }
+    }
+    Ok((!(7.0..=13.0).contains(&magnitude)).then(|| {
+        format!("{shown}: a record not at rest, or in another unit, gives noise in that unit")
+    }))
 }
 
 /// One axis's composite, with the AR part (order by BIC, 0 to [`LAGS`]) from its streamed
@@ -672,38 +741,70 @@ pub(crate) fn parse_unit(name: &str) -> Result<Unit, Fail> {
 
 /// The unit of axis `i`: its header's (or the message's), else the flag's, checked to measure
 /// what the axis measures. `bracket` is a header bracket that names no unit known here;
-/// `messages`: the axes are a ROS message's, not CSV columns.
+/// `kind`: the recording's kind, which says where `read` comes from. A ROS message's unit
+/// (SI, REP 103) gives way to a flag that names another (a driver that publishes g), with a
+/// warning; a CSV header's, a ULog's or a DataFlash log's does not.
 pub(crate) fn axis_unit(
     i: usize,
     read: Option<Unit>,
     bracket: Option<&str>,
     given: Option<Unit>,
     column: &str,
-    messages: bool,
+    kind: Kind,
 ) -> Result<Unit, Fail> {
     let (want, flag) = match i {
         0..3 => (Quantity::AngularRate, "--gyro-unit"),
         _ => (Quantity::Acceleration, "--accel-unit"),
     };
+    let mut read = read;
     if let (Some(r), Some(g)) = (read, given)
         && r != g
     {
-        return Err(Fail(if messages {
-            format!(
-                "{flag} {}: a sensor_msgs/Imu message gives {} in {} (SI units, REP 103); \
-                 {flag} is for CSV columns without a unit",
-                g.name,
+        let what = match kind {
+            Kind::Bag | Kind::Mcap | Kind::Rosbag2 | Kind::Db3 if g.quantity == want => {
+                eprintln!(
+                    "imu-ar: warning: {flag} {}: {} read in {}, not in the {} a sensor_msgs/Imu \
+                     message gives (SI units, REP 103)",
+                    g.name,
+                    escaped(column),
+                    g.name,
+                    r.name
+                );
+                read = None;
+                None
+            }
+            Kind::Bag | Kind::Mcap | Kind::Rosbag2 | Kind::Db3 => Some(format!(
+                "a sensor_msgs/Imu message gives {} in {} (SI units, REP 103)",
                 escaped(column),
                 r.name
-            )
-        } else {
-            format!(
-                "{flag} {}: the header of column '{}' says {}",
-                g.name,
+            )),
+            Kind::Ulog => Some(format!(
+                "a ULog's sensor topics give {} in {} (PX4's SI units)",
                 escaped(column),
                 r.name
-            )
-        }));
+            )),
+            Kind::DataFlash => Some(format!(
+                "an ArduPilot IMU message gives {} in {} (SI units)",
+                escaped(column),
+                r.name
+            )),
+            _ => Some(format!(
+                "the header of column '{}' says {}",
+                escaped(column),
+                r.name
+            )),
+        };
+        if let Some(what) = what {
+            return Err(Fail(format!(
+                "{flag} {}: {what}; {flag} is for CSV columns without a unit{}",
+                g.name,
+                if matches!(kind, Kind::Bag | Kind::Mcap | Kind::Rosbag2 | Kind::Db3) {
+                    " or a driver's messages in another unit"
+                } else {
+                    ""
+                }
+            )));
+        }
     }
     if let Some(g) = given
         && g.quantity != want
@@ -816,6 +917,11 @@ impl Output for Characterisation {
 mod tests {
     use super::*;
 
+    /// An earlier run's file `f`.
+    fn old(f: &str) -> String {
+        format!("old {f}, written by {}", crate::export::files::TOOL)
+    }
+
     /// A folder `out` with the old files `a`, `b`, `c` and `e` (a format not asked for this
     /// time), and new `a` to `d` staged in it.
     fn staged(name: &str) -> (PathBuf, Vec<PathBuf>) {
@@ -824,7 +930,7 @@ mod tests {
         let staging = out.join(".staging");
         std::fs::create_dir_all(&staging).unwrap();
         for f in ["a", "b", "c", "e"] {
-            std::fs::write(out.join(f), format!("old {f}")).unwrap();
+            std::fs::write(out.join(f), old(f)).unwrap();
         }
         let paths = ["a", "b", "c", "d"]
             .iter()
@@ -856,7 +962,7 @@ mod tests {
         let old = |out: &Path| {
             ["a", "b", "c", "e"]
                 .iter()
-                .map(|f| (f.to_string(), format!("old {f}")))
+                .map(|f| (f.to_string(), old(f)))
                 .collect::<Vec<_>>()
                 == contents(out)
         };
@@ -905,6 +1011,27 @@ mod tests {
             .map(|f| (f.to_string(), format!("new {f}")))
             .collect();
         assert_eq!(contents(&out), new);
+        std::fs::remove_dir_all(&out).unwrap();
+    }
+
+    #[test]
+    fn a_file_named_as_a_format_not_asked_for_that_no_export_wrote_is_kept() {
+        // A hand-written `e` (a format's name) beside the run's files: it stays as it is
+        // (it was set aside with the commit, and lost, before); an earlier run's `e` goes.
+        let (out, paths) = staged("foreign");
+        std::fs::write(out.join("e"), "gyroscope_noise_density: 1.0e-3 # by hand").unwrap();
+        let rename = |from: &Path, to: &Path| std::fs::rename(from, to);
+        commit(&paths, &["e"], &out, &out.join(".staging/kept"), &rename)
+            .unwrap_or_else(|e| panic!("{}", e.0));
+        let mut expected: Vec<(String, String)> = ["a", "b", "c", "d"]
+            .iter()
+            .map(|f| (f.to_string(), format!("new {f}")))
+            .collect();
+        expected.push((
+            "e".into(),
+            "gyroscope_noise_density: 1.0e-3 # by hand".into(),
+        ));
+        assert_eq!(contents(&out), expected);
         std::fs::remove_dir_all(&out).unwrap();
     }
 }

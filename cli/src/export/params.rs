@@ -37,28 +37,38 @@ fn per_step(what: &str, x: f64, dt: f64) -> Result<f64, Fail> {
 }
 
 /// An autopilot's four parameters (gyro noise, accelerometer noise, gyro bias noise,
-/// accelerometer bias noise), each with its documented range.
-type Names = [(&'static str, (f64, f64)); 4];
+/// accelerometer bias noise), each with its documented range and the most its filter takes
+/// at run time (a larger value is constrained to it).
+type Names = [(&'static str, (f64, f64), f64); 4];
 
-/// A parameter, its value and its documented range.
-type Value = (&'static str, f64, (f64, f64));
+/// A parameter, its value, its documented range and the most its filter takes.
+type Value = (&'static str, f64, (f64, f64), f64);
 
-/// PX4's, from `src/modules/ekf2/module.yaml`.
+/// PX4's, from `src/modules/ekf2/module.yaml`; EKF2 constrains each to [0, 1]
+/// (`Ekf::updateParameters`).
 const PX4_NAMES: Names = [
-    ("EKF2_GYR_NOISE", (1e-4, 0.1)),
-    ("EKF2_ACC_NOISE", (0.01, 1.0)),
-    ("EKF2_GYR_B_NOISE", (0.0, 0.01)),
-    ("EKF2_ACC_B_NOISE", (0.0, 0.01)),
+    ("EKF2_GYR_NOISE", (1e-4, 0.1), 1.0),
+    ("EKF2_ACC_NOISE", (0.01, 1.0), 1.0),
+    ("EKF2_GYR_B_NOISE", (0.0, 0.01), 1.0),
+    ("EKF2_ACC_B_NOISE", (0.0, 0.01), 1.0),
 ];
+
+/// PX4's filter, as its notes name it.
+const PX4_FILTER: &str = "EKF2 (Ekf::updateParameters)";
 
 /// ArduPilot's, from the `@Range` of `libraries/AP_NavEKF3/AP_NavEKF3.cpp` (master:
-/// `EK3_ABIAS_P_NSE` to 0.02).
+/// `EK3_ABIAS_P_NSE` to 0.02); EKF3 constrains the gyro noise and both bias noises to
+/// [0, 1] and the accelerometer noise to [0, 5] (`BAD_IMU_DATA_ACC_P_NSE`) in
+/// `NavEKF3_core::CovariancePrediction`.
 const ARDUPILOT_NAMES: Names = [
-    ("EK3_GYRO_P_NSE", (1e-4, 0.1)),
-    ("EK3_ACC_P_NSE", (0.01, 1.0)),
-    ("EK3_GBIAS_P_NSE", (1e-5, 1e-3)),
-    ("EK3_ABIAS_P_NSE", (1e-5, 0.02)),
+    ("EK3_GYRO_P_NSE", (1e-4, 0.1), 1.0),
+    ("EK3_ACC_P_NSE", (0.01, 1.0), 5.0),
+    ("EK3_GBIAS_P_NSE", (1e-5, 1e-3), 1.0),
+    ("EK3_ABIAS_P_NSE", (1e-5, 0.02), 1.0),
 ];
+
+/// ArduPilot's filter, as its notes name it.
+const ARDUPILOT_FILTER: &str = "EKF3 (NavEKF3_core::CovariancePrediction)";
 
 /// The values `N / sqrt(dt)`, `K / sqrt(dt)` of `names` for a filter stepping `dt`, and the
 /// two sensors written.
@@ -74,22 +84,32 @@ fn autopilot(
     ];
     let [g, a] = &sensors;
     let mut values = Vec::new();
-    for (&(name, range), x) in names.iter().zip([g.n, a.n, g.k, a.k]) {
-        values.push((name, per_step(name, x, dt)?, range));
+    for (&(name, range, most), x) in names.iter().zip([g.n, a.n, g.k, a.k]) {
+        values.push((name, per_step(name, x, dt)?, range, most));
     }
     Ok((values, sensors))
 }
 
-/// A note for each value outside the target's documented range.
-fn range_notes(values: &[Value]) -> Vec<String> {
+/// A note for each value outside the target's documented range, and what `filter` takes
+/// of one past the most it takes.
+fn range_notes(values: &[Value], filter: &str) -> Vec<String> {
     values
         .iter()
-        .filter(|(_, v, (low, high))| v < low || v > high)
-        .map(|(name, v, (low, high))| {
+        .filter(|(_, v, (low, high), _)| v < low || v > high)
+        .map(|&(name, v, (low, high), most)| {
+            let run = if v > most {
+                format!(
+                    "; {filter} takes {most} at run time whatever is set, a variance {:.3} \
+                     times the model's",
+                    (most / v).powi(2)
+                )
+            } else {
+                String::new()
+            };
             format!(
                 "note: {name} = {} is outside its documented range [{low}, {high}]; the ground \
-                 station may refuse or clamp it.",
-                short(*v)
+                 station may refuse or clamp it{run}.",
+                short(v)
             )
         })
         .collect()
@@ -164,12 +184,12 @@ pub fn px4(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
         ],
         &[&sensors[0], &sensors[1]],
     ));
-    lines.extend(range_notes(&values));
+    lines.extend(range_notes(&values, PX4_FILTER));
     lines.push(String::new());
     lines.push("Vehicle-Id\tComponent-Id\tName\tValue\tType".into());
     let mut text = comments(&lines);
     text += &format!("{sysid}\t1\tEKF2_PREDICT_US\t{predict_us}\t6\n");
-    for (name, v, _) in values {
+    for (name, v, ..) in values {
         text += &format!("{sysid}\t1\t{name}\t{}\t9\n", num(v));
     }
     Ok(text)
@@ -234,10 +254,44 @@ pub fn ardupilot(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail>
             "note: --filter-rate {f} Hz is not EKF3's step, which its loop rate sets."
         ));
     }
-    lines.extend(range_notes(&values));
+    lines.extend(range_notes(&values, ARDUPILOT_FILTER));
     let mut text = comments(&lines);
-    for (name, v, _) in values {
+    for (name, v, ..) in values {
         text += &format!("{name},{}\n", num(v));
     }
     Ok(text)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_value_past_what_the_filter_takes_says_what_it_takes() {
+        // EKF2 constrains its noises to [0, 1] whatever the parameter holds: a value of 2
+        // runs as 1, a quarter of the variance (the note said only that the ground station
+        // may refuse or clamp it). One under its range, or over it but within what the
+        // filter takes, has only the range's note.
+        let notes = range_notes(
+            &[
+                ("EKF2_ACC_NOISE", 2.0, (0.01, 1.0), 1.0),
+                ("EKF2_GYR_NOISE", 5e-5, (1e-4, 0.1), 1.0),
+                ("EK3_ACC_P_NSE", 2.0, (0.01, 1.0), 5.0),
+                ("EKF2_GYR_B_NOISE", 1e-3, (0.0, 0.01), 1.0),
+            ],
+            PX4_FILTER,
+        );
+        assert_eq!(notes.len(), 3, "{notes:?}");
+        assert!(
+            notes[0].ends_with(
+                "; EKF2 (Ekf::updateParameters) takes 1 at run time whatever is set, a variance \
+                 0.250 times the model's."
+            ),
+            "{}",
+            notes[0]
+        );
+        for note in &notes[1..] {
+            assert!(note.ends_with("may refuse or clamp it."), "{note}");
+        }
+    }
 }

@@ -436,6 +436,25 @@ pub fn check_span(flag: &str, rate: f64, samples: usize) -> Result<(), Fail> {
     Ok(())
 }
 
+/// The samples the record's gaps miss (`timing`, as its stamps tell them) against the `n`
+/// it holds: more than a tenth is refused. The Allan variance takes the samples as one run;
+/// each gap joins stretches whose biases have walked apart over it, and makes the long
+/// averaging times up (two 10-minute stretches 2 h apart gave a random walk 2 to 4 times
+/// the sensor's), by about the gaps' share of the record.
+pub fn check_gaps(timing: Option<&TimingSummary>, n: usize) -> Result<(), String> {
+    let Some(t) = timing.filter(|t| t.missing_samples as f64 > 0.1 * n as f64) else {
+        return Ok(());
+    };
+    Err(format!(
+        "{} gaps miss {} samples, {:.0} % as many as the {n} the record holds: the Allan \
+         variance takes the samples as one run, and stretches so far apart join biases that \
+         walked apart meanwhile; read the stretches one at a time",
+        t.gaps,
+        t.missing_samples,
+        100.0 * t.missing_samples as f64 / n.max(1) as f64
+    ))
+}
+
 /// 0.1 x the variance of the finite samples among the first 1000 (what firmware sees at
 /// start-up; NaN and infinities are rejected there), or 1 when that is 0 or there are none;
 /// an error when that variance overflows f64.

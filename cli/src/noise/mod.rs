@@ -365,6 +365,8 @@ pub fn run_with(args: &Args, given: Option<&[f64]>) -> Result<NoiseResult, Fail>
         None => args.input.series(args.rate.is_none())?,
     };
     let rate = series.rate(args.rate, &args.input)?;
+    crate::input::check_gaps(series.timing.as_ref(), series.x.len())
+        .map_err(|e| args.input.fail(e))?;
     let x = decimated(&args.input.files, &series.x, args.decimate)?;
     check_span("--rate", rate, x.len())?;
     let rate = rate / args.decimate as f64;
@@ -428,6 +430,37 @@ pub fn run_with(args: &Args, given: Option<&[f64]>) -> Result<NoiseResult, Fail>
     }
     result.timing = series.timing;
     Ok(result)
+}
+
+/// Checks that the model's Allan deviation stays within the record's at every `tau` of 1 s
+/// or more (and 32 samples) that the record holds 16 times or more (past that, the few
+/// differences a row averages may fall far under their mean), give or take three of the
+/// row's tolerances: each of its terms
+/// only adds to it, so a model past the data there claims noise the record does not hold. A
+/// hump none of its terms takes (a spectral line) drives a white level or a short
+/// Gauss-Markov term over the whole curve: refused, naming the line and `--oscillators`.
+fn within_the_data(result: &NoiseResult) -> Result<(), Fail> {
+    let from = (32.0 / result.rate_hz).max(1.0);
+    let to = result.n as f64 / result.rate_hz / 16.0;
+    let worst = result
+        .allan
+        .iter()
+        .filter(|row| (from..=to).contains(&row.tau_s) && row.data_adev > 0.0)
+        .map(|row| (row.model_adev / row.data_adev, row))
+        .filter(|(over, row)| *over > 1.0 + 3.0 * row.tolerance)
+        .max_by(|a, b| a.0.total_cmp(&b.0));
+    match worst {
+        None => Ok(()),
+        Some((over, row)) => Err(Fail(format!(
+            "the model's Allan deviation is {over:.2} times the record's at {} s ({} against \
+             {}): it claims noise the record does not hold, to cover a hump at shorter times \
+             that none of its terms takes (a spectral line: a vibration, a fan; \
+             --oscillators models one)",
+            number(row.tau_s),
+            number(row.model_adev),
+            number(row.data_adev)
+        ))),
+    }
 }
 
 /// What draws a fit's decomposition on an area, with a caption.
@@ -512,6 +545,7 @@ impl Fitting {
             ))
         })?;
         let mut result = self.result(&model, ar, &model.ieee952(octaves), &form, &check);
+        within_the_data(&result)?;
         result.budget_limited = fit.budget_limited;
         result.curve_fit = fit.curve_fit;
         result.intervals = uncertainty

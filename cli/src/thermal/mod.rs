@@ -985,7 +985,7 @@ fn read_csv(args: &Args) -> Result<WarmUp, Fail> {
             read.unknown.get(i).and_then(Option::as_deref),
             given[i / 3],
             &columns[i],
-            false,
+            Kind::of(&args.files[0]),
         )
         .map_err(|e| with_file(&args.files, e.0))?;
         for x in axis.iter_mut() {

@@ -231,7 +231,8 @@ fn other_mcap_encodings_are_refused() {
     drop(w);
     assert_eq!(
         problem(&path, mcap_reader::read(&path, "/imu", &mut |_| {})),
-        "unknown schema encoding 'jsonschema' on topic '/imu' (supported: ros2msg, ros2idl)"
+        "unknown schema encoding 'jsonschema' on topic '/imu' (supported: ros2msg, ros2idl, or \
+         ros1msg for the ROS 1 type sensor_msgs/Imu)"
     );
 }
 

@@ -497,8 +497,9 @@ fn bad_recordings_exit_2_with_one_line() {
         "IMU topics: /imu0",
     );
     refused(&["noise", b, "--column", "gx"], "/imu0");
-    // A message's units are SI: a unit flag that says otherwise is refused in the words of a
-    // message, not of a CSV header; a --rate the header stamps disagree with names them.
+    // A message's units are SI: a unit flag of what the axis does not measure is refused in
+    // the words of a message, not of a CSV header; a --rate the header stamps disagree with
+    // names them.
     refused(
         &[
             "characterise",
@@ -506,11 +507,11 @@ fn bad_recordings_exit_2_with_one_line() {
             "--topic",
             "/imu0",
             "--gyro-unit",
-            "deg/s",
+            "m/s^2",
             "--out",
             o,
         ],
-        "--gyro-unit deg/s: a sensor_msgs/Imu message gives gx in rad/s (SI units, REP 103)",
+        "--gyro-unit m/s^2: a sensor_msgs/Imu message gives gx in rad/s (SI units, REP 103)",
     );
     refused(
         &[
@@ -902,4 +903,186 @@ fn an_axis_without_a_walk_lends_the_file_its_bound() {
         text.contains("An axis without a random walk leaves room for more"),
         "{text}"
     );
+}
+
+#[test]
+fn accelerometers_in_g_or_mg_are_told_by_gravity() {
+    // A static record reads gravity's 9.81 m/s^2 in magnitude: values of about 1 or 1000
+    // under m/s^2 (a header that says m/s^2, a driver that publishes g despite REP 103) are
+    // g or mg, refused naming the unit and how to give it (read as m/s^2, with noise 9.8
+    // times too small, before). A driver's g given with --accel-unit reads as the same
+    // record in m/s^2 does.
+    let dir = temp_dir("gravity");
+    let out = dir.join("out");
+    let frames = noise_frames();
+    let scaled = |by: f64| -> Vec<Frame> {
+        frames
+            .iter()
+            .map(|f| Frame {
+                stamp_ns: f.stamp_ns,
+                axes: std::array::from_fn(|k| if k < 3 { f.axes[k] } else { f.axes[k] * by }),
+            })
+            .collect()
+    };
+    let g = 1.0 / 9.806_65;
+    for (by, unit) in [(g, "g"), (1000.0 * g, "mg")] {
+        let csv = dir.join(format!("{unit}.csv"));
+        write_euroc(&csv, &scaled(by));
+        refused(
+            &["characterise", path(&csv), "--out", path(&out)],
+            &format!(
+                "the values are in {unit}, not m/s^2: say so in the header's bracket ([{unit}])"
+            ),
+        );
+    }
+    let bag = edited_bag(&dir, "noise.bag", "g.bag", &scaled(g));
+    let topic = ["--topic", "/imu0"];
+    refused(
+        &[
+            "characterise",
+            path(&bag),
+            topic[0],
+            topic[1],
+            "--out",
+            path(&out),
+        ],
+        "the values are in g, not m/s^2 (a driver that does not keep REP 103): --accel-unit g \
+         reads them so",
+    );
+    let si = characterise(
+        &[path(&fixture("noise.bag")), topic[0], topic[1]],
+        &out,
+        &[],
+    );
+    let read = imu_ar(&[
+        "characterise",
+        path(&bag),
+        topic[0],
+        topic[1],
+        "--accel-unit",
+        "g",
+        "--out",
+        path(&out),
+        "--json",
+    ]);
+    assert!(
+        stderr(&read).contains("--accel-unit g: ax read in g, not in the m/s^2"),
+        "{}",
+        stderr(&read)
+    );
+    let read = json(&read);
+    for k in 3..6 {
+        let n = |v: &serde_json::Value| v["axes"][k]["model"]["white_noise"].as_f64().unwrap();
+        assert!((n(&read) / n(&si) - 1.0).abs() < 1e-9, "{k}: {read} {si}");
+    }
+}
+
+#[test]
+fn files_given_out_of_time_order_are_named_so() {
+    // Two pieces of one record, the later first (as a shell's glob orders rec_10 before
+    // rec_2): refused as files out of order (a stamp not after the one before, with
+    // --drop-backward as the remedy, before); in time order, read.
+    let dir = temp_dir("file-order");
+    let out = dir.join("out");
+    let frames = imu_frames(8_000, 200.0, 3);
+    let (early, late) = (dir.join("rec_2.csv"), dir.join("rec_10.csv"));
+    write_euroc(&early, &frames[..4_000]);
+    write_euroc(&late, &frames[4_000..]);
+    refused(
+        &[
+            "characterise",
+            path(&late),
+            path(&early),
+            "--out",
+            path(&out),
+        ],
+        "the files are out of order; give them in time order",
+    );
+    let read = characterise(&[path(&early), path(&late)], &out, &[]);
+    assert_eq!(read["n"], 8_000, "{read}");
+}
+
+#[test]
+fn an_axis_whose_allan_variance_underflows_is_named_so() {
+    // Values of about 1e-300 that differ: their Allan variance underflows to zero, named so
+    // (refused as "the input is constant" before), as `noise` names it.
+    let dir = temp_dir("underflow");
+    let mut frames = imu_frames(6_000, 200.0, 4);
+    frames.iter_mut().for_each(|f| f.axes[0] *= 1e-298);
+    let file = dir.join("tiny.csv");
+    write_euroc(&file, &frames);
+    refused(
+        &["characterise", path(&file), "--out", path(&dir.join("out"))],
+        "gx (w_RS_S_x): the Allan variance underflows f64",
+    );
+}
+
+#[test]
+fn a_spectral_line_the_model_cannot_take_is_refused_not_read_as_white_noise() {
+    // White noise of 1e-3 per sqrt(Hz) with a 3 Hz line of 0.05 (a fan on the bench), 200 Hz
+    // for 20 minutes: without oscillators a short Gauss-Markov term (or a white level 20
+    // times too large) covered the line's hump, the model's Allan deviation 9 times the
+    // record's at 1.28 s, and was written into every file; refused, naming the line and
+    // --oscillators, with which N is read.
+    let dir = temp_dir("line");
+    let noise = Noise {
+        white: [1e-3, 1e-3, 1e-3, 2e-2, 2e-2, 2e-2],
+        walk: [0.0; 6],
+        gm_sigma: [0.0; 6],
+        gm_t: 5.0,
+    };
+    let mut frames = noise_frames_of(&noise, 240_000, 200.0, 5);
+    for (i, f) in frames.iter_mut().enumerate() {
+        let line = (std::f64::consts::TAU * 3.0 * i as f64 / 200.0).sin();
+        f.axes[0] += 0.05 * line;
+    }
+    let file = dir.join("line.csv");
+    write_euroc(&file, &frames);
+    let out = dir.join("out");
+    refused(
+        &["characterise", path(&file), "--out", path(&out)],
+        "it claims noise the record does not hold, to cover a hump at shorter times",
+    );
+    let read = characterise(&[path(&file)], &out, &["--oscillators"]);
+    let n = read["axes"][0]["model"]["white_noise"].as_f64().unwrap();
+    assert!((n / 1e-3 - 1.0).abs() < 0.1, "{read}");
+}
+
+#[test]
+fn stretches_far_apart_are_not_read_as_one_run() {
+    // Two stretches of 20 s, 2 h apart, as two files (or as one): the Allan variance of
+    // samples taken as one run joins biases that walked apart over the gap (a random walk
+    // 2 to 4 times the sensor's, exit 0, before); refused, naming the gaps. The same with
+    // samples missing under a tenth of those held, read.
+    let dir = temp_dir("far-apart");
+    let out = dir.join("out");
+    let mut frames = imu_frames(8_000, 200.0, 6);
+    frames[4_000..]
+        .iter_mut()
+        .for_each(|f| f.stamp_ns += 7_200_000_000_000);
+    let (early, late) = (dir.join("a.csv"), dir.join("b.csv"));
+    write_euroc(&early, &frames[..4_000]);
+    write_euroc(&late, &frames[4_000..]);
+    refused(
+        &[
+            "characterise",
+            path(&early),
+            path(&late),
+            "--out",
+            path(&out),
+        ],
+        "1 gaps miss 1439999 samples",
+    );
+    refused(
+        &["noise", path(&early), path(&late), "--column", "w_RS_S_x"],
+        "the Allan variance takes the samples as one run",
+    );
+    let mut frames = imu_frames(8_000, 200.0, 6);
+    frames[4_000..]
+        .iter_mut()
+        .for_each(|f| f.stamp_ns += 3_000_000_000);
+    let near = dir.join("near.csv");
+    write_euroc(&near, &frames);
+    let read = characterise(&[path(&near)], &out, &[]);
+    assert_eq!(read["timing"]["missing_samples"], 600, "{read}");
 }

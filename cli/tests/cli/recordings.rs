@@ -887,6 +887,40 @@ struct MessagesOf<'a, D: Fn(&Frame, usize) -> Vec<u8>> {
     data: D,
 }
 
+/// An MCAP file's magic and header, and the record of schema 1 (`name`, `encoding`).
+fn mcap_start((name, encoding): (&str, &str)) -> (Vec<u8>, Vec<u8>) {
+    let mut out = b"\x89MCAP0\r\n".to_vec();
+    let mut body = Vec::new();
+    string(&mut body, "ros2");
+    string(&mut body, "hand");
+    record(&mut out, 0x01, &body);
+    let mut schema = 1u16.to_le_bytes().to_vec();
+    string(&mut schema, name);
+    string(&mut schema, encoding);
+    schema.extend(0u32.to_le_bytes());
+    (out, schema)
+}
+
+/// The record of channel `id` of schema 1 on `topic`, in message `encoding`.
+fn mcap_channel(id: u16, topic: &str, encoding: &str) -> Vec<u8> {
+    let mut c = id.to_le_bytes().to_vec();
+    c.extend(1u16.to_le_bytes());
+    string(&mut c, topic);
+    string(&mut c, encoding);
+    c.extend(0u32.to_le_bytes());
+    c
+}
+
+/// The data end, the footer (with the summary at `summary_start`, or none at 0) and the
+/// closing magic.
+fn mcap_end(out: &mut Vec<u8>, summary_start: u64) {
+    let mut footer = summary_start.to_le_bytes().to_vec();
+    footer.extend(0u64.to_le_bytes());
+    footer.extend(0u32.to_le_bytes());
+    record(out, 0x02, &footer);
+    out.extend(b"\x89MCAP0\r\n");
+}
+
 /// [`hand_mcap`] of `messages`.
 fn hand_mcap_of<D: Fn(&Frame, usize) -> Vec<u8>>(
     messages: &MessagesOf<'_, D>,
@@ -894,23 +928,10 @@ fn hand_mcap_of<D: Fn(&Frame, usize) -> Vec<u8>>(
     frames: &[Frame],
     channel_of: impl Fn(usize) -> u16,
 ) -> Vec<u8> {
-    let mut out = b"\x89MCAP0\r\n".to_vec();
-    let mut body = Vec::new();
-    string(&mut body, "ros2");
-    string(&mut body, "hand");
-    record(&mut out, 0x01, &body);
-    let mut schema = 1u16.to_le_bytes().to_vec();
-    string(&mut schema, messages.schema.0);
-    string(&mut schema, messages.schema.1);
-    schema.extend(0u32.to_le_bytes());
+    let (mut out, schema) = mcap_start(messages.schema);
     record(&mut out, 0x03, &schema);
     for &(id, topic) in channels {
-        let mut c = id.to_le_bytes().to_vec();
-        c.extend(1u16.to_le_bytes());
-        string(&mut c, topic);
-        string(&mut c, messages.encoding);
-        c.extend(0u32.to_le_bytes());
-        record(&mut out, 0x04, &c);
+        record(&mut out, 0x04, &mcap_channel(id, topic, messages.encoding));
     }
     for (i, f) in frames.iter().enumerate() {
         let mut m = channel_of(i).to_le_bytes().to_vec();
@@ -921,11 +942,7 @@ fn hand_mcap_of<D: Fn(&Frame, usize) -> Vec<u8>>(
         record(&mut out, 0x05, &m);
     }
     record(&mut out, 0x0f, &0u32.to_le_bytes());
-    let mut footer = 0u64.to_le_bytes().to_vec();
-    footer.extend(0u64.to_le_bytes());
-    footer.extend(0u32.to_le_bytes());
-    record(&mut out, 0x02, &footer);
-    out.extend(b"\x89MCAP0\r\n");
+    mcap_end(&mut out, 0);
     out
 }
 
@@ -1313,4 +1330,312 @@ fn values_separated_by_tabs_or_semicolons_are_named_for_it() {
             );
         }
     }
+}
+
+/// The files beside the database `file` whose names start with its name (`-wal`, `-shm`,
+/// `-journal`).
+fn beside(file: &Path) -> Vec<String> {
+    let name = file.file_name().unwrap().to_str().unwrap();
+    let mut found: Vec<String> = std::fs::read_dir(file.parent().unwrap())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with(name) && n != name)
+        .collect();
+    found.sort();
+    found
+}
+
+#[test]
+fn a_database_in_wal_mode_is_read_without_writing_beside_it() {
+    // rosbag2's `resilient` storage preset records in WAL mode, which the file keeps; the
+    // database closed cleanly. The folder's name holds characters a URI escapes.
+    use std::os::unix::fs::PermissionsExt as _;
+    let dir = temp_dir("db3-wal").join("a b?c#d%e");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("bag.db3");
+    std::fs::copy(fixture("noise.db3"), &file).unwrap();
+    let db = rusqlite::Connection::open(&file).unwrap();
+    let mode: String = db
+        .query_row("PRAGMA journal_mode=WAL", [], |r| r.get(0))
+        .unwrap();
+    assert_eq!(mode, "wal");
+    db.close().unwrap();
+    assert_eq!(beside(&file), Vec::<String>::new(), "closed cleanly");
+    let (got, result) = read(&file, None);
+    assert_eq!(result, Ok(0));
+    assert_bits(&got, &noise_frames(), "WAL mode");
+    assert_eq!(beside(&file), Vec::<String>::new(), "after the read");
+    let out = noise_of(&file, &[]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(beside(&file), Vec::<String>::new(), "after the tool");
+    // The file and its folder read-only (as a shared dataset is; root may write anyway).
+    std::fs::set_permissions(&file, std::fs::Permissions::from_mode(0o444)).unwrap();
+    std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o555)).unwrap();
+    let (got, result) = read(&file, None);
+    let left = beside(&file);
+    std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o755)).unwrap();
+    std::fs::set_permissions(&file, std::fs::Permissions::from_mode(0o644)).unwrap();
+    assert_eq!(result, Ok(0));
+    assert_bits(&got, &noise_frames(), "read-only WAL mode");
+    assert_eq!(left, Vec::<String>::new(), "after the read-only read");
+    // A write-ahead log that holds changes (a recording still open, or not closed): they are
+    // read from it.
+    let db = rusqlite::Connection::open(&file).unwrap();
+    db.execute_batch("PRAGMA wal_autocheckpoint=0; DELETE FROM messages WHERE id > 600")
+        .unwrap();
+    assert!(beside(&file).contains(&"bag.db3-wal".to_string()));
+    let (got, result) = read(&file, None);
+    drop(db);
+    assert_eq!(result, Ok(0));
+    assert_bits(&got, &noise_frames()[..600], "changes in the log");
+}
+
+#[test]
+fn messages_that_mark_a_sensor_as_not_provided_are_counted_for_its_refusal() {
+    // sensor_msgs/Imu: -1 in the first element of a covariance means "not provided". A
+    // gyro-only IMU marks its accelerometer so, its linear_acceleration zeros or placeholders.
+    let dir = temp_dir("not-provided");
+    let mut bytes = ros::fixture_bytes("noise.bag");
+    for id in ros::frame_ids(&bytes) {
+        // linear_acceleration_covariance[0]: after `imu_link`, 28 float64.
+        bytes[id + 232..id + 240].copy_from_slice(&(-1.0f64).to_le_bytes());
+    }
+    let bag_file = dir.join("gyro-only.bag");
+    std::fs::write(&bag_file, bytes).unwrap();
+    let frames = noise(300, 2);
+    // A CDR (ROS 2) message marking the gyro, and a ROS 1 one marking the accelerometer.
+    let marked = |data: Vec<u8>, at: usize| {
+        let mut data = data;
+        data[at..at + 8].copy_from_slice(&(-1.0f64).to_le_bytes());
+        data
+    };
+    let cdr_marked = MessagesOf {
+        schema: ("sensor_msgs/msg/Imu", "ros2msg"),
+        encoding: "cdr",
+        // 4 bytes of encapsulation, 24 of header with `imu_link\0` aligned to 8, 16 float64.
+        data: |f: &Frame, _| marked(cdr(f), 4 + 24 + 16 * 8),
+    };
+    let ros1_marked = MessagesOf {
+        schema: ("sensor_msgs/Imu", "ros1msg"),
+        encoding: "ros1",
+        data: |f: &Frame, i| marked(ros1(f, i as u32), 24 + 28 * 8),
+    };
+    let cdr_file = dir.join("accel-only.mcap");
+    std::fs::write(
+        &cdr_file,
+        hand_mcap_of(&cdr_marked, &[(1, "/imu0")], &frames, |_| 1),
+    )
+    .unwrap();
+    let ros1_file = dir.join("gyro-only-ros1.mcap");
+    std::fs::write(
+        &ros1_file,
+        hand_mcap_of(&ros1_marked, &[(1, "/imu0")], &frames, |_| 1),
+    )
+    .unwrap();
+    let select = Select::topic("/imu0");
+    let bag_frames = noise_frames();
+    let cases: [(&Path, u64, u64, &[Frame]); 3] = [
+        (&bag_file, 0, bag_frames.len() as u64, &bag_frames),
+        (&cdr_file, 300, 0, &frames),
+        (&ros1_file, 0, 300, &frames),
+    ];
+    for (file, gyro, accel, want) in cases {
+        let name = file.display().to_string();
+        let mut got = Vec::new();
+        let each = &mut |f| got.push(f);
+        let skipped = if file.extension().unwrap() == "bag" {
+            bag::read_selected(file, &select, each)
+        } else {
+            mcap::read_selected(file, &select, each)
+        }
+        .unwrap();
+        assert_bits(&got, want, &name);
+        assert_eq!(
+            (skipped.gyro_not_provided, skipped.accel_not_provided),
+            (gyro, accel),
+            "{name}"
+        );
+        let (sensor, field, other) = if gyro > 0 {
+            ("gyro", "angular_velocity", (false, true))
+        } else {
+            ("accelerometer", "linear_acceleration", (true, false))
+        };
+        let refusal = skipped.not_provided(true, true).expect(&name);
+        assert_eq!(
+            refusal,
+            format!(
+                "the messages mark the {sensor} as not provided: {field}_covariance[0] = -1 in \
+                 {} of them (sensor_msgs/Imu: disregard its values); the {} axes can be read \
+                 alone",
+                gyro + accel,
+                if gyro > 0 {
+                    "accelerometer's (ax, ay, az)"
+                } else {
+                    "gyro's (gx, gy, gz)"
+                }
+            ),
+            "{name}"
+        );
+        assert_eq!(skipped.not_provided(other.0, other.1), None, "{name}");
+    }
+    // Through the tool: characterise (all six axes) is refused naming the flag (a gyro-only
+    // bag read as "ax: constant (a stuck sensor?)", its placeholders modelled, before); the
+    // sensor provided is read alone.
+    let out = dir.join("out");
+    let refused = imu_ar(&[
+        "characterise",
+        path(&bag_file),
+        "--topic",
+        "/imu0",
+        "--out",
+        path(&out),
+    ]);
+    assert_eq!(refused.status.code(), Some(2), "{}", stderr(&refused));
+    assert!(
+        stderr(&refused).contains("the messages mark the accelerometer as not provided"),
+        "{}",
+        stderr(&refused)
+    );
+    assert!(!out.exists());
+    let column = |c: &str| imu_ar(&["noise", path(&bag_file), "--topic", "/imu0", "--column", c]);
+    let gyro = column("gx");
+    assert_eq!(gyro.status.code(), Some(0), "{}", stderr(&gyro));
+    let accel = column("ax");
+    assert!(
+        stderr(&accel).contains("linear_acceleration_covariance[0] = -1"),
+        "{}",
+        stderr(&accel)
+    );
+}
+
+/// A chunked MCAP file of the IMU messages `frames` on `/imu0` (channel 1), in the order
+/// given, `per_chunk` of them to an uncompressed chunk, and, when `indexed`, a summary with
+/// each chunk's index.
+fn chunked_mcap(frames: &[Frame], per_chunk: usize, indexed: bool) -> Vec<u8> {
+    let (mut out, schema) = mcap_start(("sensor_msgs/msg/Imu", "ros2msg"));
+    record(&mut out, 0x03, &schema);
+    let channel = mcap_channel(1, "/imu0", "cdr");
+    record(&mut out, 0x04, &channel);
+    let mut indexes = Vec::new();
+    for (k, group) in frames.chunks(per_chunk).enumerate() {
+        let mut records = Vec::new();
+        for (i, f) in group.iter().enumerate() {
+            let mut m = 1u16.to_le_bytes().to_vec();
+            m.extend(((k * per_chunk + i) as u32).to_le_bytes());
+            m.extend((f.stamp_ns as u64).to_le_bytes());
+            m.extend((f.stamp_ns as u64).to_le_bytes());
+            m.extend(cdr(f));
+            record(&mut records, 0x05, &m);
+        }
+        let start = group.iter().map(|f| f.stamp_ns as u64).min().unwrap();
+        let end = group.iter().map(|f| f.stamp_ns as u64).max().unwrap();
+        let mut chunk = start.to_le_bytes().to_vec();
+        chunk.extend(end.to_le_bytes());
+        chunk.extend((records.len() as u64).to_le_bytes());
+        chunk.extend(0u32.to_le_bytes());
+        string(&mut chunk, "");
+        chunk.extend((records.len() as u64).to_le_bytes());
+        chunk.extend(&records);
+        let offset = out.len() as u64;
+        record(&mut out, 0x06, &chunk);
+        let mut index = start.to_le_bytes().to_vec();
+        index.extend(end.to_le_bytes());
+        index.extend(offset.to_le_bytes());
+        index.extend((out.len() as u64 - offset).to_le_bytes());
+        index.extend(0u32.to_le_bytes());
+        index.extend(0u64.to_le_bytes());
+        string(&mut index, "");
+        index.extend((records.len() as u64).to_le_bytes());
+        index.extend((records.len() as u64).to_le_bytes());
+        indexes.push(index);
+    }
+    record(&mut out, 0x0f, &0u32.to_le_bytes());
+    let summary_start = if indexed { out.len() as u64 } else { 0 };
+    if indexed {
+        record(&mut out, 0x03, &schema);
+        record(&mut out, 0x04, &channel);
+        for index in &indexes {
+            record(&mut out, 0x08, index);
+        }
+    }
+    mcap_end(&mut out, summary_start);
+    out
+}
+
+#[test]
+fn an_mcap_file_out_of_log_time_order_is_read_in_it_by_its_chunk_index() {
+    let dir = temp_dir("mcap-log-time");
+    let frames = noise(400, 2);
+    // The second half written first; chunks of 50 that follow each other in time otherwise.
+    let swapped: Vec<Frame> = frames[200..]
+        .iter()
+        .chain(&frames[..200])
+        .copied()
+        .collect();
+    // Chunks whose times overlap: each pair of chunks shares a stretch of 100 frames.
+    let interleaved: Vec<Frame> = frames
+        .chunks(100)
+        .flat_map(|c| c.iter().step_by(2).chain(c.iter().skip(1).step_by(2)))
+        .copied()
+        .collect();
+    for (name, order) in [
+        ("in-order", &frames),
+        ("swapped", &swapped),
+        ("overlapping", &interleaved),
+    ] {
+        let file = dir.join(format!("{name}.mcap"));
+        std::fs::write(&file, chunked_mcap(order, 50, true)).unwrap();
+        let (got, result) = read(&file, None);
+        assert_eq!(result, Ok(0), "{name}");
+        assert_bits(&got, &frames, name);
+        let out = noise_json(&file, &["--topic", "/imu0"]);
+        assert_eq!(out["n"], 400, "{name}");
+    }
+    // Without a chunk index (unchunked, or chunked with no summary) the order cannot be
+    // known before the end: the file's order is named, not the stamps.
+    for (name, bytes) in [
+        ("unchunked", hand_mcap(&[(1, "/imu0")], &swapped, |_| 1)),
+        ("no-summary", chunked_mcap(&swapped, 50, false)),
+    ] {
+        let file = dir.join(format!("{name}.mcap"));
+        std::fs::write(&file, bytes).unwrap();
+        let e = read(&file, None).1.unwrap_err();
+        assert!(
+            e.starts_with("the file's messages are out of log-time order")
+                && e.ends_with("and the file has no chunk index to read them in order by"),
+            "{name}: {e}"
+        );
+        let out = noise_of(&file, &[]);
+        assert_one_line_failure(&out);
+        assert!(
+            stderr(&out).contains("out of log-time order")
+                && !stderr(&out).contains("--drop-backward"),
+            "{name}: {}",
+            stderr(&out)
+        );
+    }
+}
+
+#[test]
+fn an_mcap_channel_of_another_schema_encoding_lists_the_ones_read() {
+    let dir = temp_dir("mcap-json");
+    let messages = MessagesOf {
+        schema: ("sensor_msgs/msg/Imu", "jsonschema"),
+        encoding: "json",
+        data: |f: &Frame, _| cdr(f),
+    };
+    let file = dir.join("json.mcap");
+    std::fs::write(
+        &file,
+        hand_mcap_of(&messages, &[(1, "/imu0")], &noise(10, 2), |_| 1),
+    )
+    .unwrap();
+    assert_eq!(
+        read(&file, None).1,
+        Err(
+            "unknown schema encoding 'jsonschema' on topic '/imu0' (supported: ros2msg, \
+             ros2idl, or ros1msg for the ROS 1 type sensor_msgs/Imu)"
+                .to_string()
+        )
+    );
 }

@@ -1006,8 +1006,14 @@ fn second_red_team_pass_on_logs() {
                 &sensor(t, t, device + 1, [f(a[3]), f(a[4]), f(a[5])], f(*celsius)),
             );
         }
+        // (Counts of -9 to 9 scrambled: a pattern that repeats would hold no noise a model
+        // of noise could take.)
         let xyz: [[i16; 32]; 3] = std::array::from_fn(|j| {
-            std::array::from_fn(|i| ((k * 31 + i * 7 + j * 3) % 19) as i16 - 9)
+            std::array::from_fn(|i| {
+                let mut z = (((k * 32 + i) * 3 + j) as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+                z = (z ^ (z >> 31)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+                ((z >> 40) % 19) as i16 - 9
+            })
         });
         log.data(0, &fifo(t, 100, 1000.0, 1e-4, 10, &xyz));
         log.data(1, &fifo(t, 101, 1000.0, 1e-3, 10, &xyz));
