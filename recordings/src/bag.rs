@@ -24,8 +24,8 @@ use rosbag::{ChunkRecord, IndexRecord, MessageRecord, RosBag};
 use crate::csv::DataError;
 use crate::error::escaped;
 use crate::frame::{
-    Decoded, Frame, IMU_F64S, NotProvided, Select, Skipped, Tally, absent_topic, data_error,
-    imu_axes, stamp_ns, u32_at,
+    Decoded, Frame, IMU_F64S, Select, Skipped, Tally, absent_topic, data_error, imu_axes, stamp_ns,
+    u32_at,
 };
 
 /// The message type of the IMU connections.
@@ -186,12 +186,12 @@ pub fn read_selected(
                 continue;
             }
             found += 1;
-            let frame = decode(m.data).map(|(f, marks, id)| {
+            let frame = decode(m.data).map(|(f, id)| {
                 let k = frame_ids.iter().position(|i| i == id).unwrap_or_else(|| {
                     frame_ids.push(id.to_vec());
                     frame_ids.len() - 1
                 });
-                (f, marks, u16::try_from(k).unwrap_or(u16::MAX))
+                (f, u16::try_from(k).unwrap_or(u16::MAX))
             });
             sorted.push((m.time, m.conn_id, frame));
         }
@@ -225,13 +225,13 @@ fn deliver(held: &mut Vec<Held>, frame_ids: &[Vec<u8>], tally: &mut Tally) {
     held.sort_by_key(|&(time, _, _)| time);
     for (_, conn, frame) in held.drain(..) {
         let id = |k: u16| frame_ids.get(usize::from(k)).map_or(&[][..], Vec::as_slice);
-        tally.offer(conn, frame.map(|(f, marks, k)| (f, marks, id(k))));
+        tally.offer(conn, frame.map(|(f, k)| (f, id(k))));
     }
 }
 
 /// A message held to be sorted: its receive time, connection, and frame with the sensors it
 /// marks as not provided and the index of its frame_id (`None` when it did not decode).
-type Held = (u64, u32, Option<(Frame, NotProvided, u16)>);
+type Held = (u64, u32, Option<(Frame, u16)>);
 
 /// The rosbag crate's error text without its `rosbag::Error: ` prefix.
 fn text(e: &rosbag::Error) -> String {
@@ -327,6 +327,7 @@ pub(crate) fn decode(b: &[u8]) -> Option<Decoded<'_>> {
     let frame = Frame {
         stamp_ns: stamp_ns(i64::from(secs), nsecs),
         axes,
+        not_provided: marks,
     };
-    Some((frame, marks, b.get(16..at)?))
+    Some((frame, b.get(16..at)?))
 }

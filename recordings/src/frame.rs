@@ -12,14 +12,16 @@ use std::path::Path;
 use crate::csv::DataError;
 use crate::error::escaped;
 
-/// One IMU message: the header stamp in nanoseconds since the epoch, and the six axes in the
-/// message's SI units (rad/s, m/s^2).
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// One IMU message: the header stamp in nanoseconds since the epoch, the six axes in the
+/// message's SI units (rad/s, m/s^2), and the sensors it marks as not provided.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Frame {
     /// The message's `header.stamp` in nanoseconds since the epoch.
     pub stamp_ns: i64,
     /// angular_velocity.x, .y, .z, linear_acceleration.x, .y, .z
     pub axes: [f64; 6],
+    /// The sensors whose values the message says to disregard.
+    pub not_provided: NotProvided,
 }
 
 /// What a reader skipped, counted.
@@ -31,6 +33,10 @@ pub struct Skipped {
     pub non_finite: u64,
     /// Messages of another IMU on the topic than the one `--frame-id` chose.
     pub other_frame_id: u64,
+    /// Messages that mark a sensor read as not provided, among a record whose other messages
+    /// provide it (a driver's placeholder while the sensor restarts): their values are not
+    /// measurements.
+    pub disregarded: u64,
     /// Samples of a log's gyro or accelerometer without a partner of the same time in the
     /// other (a PX4 ULog file's two topics read together).
     pub unpaired: u64,
@@ -56,6 +62,7 @@ impl Skipped {
                 "undecodable (a batch or message dropped whole)",
             ),
             (self.non_finite, "not finite"),
+            (self.disregarded, "marking a sensor read as not provided"),
             (self.unpaired, "without a partner of the other sensor"),
         ]
         .iter()
@@ -65,22 +72,22 @@ impl Skipped {
         (!parts.is_empty()).then(|| format!("messages skipped: {}", parts.join(", ")))
     }
 
-    /// The refusal of a read of the gyro's axes (`gyro`) or the accelerometer's (`accel`) when
-    /// the messages mark that sensor as not provided: sensor_msgs/Imu says a covariance whose
-    /// first element is -1 means "this estimate is not provided; disregard it". `None` when
-    /// no message marks a sensor read.
+    /// The refusal of a read of the gyro's axes (`gyro`) or the accelerometer's (`accel`) of
+    /// `total` messages when they mark that sensor as not provided: sensor_msgs/Imu says a
+    /// covariance whose first element is -1 means "this estimate is not provided; disregard
+    /// it". `None` when no message marks a sensor read.
     ///
     /// ```
     /// use imu_ar_recordings::frame::Skipped;
     /// let gyro_only = Skipped { accel_not_provided: 400, ..Skipped::default() };
-    /// assert!(gyro_only.not_provided(true, false).is_none());
-    /// let refusal = gyro_only.not_provided(true, true).unwrap();
+    /// assert!(gyro_only.not_provided(true, false, 400).is_none());
+    /// let refusal = gyro_only.not_provided(true, true, 400).unwrap();
     /// assert!(refusal.starts_with(
     ///     "the messages mark the accelerometer as not provided: \
-    ///      linear_acceleration_covariance[0] = -1"
+    ///      linear_acceleration_covariance[0] = -1 in 400 of the 400"
     /// ));
     /// ```
-    pub fn not_provided(&self, gyro: bool, accel: bool) -> Option<String> {
+    pub fn not_provided(&self, gyro: bool, accel: bool, total: u64) -> Option<String> {
         let marked: Vec<String> = [
             (
                 gyro,
@@ -102,8 +109,8 @@ impl Skipped {
         .map(|(_, n, sensor, field, other)| {
             format!(
                 "the messages mark the {sensor} as not provided: {field}_covariance[0] = -1 \
-                 in {n} of them (sensor_msgs/Imu: disregard its values); the {other} axes \
-                 can be read alone"
+                 in {n} of the {total} (sensor_msgs/Imu: disregard its values); the {other} \
+                 axes can be read alone"
             )
         })
         .collect();
@@ -164,11 +171,11 @@ const LINEAR: usize = 25;
 /// `angular_velocity_covariance`, of `linear_acceleration_covariance`, is -1 ("this estimate
 /// is not provided; disregard it").
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub(crate) struct NotProvided {
-    /// angular_velocity_covariance[0] is -1.
-    pub(crate) gyro: bool,
-    /// linear_acceleration_covariance[0] is -1.
-    pub(crate) accel: bool,
+pub struct NotProvided {
+    /// `angular_velocity_covariance[0]` is -1.
+    pub gyro: bool,
+    /// `linear_acceleration_covariance[0]` is -1.
+    pub accel: bool,
 }
 
 /// The six axes of the float64 fields of a `sensor_msgs/Imu` that start at byte `at` of
@@ -246,9 +253,9 @@ pub(crate) struct Tally<'a> {
     zstd: u64,
 }
 
-/// A decoded message: its frame, the sensors it marks as not provided, and its header's
+/// A decoded message: its frame (with the sensors it marks as not provided) and its header's
 /// frame_id.
-pub(crate) type Decoded<'a> = (Frame, NotProvided, &'a [u8]);
+pub(crate) type Decoded<'a> = (Frame, &'a [u8]);
 
 /// A message's decoder: the message decoded, or `None`.
 pub(crate) type Decode = fn(&[u8]) -> Option<Decoded<'_>>;
@@ -297,7 +304,7 @@ impl<'a> Tally<'a> {
     /// finite and of the chosen frame_id (and counted when it marks a sensor as not
     /// provided); counted otherwise.
     pub(crate) fn offer(&mut self, source: u32, decoded: Option<Decoded<'_>>) {
-        let Some((frame, not_provided, frame_id)) = decoded else {
+        let Some((frame, frame_id)) = decoded else {
             self.skipped.undecodable += 1;
             return;
         };
@@ -347,8 +354,8 @@ impl<'a> Tally<'a> {
             s.span = Some(s.span.map_or((t, t), |(a, b)| (a.min(t), b.max(t))));
         }
         self.delivered += 1;
-        self.skipped.gyro_not_provided += u64::from(not_provided.gyro);
-        self.skipped.accel_not_provided += u64::from(not_provided.accel);
+        self.skipped.gyro_not_provided += u64::from(frame.not_provided.gyro);
+        self.skipped.accel_not_provided += u64::from(frame.not_provided.accel);
         (self.each)(frame);
     }
 
@@ -523,6 +530,7 @@ mod tests {
         Frame {
             stamp_ns: t,
             axes: [0.5; 6],
+            ..Frame::default()
         }
     }
 
@@ -542,9 +550,8 @@ mod tests {
             };
             let mut tally = Tally::new(&select, &mut each);
             for t in 0..10 {
-                let none = NotProvided::default();
-                tally.offer(1, Some((frame(2 * t), none, text)));
-                tally.offer(2, Some((frame(2 * t + 1), none, bytes)));
+                tally.offer(1, Some((frame(2 * t), text)));
+                tally.offer(2, Some((frame(2 * t + 1), bytes)));
             }
             let finished = tally.finish(file, "/imu", &|id| format!("connection {id}"));
             match result {

@@ -41,8 +41,8 @@ use ::mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
 
 use crate::csv::DataError;
 use crate::frame::{
-    Decoded, Frame, NotProvided, Select, Skipped, Tally, absent_topic, bytes_at, data_error,
-    imu_axes, stamp_ns, u32_at,
+    Decoded, Frame, Select, Skipped, Tally, absent_topic, bytes_at, data_error, imu_axes, stamp_ns,
+    u32_at,
 };
 
 /// The schema name of the IMU channels.
@@ -292,7 +292,7 @@ struct Held {
     log_time: u64,
     number: u64,
     channel: u16,
-    decoded: Option<(Frame, NotProvided, u32)>,
+    decoded: Option<(Frame, u32)>,
 }
 
 impl Ord for Held {
@@ -394,7 +394,7 @@ impl State<'_> {
                     } else {
                         decode
                     };
-                    let decoded = self.tally.decode(body, decode).map(|(f, marks, id)| {
+                    let decoded = self.tally.decode(body, decode).map(|(f, id)| {
                         let k = match self.frame_ids.iter().position(|i| i == id) {
                             Some(k) => k,
                             None => {
@@ -402,7 +402,7 @@ impl State<'_> {
                                 self.frame_ids.len() - 1
                             }
                         };
-                        (f, marks, u32::try_from(k).unwrap_or(u32::MAX))
+                        (f, u32::try_from(k).unwrap_or(u32::MAX))
                     });
                     self.held.push(Held {
                         log_time,
@@ -433,14 +433,14 @@ impl State<'_> {
                 decoded,
                 ..
             } = PeekMut::pop(top);
-            let decoded: Option<Decoded<'_>> = decoded.map(|(f, marks, k)| {
+            let decoded: Option<Decoded<'_>> = decoded.map(|(f, k)| {
                 let id = usize::try_from(k)
                     .ok()
                     .and_then(|k| self.frame_ids.get(k))
                     .map_or(&[][..], Vec::as_slice);
-                (f, marks, id)
+                (f, id)
             });
-            if let Some((frame, _, id)) = decoded {
+            if let Some((frame, id)) = decoded {
                 let full = self.last.len() >= CHECKED_FRAME_IDS;
                 match self.last.iter_mut().find(|(i, _, _)| i.as_slice() == id) {
                     Some((_, t, stamp)) if log_time < *t && frame.stamp_ns < *stamp => {
@@ -788,7 +788,8 @@ pub(crate) fn decode(b: &[u8]) -> Option<Decoded<'_>> {
     let frame = Frame {
         stamp_ns: stamp_ns(i64::from(sec), nanosec),
         axes,
+        not_provided: marks,
     };
     let id = body.get(12..end)?;
-    Some((frame, marks, id.strip_suffix(&[0]).unwrap_or(id)))
+    Some((frame, id.strip_suffix(&[0]).unwrap_or(id)))
 }

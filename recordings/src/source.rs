@@ -912,9 +912,23 @@ fn messages(
         topic,
         frame_id: request.frame_id,
     };
+    // The sensors read: a message that marks one of them as not provided is skipped.
+    let gyro = picks.iter().any(|&i| i < 3);
+    let accel = picks.iter().any(|&i| i >= 3);
+    let mut disregarded = 0u64;
+    // The first and last stamps of the file before, and this file's first.
+    let mut before: Option<(i64, i64)> = None;
     for file in files {
+        let mut first: Option<i64> = None;
         let s = read(file, &select, &mut |frame: Frame| {
             count += 1;
+            if (gyro && frame.not_provided.gyro) || (accel && frame.not_provided.accel) {
+                disregarded += 1;
+                return;
+            }
+            if frame.stamp_ns != 0 && first.is_none() {
+                first = Some(frame.stamp_ns);
+            }
             if frame.stamp_ns == 0 {
                 unstamped += 1;
             } else if !take_stamp(&mut timing, frame.stamp_ns, request.drop_backward) {
@@ -927,29 +941,46 @@ fn messages(
             each((frame.stamp_ns != 0).then_some(frame.stamp_ns), &values);
         })
         .map_err(|e| Fail(e.to_string()))?;
+        if let (Some(t), Some(before)) = (first, before)
+            && t <= before.1
+            && !request.drop_backward
+        {
+            return Err(with_file(std::slice::from_ref(file), file_order(t, before)));
+        }
+        if let Some(t) = first {
+            before = Some((t, timing.last().max(t)));
+        }
         skipped.undecodable += s.undecodable;
         skipped.non_finite += s.non_finite;
         skipped.other_frame_id += s.other_frame_id;
         skipped.gyro_not_provided += s.gyro_not_provided;
         skipped.accel_not_provided += s.accel_not_provided;
     }
-    // A sensor the messages mark as not provided (sensor_msgs/Imu: its covariance's first
-    // element -1) holds no measurement: reading its axes is refused.
-    let gyro = picks.iter().any(|&i| i < 3);
-    let accel = picks.iter().any(|&i| i >= 3);
-    if let Some(refusal) = skipped.not_provided(gyro, accel) {
+    // Skipped messages leave holes the stamps show only as gaps; uniform ones (every other
+    // message) would pass for a lower rate. More than 1 % of the record is refused. A sensor
+    // the messages mark as not provided (sensor_msgs/Imu: its covariance's first element -1)
+    // holds no measurement there: more than 1 % of them is refused naming the mark (all of
+    // them: a gyro-only IMU's zeros), fewer are skipped and counted.
+    let total = count
+        .saturating_add(skipped.undecodable)
+        .saturating_add(skipped.non_finite);
+    skipped.disregarded = disregarded;
+    if disregarded.saturating_mul(100) > total
+        && let Some(refusal) = skipped.not_provided(gyro, accel, total)
+    {
         return Err(with_file(files, refusal));
     }
-    // Skipped messages leave holes the stamps show only as gaps; uniform ones (every other
-    // message) would pass for a lower rate. More than 1 % of the record is refused.
-    let lost = skipped.undecodable.saturating_add(skipped.non_finite);
-    let total = count.saturating_add(lost);
+    let lost = skipped
+        .undecodable
+        .saturating_add(skipped.non_finite)
+        .saturating_add(disregarded);
     if lost.saturating_mul(100) > total {
         return Err(with_file(
             files,
             format!(
                 "{lost} of the {total} messages on '{}' were skipped ({} undecodable, {} with \
-                 a NaN or infinite axis): more than 1 % of the record is missing",
+                 a NaN or infinite axis, {disregarded} marking a sensor read as not provided): \
+                 more than 1 % of the record is missing",
                 escaped(topic),
                 skipped.undecodable,
                 skipped.non_finite
@@ -976,6 +1007,27 @@ fn messages(
         });
     }
     stamped(files, request, &picks, (timing, backward), skipped)
+}
+
+/// The refusal of a file whose first stamp `t` is not after the last of the file before it
+/// (`before`: that file's first and last stamps): files out of order (or a clock restarted
+/// between them) where it lies before that file's first, files that overlap (one given twice)
+/// where it lies within it.
+fn file_order(t: i64, (first, last): (i64, i64)) -> String {
+    if t < first {
+        format!(
+            "the file's first timestamp, {t} ns, is before the first of the file before \
+             ({first} ns): the files are out of order (give them in time order; a shell's glob \
+             puts rec_10 before rec_2), or the clock restarted between them (give each as a \
+             record of its own)"
+        )
+    } else {
+        format!(
+            "the file's first timestamp, {t} ns, lies within the file before ({first} to \
+             {last} ns): the files overlap (a file given twice, or pieces that share a \
+             stretch); give each stretch once"
+        )
+    }
 }
 
 /// The unit of a message's axis `i` (of [`AXES`]).
@@ -1076,6 +1128,8 @@ fn csv_stream(
     let mut values = vec![0.0; request.columns.len()];
     // The files begun, and whether the one being read has passed a row yet.
     let begun = std::cell::Cell::new((0usize, false));
+    // The first stamps of the file before and of the one being read, and that one's number.
+    let mut firsts: (Option<i64>, Option<i64>, usize) = (None, None, 0);
     let mut select = |header: &[String]| -> Result<Vec<usize>, String> {
         begun.set((begun.get().0 + 1, true));
         let mut picks = request
@@ -1175,6 +1229,11 @@ fn csv_stream(
             }
             None => (cells, None),
         };
+        if let Some(t) = stamp
+            && firsts.2 != files
+        {
+            firsts = (firsts.1, Some(t), files);
+        }
         let step = stamp.map(|t| (t, timing.push(t)));
         if let Some((_, Step::Repeat)) = step
             && !request.drop_backward
@@ -1195,11 +1254,7 @@ fn csv_stream(
                 timing.drop_one();
             }
             if !request.drop_backward && first_row && files > 1 {
-                return Err(format!(
-                    "the file's first timestamp, {t} ns, is not after the last of the file \
-                     before ({last} ns): the files are out of order; give them in time order \
-                     (a shell's glob puts rec_10 before rec_2)"
-                ));
+                return Err(file_order(t, (firsts.0.unwrap_or(last), last)));
             }
             if !request.drop_backward {
                 return Err(format!(

@@ -2163,6 +2163,26 @@ impl Timing {
             None => None,
         };
         let Some((fit, rate, sigma, x)) = lattice else {
+            // A rate within 3 % of the quantum's beats with it at their difference: where the
+            // places repeated or left empty come in bunches evenly spaced at another beat, the
+            // rate read does not make them.
+            if q > 0.0 && (q * hz - 1.0).abs() < 0.03 {
+                let (more, fewer) = Self::places_off(t, q);
+                if let Some(every) = evenly(&more, &fewer, q) {
+                    let made = (hz - 1.0 / q).abs() * every;
+                    if !(0.75..=1.25).contains(&made) {
+                        return Err(format!(
+                            "the timestamps, stamped to {q:e} s, repeat or leave places empty \
+                             in bunches that come evenly, about every {} s (a beat of {} Hz \
+                             with the stamps), which the rate read from them, {} Hz, does not \
+                             make: the rate is not told; give --rate",
+                            short(every),
+                            short(1.0 / every),
+                            short(hz)
+                        ));
+                    }
+                }
+            }
             return unresolved();
         };
         if fit.coherent < 0.9 {
@@ -2223,6 +2243,31 @@ impl Timing {
             summary.unexplained_repeat = None;
         }
         Ok(())
+    }
+
+    /// The samples more than their places hold (a stamp's repeats) and the places left empty
+    /// between stamps up to four quanta apart (`q`, s), as times (s from the first stamp), a
+    /// time for each; but for those a gap of five quanta or more reached, or the gap's length
+    /// after it (a host's late samples caught up on), as [`Self::beat`] leaves them.
+    fn places_off(t: &[i64], q: f64) -> (Vec<f64>, Vec<f64>) {
+        let secs = |x: i64| (i128::from(x) - i128::from(t[0])) as f64 * 1e-9;
+        let quantum = q * 1e9;
+        let (mut more, mut fewer) = (Vec::new(), Vec::new());
+        let mut quiet = i64::MIN;
+        for w in t.windows(2) {
+            let iv = (i128::from(w[1]) - i128::from(w[0])) as f64;
+            if iv > 4.5 * quantum {
+                quiet = w[1].saturating_add(iv as i64);
+            } else if w[1] > quiet {
+                if iv == 0.0 {
+                    more.push(secs(w[1]));
+                } else {
+                    let places = (iv / quantum).round() as i64;
+                    fewer.extend((1..places).map(|j| secs(w[0]) + j as f64 * q));
+                }
+            }
+        }
+        (more, fewer)
     }
 
     /// Where the stamps' beat with their quantum `q` (s) keeps no one phase over the whole
@@ -4886,7 +4931,8 @@ mod tests {
     #[test]
     fn a_drifting_clocks_beat_with_its_stamps_is_not_samples_lost() {
         // Clocks 0.4 % to 1.5 % slower than their whole-ms stamps, drifting by 1e-4 over the
-        // record (too much for the beat to keep one phase) or losing 1 % of their samples,
+        // record (too much for the beat to keep one phase) or losing 1 % of their samples, and
+        // clocks 0.3 % and 0.5 % faster with too few beats for the fold,
         // with a gap whose last samples are caught up a quantum apart: their places left
         // empty come in bunches on the beat, not at random. Read as 1000 Hz with every such
         // place a sample lost before; refused, or read right.
@@ -4897,6 +4943,10 @@ mod tests {
             (988.431, 1e-4, 0.0, true, 158.0, (10.478, 11.232, 242)),
             (996.247, 1e-4, 0.0, false, 299.0, (10.519, 41.577, 3)),
             (985.153, 0.0, 0.01, true, 133.0, (11.85, 0.972, 587)),
+            // Faster clocks, their stamps repeated on the beat, a gap of 11 s leaving 8 s of
+            // beats before it: read 1000.32 and 1000.87 Hz before.
+            (1005.307, 0.0, 0.0, false, 40.0, (8.565, 11.246, 2)),
+            (1002.827, 0.0, 0.0, false, 50.0, (19.137, 10.918, 4)),
         ] {
             let n = (secs * rate) as usize;
             let mut due = vec![12.345_678_9];

@@ -261,7 +261,9 @@ fn characterise(
         summary(read.timing, args.rate.is_none()).map_err(|e| with_file(&args.files, e))?;
     let rate = resolve_rate(args.rate, timing.as_ref()).map_err(|e| with_file(&args.files, e.0))?;
     check_span("--rate", rate, n as usize)?;
-    crate::input::check_gaps(timing.as_ref(), n as usize).map_err(|e| with_file(&args.files, e))?;
+    crate::input::check_gaps(timing.as_ref(), n as usize)
+        .and_then(|()| crate::input::check_subsampled(&args.files, timing.as_ref()))
+        .map_err(|e| with_file(&args.files, e))?;
     let kind = Kind::of(&args.files[0]);
     let units: Vec<Unit> = (0..6)
         .map(|i| {
@@ -278,8 +280,11 @@ fn characterise(
         .map_err(|e| with_file(&args.files, e.0))?;
     if let Some(w) = gravity(
         std::array::from_fn(|k| axes[3 + k].mean() * units[3 + k].to_si),
+        units[3].name,
         kind,
-    )? {
+    )
+    .map_err(|e| with_file(&args.files, e))?
+    {
         eprintln!("imu-ar: warning: {}", with_file(&args.files, w).0);
     }
     let fits: Vec<Fitting> = units
@@ -619,34 +624,44 @@ fn commit(
         .collect())
 }
 
-/// The accelerometers' mean (m/s^2, as read) against gravity's: a record at rest reads
-/// 9.81 m/s^2 in magnitude whatever way the sensor lies. A magnitude within 20 % of 1 or of
-/// 1000 is a record in g or mg read as m/s^2: refused, naming the flag that reads it so;
-/// another outside 7 to 13 m/s^2 (a record not at rest, gravity taken out, or another unit)
-/// is a warning, returned.
-fn gravity(mean: [f64; 3], kind: Kind) -> Result<Option<String>, Fail> {
+/// The accelerometers' mean (m/s^2, as read in the unit `read`) against gravity's: a record
+/// at rest reads 9.81 m/s^2 in magnitude whatever way the sensor lies. A magnitude within 20 %
+/// of what values in another of m/s^2, g and mg read in `read` give (1 or 1000 for g or mg
+/// read as m/s^2, 96 for m/s^2 read as g, 9807 for mg read as g, ...) is a unit mistaken:
+/// refused, naming the unit and how to say it; another outside 7 to 13 m/s^2 (a record not at
+/// rest, gravity taken out) is a warning, returned.
+fn gravity(mean: [f64; 3], read: &str, kind: Kind) -> Result<Option<String>, String> {
     const G: f64 = 9.806_65;
+    const UNITS: [(&str, f64); 3] = [("m/s^2", 1.0), ("g", G), ("mg", 1e-3 * G)];
     let magnitude = mean.iter().map(|a| a * a).sum::<f64>().sqrt();
     let shown = format!(
         "the accelerometers read {magnitude:.4} m/s^2 on average (x, y, z: {:.4}, {:.4}, \
          {:.4}), where a sensor at rest reads gravity's {G} whatever way it lies",
         mean[0], mean[1], mean[2]
     );
-    for (unit, scale) in [("g", 1.0), ("mg", 1000.0)] {
-        if (0.8 * scale..=1.25 * scale).contains(&magnitude) {
+    let read_si = UNITS.iter().find(|u| u.0 == read).map_or(1.0, |u| u.1);
+    for &(unit, si) in UNITS.iter().filter(|u| u.0 != read) {
+        let reading = G * read_si / si;
+        if (0.8 * reading..=1.25 * reading).contains(&magnitude) {
             let how = match kind {
                 Kind::Csv => format!(
                     ": say so in the header's bracket ([{unit}]), or with --accel-unit {unit} \
                      for columns without one"
                 ),
-                Kind::Bag | Kind::Mcap | Kind::Rosbag2 | Kind::Db3 => format!(
-                    " (a driver that does not keep REP 103): --accel-unit {unit} reads them so"
-                ),
+                Kind::Bag | Kind::Mcap | Kind::Rosbag2 | Kind::Db3 if read == "m/s^2" => {
+                    format!(
+                        " (a driver that does not keep REP 103): --accel-unit {unit} reads them \
+                         so"
+                    )
+                }
+                Kind::Bag | Kind::Mcap | Kind::Rosbag2 | Kind::Db3 => {
+                    format!(" (the messages' own unit, REP 103): leave --accel-unit {read} out")
+                }
                 _ => String::new(),
             };
-            return Err(Fail(format!(
-                "{shown}: the values are in {unit}, not m/s^2{how}"
-            )));
+            return Err(format!(
+                "{shown}: the values are in {unit}, not {read}{how}"
+            ));
         }
     }
     Ok((!(7.0..=13.0).contains(&magnitude)).then(|| {
@@ -901,11 +916,10 @@ impl Output for Characterisation {
                 e(m.white_noise_at_1s()),
                 e(m.random_walk),
                 e(Some(m.bias_instability.value)),
-                format!("{}", m.bias_instability.tau_s),
+                seconds(m.bias_instability.tau_s),
                 m.gauss_markov.len(),
                 m.ar.as_ref().map_or(0, |a| a.order),
-                m.explained_up_to_s
-                    .map_or("none".to_string(), |t| t.to_string())
+                m.explained_up_to_s.map_or("none".to_string(), seconds)
             );
         }
         s += &format!("wrote {}\n", self.files.join(", "));
@@ -913,9 +927,36 @@ impl Output for Characterisation {
     }
 }
 
+/// An averaging time in the text table: five significant digits, trailing zeros left out
+/// (514.01, 0.104, 131072); the JSON keeps every digit.
+fn seconds(t: f64) -> String {
+    if !t.is_finite() || t == 0.0 {
+        return t.to_string();
+    }
+    let digits = (4 - t.abs().log10().floor() as i32).clamp(0, 12) as usize;
+    let text = format!("{t:.digits$}");
+    match text.contains('.') {
+        true => text.trim_end_matches('0').trim_end_matches('.').to_string(),
+        false => text,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn averaging_times_are_shown_to_five_digits() {
+        for (t, shown) in [
+            (131_072.0 / 255.0, "514.01"),
+            (0.104_000_000_000_000_01, "0.104"),
+            (131_072.0, "131072"),
+            (2.5e-3, "0.0025"),
+            (1.0, "1"),
+        ] {
+            assert_eq!(seconds(t), shown, "{t}");
+        }
+    }
 
     /// An earlier run's file `f`.
     fn old(f: &str) -> String {

@@ -455,6 +455,34 @@ pub fn check_gaps(timing: Option<&TimingSummary>, n: usize) -> Result<(), String
     ))
 }
 
+/// The least rate of a PX4 sensor topic read as the sensor's own samples, Hz: PX4's IMU
+/// drivers publish `sensor_gyro` and `sensor_accel` at hundreds of Hz, and its logger's
+/// profiles write them once a second (the default) or ten times (thermal calibration,
+/// sensor comparison), a sample kept each interval.
+pub const LEAST_ULOG_RATE: f64 = 50.0;
+
+/// A PX4 log's sensor samples at a rate under [`LEAST_ULOG_RATE`] (`timing`, as their stamps
+/// tell it) are the logger's subsample of the sensor's stream: single readings, whose spread
+/// is the sensor's at its own rate, not an average over the interval (the noise density read
+/// at the subsample's rate is `sqrt(sensor rate / logged rate)` times the sensor's: 16 times
+/// for 250 Hz logged at 1 Hz). Refused for a noise model, naming the logger's profiles.
+pub fn check_subsampled(files: &[PathBuf], timing: Option<&TimingSummary>) -> Result<(), String> {
+    let Some(t) = timing.filter(|t| t.rate_hz < LEAST_ULOG_RATE) else {
+        return Ok(());
+    };
+    if files.first().map(|f| source::Kind::of(f)) != Some(source::Kind::Ulog) {
+        return Ok(());
+    }
+    Err(format!(
+        "the PX4 log holds the sensor's samples at {} Hz: the logger's subsample of its \
+         stream (its default profile writes sensor_gyro and sensor_accel once a second, the \
+         thermal calibration profile ten times), single readings whose noise is the sensor's at \
+         its own rate; log the IMU at full rate (SDLOG_PROFILE's high rate or raw FIFO bits) for \
+         its noise model",
+        number(t.rate_hz)
+    ))
+}
+
 /// 0.1 x the variance of the finite samples among the first 1000 (what firmware sees at
 /// start-up; NaN and infinities are rejected there), or 1 when that is 0 or there are none;
 /// an error when that variance overflows f64.

@@ -366,6 +366,7 @@ pub fn run_with(args: &Args, given: Option<&[f64]>) -> Result<NoiseResult, Fail>
     };
     let rate = series.rate(args.rate, &args.input)?;
     crate::input::check_gaps(series.timing.as_ref(), series.x.len())
+        .and_then(|()| crate::input::check_subsampled(&args.input.files, series.timing.as_ref()))
         .map_err(|e| args.input.fail(e))?;
     let x = decimated(&args.input.files, &series.x, args.decimate)?;
     check_span("--rate", rate, x.len())?;

@@ -62,7 +62,11 @@ fn noise_frames_of(noise: &Noise, n: usize, rate: f64, seed: u64) -> Vec<Frame> 
                     phi * gm[k] + noise.gm_sigma[k] * (1.0 - phi * phi).sqrt() * normal(&mut rng);
                 mean[k] + noise.white[k] / dt.sqrt() * normal(&mut rng) + rw[k] + gm[k]
             });
-            Frame { stamp_ns, axes }
+            Frame {
+                stamp_ns,
+                axes,
+                ..Frame::default()
+            }
         })
         .collect()
 }
@@ -921,6 +925,7 @@ fn accelerometers_in_g_or_mg_are_told_by_gravity() {
             .map(|f| Frame {
                 stamp_ns: f.stamp_ns,
                 axes: std::array::from_fn(|k| if k < 3 { f.axes[k] } else { f.axes[k] * by }),
+                ..*f
             })
             .collect()
     };
@@ -935,36 +940,66 @@ fn accelerometers_in_g_or_mg_are_told_by_gravity() {
             ),
         );
     }
+    // The other way: m/s^2 under a [g] header reads 96 "m/s^2", mg under [g] 9807, m/s^2
+    // under [mg] 0.0098; each is named for the unit it is in.
+    for (by, header, unit, read) in [
+        (1.0, "g", "m/s^2", "g"),
+        (1000.0 * g, "g", "mg", "g"),
+        (1.0, "mg", "m/s^2", "mg"),
+    ] {
+        let csv = dir.join(format!("{unit}-as-{header}.csv").replace('/', "_"));
+        let columns = "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],\
+                       w_RS_S_z [rad s^-1]";
+        let header =
+            format!("{columns},a_RS_S_x [{header}],a_RS_S_y [{header}],a_RS_S_z [{header}]");
+        let frames = scaled(by);
+        write_with(&csv, &header, &frames, |i| frames[i].stamp_ns.to_string());
+        refused(
+            &["characterise", path(&csv), "--out", path(&out)],
+            &format!("the values are in {unit}, not {read}: say so in the header's bracket"),
+        );
+    }
     let bag = edited_bag(&dir, "noise.bag", "g.bag", &scaled(g));
     let topic = ["--topic", "/imu0"];
-    refused(
-        &[
-            "characterise",
-            path(&bag),
-            topic[0],
-            topic[1],
-            "--out",
-            path(&out),
-        ],
-        "the values are in g, not m/s^2 (a driver that does not keep REP 103): --accel-unit g \
-         reads them so",
+    // `characterise BAG --topic /imu0 EXTRA --out OUT`.
+    let of_bag = |bag: &Path, extra: &[&str]| {
+        let mut args = vec!["characterise", path(bag), topic[0], topic[1]];
+        args.extend_from_slice(extra);
+        args.extend_from_slice(&["--out", path(&out)]);
+        imu_ar(&args)
+    };
+    // A bag in m/s^2 (REP 103) read with --accel-unit g is refused (after the flag's
+    // warnings), naming the file.
+    let si_bag = fixture("noise.bag");
+    let wrong = of_bag(&si_bag, &["--accel-unit", "g"]);
+    assert_eq!(wrong.status.code(), Some(2));
+    let last = stderr(&wrong).lines().last().unwrap_or_default().to_owned();
+    assert!(
+        last.starts_with(&format!(
+            "imu-ar: {}: the accelerometers read 96.2",
+            path(&si_bag)
+        )) && last.ends_with(
+            "the values are in m/s^2, not g (the messages' own unit, REP 103): leave \
+                 --accel-unit g out"
+        ),
+        "{last}"
+    );
+    let in_g = of_bag(&bag, &[]);
+    assert_one_line_failure(&in_g);
+    assert!(
+        stderr(&in_g).contains(
+            "the values are in g, not m/s^2 (a driver that does not keep REP 103): \
+             --accel-unit g reads them so"
+        ),
+        "{}",
+        stderr(&in_g)
     );
     let si = characterise(
         &[path(&fixture("noise.bag")), topic[0], topic[1]],
         &out,
         &[],
     );
-    let read = imu_ar(&[
-        "characterise",
-        path(&bag),
-        topic[0],
-        topic[1],
-        "--accel-unit",
-        "g",
-        "--out",
-        path(&out),
-        "--json",
-    ]);
+    let read = of_bag(&bag, &["--accel-unit", "g", "--json"]);
     assert!(
         stderr(&read).contains("--accel-unit g: ax read in g, not in the m/s^2"),
         "{}",
@@ -996,10 +1031,81 @@ fn files_given_out_of_time_order_are_named_so() {
             "--out",
             path(&out),
         ],
-        "the files are out of order; give them in time order",
+        &format!(
+            "rec_2.csv:2: the file's first timestamp, {} ns, is before the first of the file \
+             before ({} ns): the files are out of order",
+            frames[0].stamp_ns, frames[4_000].stamp_ns
+        ),
     );
+    // A file given twice, or pieces that overlap: named so (out of order before).
+    let middle = dir.join("rec_1b.csv");
+    write_euroc(&middle, &frames[2_000..6_000]);
+    for (second, first_at) in [
+        (&early, frames[0].stamp_ns),
+        (&middle, frames[2_000].stamp_ns),
+    ] {
+        refused(
+            &[
+                "characterise",
+                path(&early),
+                path(second),
+                "--out",
+                path(&out),
+            ],
+            &format!(
+                "the file's first timestamp, {first_at} ns, lies within the file before ({} \
+                 to {} ns): the files overlap",
+                frames[0].stamp_ns, frames[3_999].stamp_ns
+            ),
+        );
+    }
     let read = characterise(&[path(&early), path(&late)], &out, &[]);
     assert_eq!(read["n"], 8_000, "{read}");
+    // The same of bags (refused as a stamp not after the one before, with --drop-backward
+    // as the remedy, before).
+    let frames = noise_frames();
+    let later: Vec<Frame> = frames
+        .iter()
+        .map(|f| Frame {
+            stamp_ns: f.stamp_ns + 12_000_000_000,
+            ..*f
+        })
+        .collect();
+    let (one, two) = (
+        edited_bag(&dir, "noise.bag", "one.bag", &frames),
+        edited_bag(&dir, "noise.bag", "two.bag", &later),
+    );
+    let bag_args = |a: &Path, b: &Path| -> Vec<String> {
+        [
+            "characterise",
+            path(a),
+            path(b),
+            "--topic",
+            "/imu0",
+            "--out",
+            path(&out),
+        ]
+        .map(String::from)
+        .to_vec()
+    };
+    for (a, b, want) in [
+        (&two, &one, "one.bag: the file's first timestamp, "),
+        (&two, &one, "the files are out of order"),
+        (&one, &one, "one.bag: the file's first timestamp, "),
+        (&one, &one, "the files overlap"),
+    ] {
+        let args = bag_args(a, b);
+        refused(&args.iter().map(String::as_str).collect::<Vec<_>>(), want);
+    }
+    let args = bag_args(&one, &two);
+    let read = json(&imu_ar(
+        &args
+            .iter()
+            .map(String::as_str)
+            .chain(["--json"])
+            .collect::<Vec<_>>(),
+    ));
+    assert_eq!(read["n"], 2_400, "{read}");
 }
 
 #[test]

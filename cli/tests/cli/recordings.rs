@@ -1460,13 +1460,14 @@ fn messages_that_mark_a_sensor_as_not_provided_are_counted_for_its_refusal() {
         } else {
             ("accelerometer", "linear_acceleration", (true, false))
         };
-        let refusal = skipped.not_provided(true, true).expect(&name);
+        let total = want.len() as u64;
+        let refusal = skipped.not_provided(true, true, total).expect(&name);
         assert_eq!(
             refusal,
             format!(
                 "the messages mark the {sensor} as not provided: {field}_covariance[0] = -1 in \
-                 {} of them (sensor_msgs/Imu: disregard its values); the {} axes can be read \
-                 alone",
+                 {} of the {total} (sensor_msgs/Imu: disregard its values); the {} axes can be \
+                 read alone",
                 gyro + accel,
                 if gyro > 0 {
                     "accelerometer's (ax, ay, az)"
@@ -1476,7 +1477,11 @@ fn messages_that_mark_a_sensor_as_not_provided_are_counted_for_its_refusal() {
             ),
             "{name}"
         );
-        assert_eq!(skipped.not_provided(other.0, other.1), None, "{name}");
+        assert_eq!(
+            skipped.not_provided(other.0, other.1, total),
+            None,
+            "{name}"
+        );
     }
     // Through the tool: characterise (all six axes) is refused naming the flag (a gyro-only
     // bag read as "ax: constant (a stuck sensor?)", its placeholders modelled, before); the
@@ -1505,6 +1510,54 @@ fn messages_that_mark_a_sensor_as_not_provided_are_counted_for_its_refusal() {
         stderr(&accel).contains("linear_acceleration_covariance[0] = -1"),
         "{}",
         stderr(&accel)
+    );
+    // A few messages marked among a record that provides the sensor (a driver's placeholder
+    // while the sensor restarts; the whole sensor refused before): 6 of 1200 are skipped and
+    // counted, read as the record without them is; 24 (2 %) are refused giving the total.
+    let marked_bag = |every: usize| {
+        let mut bytes = ros::fixture_bytes("noise.bag");
+        for id in ros::frame_ids(&bytes).into_iter().step_by(every) {
+            bytes[id + 232..id + 240].copy_from_slice(&(-1.0f64).to_le_bytes());
+        }
+        let file = dir.join(format!("every-{every}.bag"));
+        std::fs::write(&file, bytes).unwrap();
+        file
+    };
+    let few = marked_bag(200);
+    let read = imu_ar(&[
+        "noise",
+        path(&few),
+        "--topic",
+        "/imu0",
+        "--column",
+        "ax",
+        "--json",
+    ]);
+    assert_eq!(read.status.code(), Some(0), "{}", stderr(&read));
+    assert!(
+        stderr(&read).contains("messages skipped: 6 marking a sensor read as not provided"),
+        "{}",
+        stderr(&read)
+    );
+    let read = json(&read);
+    assert_eq!(read["n"], 1_194, "{read}");
+    let gyro_read = json(&imu_ar(&[
+        "noise",
+        path(&few),
+        "--topic",
+        "/imu0",
+        "--column",
+        "gx",
+        "--json",
+    ]));
+    assert_eq!(gyro_read["n"], 1_200, "{gyro_read}");
+    let many = marked_bag(50);
+    let refused = imu_ar(&["noise", path(&many), "--topic", "/imu0", "--column", "az"]);
+    assert_eq!(refused.status.code(), Some(2));
+    assert!(
+        stderr(&refused).contains("linear_acceleration_covariance[0] = -1 in 24 of the 1200"),
+        "{}",
+        stderr(&refused)
     );
 }
 

@@ -1258,25 +1258,10 @@ fn second_red_team_pass_on_logs() {
     assert!(!out.join("px4_thermal.params").exists(), "nothing written");
 
     // D8, D9: NaN gyro samples in a ULog file are not finite, not unpaired; noise says so.
-    let mut log = ULog::new(0);
-    log.format(SENSOR_GYRO);
-    log.format(SENSOR_ACCEL);
-    log.subscribe(0, 0, "sensor_gyro");
-    log.subscribe(0, 1, "sensor_accel");
-    for (k, (celsius, a)) in rows.iter().enumerate() {
-        let t = 1_000_000 + 10_000 * k as u64;
-        let g = if k % 50 == 0 {
-            [f32::NAN; 3]
-        } else {
-            [f(a[0]), f(a[1]), f(a[2])]
-        };
-        log.data(0, &sensor(t, t, 7, g, f(*celsius)));
-        log.data(
-            1,
-            &sensor(t, t, 8, [f(a[3]), f(a[4]), f(a[5])], f(*celsius)),
-        );
-    }
-    let nan = temp_file("nan-gyro.ulg", log.bytes);
+    let log = paired_log(&rows, 10_000, [7, 8], |k, g| {
+        if k % 50 == 0 { [f32::NAN; 3] } else { g }
+    });
+    let nan = temp_file("nan-gyro.ulg", log);
     let out = temp_path("nan-gyro");
     let j = json(&imu_ar(&[
         "characterise",
@@ -1298,6 +1283,61 @@ fn second_red_team_pass_on_logs() {
     assert!(e.contains("warning") && e.contains("120 not finite"), "{e}");
 }
 
+/// A PX4 ULog file of `sensor_gyro` and `sensor_accel` (device ids `devices`) holding `rows`
+/// (temperature, six axes) `period_us` apart from 1 s, the `k`-th gyro values as `gyro` makes
+/// them of the row's.
+fn paired_log(
+    rows: &[(f64, [f64; 6])],
+    period_us: u64,
+    devices: [u32; 2],
+    gyro: impl Fn(usize, [f32; 3]) -> [f32; 3],
+) -> Vec<u8> {
+    let mut log = ULog::new(0);
+    log.format(SENSOR_GYRO);
+    log.format(SENSOR_ACCEL);
+    log.subscribe(0, 0, "sensor_gyro");
+    log.subscribe(0, 1, "sensor_accel");
+    for (k, (celsius, a)) in rows.iter().enumerate() {
+        let t = 1_000_000 + period_us * k as u64;
+        let three = |i: usize| [a[i] as f32, a[i + 1] as f32, a[i + 2] as f32];
+        let celsius = *celsius as f32;
+        log.data(0, &sensor(t, t, devices[0], gyro(k, three(0)), celsius));
+        log.data(1, &sensor(t, t, devices[1], three(3), celsius));
+    }
+    log.bytes
+}
+
 fn path_str(p: &Path) -> &str {
     p.to_str().unwrap()
+}
+
+#[test]
+fn a_px4_logs_subsampled_sensor_topics_give_no_noise_model() {
+    // PX4's default logger profile writes sensor_gyro and sensor_accel once a second: single
+    // readings of a faster stream, whose noise density read at 1 Hz is sqrt(rate) times the
+    // sensor's (16 times for 250 Hz, exit 0, before). Refused by noise and characterise,
+    // naming the profile; the thermal calibration, which needs only the bias, reads them.
+    let log = paired_log(&samples(600, 0.0), 1_000_000, [100, 101], |_, g| g);
+    let file = temp_file("one-hz.ulg", log);
+    let m = path_str(&file);
+    let out = temp_path("one-hz");
+    for args in [
+        vec!["noise", m, "--column", "gx"],
+        vec!["characterise", m, "--out", path_str(&out)],
+    ] {
+        let run = imu_ar(&args);
+        assert_eq!(
+            run.status.code(),
+            Some(2),
+            "{args:?}: {}",
+            crate::common::stderr(&run)
+        );
+        assert!(
+            crate::common::stderr(&run).contains("the logger's subsample of its stream"),
+            "{args:?}: {}",
+            crate::common::stderr(&run)
+        );
+    }
+    let j = json(&imu_ar(&["thermal", m, "--out", path_str(&out), "--json"]));
+    assert_eq!(j["n"], 600, "{j}");
 }

@@ -92,7 +92,11 @@ pub fn frames(n: usize, seed: u64) -> Vec<Frame> {
                     f64::from_bits((r & 1 << 63) | exponent << 52 | (r & ((1 << 52) - 1)))
                 }
             });
-            Frame { stamp_ns, axes }
+            Frame {
+                stamp_ns,
+                axes,
+                ..Frame::default()
+            }
         })
         .collect()
 }
@@ -118,7 +122,11 @@ pub fn noise(n: usize, seed: u64) -> Vec<Frame> {
                 let lsb = if k < 3 { GYRO_LSB } else { ACCEL_LSB };
                 counts as f64 * lsb / 64.0
             });
-            Frame { stamp_ns, axes }
+            Frame {
+                stamp_ns,
+                axes,
+                ..Frame::default()
+            }
         })
         .collect()
 }
