@@ -37,6 +37,9 @@ pub struct Skipped {
     /// provide it (a driver's placeholder while the sensor restarts): their values are not
     /// measurements.
     pub disregarded: u64,
+    /// Samples kept in file order though their stamp is not after the one before: a CSV
+    /// read at a given rate, its stamps only a check.
+    pub backward_kept: u64,
     /// Samples of a log's gyro or accelerometer without a partner of the same time in the
     /// other (a PX4 ULog file's two topics read together).
     pub unpaired: u64,
@@ -54,7 +57,8 @@ pub struct Skipped {
 
 impl Skipped {
     /// What was lost, in words, when anything was (`None` otherwise): "12 undecodable, 3 not
-    /// finite". Messages of another IMU (`other_frame_id`), left out by choice, are not.
+    /// finite", and the samples kept out of time order. Messages of another IMU
+    /// (`other_frame_id`), left out by choice, are not.
     pub fn summary(&self) -> Option<String> {
         let parts: Vec<String> = [
             (
@@ -69,7 +73,19 @@ impl Skipped {
         .filter(|(n, _)| *n > 0)
         .map(|(n, what)| format!("{n} {what}"))
         .collect();
-        (!parts.is_empty()).then(|| format!("messages skipped: {}", parts.join(", ")))
+        let skipped =
+            (!parts.is_empty()).then(|| format!("messages skipped: {}", parts.join(", ")));
+        let kept = (self.backward_kept > 0).then(|| {
+            format!(
+                "{} samples stamped before the one before kept in file order, as the rate \
+                 given reads them (--drop-backward drops them)",
+                self.backward_kept
+            )
+        });
+        match (skipped, kept) {
+            (Some(s), Some(k)) => Some(format!("{s}; {k}")),
+            (s, k) => s.or(k),
+        }
     }
 
     /// The refusal of a read of the gyro's axes (`gyro`) or the accelerometer's (`accel`) of

@@ -1130,6 +1130,8 @@ fn csv_stream(
     let begun = std::cell::Cell::new((0usize, false));
     // The first stamps of the file before and of the one being read, and that one's number.
     let mut firsts: (Option<i64>, Option<i64>, usize) = (None, None, 0);
+    // Samples kept, at a given rate, whose stamp is not after the one before.
+    let mut backward_kept = 0u64;
     let mut select = |header: &[String]| -> Result<Vec<usize>, String> {
         begun.set((begun.get().0 + 1, true));
         let mut picks = request
@@ -1243,18 +1245,20 @@ fn csv_stream(
         } else if let Some((t, step)) = step
             && let Some(last) = not_after(step, t)
         {
+            // Files out of order, or overlapping, are refused whatever the rate.
+            if !request.drop_backward && first_row && files > 1 {
+                return Err(file_order(t, (firsts.0.unwrap_or(last), last)));
+            }
             if !strict && !request.drop_backward {
-                // The rate is given: the sample stays, its stamp is left out of the stamps'
-                // statistics, which still check the rate given.
+                // The rate is given: the sample stays, counted, its stamp left out of the
+                // stamps' statistics, which still check the rate given.
+                backward_kept += 1;
                 return row_values(&mut values, cells, request, Some(t), &mut *each);
             }
             if step == Step::Repeat {
                 timing.drop_repeat();
             } else {
                 timing.drop_one();
-            }
-            if !request.drop_backward && first_row && files > 1 {
-                return Err(file_order(t, (firsts.0.unwrap_or(last), last)));
             }
             if !request.drop_backward {
                 return Err(format!(
@@ -1285,7 +1289,10 @@ fn csv_stream(
         timing: time
             .get()
             .map(|(_, u)| (timing, u.unwrap_or(TimeUnit::Seconds))),
-        skipped: Skipped::default(),
+        skipped: Skipped {
+            backward_kept,
+            ..Skipped::default()
+        },
     })
 }
 

@@ -1378,6 +1378,14 @@ impl Timing {
     }
 
     /// The time from the first stamp to the last accepted one, ns (beyond `i64` too).
+    /// The samples kept and the span of their stamps, s (`None` for fewer than two, or no
+    /// span): where no sample is missing, the rate is their intervals over it; a rate below
+    /// that packs the samples into too short a time.
+    pub fn kept_over_span(&self) -> Option<(u64, f64)> {
+        let span = self.span_ns() * 1e-9;
+        (self.kept >= 2 && span > 0.0).then_some((self.kept, span))
+    }
+
     fn span_ns(&self) -> f64 {
         let first = self.first.unwrap_or(self.last);
         (i128::from(self.last) - i128::from(first)) as f64
@@ -1408,12 +1416,11 @@ impl Timing {
     /// sample need not show as a gap.
     fn stray(
         &self,
-        window: &Window,
+        (window, buckets): (&Window, &[Bucket]),
         period: f64,
         (resolution, counted): (Option<i64>, bool),
     ) -> Option<String> {
         let marks = self.all_marks();
-        let buckets = self.histogram();
         let deviation = buckets
             .iter()
             .filter(|b| window.judge(b.mean()) == Ordering::Equal)
@@ -1991,7 +1998,7 @@ impl Timing {
         {
             return Err(crowded);
         }
-        if let Some(stretch) = self.stray(&window, period, (resolution, repeats > 0)) {
+        if let Some(stretch) = self.stray((&window, &buckets), period, (resolution, repeats > 0)) {
             return Err(stretch);
         }
         let mut summary = summary;
@@ -2121,10 +2128,9 @@ impl Timing {
                 // (Folded on the first 32,768 and about 65,536 more picked at random; the
                 // line through about 65,536 picked at random.)
                 let distinct = t.len() - self.repeats as usize;
-                let x = fold::times(t, distinct, 0, 1 << 16);
+                let [x, folded] = fold::times(t, distinct, [(0, 1 << 16), (1 << 15, 1 << 16)]);
                 let window = |f: f64| (0.5 * q * f + 0.2).min(0.5);
-                let Some(f) = fold::fold(&fold::times(t, distinct, 1 << 15, 1 << 16), lo, hi)
-                else {
+                let Some(f) = fold::fold(&folded, lo, hi) else {
                     return self.drifting(x, (lo, hi), window);
                 };
                 let fit = fold::fit(&x, f, window(f))

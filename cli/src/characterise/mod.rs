@@ -130,6 +130,12 @@ pub struct SkippedCounts {
     pub unpaired: u64,
     /// 1 when the log's last message is cut short by the end of the file.
     pub cut_short: u64,
+    /// Messages that mark a sensor read as not provided (`sensor_msgs/Imu`'s covariance
+    /// flag), skipped.
+    pub not_provided: u64,
+    /// Samples kept in file order though their stamp is not after the one before (a given
+    /// `--rate`).
+    pub backward_kept: u64,
 }
 
 /// One axis.
@@ -254,9 +260,14 @@ fn characterise(
     if let Some(w) = read.skipped.cut_short_warning() {
         eprintln!("imu-ar: warning: {}", with_file(&args.files, w).0);
     }
+    if let Some(w) = read.skipped.summary() {
+        eprintln!("imu-ar: warning: {}", with_file(&args.files, w).0);
+    }
     progress.finish();
     let n = axes[0].samples();
     let backward = read.timing.as_ref().map_or(0, |(t, _)| t.dropped());
+    let stamped = read.timing.as_ref().and_then(|(t, _)| t.kept_over_span());
+    crate::input::check_packed(args.rate, stamped).map_err(|e| with_file(&args.files, e))?;
     let timing =
         summary(read.timing, args.rate.is_none()).map_err(|e| with_file(&args.files, e))?;
     let rate = resolve_rate(args.rate, timing.as_ref()).map_err(|e| with_file(&args.files, e.0))?;
@@ -410,6 +421,8 @@ fn characterise(
             other_frame_id: read.skipped.other_frame_id,
             unpaired: read.skipped.unpaired,
             cut_short: read.skipped.cut_short,
+            not_provided: read.skipped.disregarded,
+            backward_kept: read.skipped.backward_kept,
         },
         timing,
         axes: results,
@@ -895,10 +908,24 @@ impl Output for Characterisation {
             self.skipped.non_finite,
             self.skipped.backward,
             self.skipped.other_frame_id,
-            match self.skipped.unpaired {
-                0 => String::new(),
-                n => format!(", {n} without a partner in the other sensor's topic"),
-            }
+            [
+                (
+                    self.skipped.unpaired,
+                    "without a partner in the other sensor's topic"
+                ),
+                (
+                    self.skipped.not_provided,
+                    "marking a sensor read as not provided"
+                ),
+                (
+                    self.skipped.backward_kept,
+                    "kept though stamped before the one before"
+                ),
+            ]
+            .iter()
+            .filter(|(n, _)| *n > 0)
+            .map(|(n, what)| format!(", {n} {what}"))
+            .collect::<String>()
         );
         if let Some(t) = &self.timing {
             s += &t.text();

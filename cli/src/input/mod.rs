@@ -66,6 +66,8 @@ pub struct Series {
     pub unit: String,
     /// Messages skipped, counted.
     pub skipped: Skipped,
+    /// The samples kept with a stamp, and the span of their stamps, s, when they give one.
+    pub stamped: Option<(u64, f64)>,
 }
 
 impl Input {
@@ -130,12 +132,14 @@ impl Input {
         if factor != 1.0 {
             x.iter_mut().for_each(|v| *v *= factor);
         }
+        let stamped = read.timing.as_ref().and_then(|(t, _)| t.kept_over_span());
         let timing = summary(read.timing, want_time).map_err(|e| self.fail(e))?;
         Ok(Series {
             x,
             timing,
             unit,
             skipped: read.skipped,
+            stamped,
         })
     }
 
@@ -147,6 +151,7 @@ impl Input {
             timing: None,
             unit: self.unit.clone().unwrap_or_else(|| "units".into()),
             skipped: Skipped::default(),
+            stamped: None,
         }
     }
 
@@ -160,8 +165,29 @@ impl Series {
     /// The sample rate: `--rate` when given (an error when the timestamps give none within
     /// 1 % of it), else the timestamps'. Errors name `input`'s files.
     pub fn rate(&self, given: Option<f64>, input: &Input) -> Result<f64, Fail> {
+        check_packed(given, self.stamped).map_err(|e| input.fail(e))?;
         resolve_rate(given, self.timing.as_ref()).map_err(|e| input.fail(e.0))
     }
+}
+
+/// A rate `given` must not pack the samples kept into less time than their stamps span
+/// (`stamped`: the samples, the span, s), whatever else the stamps show: rows written twice
+/// read at the rate of their distinct stamps fit in half the time.
+pub fn check_packed(given: Option<f64>, stamped: Option<(u64, f64)>) -> Result<(), String> {
+    let (Some(r), Some((kept, span))) = (given, stamped) else {
+        return Ok(());
+    };
+    let needs = (kept - 1) as f64 / r;
+    if needs * 0.99 <= span {
+        return Ok(());
+    }
+    Err(format!(
+        "--rate {}: the {kept} samples would span {} s at it, where their stamps span {} s; \
+         rows written twice? --drop-backward drops samples whose stamp repeats",
+        number(r),
+        number((needs * 1e3).round() / 1e3),
+        number((span * 1e3).round() / 1e3),
+    ))
 }
 
 /// The highest rate taken from timestamps without `--rate` to confirm it, Hz.

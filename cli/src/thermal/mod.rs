@@ -967,6 +967,8 @@ fn read_csv(args: &Args) -> Result<WarmUp, Fail> {
         args.accel_unit.as_deref().map(parse_unit).transpose()?,
     ];
     // The rate from --rate or the time column; without either, the noise bands say why not.
+    let stamped = read.timing.as_ref().and_then(|(t, _)| t.kept_over_span());
+    crate::input::check_packed(args.rate, stamped).map_err(|e| with_file(&args.files, e))?;
     let timing =
         crate::input::summary(read.timing, false).map_err(|e| with_file(&args.files, e))?;
     let rate = match (args.rate, &timing) {

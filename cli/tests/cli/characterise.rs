@@ -1040,18 +1040,24 @@ fn files_given_out_of_time_order_are_named_so() {
     // A file given twice, or pieces that overlap: named so (out of order before).
     let middle = dir.join("rec_1b.csv");
     write_euroc(&middle, &frames[2_000..6_000]);
-    for (second, first_at) in [
-        (&early, frames[0].stamp_ns),
-        (&middle, frames[2_000].stamp_ns),
+    // With --rate too (read as one record, the samples twice, before: the stamps only check
+    // a rate given).
+    for (second, first_at, rate) in [
+        (&early, frames[0].stamp_ns, None),
+        (&middle, frames[2_000].stamp_ns, None),
+        (&early, frames[0].stamp_ns, Some("200")),
+        (&middle, frames[2_000].stamp_ns, Some("200")),
     ] {
+        let mut args = vec![
+            "characterise",
+            path(&early),
+            path(second),
+            "--out",
+            path(&out),
+        ];
+        args.extend(rate.map(|r| ["--rate", r]).iter().flatten());
         refused(
-            &[
-                "characterise",
-                path(&early),
-                path(second),
-                "--out",
-                path(&out),
-            ],
+            &args,
             &format!(
                 "the file's first timestamp, {first_at} ns, lies within the file before ({} \
                  to {} ns): the files overlap",
@@ -1059,8 +1065,50 @@ fn files_given_out_of_time_order_are_named_so() {
             ),
         );
     }
+    refused(
+        &[
+            "characterise",
+            path(&late),
+            path(&early),
+            "--rate",
+            "200",
+            "--out",
+            path(&out),
+        ],
+        "the files are out of order",
+    );
     let read = characterise(&[path(&early), path(&late)], &out, &[]);
     assert_eq!(read["n"], 8_000, "{read}");
+    // Within a file, at a rate given, samples stamped before the one before are kept in file
+    // order (the stamps only check the rate), counted and warned of (kept silently before).
+    let again = dir.join("again.csv");
+    let mut rows = frames[..3_000].to_vec();
+    rows.extend_from_slice(&frames[2_000..2_100]);
+    rows.extend_from_slice(&frames[3_000..6_000]);
+    write_euroc(&again, &rows);
+    let kept = imu_ar(&[
+        "characterise",
+        path(&again),
+        "--rate",
+        "200",
+        "--out",
+        path(&out),
+        "--json",
+    ]);
+    assert!(
+        stderr(&kept).contains(
+            "100 samples stamped before the one before kept in file order, as the rate given \
+             reads them (--drop-backward drops them)"
+        ),
+        "{}",
+        stderr(&kept)
+    );
+    let kept = json(&kept);
+    assert_eq!(
+        (&kept["n"], &kept["skipped"]["backward_kept"]),
+        (&6_100.into(), &100.into()),
+        "{kept}"
+    );
     // The same of bags (refused as a stamp not after the one before, with --drop-backward
     // as the remedy, before).
     let frames = noise_frames();
@@ -1191,4 +1239,32 @@ fn stretches_far_apart_are_not_read_as_one_run() {
     write_euroc(&near, &frames);
     let read = characterise(&[path(&near)], &out, &[]);
     assert_eq!(read["timing"]["missing_samples"], 600, "{read}");
+}
+
+#[test]
+fn a_rate_given_must_fit_the_samples_in_their_stamps_span() {
+    // Every row written twice, its stamp too: read at 400 Hz (a FIFO of two) from the
+    // stamps; --rate 200 packed the 12,000 samples into 30 s, as if 60 s (N 33 % high, exit
+    // 0, before): refused, naming the rows written twice.
+    let dir = temp_dir("rate-fits");
+    let frames = imu_frames(6_000, 200.0, 5);
+    let twice: Vec<Frame> = frames.iter().flat_map(|f| [*f, *f]).collect();
+    let file = dir.join("twice.csv");
+    write_euroc(&file, &twice);
+    let column = ["--column", "w_RS_S_x"];
+    let run = |rate: &str| imu_ar(&["noise", path(&file), column[0], column[1], "--rate", rate]);
+    let refused = run("200");
+    assert_one_line_failure(&refused);
+    assert!(
+        stderr(&refused).contains(
+            "--rate 200: the 12000 samples would span 59.995 s at it, where their stamps span 29.9"
+        ) && stderr(&refused).contains("rows written twice?"),
+        "{}",
+        stderr(&refused)
+    );
+    assert_eq!(run("400").status.code(), Some(0));
+    let once = dir.join("once.csv");
+    write_euroc(&once, &frames);
+    let read = imu_ar(&["noise", path(&once), column[0], column[1], "--rate", "200"]);
+    assert_eq!(read.status.code(), Some(0), "{}", stderr(&read));
 }

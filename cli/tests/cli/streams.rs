@@ -6,7 +6,7 @@ use std::process::{Output, Stdio};
 
 use crate::common;
 
-use common::{ar2, command, imu_ar, stderr, stdout, temp_file};
+use common::{ar2, column_file, command, imu_ar, json, stderr, stdout, temp_file};
 
 /// Issue 23 item 7: `simulate` streams its output, so a huge `--n` starts writing at once
 /// instead of aborting on an allocation.
@@ -162,15 +162,31 @@ fn standard_input_is_read_once() {
     let file = ar2("stdin-twice.csv");
     let csv = std::fs::read(&file).unwrap();
     let f = file.to_str().unwrap();
-    // Its stamps are 1 Hz (`simulate`); the second copy's go back to the start, and are left
-    // out of the stamps' statistics.
+    // Its stamps (1 Hz, `simulate`) go back to the start in the second copy: refused alike,
+    // as files that overlap.
     let once = imu_ar(&["adev", f, f, "--column", "x", "--rate", "1", "--json"]);
     let twice = piped(
         &["adev", "-", "-", "--column", "x", "--rate", "1", "--json"],
         &csv,
     );
+    for run in [&once, &twice] {
+        assert_eq!(run.status.code(), Some(2));
+        assert!(stderr(run).contains("the files overlap"), "{}", stderr(run));
+    }
+    // Without stamps, the record twice.
+    let bare = column_file(
+        "stdin-twice-bare.csv",
+        (0..2000).map(|k| format!("{}", (k * 7919) % 101)),
+    );
+    let b = bare.to_str().unwrap();
+    let once = imu_ar(&["adev", b, b, "--column", "x", "--rate", "1", "--json"]);
+    let twice = piped(
+        &["adev", "-", "-", "--column", "x", "--rate", "1", "--json"],
+        &std::fs::read(&bare).unwrap(),
+    );
     assert!(once.status.success(), "{}", stderr(&once));
     assert_eq!(stdout(&twice), stdout(&once));
+    assert_eq!(json(&once)["n"], 4_000, "{}", stdout(&once));
 
     let table = temp_file(
         "stdin-table.csv",

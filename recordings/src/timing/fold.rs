@@ -32,38 +32,80 @@ fn threshold(bins: usize) -> f64 {
     (bins as f64).ln() + 12.0
 }
 
-/// Whether the `i`-th of `n` things is among about `most` picked at random (splitmix64 of
-/// its number: the same pick every time). A clock's every m-th sample keeps its phase, but
-/// folds alike on rates the m-th part of the clock's apart; a random pick folds on one.
-fn picked(i: usize, n: usize, most: usize) -> bool {
-    let every = n.div_ceil(most.max(1)) as u64;
-    if every <= 1 {
-        return true;
+/// About `most` of `n` things picked at random: the `i`-th where splitmix64 of its number is
+/// a multiple of `ceil(n / most)` (the same pick every time). A clock's every m-th sample
+/// keeps its phase, but folds alike on rates the m-th part of the clock's apart; a random
+/// pick folds on one.
+#[derive(Clone, Copy)]
+struct Pick {
+    /// The odd part of the divisor's inverse modulo 2^64, its power of two, and the
+    /// largest quotient: `h` is a multiple of the divisor where `h` times the inverse,
+    /// rotated right by the power, is no more than it (Granlund and Montgomery's test,
+    /// without a division for each thing).
+    inverse: u64,
+    twos: u32,
+    limit: u64,
+}
+
+impl Pick {
+    fn new(n: usize, most: usize) -> Self {
+        let every = (n.div_ceil(most.max(1)) as u64).max(1);
+        let twos = every.trailing_zeros();
+        let odd = every >> twos;
+        // Newton's iteration doubles the bits right of an odd number's inverse: 3 to 96.
+        let mut inverse = odd;
+        for _ in 0..5 {
+            inverse = inverse.wrapping_mul(2u64.wrapping_sub(odd.wrapping_mul(inverse)));
+        }
+        Pick {
+            inverse,
+            twos,
+            limit: u64::MAX / every,
+        }
     }
-    let mut z = (i as u64).wrapping_add(0x9e37_79b9_7f4a_7c15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    (z ^ (z >> 31)).is_multiple_of(every)
+
+    /// Whether the `i`-th thing is picked.
+    #[inline]
+    fn picked(self, i: usize) -> bool {
+        let mut z = (i as u64).wrapping_add(0x9e37_79b9_7f4a_7c15);
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        self.divides(z ^ (z >> 31))
+    }
+
+    /// Whether `h` is a multiple of the divisor.
+    #[inline]
+    fn divides(self, h: u64) -> bool {
+        h.wrapping_mul(self.inverse).rotate_right(self.twos) <= self.limit
+    }
 }
 
 /// About `most` of the times `t`, picked at random where they are more.
 fn thin(t: &[f64], most: usize) -> Vec<f64> {
-    let n = t.len();
+    let pick = Pick::new(t.len(), most);
     t.iter()
         .enumerate()
-        .filter(|&(i, _)| picked(i, n, most))
+        .filter(|&(i, _)| pick.picked(i))
         .map(|(_, &x)| x)
         .collect()
 }
 
-/// The distinct stamps of `stamps` (ns, in order; `distinct` of them), as s from the first:
-/// the first `all` of them, then about `most` more picked at random from the rest.
-pub(super) fn times(stamps: &[i64], distinct: usize, all: usize, most: usize) -> Vec<f64> {
+/// The distinct stamps of `stamps` (ns, in order; `distinct` of them), as s from the first,
+/// in one pass for each of `sets`: the first `all` of them, then about `most` more picked at
+/// random from the rest.
+pub(super) fn times<const N: usize>(
+    stamps: &[i64],
+    distinct: usize,
+    sets: [(usize, usize); N],
+) -> [Vec<f64>; N] {
+    let mut x: [Vec<f64>; N] = std::array::from_fn(|k| {
+        let (all, most) = sets[k];
+        Vec::with_capacity(all.min(distinct) + most.min(distinct.saturating_sub(all)) + 16)
+    });
     let Some(&first) = stamps.first() else {
-        return Vec::new();
+        return x;
     };
-    let rest = distinct.saturating_sub(all);
-    let mut x = Vec::with_capacity(all.min(distinct) + most.min(rest) + 16);
+    let picks = sets.map(|(all, most)| Pick::new(distinct.saturating_sub(all), most));
     let mut i = 0;
     let mut last = None;
     for &s in stamps {
@@ -71,8 +113,15 @@ pub(super) fn times(stamps: &[i64], distinct: usize, all: usize, most: usize) ->
             continue;
         }
         last = Some(s);
-        if i < all || picked(i - all, rest, most) {
-            x.push((i128::from(s) - i128::from(first)) as f64 * 1e-9);
+        for ((out, &(all, _)), pick) in x.iter_mut().zip(&sets).zip(picks) {
+            if i < all || pick.picked(i - all) {
+                // (Stamps in order: the difference fits an i64 but where the span passes
+                // 292 years.)
+                out.push(match s.checked_sub(first) {
+                    Some(d) => d as f64 * 1e-9,
+                    None => (i128::from(s) - i128::from(first)) as f64 * 1e-9,
+                });
+            }
         }
         i += 1;
     }
@@ -415,6 +464,24 @@ mod tests {
             let fit = fit(&t, f, 0.5).unwrap_or_else(|| panic!("{hz}: {f}: no fit"));
             assert!((fit.period * hz - 1.0).abs() < 1e-7, "{hz}: {fit:?}");
             assert_eq!(fit.coherent, 1.0, "{hz}");
+        }
+    }
+
+    #[test]
+    fn the_pick_divides_as_the_remainder_does() {
+        let mut next = crate::xorshift(0x0d1f_1de5_0000_0001);
+        let mut every: Vec<u64> = (1..=2048).collect();
+        every.extend([1 << 20, 3 << 40, u64::MAX / 7, u64::MAX]);
+        for d in every {
+            let pick = Pick::new(d as usize, 1);
+            for k in 0..200u64 {
+                let h = match k {
+                    0..50 => k.wrapping_mul(d),
+                    50..60 => k.wrapping_mul(d).wrapping_sub(1),
+                    _ => next(),
+                };
+                assert_eq!(pick.divides(h), h.is_multiple_of(d), "{h} {d}");
+            }
         }
     }
 
