@@ -232,6 +232,9 @@ pub struct Select<'a> {
     pub topic: &'a str,
     /// The frame_id of the IMU to read, when the topic carries several.
     pub frame_id: Option<&'a str>,
+    /// Whether messages with a NaN or infinite axis are delivered too (counted all the
+    /// same): for a caller that reads their stamps, or the axes that are finite.
+    pub non_finite: bool,
 }
 
 impl<'a> Select<'a> {
@@ -240,6 +243,7 @@ impl<'a> Select<'a> {
         Select {
             topic,
             frame_id: None,
+            non_finite: false,
         }
     }
 }
@@ -259,6 +263,7 @@ struct Source {
 pub(crate) struct Tally<'a> {
     each: &'a mut dyn FnMut(Frame),
     frame_id: Option<&'a str>,
+    non_finite: bool,
     delivered: u64,
     skipped: Skipped,
     /// Each frame_id seen, with its messages and whether it is the one chosen.
@@ -288,6 +293,7 @@ impl<'a> Tally<'a> {
         Tally {
             each,
             frame_id: select.frame_id,
+            non_finite: select.non_finite,
             delivered: 0,
             skipped: Skipped::default(),
             frame_ids: Vec::new(),
@@ -317,8 +323,8 @@ impl<'a> Tally<'a> {
     }
 
     /// One message on the topic from publisher `source`, when decoded. Delivered when decoded,
-    /// finite and of the chosen frame_id (and counted when it marks a sensor as not
-    /// provided); counted otherwise.
+    /// finite (or the selection takes the others too: counted) and of the chosen frame_id
+    /// (and counted when it marks a sensor as not provided); counted otherwise.
     pub(crate) fn offer(&mut self, source: u32, decoded: Option<Decoded<'_>>) {
         let Some((frame, frame_id)) = decoded else {
             self.skipped.undecodable += 1;
@@ -349,7 +355,9 @@ impl<'a> Tally<'a> {
         }
         if !frame.axes.iter().all(|v| v.is_finite()) {
             self.skipped.non_finite += 1;
-            return;
+            if !self.non_finite {
+                return;
+            }
         }
         let at = match self.sources.iter().position(|s| s.id == source) {
             Some(at) => at,
@@ -561,8 +569,8 @@ mod tests {
             let mut got = 0;
             let mut each = |_: Frame| got += 1;
             let select = Select {
-                topic: "/imu",
                 frame_id: Some(want),
+                ..Select::topic("/imu")
             };
             let mut tally = Tally::new(&select, &mut each);
             for t in 0..10 {

@@ -911,21 +911,20 @@ fn messages(
     let select = Select {
         topic,
         frame_id: request.frame_id,
+        non_finite: true,
     };
-    // The sensors read: a message that marks one of them as not provided is skipped.
+    // The sensors read: a message that marks one of them as not provided, or holds a NaN or
+    // an infinity in an axis read, is skipped, its stamp read with the others' (the clock's:
+    // evenly spaced holes would read as a slower clock's beat with a coarse quantum).
     let gyro = picks.iter().any(|&i| i < 3);
     let accel = picks.iter().any(|&i| i >= 3);
-    let mut disregarded = 0u64;
+    let (mut disregarded, mut non_finite) = (0u64, 0u64);
     // The first and last stamps of the file before, and this file's first.
     let mut before: Option<(i64, i64)> = None;
     for file in files {
         let mut first: Option<i64> = None;
         let s = read(file, &select, &mut |frame: Frame| {
             count += 1;
-            if (gyro && frame.not_provided.gyro) || (accel && frame.not_provided.accel) {
-                disregarded += 1;
-                return;
-            }
             if frame.stamp_ns != 0 && first.is_none() {
                 first = Some(frame.stamp_ns);
             }
@@ -933,6 +932,14 @@ fn messages(
                 unstamped += 1;
             } else if !take_stamp(&mut timing, frame.stamp_ns, request.drop_backward) {
                 backward.get_or_insert((count, frame.stamp_ns, timing.last()));
+                return;
+            }
+            if (gyro && frame.not_provided.gyro) || (accel && frame.not_provided.accel) {
+                disregarded += 1;
+                return;
+            }
+            if picks.iter().any(|&i| !frame.axes[i].is_finite()) {
+                non_finite += 1;
                 return;
             }
             for (v, &i) in values.iter_mut().zip(&picks) {
@@ -951,7 +958,6 @@ fn messages(
             before = Some((t, timing.last().max(t)));
         }
         skipped.undecodable += s.undecodable;
-        skipped.non_finite += s.non_finite;
         skipped.other_frame_id += s.other_frame_id;
         skipped.gyro_not_provided += s.gyro_not_provided;
         skipped.accel_not_provided += s.accel_not_provided;
@@ -961,10 +967,9 @@ fn messages(
     // the messages mark as not provided (sensor_msgs/Imu: its covariance's first element -1)
     // holds no measurement there: more than 1 % of them is refused naming the mark (all of
     // them: a gyro-only IMU's zeros), fewer are skipped and counted.
-    let total = count
-        .saturating_add(skipped.undecodable)
-        .saturating_add(skipped.non_finite);
+    let total = count.saturating_add(skipped.undecodable);
     skipped.disregarded = disregarded;
+    skipped.non_finite = non_finite;
     if disregarded.saturating_mul(100) > total
         && let Some(refusal) = skipped.not_provided(gyro, accel, total)
     {

@@ -106,8 +106,8 @@ fn big_endian_cdr_and_every_frame_id_alignment() {
     for id_len in 0..10 {
         let id = "f".repeat(id_len);
         let select = Select {
-            topic: "/imu",
             frame_id: Some(&id),
+            ..Select::topic("/imu")
         };
         let mut got = Vec::new();
         let result = mcap_reader::read_selected(&path, &select, &mut |f| got.push(f));

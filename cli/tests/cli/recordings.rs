@@ -21,8 +21,8 @@ fn path(p: &Path) -> &str {
 /// The readers by extension, with a chosen frame_id.
 fn read(file: &Path, frame_id: Option<&str>) -> (Vec<Frame>, Result<u64, String>) {
     let select = Select {
-        topic: "/imu0",
         frame_id,
+        ..Select::topic("/imu0")
     };
     let mut got = Vec::new();
     let each = &mut |f| got.push(f);
@@ -1721,4 +1721,72 @@ fn an_mcap_channel_of_another_schema_encoding_lists_the_ones_read() {
                 .to_string()
         )
     );
+}
+
+#[test]
+fn messages_skipped_evenly_keep_the_clocks_rate() {
+    // 100 Hz on an exact 10 ms grid, every 250th message with a NaN in ax, or marking the
+    // accelerometer as not provided: the holes the reader made, evenly spaced, read as a
+    // 99.6 Hz clock's beat with the 10 ms quantum (the rate 0.4 % low, exit 0, before). The
+    // skipped messages' stamps are the clock's: 100 Hz, the samples counted.
+    let dir = temp_dir("even-holes");
+    let mut frames = noise(60_000, 9);
+    for (k, f) in frames.iter_mut().enumerate() {
+        f.stamp_ns = 1_700_000_000_000_000_000 + 10_000_000 * k as i64;
+    }
+    let mut nan = frames.clone();
+    nan.iter_mut()
+        .step_by(250)
+        .for_each(|f| f.axes[3] = f64::NAN);
+    let file = dir.join("nan.mcap");
+    std::fs::write(&file, hand_mcap(&[(1, "/imu0")], &nan, |_| 1)).unwrap();
+    let marked = MessagesOf {
+        schema: ("sensor_msgs/msg/Imu", "ros2msg"),
+        encoding: "cdr",
+        // linear_acceleration_covariance[0]: 4 bytes of encapsulation, 24 of header, 28
+        // float64.
+        data: |f: &Frame, i| {
+            let mut data = cdr(f);
+            if i % 250 == 0 {
+                data[4 + 24 + 28 * 8..4 + 24 + 29 * 8].copy_from_slice(&(-1.0f64).to_le_bytes());
+            }
+            data
+        },
+    };
+    let flagged = dir.join("flagged.mcap");
+    std::fs::write(
+        &flagged,
+        hand_mcap_of(&marked, &[(1, "/imu0")], &frames, |_| 1),
+    )
+    .unwrap();
+    for (file, skipped) in [
+        (&file, "240 not finite"),
+        (&flagged, "240 marking a sensor read"),
+    ] {
+        let out = imu_ar(&[
+            "noise",
+            path(file),
+            "--topic",
+            "/imu0",
+            "--column",
+            "ax",
+            "--json",
+        ]);
+        assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+        assert!(stderr(&out).contains(skipped), "{}", stderr(&out));
+        let got = json(&out);
+        assert_eq!(got["n"], 59_760, "{got}");
+        assert_eq!(got["timing"]["rate_hz"], 100.0, "{}", got["timing"]);
+        // The gyro's axes, finite and provided in every message, are all read.
+        let gyro = json(&imu_ar(&[
+            "noise",
+            path(file),
+            "--topic",
+            "/imu0",
+            "--column",
+            "gx",
+            "--json",
+        ]));
+        assert_eq!(gyro["n"], 60_000, "{gyro}");
+    }
 }
