@@ -203,7 +203,7 @@ pub struct AxisResult {
     pub reference_c: f64,
     /// Bins fitted.
     pub bins: usize,
-    /// The bias change over the range: the largest bin less the smallest.
+    /// The bias change over the range: the fitted bias's largest less its smallest.
     pub change: f64,
     /// The largest `|bin - fit|`.
     pub residual: f64,
