@@ -949,8 +949,7 @@ fn messages(
         })
         .map_err(|e| Fail(e.to_string()))?;
         if let (Some(t), Some(before)) = (first, before)
-            && t <= before.1
-            && !request.drop_backward
+            && misordered(t, before, request.drop_backward)
         {
             return Err(with_file(std::slice::from_ref(file), file_order(t, before)));
         }
@@ -1012,6 +1011,14 @@ fn messages(
         });
     }
     stamped(files, request, &picks, (timing, backward), skipped)
+}
+
+/// Whether a file whose first stamp is `t` follows the file `before` (its first and last
+/// stamps) out of order: not after its last, or with `drop_backward` (which drops the
+/// stamps of a stretch two files share), not after its first (files out of order, or one
+/// given twice, whose samples it would drop whole).
+fn misordered(t: i64, (first, last): (i64, i64), drop_backward: bool) -> bool {
+    if drop_backward { t <= first } else { t <= last }
 }
 
 /// The refusal of a file whose first stamp `t` is not after the last of the file before it
@@ -1251,8 +1258,9 @@ fn csv_stream(
             && let Some(last) = not_after(step, t)
         {
             // Files out of order, or overlapping, are refused whatever the rate.
-            if !request.drop_backward && first_row && files > 1 {
-                return Err(file_order(t, (firsts.0.unwrap_or(last), last)));
+            let before = (firsts.0.unwrap_or(last), last);
+            if first_row && files > 1 && misordered(t, before, request.drop_backward) {
+                return Err(file_order(t, before));
             }
             if !strict && !request.drop_backward {
                 // The rate is given: the sample stays, counted, its stamp left out of the

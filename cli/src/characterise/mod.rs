@@ -267,10 +267,13 @@ fn characterise(
     let n = axes[0].samples();
     let backward = read.timing.as_ref().map_or(0, |(t, _)| t.dropped());
     let stamped = read.timing.as_ref().and_then(|(t, _)| t.kept_over_span());
-    crate::input::check_packed(args.rate, stamped).map_err(|e| with_file(&args.files, e))?;
-    let timing =
+    let (timing, unchecked) =
         summary(read.timing, args.rate.is_none()).map_err(|e| with_file(&args.files, e))?;
     let rate = resolve_rate(args.rate, timing.as_ref()).map_err(|e| with_file(&args.files, e.0))?;
+    crate::input::check_packed(args.rate, stamped).map_err(|e| with_file(&args.files, e))?;
+    if let Some(w) = crate::input::unchecked(args.rate, unchecked.as_deref()) {
+        eprintln!("imu-ar: warning: {}", with_file(&args.files, w).0);
+    }
     check_span("--rate", rate, n as usize)?;
     crate::input::check_gaps(timing.as_ref(), n as usize)
         .and_then(|()| crate::input::check_subsampled(&args.files, timing.as_ref()))

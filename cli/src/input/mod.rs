@@ -68,6 +68,8 @@ pub struct Series {
     pub skipped: Skipped,
     /// The samples kept with a stamp, and the span of their stamps, s, when they give one.
     pub stamped: Option<(u64, f64)>,
+    /// What the stamps show that would refuse them without a rate given (see [`summary`]).
+    pub unchecked: Option<String>,
 }
 
 impl Input {
@@ -133,13 +135,14 @@ impl Input {
             x.iter_mut().for_each(|v| *v *= factor);
         }
         let stamped = read.timing.as_ref().and_then(|(t, _)| t.kept_over_span());
-        let timing = summary(read.timing, want_time).map_err(|e| self.fail(e))?;
+        let (timing, unchecked) = summary(read.timing, want_time).map_err(|e| self.fail(e))?;
         Ok(Series {
             x,
             timing,
             unit,
             skipped: read.skipped,
             stamped,
+            unchecked,
         })
     }
 
@@ -152,6 +155,7 @@ impl Input {
             unit: self.unit.clone().unwrap_or_else(|| "units".into()),
             skipped: Skipped::default(),
             stamped: None,
+            unchecked: None,
         }
     }
 
@@ -165,8 +169,12 @@ impl Series {
     /// The sample rate: `--rate` when given (an error when the timestamps give none within
     /// 1 % of it), else the timestamps'. Errors name `input`'s files.
     pub fn rate(&self, given: Option<f64>, input: &Input) -> Result<f64, Fail> {
+        let rate = resolve_rate(given, self.timing.as_ref()).map_err(|e| input.fail(e.0))?;
         check_packed(given, self.stamped).map_err(|e| input.fail(e))?;
-        resolve_rate(given, self.timing.as_ref()).map_err(|e| input.fail(e.0))
+        if let Some(w) = unchecked(given, self.unchecked.as_deref()) {
+            eprintln!("imu-ar: warning: {}", input.fail(w).0);
+        }
+        Ok(rate)
     }
 }
 
@@ -182,8 +190,8 @@ pub fn check_packed(given: Option<f64>, stamped: Option<(u64, f64)>) -> Result<(
         return Ok(());
     }
     Err(format!(
-        "--rate {}: the {kept} samples would span {} s at it, where their stamps span {} s; \
-         rows written twice? --drop-backward drops samples whose stamp repeats",
+        "--rate {}: the {kept} samples would span {} s at it, where their stamps span {} s \
+         (rows written twice, or stretches at a faster rate?)",
         number(r),
         number((needs * 1e3).round() / 1e3),
         number((span * 1e3).round() / 1e3),
@@ -248,19 +256,34 @@ pub fn resolve_rate(given: Option<f64>, timing: Option<&TimingSummary>) -> Resul
 /// The timestamps' summary: an error when they give no single rate, or repeat where they
 /// resolve the interval, and it is `needed` (`--rate` was not given); otherwise such
 /// timestamps are not reported, or their repeats are (the rate the others give checks
-/// `--rate`).
+/// `--rate`), and what they show is returned beside, for [`unchecked`] to warn of where a
+/// rate is given.
 pub fn summary(
     timing: Option<(timing::Timing, timing::TimeUnit)>,
     needed: bool,
-) -> Result<Option<TimingSummary>, String> {
+) -> Result<(Option<TimingSummary>, Option<String>), String> {
     match timing.map(|(t, u)| t.summary(u)) {
         Some(Err(e)) if needed => Err(e),
-        Some(Err(_)) | None => Ok(None),
+        Some(Err(e)) => Ok((None, Some(e))),
+        None => Ok((None, None)),
         Some(Ok(s)) => match s.repeat_refusal() {
             Some(e) if needed => Err(e),
-            _ => Ok(Some(s)),
+            e => Ok((Some(s), e)),
         },
     }
+}
+
+/// The warning, where a rate is `given`, of what the stamps show that would refuse them
+/// without it (`why`, from [`summary`]): mixed rates, samples repeated, too short a span.
+pub fn unchecked(given: Option<f64>, why: Option<&str>) -> Option<String> {
+    let (Some(r), Some(why)) = (given, why) else {
+        return None;
+    };
+    let why = why
+        .trim_end_matches(" (or give --rate)")
+        .trim_end_matches("; give --rate")
+        .trim_end_matches(" (give --rate)");
+    Some(format!("read at --rate {}, but {why}", number(r)))
 }
 
 /// The factor from a column in `from` (where known) to `--unit` `to`, and the unit of the result.

@@ -968,16 +968,22 @@ fn read_csv(args: &Args) -> Result<WarmUp, Fail> {
     ];
     // The rate from --rate or the time column; without either, the noise bands say why not.
     let stamped = read.timing.as_ref().and_then(|(t, _)| t.kept_over_span());
-    crate::input::check_packed(args.rate, stamped).map_err(|e| with_file(&args.files, e))?;
-    let timing =
+    let (timing, unchecked) =
         crate::input::summary(read.timing, false).map_err(|e| with_file(&args.files, e))?;
+    if let Some(w) = crate::input::unchecked(args.rate, unchecked.as_deref()) {
+        eprintln!("imu-ar: warning: {}", with_file(&args.files, w).0);
+    }
     let rate = match (args.rate, &timing) {
         (None, None) => Err(
             "the record gives no sample rate (no time column whose unit is clear): give --rate \
              for the noise bands"
                 .to_string(),
         ),
-        (r, t) => Ok(resolve_rate(r, t.as_ref()).map_err(|e| with_file(&args.files, e.0))?),
+        (r, t) => {
+            let rate = resolve_rate(r, t.as_ref()).map_err(|e| with_file(&args.files, e.0))?;
+            crate::input::check_packed(r, stamped).map_err(|e| with_file(&args.files, e))?;
+            Ok(rate)
+        }
     };
     let mut names = [""; 6];
     for (i, axis) in axes.iter_mut().enumerate() {

@@ -1079,6 +1079,31 @@ fn files_given_out_of_time_order_are_named_so() {
     );
     let read = characterise(&[path(&early), path(&late)], &out, &[]);
     assert_eq!(read["n"], 8_000, "{read}");
+    // With --drop-backward, files out of order or given twice are refused as well (the
+    // second dropped whole, exit 0, before); pieces that share a short stretch are read, the
+    // stretch dropped once.
+    for (a, b, want) in [
+        (&late, &early, "the files are out of order"),
+        (&early, &early, "the files overlap"),
+    ] {
+        let args = [
+            "characterise",
+            path(a),
+            path(b),
+            "--drop-backward",
+            "--out",
+            path(&out),
+        ];
+        refused(&args, want);
+    }
+    let next = dir.join("rec_3.csv");
+    write_euroc(&next, &frames[3_990..6_000]);
+    let shared = characterise(&[path(&early), path(&next)], &out, &["--drop-backward"]);
+    assert_eq!(
+        (&shared["n"], &shared["skipped"]["backward"]),
+        (&6_000.into(), &10.into()),
+        "{shared}"
+    );
     // Within a file, at a rate given, samples stamped before the one before are kept in file
     // order (the stamps only check the rate), counted and warned of (kept silently before).
     let again = dir.join("again.csv");
@@ -1258,7 +1283,7 @@ fn a_rate_given_must_fit_the_samples_in_their_stamps_span() {
     assert!(
         stderr(&refused).contains(
             "--rate 200: the 12000 samples would span 59.995 s at it, where their stamps span 29.9"
-        ) && stderr(&refused).contains("rows written twice?"),
+        ) && stderr(&refused).contains("(rows written twice, or stretches at a faster rate?)"),
         "{}",
         stderr(&refused)
     );
@@ -1267,4 +1292,42 @@ fn a_rate_given_must_fit_the_samples_in_their_stamps_span() {
     write_euroc(&once, &frames);
     let read = imu_ar(&["noise", path(&once), column[0], column[1], "--rate", "200"]);
     assert_eq!(read.status.code(), Some(0), "{}", stderr(&read));
+    // A rate the stamps do not give is named so first (read as rows written twice before).
+    let half = imu_ar(&["noise", path(&once), column[0], column[1], "--rate", "100"]);
+    assert_one_line_failure(&half);
+    assert!(
+        stderr(&half).contains("--rate 100: the timestamps give 200"),
+        "{}",
+        stderr(&half)
+    );
+    // One row written twice: read at the rate given, warned of (silently before).
+    let mut one = frames.clone();
+    one.insert(3_000, frames[2_999]);
+    let file = dir.join("one-twice.csv");
+    write_euroc(&file, &one);
+    let read = imu_ar(&["noise", path(&file), column[0], column[1], "--rate", "200"]);
+    assert_eq!(read.status.code(), Some(0), "{}", stderr(&read));
+    assert!(
+        stderr(&read).contains("warning") && stderr(&read).contains("read at --rate 200, but"),
+        "{}",
+        stderr(&read)
+    );
+    // Mixed rates (100 Hz, then 300 Hz), whose average a rate given matched: read as the
+    // rate given says, warned of (silently before).
+    let mut mixed = imu_frames(4_000, 100.0, 6);
+    let end = mixed[3_999].stamp_ns;
+    mixed.extend(imu_frames(12_000, 300.0, 7).into_iter().map(|f| Frame {
+        stamp_ns: f.stamp_ns - frames[0].stamp_ns + end + 3_333_333,
+        ..f
+    }));
+    let file = dir.join("mixed.csv");
+    write_euroc(&file, &mixed);
+    let read = imu_ar(&["noise", path(&file), column[0], column[1], "--rate", "200"]);
+    assert_eq!(read.status.code(), Some(0), "{}", stderr(&read));
+    assert!(
+        stderr(&read).contains("warning")
+            && stderr(&read).contains("read at --rate 200, but the timestamps show mixed rates"),
+        "{}",
+        stderr(&read)
+    );
 }
