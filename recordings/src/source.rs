@@ -622,24 +622,34 @@ fn ulog_stream(
             if (tg - ta).abs() < 0.5 {
                 take(tg, [wg[0], wg[1], wg[2], wa[0], wa[1], wa[2]]);
                 pairing.pair();
+                pairing.spans.seen(tg, ta);
                 (next_gyro, next_accel) = (gyro.next(), accel.next());
             } else if tg < ta {
                 pairing.alone(Sensor::Gyro, 1);
+                pairing.spans.gyro.seen(tg);
                 next_gyro = gyro.next();
             } else {
                 pairing.alone(Sensor::Accel, 1);
+                pairing.spans.accel.seen(ta);
                 next_accel = accel.next();
             }
         }
         // The samples after the other sensor's last.
-        pairing.alone(
-            Sensor::Gyro,
-            (next_gyro.iter().count() + gyro.count()) as u64,
-        );
-        pairing.alone(
-            Sensor::Accel,
-            (next_accel.iter().count() + accel.count()) as u64,
-        );
+        for (sensor, rest) in [
+            (Sensor::Gyro, next_gyro.into_iter().chain(gyro)),
+            (Sensor::Accel, next_accel.into_iter().chain(accel)),
+        ] {
+            let span = match sensor {
+                Sensor::Gyro => &mut pairing.spans.gyro,
+                Sensor::Accel => &mut pairing.spans.accel,
+            };
+            let mut n = 0;
+            for (t, _) in rest {
+                span.seen(t);
+                n += 1;
+            }
+            pairing.alone(sensor, n);
+        }
         pairing.finish();
         let join = |h: std::thread::ScopedJoinHandle<'_, Result<ulog::Report, DataError>>| {
             h.join().unwrap_or_else(|_| {
@@ -667,6 +677,9 @@ fn ulog_stream(
             ],
             [gyro, accel],
         ) else {
+            if let Some(apart) = pairing.spans.rates_apart([gyro, accel]) {
+                return Err(with_file(files, apart));
+            }
             return Err(with_file(
                 files,
                 format!(
@@ -727,7 +740,7 @@ struct Alone {
 
 /// The tally of gyro and accelerometer samples paired by their times, met in time order: how
 /// many pair, and where those without a partner lie.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 struct Pairing {
     /// Samples paired.
     paired: u64,
@@ -740,6 +753,83 @@ struct Pairing {
     mixed: u64,
     /// The gyro and accelerometer samples alone since the last paired sample.
     open: (u64, u64),
+    /// The times each sensor's samples span.
+    spans: Spans,
+}
+
+/// The times of one sensor's samples met, microseconds.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Span {
+    /// Samples met.
+    samples: u64,
+    /// The first one's time.
+    first: f64,
+    /// The last one's time.
+    last: f64,
+}
+
+impl Span {
+    /// A sample at `t`.
+    fn seen(&mut self, t: f64) {
+        if self.samples == 0 {
+            self.first = t;
+        }
+        self.last = t;
+        self.samples += 1;
+    }
+
+    /// The samples' mean rate over their span, Hz; `None` for fewer than two or no span.
+    fn rate(&self) -> Option<f64> {
+        let span = (self.last - self.first) * 1e-6;
+        (self.samples > 1 && span > 0.0).then(|| (self.samples - 1) as f64 / span)
+    }
+}
+
+/// The times each sensor's samples span.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Spans {
+    /// The gyro's.
+    gyro: Span,
+    /// The accelerometer's.
+    accel: Span,
+}
+
+impl Spans {
+    /// A gyro sample at `tg` paired with an accelerometer sample at `ta`.
+    fn seen(&mut self, tg: f64, ta: f64) {
+        self.gyro.seen(tg);
+        self.accel.seen(ta);
+    }
+
+    /// Where the two sensors' mean rates differ by more than a tenth: each topic's (`topics`,
+    /// gyro then accelerometer) rate, and what a topic logged under
+    /// [`ulog::LEAST_SENSOR_RATE`] holds.
+    fn rates_apart(&self, topics: [&str; 2]) -> Option<String> {
+        let (g, a) = (self.gyro.rate()?, self.accel.rate()?);
+        if (g - a).abs() <= 0.1 * g.max(a) {
+            return None;
+        }
+        let slow = if g < a { topics[0] } else { topics[1] };
+        let subsample = if g.min(a) < ulog::LEAST_SENSOR_RATE {
+            format!(
+                "; {slow} under {} Hz is the logger's subsample of the sensor's stream (PX4's \
+                 default profile writes sensor topics once a second, the thermal calibration \
+                 profile ten times): single readings, whose noise is the sensor's at its own \
+                 rate, fit for a thermal calibration but not a noise model",
+                ulog::LEAST_SENSOR_RATE
+            )
+        } else {
+            String::new()
+        };
+        Some(format!(
+            "{} is logged at {} Hz and {} at {} Hz, so few of their samples share a time: read \
+             the gyro axes and the accelerometer axes apart{subsample}",
+            topics[0],
+            crate::timing::short(g),
+            topics[1],
+            crate::timing::short(a),
+        ))
+    }
 }
 
 impl Pairing {

@@ -3195,7 +3195,7 @@ impl TimingSummary {
 }
 
 /// `v` to 7 significant digits, without trailing zeros.
-fn short(v: f64) -> String {
+pub(crate) fn short(v: f64) -> String {
     let s = format!("{v:.6}");
     let s = s.trim_end_matches('0').trim_end_matches('.');
     s.to_string()

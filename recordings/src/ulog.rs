@@ -54,6 +54,12 @@ pub const MAGIC: [u8; 7] = [0x55, 0x4c, 0x6f, 0x67, 0x01, 0x12, 0x35];
 /// The deepest nesting of formats read (a format holding one holding one ... ).
 pub const MAX_NESTING: usize = 8;
 
+/// The least rate of a sensor topic read as the sensor's own samples, Hz: PX4's IMU drivers
+/// publish `sensor_gyro` and `sensor_accel` at hundreds of Hz, and its logger's profiles write
+/// them once a second (the default) or ten times (thermal calibration, sensor comparison), a
+/// sample kept each interval.
+pub const LEAST_SENSOR_RATE: f64 = 50.0;
+
 /// The header's length: magic, version, start time.
 const HEADER_LEN: usize = 16;
 /// The longest data payload: a message's size is a u16, the msg_id takes two bytes.

@@ -504,11 +504,8 @@ pub fn check_gaps(timing: Option<&TimingSummary>, n: usize) -> Result<(), String
     ))
 }
 
-/// The least rate of a PX4 sensor topic read as the sensor's own samples, Hz: PX4's IMU
-/// drivers publish `sensor_gyro` and `sensor_accel` at hundreds of Hz, and its logger's
-/// profiles write them once a second (the default) or ten times (thermal calibration,
-/// sensor comparison), a sample kept each interval.
-pub const LEAST_ULOG_RATE: f64 = 50.0;
+/// The least rate of a PX4 sensor topic read as the sensor's own samples, Hz.
+pub use imu_ar_recordings::ulog::LEAST_SENSOR_RATE as LEAST_ULOG_RATE;
 
 /// A PX4 log's sensor samples at a rate under [`LEAST_ULOG_RATE`] (`timing`, as their stamps
 /// tell it) are the logger's subsample of the sensor's stream: single readings, whose spread

@@ -1341,3 +1341,40 @@ fn a_px4_logs_subsampled_sensor_topics_give_no_noise_model() {
     let j = json(&imu_ar(&["thermal", m, "--out", path_str(&out), "--json"]));
     assert_eq!(j["n"], 600, "{j}");
 }
+
+#[test]
+fn a_px4_logs_sensor_topics_at_rates_apart_are_named_with_their_rates() {
+    // sensor_gyro at 200 Hz, sensor_accel at 10 Hz (the thermal profile's subsample) on the
+    // same clock: every accelerometer sample has a gyro partner, and the gyro samples alone
+    // were named as topics "published at times of their own" before. Named now with both
+    // rates and the subsample; the gyro read alone gives its model.
+    let rows = samples(12_000, 0.0);
+    let mut log = ULog::new(0);
+    log.format(SENSOR_GYRO);
+    log.format(SENSOR_ACCEL);
+    log.subscribe(0, 0, "sensor_gyro");
+    log.subscribe(0, 1, "sensor_accel");
+    for (k, (celsius, a)) in rows.iter().enumerate() {
+        let t = 1_000_000 + 5_000 * k as u64;
+        let three = |i: usize| [a[i] as f32, a[i + 1] as f32, a[i + 2] as f32];
+        log.data(0, &sensor(t, t, 100, three(0), *celsius as f32));
+        if k % 20 == 0 {
+            log.data(1, &sensor(t, t, 101, three(3), *celsius as f32));
+        }
+    }
+    let file = temp_file("rates-apart.ulg", log.bytes);
+    let m = path_str(&file);
+    let out = temp_path("rates-apart");
+    let run = imu_ar(&["characterise", m, "--out", path_str(&out)]);
+    let e = crate::common::stderr(&run);
+    assert_eq!(run.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains("sensor_gyro is logged at 200 Hz and sensor_accel at 10 Hz")
+            && e.contains("sensor_accel under 50 Hz is the logger's subsample")
+            && !e.contains("times of their own"),
+        "{e}"
+    );
+    assert!(!out.exists(), "{}", out.display());
+    let j = json(&imu_ar(&["noise", m, "--column", "gx", "--json"]));
+    assert_eq!(j["n"], 12_000, "{j}");
+}
