@@ -1568,18 +1568,23 @@ mod tests {
     }
 
     #[test]
-    fn samples_of_two_clocks_or_rates_are_still_called_times_of_their_own() {
+    fn samples_of_two_clocks_are_called_times_of_their_own_and_two_rates_named() {
         // The accelerometer's samples half a step after the gyro's: none pairs.
         let gyro = messages(1_000, 500, |_| false);
         let late: Vec<u64> = gyro.iter().map(|t| t + 250).collect();
         let e = six_axis_refusal(&fifo_log((&gyro, 500), (&late, 500)));
         assert!(e.contains("published at times of their own"), "{e}");
         // The accelerometer at half the gyro's rate: every other gyro sample has no partner,
-        // one in each of the accelerometer's steps, which are no gaps.
+        // one in each of the accelerometer's steps, which are no gaps: the two rates named.
         let e = six_axis_refusal(&fifo_log(
             (&gyro, 500),
             (&messages(500, 1_000, |_| false), 1_000),
         ));
-        assert!(e.contains("published at times of their own"), "{e}");
+        assert!(
+            e.contains("sensor_gyro_fifo is logged at 2000 Hz and sensor_accel_fifo at 1000 Hz")
+                && !e.contains("subsample")
+                && !e.contains("times of their own"),
+            "{e}"
+        );
     }
 }
