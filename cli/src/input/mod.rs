@@ -507,26 +507,46 @@ pub fn check_gaps(timing: Option<&TimingSummary>, n: usize) -> Result<(), String
 /// The least rate of a PX4 sensor topic read as the sensor's own samples, Hz.
 pub use imu_ar_recordings::ulog::LEAST_SENSOR_RATE as LEAST_ULOG_RATE;
 
-/// A PX4 log's sensor samples at a rate under [`LEAST_ULOG_RATE`] (`timing`, as their stamps
-/// tell it) are the logger's subsample of the sensor's stream: single readings, whose spread
-/// is the sensor's at its own rate, not an average over the interval (the noise density read
-/// at the subsample's rate is `sqrt(sensor rate / logged rate)` times the sensor's: 16 times
-/// for 250 Hz logged at 1 Hz). Refused for a noise model, naming the logger's profiles.
+/// A PX4 or ArduPilot log's sensor samples at a rate under [`LEAST_ULOG_RATE`] (`timing`, as
+/// their stamps tell it): see [`subsampled`]. Refused for a noise model.
 pub fn check_subsampled(files: &[PathBuf], timing: Option<&TimingSummary>) -> Result<(), String> {
-    let Some(t) = timing.filter(|t| t.rate_hz < LEAST_ULOG_RATE) else {
-        return Ok(());
-    };
-    if files.first().map(|f| source::Kind::of(f)) != Some(source::Kind::Ulog) {
-        return Ok(());
+    match (files.first(), timing) {
+        (Some(f), Some(t)) => subsampled(source::Kind::of(f), t.rate_hz).map_or(Ok(()), Err),
+        _ => Ok(()),
     }
-    Err(format!(
-        "the PX4 log holds the sensor's samples at {} Hz: the logger's subsample of its \
-         stream (its default profile writes sensor_gyro and sensor_accel once a second, the \
-         thermal calibration profile ten times), single readings whose noise is the sensor's at \
-         its own rate; log the IMU at full rate (SDLOG_PROFILE's high rate or raw FIFO bits) for \
-         its noise model",
-        number(t.rate_hz)
-    ))
+}
+
+/// Why a log of `kind` whose sensor samples come at `rate` Hz gives no noise model: under
+/// [`LEAST_ULOG_RATE`] they are the logger's subsample of the sensor's stream, single
+/// readings whose spread is the sensor's at its own rate (through its filter), not an
+/// average over the interval (the noise density read at the subsample's rate is
+/// `sqrt(sensor rate / logged rate)` times the sensor's: 16 times for 250 Hz logged at 1 Hz).
+/// PX4's logger profiles write `sensor_gyro` and `sensor_accel` once a second (the default)
+/// or ten times (thermal calibration); ArduCopter writes its `IMU` messages at 25 Hz unless
+/// `LOG_BITMASK` asks for them fast. `None` for other sources and faster logs.
+pub fn subsampled(kind: source::Kind, rate: f64) -> Option<String> {
+    if rate >= LEAST_ULOG_RATE {
+        return None;
+    }
+    match kind {
+        source::Kind::Ulog => Some(format!(
+            "the PX4 log holds the sensor's samples at {} Hz: the logger's subsample of its \
+             stream (its default profile writes sensor_gyro and sensor_accel once a second, the \
+             thermal calibration profile ten times), single readings whose noise is the sensor's \
+             at its own rate; log the IMU at full rate (SDLOG_PROFILE's high rate or raw FIFO \
+             bits) for its noise model",
+            number(rate)
+        )),
+        source::Kind::DataFlash => Some(format!(
+            "the ArduPilot log holds the IMU messages at {} Hz: the logger's subsample of the \
+             sensor's stream (ArduCopter writes IMU at 25 Hz unless LOG_BITMASK's fast IMU bit, \
+             IMU_FAST, is set), single filtered readings whose noise is not the sensor's at \
+             this rate; log the IMU fast (IMU_FAST, or IMU_RAW for the unfiltered samples) for \
+             its noise model",
+            number(rate)
+        )),
+        _ => None,
+    }
 }
 
 /// 0.1 x the variance of the finite samples among the first 1000 (what firmware sees at

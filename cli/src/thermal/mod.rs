@@ -590,6 +590,12 @@ fn rate_of(us: &[f64]) -> Result<f64, String> {
     Ok(1e6 / *median)
 }
 
+/// A log's sensor rate `rate` for the noise bands, or why its samples give none (the
+/// logger's subsample: [`crate::input::subsampled`]); the calibration reads them all the same.
+fn logged(kind: Kind, rate: f64) -> Result<f64, String> {
+    crate::input::subsampled(kind, rate).map_or(Ok(rate), Err)
+}
+
 /// Keeps a sample of `record` at `celsius` with the values `xyz` (and its time `us` in
 /// `times`), or counts why not.
 fn keep(record: &mut Record, times: &mut Vec<f64>, us: f64, celsius: Option<f64>, xyz: [f64; 3]) {
@@ -763,7 +769,7 @@ fn read_ulog(path: &Path, instance: Option<u8>) -> Result<WarmUp, Fail> {
         .map_err(|e| Fail(e.to_string()))?;
         // The reader leaves out the samples that are not finite; they are counted here.
         record.dropped.non_finite += report.non_finite;
-        record.rate = rate_of(&times);
+        record.rate = rate_of(&times).and_then(|r| logged(Kind::Ulog, r));
         let files = [path.to_path_buf()];
         check_dropped(&files, &record, topic.name(), report.held_temperature)?;
         if devices.len() > 1 {
@@ -900,8 +906,8 @@ fn read_dataflash(path: &Path, instance: Option<u8>) -> Result<WarmUp, Fail> {
     let files = [path.to_path_buf()];
     check_dropped(&files, &gyro, "IMU gyro", report.held_temperature)?;
     check_dropped(&files, &accel, "IMU accelerometer", report.held_temperature)?;
-    gyro.rate = rate_of(&times);
-    accel.rate = rate_of(&accel_times);
+    gyro.rate = rate_of(&times).and_then(|r| logged(Kind::DataFlash, r));
+    accel.rate = rate_of(&accel_times).and_then(|r| logged(Kind::DataFlash, r));
     Ok(WarmUp {
         sensors: [gyro, accel],
         device_ids: None,

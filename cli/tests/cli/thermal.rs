@@ -1340,6 +1340,73 @@ fn a_px4_logs_subsampled_sensor_topics_give_no_noise_model() {
     }
     let j = json(&imu_ar(&["thermal", m, "--out", path_str(&out), "--json"]));
     assert_eq!(j["n"], 600, "{j}");
+    // Nor do thermal's noise bands: the noise files were written from them, exit 0, before.
+    let run = imu_ar(&[
+        "thermal",
+        m,
+        "--out",
+        path_str(&out),
+        "--noise-format",
+        "kalibr",
+    ]);
+    let e = crate::common::stderr(&run);
+    assert_eq!(run.status.code(), Some(2), "{e}");
+    assert!(e.contains("the logger's subsample of its stream"), "{e}");
+    assert!(!out.join("imu.yaml").exists());
+}
+
+#[test]
+fn ardupilot_imu_messages_logged_at_25_hz_give_no_noise_model() {
+    // ArduCopter writes IMU at 25 Hz unless LOG_BITMASK's IMU_FAST bit is set: single filtered
+    // readings of a 1 kHz stream (N 1.3 to 2.6 times the sensor's, exit 0, before). Refused by
+    // noise, characterise and thermal's noise files; the calibration reads them.
+    let rows = samples(1_500, 0.0);
+    let mut df = Df::new();
+    for (k, (celsius, a)) in rows.iter().enumerate() {
+        let three = |i: usize| [a[i] as f32, a[i + 1] as f32, a[i + 2] as f32];
+        df.imu(
+            1_000_000 + 40_000 * k as u64,
+            0,
+            three(0),
+            three(3),
+            *celsius as f32,
+        );
+    }
+    let file = temp_file("copter-25-hz.bin", df.bytes);
+    let m = path_str(&file);
+    let out = temp_path("copter-25-hz");
+    for args in [
+        vec!["noise", m, "--column", "gx"],
+        vec!["characterise", m, "--out", path_str(&out)],
+        vec![
+            "thermal",
+            m,
+            "--out",
+            path_str(&out),
+            "--format",
+            "ardupilot",
+            "--noise-format",
+            "px4",
+        ],
+    ] {
+        let run = imu_ar(&args);
+        let e = crate::common::stderr(&run);
+        assert_eq!(run.status.code(), Some(2), "{args:?}: {e}");
+        assert!(
+            e.contains("IMU messages at 25 Hz") && e.contains("IMU_FAST"),
+            "{args:?}: {e}"
+        );
+    }
+    let j = json(&imu_ar(&[
+        "thermal",
+        m,
+        "--out",
+        path_str(&out),
+        "--format",
+        "ardupilot",
+        "--json",
+    ]));
+    assert_eq!(j["n"], 1_500, "{j}");
 }
 
 #[test]
