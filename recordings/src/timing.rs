@@ -1865,6 +1865,7 @@ impl Timing {
         let summary = TimingSummary {
             per_stamp,
             jittered_repeats,
+            batched: None,
             unit: unit.name(),
             header_stamps: unit == TimeUnit::HeaderStamps,
             rate_hz: 1e9 / period,
@@ -1907,6 +1908,24 @@ impl Timing {
             },
         };
         let (regular, intervals) = (regular + repeats, intervals + repeats);
+        // Runs of a FIFO's reads stamped at a period not the samples': their intervals (and
+        // the gaps between runs) tell no rate, the span does.
+        if self.repeats == 0
+            && self.dropped == 0
+            && (summary.rate_hz / summary.span_rate_hz - 1.0).abs() > 0.01
+            && let Some((samples, inside)) = self.batches(median)
+            && resolution.is_none_or(|q| (q as f64) < inside)
+        {
+            return Ok(TimingSummary {
+                rate_hz: summary.span_rate_hz,
+                gaps: 0,
+                missing_samples: 0,
+                short_intervals: 0,
+                other_rate_hz: None,
+                batched: Some((samples, inside * 1e-9)),
+                ..summary
+            });
+        }
         if judged_mixed {
             return Err(format!(
                 "the timestamps show mixed rates: stamped to {:e} s, {} of them repeated, they \
@@ -2005,6 +2024,68 @@ impl Timing {
         let rounded = matches!(window, Window::Quantum { .. });
         self.refold(&mut summary, resolution, median, rounded)?;
         Ok(summary)
+    }
+
+    /// Stamps in runs of the same number of samples (two or more), each run parted from the
+    /// next by an interval over 1.25 times the `median` (ns), for nine runs in ten or more
+    /// and at least 16 of them, one in a hundred intervals or more, half of those intervals
+    /// or more no whole number of the runs' interval (or so many that the samples they would
+    /// miss outnumber those kept): the samples a run holds and the mean interval within
+    /// runs, ns. Samples lost at random part runs of every
+    /// length; a FIFO read every `k` samples and stamped at a period not theirs parts runs
+    /// of `k`.
+    fn batches(&self, median: f64) -> Option<(u64, f64)> {
+        let t = &self.stamps;
+        if t.len() < 64 || median <= 0.0 {
+            return None;
+        }
+        let long = 1.25 * median;
+        let mut runs = std::collections::BTreeMap::<u64, u64>::new();
+        let (mut last, mut parted) = (None, 0u64);
+        let (mut inside, mut squares, mut within) = (0.0, 0.0, 0u64);
+        for (k, w) in t.windows(2).enumerate() {
+            let iv = (i128::from(w[1]) - i128::from(w[0])) as f64;
+            if iv > long {
+                parted += 1;
+                if let Some(before) = last {
+                    *runs.entry((k - before) as u64).or_default() += 1;
+                }
+                last = Some(k);
+            } else {
+                inside += iv;
+                squares += iv * iv;
+                within += 1;
+            }
+        }
+        let measured: u64 = runs.values().sum();
+        let (&samples, &most) = runs.iter().max_by_key(|&(_, &n)| n)?;
+        if samples < 2
+            || parted < 16
+            || 100 * parted < t.len() as u64
+            || 10 * most < 9 * measured
+            || within == 0
+        {
+            return None;
+        }
+        let mean = inside / within as f64;
+        let jitter = (squares / within as f64 - mean * mean).max(0.0).sqrt() / mean;
+        let inside = mean;
+        // Samples lost leave intervals of whole periods: where most of the longer intervals
+        // are (within 2 % and four times the runs' jitter), the runs are a clock's with
+        // samples lost at a steady count.
+        let tolerance = 0.02 + 4.0 * jitter;
+        let (mut whole, mut missing) = (0u64, 0.0);
+        for w in t.windows(2) {
+            let periods = (i128::from(w[1]) - i128::from(w[0])) as f64 / inside;
+            if periods * inside > long {
+                whole += u64::from((periods - periods.round()).abs() < tolerance);
+                missing += periods.round() - 1.0;
+            }
+        }
+        // (Not where they would lose more samples than the runs hold: the reads of a host
+        // stamping samples as they reach it, a whole number of their spacing apart.)
+        let lost = 2 * whole >= parted && missing < (samples * parted) as f64;
+        (!lost).then_some((samples, inside))
     }
 
     /// How many samples nearly every stamp holds, where eight in ten distinct stamps or more
@@ -3120,6 +3201,13 @@ pub struct TimingSummary {
     /// stamps' quantum leaves them (a sample written twice leaves two).
     #[serde(skip)]
     pub jittered_repeats: u64,
+    /// Stamps that come in runs of the same number of samples at an interval of their own,
+    /// each run parted from the next by a longer one, where that interval's rate is more than
+    /// 1 % from the span's: a driver stamping each read of its FIFO at a period not the
+    /// samples'. The samples a run holds and its interval, s; `rate_hz` is then the span's,
+    /// and [`TimingSummary::batch_refusal`] names them.
+    #[serde(skip)]
+    pub batched: Option<(u64, f64)>,
 }
 
 impl TimingSummary {
@@ -3161,6 +3249,23 @@ impl TimingSummary {
                 self.repeated
             )
         })
+    }
+
+    /// The refusal of stamps a driver put on each read of its FIFO at a period not the
+    /// samples' ([`TimingSummary::batched`]): their intervals tell no rate, the span tells
+    /// the samples' mean rate where none was lost.
+    pub fn batch_refusal(&self) -> Option<String> {
+        let (samples, inside) = self.batched?;
+        Some(format!(
+            "the timestamps come in runs of {samples} samples {} s apart ({} Hz), each run \
+             parted from the next by a longer interval: a driver stamping each read of its \
+             FIFO at a period not the samples', or stamping the samples as they reach the \
+             host; their intervals tell no rate, their span gives {} Hz (the samples' mean \
+             rate where none was lost); give --rate",
+            short(inside),
+            short(1.0 / inside),
+            short(self.span_rate_hz)
+        ))
     }
 
     /// One line for the text outputs.
@@ -3318,6 +3423,67 @@ mod tests {
             assert_eq!(timing.push(s), Step::Forward);
         }
         timing.summary(TimeUnit::Nanoseconds).unwrap()
+    }
+
+    /// A 1000 Hz clock read `per` samples at a time, every `per` ms (the read late by up to
+    /// `late` ns), sample `k` of a read stamped at the read less `(per - 1 - k)` times
+    /// `spacing` ns; `lost` in a thousand samples lost at random.
+    fn reads(n: usize, per: usize, spacing: i64, late: u64, lost: u64) -> Vec<i64> {
+        let mut next = crate::xorshift(0x9e37_79b9_7f4a_7c15);
+        let mut t = Vec::with_capacity(n);
+        for read in 0..n / per {
+            let at = 1_600_000_000_000_000_000
+                + (read as i64 + 1) * per as i64 * 1_000_000
+                + (next() % (late + 1)) as i64;
+            for k in 0..per {
+                if next() % 1000 >= lost {
+                    t.push(at - (per - 1 - k) as i64 * spacing);
+                }
+            }
+        }
+        t
+    }
+
+    #[test]
+    fn stamps_put_on_a_fifos_reads_at_another_period_tell_no_rate() {
+        // A driver stamping each read of 16 samples 952 us apart (1062.5 Hz with a sample
+        // lost in every 16 before, exit 0), 32 samples 985 us apart (1015.2 Hz, none
+        // missing), 16 samples 980 us apart, 20 samples 950 us apart (a run's end 2.05 of its
+        // intervals from the next: 1050 Hz, a sample lost in every 20, before); a host
+        // stamping 10 samples 200 us apart as they arrive (4999.9 Hz). Read as the span's
+        // rate, and named.
+        for (per, spacing, late) in [
+            (16, 952_000, 0),
+            (32, 985_000, 0),
+            (16, 980_000, 0),
+            (20, 950_000, 0),
+            (10, 200_000, 300_000),
+        ] {
+            let s = summary_of(&reads(60_000, per, spacing, late, 0));
+            let (samples, inside) = s.batched.expect("batched");
+            assert_eq!(samples, per as u64, "{per} x {spacing}");
+            assert!(
+                (inside / (spacing as f64 * 1e-9) - 1.0).abs() < 1e-3,
+                "{inside}"
+            );
+            assert!(
+                (s.rate_hz / 1000.0 - 1.0).abs() < 1e-3,
+                "{per} x {spacing}: {s:?}"
+            );
+            assert_eq!((s.gaps, s.missing_samples), (0, 0));
+            let e = s.batch_refusal().expect("refused");
+            assert!(e.contains(&format!("runs of {per} samples")), "{e}");
+        }
+        // Reads stamped at the samples' own period: one clock, no runs.
+        let s = summary_of(&reads(60_000, 16, 1_000_000, 0, 0));
+        assert_eq!(s.batched, None, "{s:?}");
+        // Samples lost at random part runs of every length: gaps, not batches.
+        let s = summary_of(&reads(60_000, 1, 0, 0, 20));
+        assert_eq!(s.batched, None, "{s:?}");
+        assert!(
+            s.gaps > 1000 && (s.rate_hz / 1000.0 - 1.0).abs() < 1e-6,
+            "{s:?}"
+        );
     }
 
     #[test]

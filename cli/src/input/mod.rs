@@ -266,7 +266,7 @@ pub fn summary(
         Some(Err(e)) if needed => Err(e),
         Some(Err(e)) => Ok((None, Some(e))),
         None => Ok((None, None)),
-        Some(Ok(s)) => match s.repeat_refusal() {
+        Some(Ok(s)) => match s.batch_refusal().or_else(|| s.repeat_refusal()) {
             Some(e) if needed => Err(e),
             e => Ok((Some(s), e)),
         },

@@ -979,16 +979,19 @@ fn read_csv(args: &Args) -> Result<WarmUp, Fail> {
     if let Some(w) = crate::input::unchecked(args.rate, unchecked.as_deref()) {
         eprintln!("imu-ar: warning: {}", with_file(&args.files, w).0);
     }
-    let rate = match (args.rate, &timing) {
-        (None, None) => Err(
+    // As noise reads a record: what its stamps show that would refuse them without --rate,
+    // and gaps that miss more than a tenth of the samples, leave the bands out.
+    let rate = match (args.rate, &timing, unchecked) {
+        (None, _, Some(why)) => Err(format!("{why}: no sample rate for the noise bands")),
+        (None, None, None) => Err(
             "the record gives no sample rate (no time column whose unit is clear): give --rate \
              for the noise bands"
                 .to_string(),
         ),
-        (r, t) => {
+        (r, t, _) => {
             let rate = resolve_rate(r, t.as_ref()).map_err(|e| with_file(&args.files, e.0))?;
             crate::input::check_packed(r, stamped).map_err(|e| with_file(&args.files, e))?;
-            Ok(rate)
+            crate::input::check_gaps(t.as_ref(), celsius.len()).map(|()| rate)
         }
     };
     let mut names = [""; 6];

@@ -1790,3 +1790,67 @@ fn messages_skipped_evenly_keep_the_clocks_rate() {
         assert_eq!(gyro["n"], 60_000, "{gyro}");
     }
 }
+
+#[test]
+fn stamps_put_on_a_fifos_reads_at_another_period_need_the_rate() {
+    // A 100 Hz clock read 16 samples at a time, stamped 9.52 ms apart back from the read (a
+    // driver's nominal 105 Hz): read at 106.25 Hz with a sample "missing" in every 16, exit
+    // 0, before, and the right --rate refused. Now named, and read at the rate given where
+    // the stamps' span gives it, as the same samples stamped at their own period are.
+    let dir = temp_dir("fifo-reads");
+    let frames = noise(16 * 1_250, 7);
+    let at_reads: Vec<Frame> = frames
+        .iter()
+        .enumerate()
+        .map(|(k, f)| Frame {
+            stamp_ns: frames[0].stamp_ns + (k / 16 + 1) as i64 * 160_000_000
+                - (15 - k % 16) as i64 * 9_520_000,
+            ..*f
+        })
+        .collect();
+    let on_clock: Vec<Frame> = frames
+        .iter()
+        .enumerate()
+        .map(|(k, f)| Frame {
+            stamp_ns: frames[0].stamp_ns + k as i64 * 10_000_000,
+            ..*f
+        })
+        .collect();
+    let reads = csv_of(&dir, "reads.csv", &at_reads);
+    let clock = csv_of(&dir, "clock.csv", &on_clock);
+    for args in [
+        vec!["noise", path(&reads), "--column", "gx"],
+        vec!["adev", path(&reads), "--column", "gx"],
+        vec!["characterise", path(&reads), "--out", path(&dir)],
+    ] {
+        let run = imu_ar(&args);
+        assert_one_line_failure(&run);
+        let e = stderr(&run);
+        assert!(
+            e.contains("runs of 16 samples 0.00952 s apart")
+                && e.contains("their span gives 100.0")
+                && e.ends_with("give --rate\n"),
+            "{args:?}: {e}"
+        );
+    }
+    let run = imu_ar(&[
+        "noise",
+        path(&reads),
+        "--column",
+        "gx",
+        "--rate",
+        "100",
+        "--json",
+    ]);
+    assert!(stderr(&run).contains("warning") && stderr(&run).contains("runs of 16"));
+    let (given, own) = (json(&run), noise_json(&clock, &[]));
+    assert_eq!(given["white_noise"], own["white_noise"], "{given}\n{own}");
+    assert_eq!(given["random_walk"], own["random_walk"]);
+    let run = imu_ar(&["noise", path(&reads), "--column", "gx", "--rate", "106.25"]);
+    assert_one_line_failure(&run);
+    assert!(
+        stderr(&run).contains("the timestamps give 100.0"),
+        "{}",
+        stderr(&run)
+    );
+}

@@ -1445,3 +1445,68 @@ fn a_px4_logs_sensor_topics_at_rates_apart_are_named_with_their_rates() {
     let j = json(&imu_ar(&["noise", m, "--column", "gx", "--json"]));
     assert_eq!(j["n"], 12_000, "{j}");
 }
+
+/// [`samples`] (100 Hz) as a CSV record in SI units, sample `k` stamped at `stamp(k)` s and
+/// kept where `keep(k)`.
+fn stamped_warm_up(
+    name: &str,
+    stamp: impl Fn(usize) -> f64,
+    keep: impl Fn(usize) -> bool,
+) -> PathBuf {
+    let mut text = String::from(
+        "t [s],gx [rad/s],gy [rad/s],gz [rad/s],ax [m/s^2],ay [m/s^2],az [m/s^2],temperature\n",
+    );
+    for (k, (celsius, axes)) in samples(120_000, 0.0).into_iter().enumerate() {
+        if !keep(k) {
+            continue;
+        }
+        text += &format!("{:.6}", stamp(k));
+        for v in axes {
+            text += &format!(",{v:.9e}");
+        }
+        text += &format!(",{celsius:.2}\n");
+    }
+    temp_file(name, text)
+}
+
+#[test]
+fn thermal_noise_bands_take_the_rate_as_noise_does() {
+    // A host stamping reads of 10 samples 2 ms apart (a 500 Hz "clock" among 100 Hz samples):
+    // noise files written at 500 Hz, N sqrt(5) too low, exit 0, before. And a record whose
+    // gaps miss half its samples (every other minute kept): noise refuses it, the bands read
+    // it. The calibration reads both; the noise files are refused, naming why.
+    let runs = stamped_warm_up(
+        "reads-of-ten.csv",
+        |k| (k / 10 + 1) as f64 * 0.1 - (9 - k % 10) as f64 * 0.002,
+        |_| true,
+    );
+    let halves = stamped_warm_up(
+        "every-other-minute.csv",
+        |k| k as f64 * 0.01,
+        |k| (k / 6_000) % 2 == 0,
+    );
+    for (file, why) in [(&runs, "runs of 10 samples"), (&halves, "gaps miss")] {
+        let out = temp_path("bands-rate");
+        let m = path_str(file);
+        let args = [
+            "thermal",
+            m,
+            "--out",
+            path_str(&out),
+            "--format",
+            "ardupilot",
+        ];
+        let run = imu_ar(&[&args[..], &["--noise-format", "kalibr"]].concat());
+        let e = crate::common::stderr(&run);
+        assert_eq!(run.status.code(), Some(2), "{m}: {e}");
+        assert!(e.contains("--noise-format") && e.contains(why), "{m}: {e}");
+        assert!(!out.join("imu.yaml").exists());
+        let run = imu_ar(&[&args[..], &["--json"]].concat());
+        assert_eq!(
+            run.status.code(),
+            Some(0),
+            "{m}: {}",
+            crate::common::stderr(&run)
+        );
+    }
+}
