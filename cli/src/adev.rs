@@ -76,6 +76,15 @@ pub fn run(args: &Args) -> Result<AdevResult, Fail> {
              for f64 (scale the data, --unit)"
         )));
     }
+    // All zero: the samples are all equal (a stuck sensor), or their differences underflow.
+    if avar.iter().all(|&v| v == 0.0) {
+        return Err(args.input.fail(if x.iter().all(|v| *v == x[0]) {
+            "the record is constant (a stuck sensor?): every Allan variance is zero"
+        } else {
+            "the Allan variance underflows f64 (differences of about 1e-160 or less); rescale \
+             the record"
+        }));
+    }
     let tau = ms.iter().map(|&m| m as f64 / rate).collect();
     Ok(AdevResult {
         rate_hz: rate,

@@ -744,11 +744,23 @@ fn columns(args: &Args) -> Result<Vec<String>, Fail> {
         "w_RS_S_x", "w_RS_S_y", "w_RS_S_z", "a_RS_S_x", "a_RS_S_y", "a_RS_S_z",
     ];
     for names in [euroc, AXES] {
-        if names
+        let found: Vec<Result<usize, String>> = names
             .iter()
-            .all(|n| crate::input::csv::position(&header, n).is_ok())
-        {
+            .map(|n| crate::input::csv::position(&header, n))
+            .collect();
+        if found.iter().all(Result::is_ok) {
             return Ok(named(names));
+        }
+        // All six there, some more than once (two IMUs side by side): which to read.
+        if found
+            .iter()
+            .all(|f| f.as_ref().is_ok() || f.as_ref().is_err_and(|e| e.contains(" times")))
+            && let Some(Err(e)) = found.into_iter().find(Result::is_err)
+        {
+            return Err(with_file(
+                &args.files,
+                format!("{e}: name the six to read with --columns (by number where names repeat)"),
+            ));
         }
     }
     Err(with_file(

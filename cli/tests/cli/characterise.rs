@@ -1331,3 +1331,45 @@ fn a_rate_given_must_fit_the_samples_in_their_stamps_span() {
         stderr(&read)
     );
 }
+
+#[test]
+fn two_imus_side_by_side_in_one_csv_are_named_and_read_by_number() {
+    // gx .. az twice (two IMUs side by side): "no EuRoC or gx .. az columns" before, though
+    // they are there. Named, and either IMU read by the columns' numbers.
+    let dir = temp_dir("side-by-side");
+    let frames = imu_frames(20_000, 100.0, 3);
+    let mut text = "t [ns],gx,gy,gz,ax,ay,az,gx,gy,gz,ax,ay,az\n".to_string();
+    for f in &frames {
+        write!(text, "{}", f.stamp_ns).unwrap();
+        for _ in 0..2 {
+            for v in f.axes {
+                write!(text, ",{v:e}").unwrap();
+            }
+        }
+        text.push('\n');
+    }
+    let file = dir.join("two.csv");
+    std::fs::write(&file, text).unwrap();
+    let out = dir.join("out");
+    let units = ["--gyro-unit", "rad/s", "--accel-unit", "m/s^2"];
+    let run = imu_ar(
+        &[
+            &["characterise", path(&file), "--out", path(&out)][..],
+            &units,
+        ]
+        .concat(),
+    );
+    assert_one_line_failure(&run);
+    assert!(
+        stderr(&run)
+            .contains("the header names column 'gx' 2 times: name the six to read with --columns"),
+        "{}",
+        stderr(&run)
+    );
+    let second = characterise(
+        &[path(&file)],
+        &out,
+        &[&["--columns", "7,8,9,10,11,12"][..], &units].concat(),
+    );
+    assert_eq!(second["axes"].as_array().map(Vec::len), Some(6), "{second}");
+}

@@ -101,6 +101,10 @@ misuse! {
         vec!["fit", c, "--column", "x", "--method", "burg", "--order", "1"],
         format!("{c}: data have zero variance"),
     );
+    constant_allan_deviation: |[g, t, n, e, h, c]| (
+        vec!["adev", c, "--column", "x", "--rate", "100"],
+        format!("{c}: the record is constant (a stuck sensor?): every Allan variance is zero"),
+    );
     negative_rate: |[g, t, n, e, h, c]| (
         vec!["adev", g, "--column", "x", "--rate", "-5"],
         "--rate -5: must be a positive number".into(),
@@ -203,6 +207,25 @@ fn huge_values_are_reported_as_an_overflow() {
     misused(
         &["compare", f, "--column", "x", "--order", "2"],
         "overflows f64",
+    );
+    std::fs::remove_file(file).unwrap();
+}
+
+/// Samples whose differences underflow f64: every Allan variance zero (fourteen zeros, exit
+/// 0, from `adev` before), refused as `noise` refuses them.
+#[test]
+fn an_allan_variance_that_underflows_is_refused() {
+    let file = column_file("tiny.csv", (0..500).map(|i| format!("{}e-300", 1 + i % 7)));
+    misused(
+        &[
+            "adev",
+            file.to_str().unwrap(),
+            "--column",
+            "x",
+            "--rate",
+            "100",
+        ],
+        "the Allan variance underflows f64",
     );
     std::fs::remove_file(file).unwrap();
 }
