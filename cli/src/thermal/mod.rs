@@ -618,6 +618,17 @@ fn keep(record: &mut Record, times: &mut Vec<f64>, us: f64, celsius: Option<f64>
     times.push(us);
 }
 
+/// The highest median temperature of a warm-up read as deg C.
+const HOTTEST_MEDIAN: f64 = 85.0;
+
+/// The median of `v` (none when empty).
+fn median_of(v: &[f64]) -> Option<f64> {
+    let mut v = v.to_vec();
+    let mid = v.len().checked_sub(1)? / 2;
+    let (_, m, _) = v.select_nth_unstable_by(mid, f64::total_cmp);
+    Some(*m)
+}
+
 /// An error when most of a sensor's temperatures are no die temperatures in deg C (a record in
 /// kelvin or Fahrenheit), or when more than 1 % of its samples were given a temperature held
 /// from the nearest one logged (`held`).
@@ -632,6 +643,21 @@ fn check_dropped(files: &[PathBuf], record: &Record, what: &str, held: u64) -> R
                  in deg C (kelvin or Fahrenheit?)",
                 d.implausible_temperature,
                 kept + d.implausible_temperature
+            ),
+        ));
+    }
+    // Dies run up to 85 deg C (105 or 125 for automotive parts) and a warm-up spends most of
+    // its time below that: a median above it is a column in deg F (20 to 60 deg C read as
+    // 68 to 140), whose calibration would clamp the vehicle's whole range to its TMIN.
+    if let Some(median) = median_of(&record.celsius)
+        && median > HOTTEST_MEDIAN
+    {
+        return Err(with_file(
+            files,
+            format!(
+                "{what}: the temperatures' median is {median:.1} deg C, above the {HOTTEST_MEDIAN} \
+                 deg C MEMS dies run at: a column in deg F (68 to 140 for 20 to 60 deg C)? give \
+                 the temperature in deg C"
             ),
         ));
     }

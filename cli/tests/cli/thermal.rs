@@ -1447,11 +1447,12 @@ fn a_px4_logs_sensor_topics_at_rates_apart_are_named_with_their_rates() {
 }
 
 /// [`samples`] (100 Hz) as a CSV record in SI units, sample `k` stamped at `stamp(k)` s and
-/// kept where `keep(k)`.
+/// kept where `keep(k)`, the temperature `degrees(celsius)`.
 fn stamped_warm_up(
     name: &str,
     stamp: impl Fn(usize) -> f64,
     keep: impl Fn(usize) -> bool,
+    degrees: impl Fn(f64) -> f64,
 ) -> PathBuf {
     let mut text = String::from(
         "t [s],gx [rad/s],gy [rad/s],gz [rad/s],ax [m/s^2],ay [m/s^2],az [m/s^2],temperature\n",
@@ -1464,7 +1465,7 @@ fn stamped_warm_up(
         for v in axes {
             text += &format!(",{v:.9e}");
         }
-        text += &format!(",{celsius:.2}\n");
+        text += &format!(",{:.2}\n", degrees(celsius));
     }
     temp_file(name, text)
 }
@@ -1479,11 +1480,13 @@ fn thermal_noise_bands_take_the_rate_as_noise_does() {
         "reads-of-ten.csv",
         |k| (k / 10 + 1) as f64 * 0.1 - (9 - k % 10) as f64 * 0.002,
         |_| true,
+        |c| c,
     );
     let halves = stamped_warm_up(
         "every-other-minute.csv",
         |k| k as f64 * 0.01,
         |k| (k / 6_000) % 2 == 0,
+        |c| c,
     );
     for (file, why) in [(&runs, "runs of 10 samples"), (&halves, "gaps miss")] {
         let out = temp_path("bands-rate");
@@ -1509,4 +1512,48 @@ fn thermal_noise_bands_take_the_rate_as_noise_does() {
             crate::common::stderr(&run)
         );
     }
+}
+
+#[test]
+fn a_warm_up_in_fahrenheit_is_refused() {
+    // 20 to 60 deg C written in deg F (68 to 140): read as deg C, exit 0, and INS_TCAL1_TMAX
+    // 140 written (the vehicle's whole range clamped to TMIN), before.
+    let file = stamped_warm_up(
+        "fahrenheit.csv",
+        |k| k as f64 * 0.01,
+        |_| true,
+        |c| 1.8 * c + 32.0,
+    );
+    let out = temp_path("fahrenheit");
+    let run = imu_ar(&[
+        "thermal",
+        path_str(&file),
+        "--out",
+        path_str(&out),
+        "--format",
+        "ardupilot",
+    ]);
+    assert_one_line_failure(&run);
+    let e = crate::common::stderr(&run);
+    assert!(
+        e.contains("above the 85 deg C MEMS dies run at: a column in deg F"),
+        "{e}"
+    );
+    assert!(!out.exists());
+    // The same in deg C is read.
+    let file = stamped_warm_up("celsius.csv", |k| k as f64 * 0.01, |_| true, |c| c);
+    let run = imu_ar(&[
+        "thermal",
+        path_str(&file),
+        "--out",
+        path_str(&out),
+        "--format",
+        "ardupilot",
+    ]);
+    assert_eq!(
+        run.status.code(),
+        Some(0),
+        "{}",
+        crate::common::stderr(&run)
+    );
 }
