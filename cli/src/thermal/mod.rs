@@ -205,13 +205,15 @@ pub struct AxisResult {
     pub bins: usize,
     /// The bias change over the range: the fitted bias's largest less its smallest.
     pub change: f64,
-    /// The largest `|bin - fit|`.
+    /// The largest `|bin - fit|` over the bins whose median is known to within four times
+    /// the typical bin's (not a few samples' noise at the range's end).
     pub residual: f64,
-    /// The largest `|bin - fit|` over bins held out of the fit.
+    /// The same over bins held out of the fit.
     pub held_out: f64,
     /// The root mean square of the held-out bins' residuals over their standard errors.
     pub held_out_z: f64,
-    /// The largest bias PX4's correction leaves in a bin, applied through its formula: for a
+    /// The largest bias PX4's correction leaves in a bin (of those of `residual`), applied
+    /// through its formula: for a
     /// gyro, whose X0 holds the bias, the corrected bin; for an accelerometer, whose constant
     /// the accelerometer calibration at TREF removes, the corrected bin less the fit at TREF.
     pub px4_left: f64,
@@ -328,10 +330,13 @@ pub fn run(args: &Args) -> Result<Thermal, Fail> {
     let mut results = Vec::with_capacity(6);
     for (i, fit) in fits.iter().enumerate() {
         let sensor = if i < 3 { Sensor::Gyro } else { Sensor::Accel };
+        // Over the bins that tell what the fit leaves (not a few samples' noise).
         let corrected = |correct: &dyn Fn(f32) -> f32| -> Vec<f64> {
             fit.bins
                 .iter()
-                .map(|b| b.value - f64::from(correct(b.celsius as f32)))
+                .zip(&fit.telling)
+                .filter(|(_, t)| **t)
+                .map(|(b, _)| b.value - f64::from(correct(b.celsius as f32)))
                 .collect()
         };
         let largest =
