@@ -187,6 +187,9 @@ pub struct Read {
     pub timing: Option<(Timing, TimeUnit)>,
     /// Messages skipped (undecodable or not finite), counted.
     pub skipped: Skipped,
+    /// Where a log's samples came from when it is not the one its six axes are read from
+    /// (a DataFlash log's batch sampler's batches, not its `IMU` messages).
+    pub source: Option<String>,
 }
 
 /// Reads `request` from `files` (one kind, joined in order), passing the values of each row
@@ -372,6 +375,7 @@ fn autopilot_stream(
     let path = &files[0];
     let mut timing = Timing::new();
     let mut backward: Option<(u64, i64, i64)> = None;
+    let mut from = None;
     let mut count = 0u64;
     let mut values = vec![0.0; picks.len()];
     let mut take = |time_us: f64, axes: [f64; 6]| {
@@ -426,6 +430,17 @@ fn autopilot_stream(
         };
         let instance = choose(files, request, what, &found, survey.truncated)?;
         let source = fuller_dataflash(&survey, batch, instance);
+        if source != dataflash::Kind::Imu {
+            from = Some(format!(
+                "read from the log's {} of IMU {instance} (the sensor's rate), which hold more of \
+                 its samples than its IMU messages (the loop's rate, filtered); six axes are read \
+                 from the IMU messages",
+                match source {
+                    dataflash::Kind::BatchGyro => "ISB gyro batches",
+                    _ => "ISB accel batches",
+                }
+            ));
+        }
         let select = dataflash::Select {
             kind: source,
             instance: Some(instance),
@@ -444,7 +459,11 @@ fn autopilot_stream(
     } else {
         skipped = ulog_stream(files, request, &picks, &mut take)?;
     }
-    stamped(files, request, &picks, (timing, backward), skipped)
+    let read = stamped(files, request, &picks, (timing, backward), skipped)?;
+    Ok(Read {
+        source: from,
+        ..read
+    })
 }
 
 /// The batches that could hold a DataFlash log's axes `picks`: those of the one sensor they
@@ -950,6 +969,7 @@ fn stamped(
         units: picks.iter().map(|&i| si_unit(i)).collect(),
         timing: Some((timing, TimeUnit::HeaderStamps)),
         skipped,
+        source: None,
     })
 }
 
@@ -1098,6 +1118,7 @@ fn messages(
             units: picks.iter().map(|&i| si_unit(i)).collect(),
             timing: None,
             skipped,
+            source: None,
         });
     }
     stamped(files, request, &picks, (timing, backward), skipped)
@@ -1396,6 +1417,7 @@ fn csv_stream(
             backward_kept,
             ..Skipped::default()
         },
+        source: None,
     })
 }
 

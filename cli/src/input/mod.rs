@@ -123,6 +123,12 @@ impl Input {
         if let Some(w) = read.skipped.summary() {
             eprintln!("imu-ar: warning: {}", self.fail(w).0);
         }
+        if let Some(from) = &read.source {
+            eprintln!(
+                "imu-ar: note: {}",
+                self.fail(format!("{} {from}", self.column)).0
+            );
+        }
         if let (Some(Some(bracket)), Some(to)) = (read.unknown.first(), &self.unit) {
             return Err(self.fail(format!(
                 "--unit {to}: column '{}' is in [{bracket}], which is not a unit converted here \
@@ -216,7 +222,7 @@ pub fn resolve_rate(given: Option<f64>, timing: Option<&TimingSummary>) -> Resul
                     "--rate {}: {} give {} Hz ({} Hz over their span)",
                     number(r),
                     if t.header_stamps {
-                        "the messages' header stamps"
+                        "the messages' stamps"
                     } else {
                         "the timestamps"
                     },

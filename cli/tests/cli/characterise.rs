@@ -528,7 +528,7 @@ fn bad_recordings_exit_2_with_one_line() {
             "--out",
             o,
         ],
-        "--rate 200: the messages' header stamps give 100",
+        "--rate 200: the messages' stamps give 100",
     );
     // A number too small to write out is shown in exponent form.
     refused(

@@ -900,6 +900,22 @@ fn fifo_topics_and_batches_give_the_csvs_noise_model() {
         let batch = model(&df, column);
         assert_eq!(batch["n"], 32 * BLOCKS, "DataFlash batch {column}");
         assert_eq!(batch, model(&batch_csv, column), "DataFlash batch {column}");
+        // Named as read from the batches (not the IMU messages characterise reads), which
+        // nothing told before.
+        let run = imu_ar(&["noise", df.to_str().unwrap(), "--column", column]);
+        let e = crate::common::stderr(&run);
+        let batches = if column.starts_with('g') {
+            "gyro"
+        } else {
+            "accel"
+        };
+        assert!(
+            e.contains("note: ")
+                && e.contains(&format!(
+                    "{column} read from the log's ISB {batches} batches of IMU 0"
+                )),
+            "{e}"
+        );
     }
 }
 
