@@ -1913,8 +1913,7 @@ impl Timing {
         if self.repeats == 0
             && self.dropped == 0
             && (summary.rate_hz / summary.span_rate_hz - 1.0).abs() > 0.01
-            && let Some((samples, inside)) = self.batches(median)
-            && resolution.is_none_or(|q| (q as f64) < inside)
+            && let Some((samples, inside)) = self.batches(median, resolution)
         {
             return Ok(TimingSummary {
                 rate_hz: summary.span_rate_hz,
@@ -2026,15 +2025,17 @@ impl Timing {
         Ok(summary)
     }
 
-    /// Stamps in runs of the same number of samples (two or more), each run parted from the
-    /// next by an interval over 1.25 times the `median` (ns), for nine runs in ten or more
-    /// and at least 16 of them, one in a hundred intervals or more, half of those intervals
-    /// or more no whole number of the runs' interval (or so many that the samples they would
-    /// miss outnumber those kept): the samples a run holds and the mean interval within
-    /// runs, ns. Samples lost at random part runs of every
-    /// length; a FIFO read every `k` samples and stamped at a period not theirs parts runs
-    /// of `k`.
-    fn batches(&self, median: f64) -> Option<(u64, f64)> {
+    /// Stamps in runs (of two samples or more, on the median), each run parted from the next by
+    /// an interval over 1.25 times the `median` (ns), at least 16 of them and one in a hundred
+    /// intervals or more, half of those intervals or more no whole number of the runs' interval
+    /// (or so many that the samples they would miss outnumber those kept): the runs' lengths
+    /// (5th and 95th percentiles) and their mean interval, ns; six runs in ten or more
+    /// starting within 30 % of the median time from one run's start to the next, and not
+    /// parted by one `quantum` more where that is over a tenth of the runs' interval (a
+    /// slower clock's rounding). Samples lost leave intervals of whole periods; a FIFO read
+    /// on a timer and stamped at a period not the samples' parts runs by intervals of any
+    /// length.
+    fn batches(&self, median: f64, quantum: Option<i64>) -> Option<((u64, u64), f64)> {
         let t = &self.stamps;
         if t.len() < 64 || median <= 0.0 {
             return None;
@@ -2042,34 +2043,62 @@ impl Timing {
         let long = 1.25 * median;
         let mut runs = std::collections::BTreeMap::<u64, u64>::new();
         let (mut last, mut parted) = (None, 0u64);
-        let (mut inside, mut squares, mut within) = (0.0, 0.0, 0u64);
+        let mut within = Vec::new();
+        // The times from one run's start to the next's, and the intervals parting runs.
+        let (mut starts, mut parting) = (Vec::new(), Vec::new());
         for (k, w) in t.windows(2).enumerate() {
             let iv = (i128::from(w[1]) - i128::from(w[0])) as f64;
             if iv > long {
                 parted += 1;
                 if let Some(before) = last {
                     *runs.entry((k - before) as u64).or_default() += 1;
+                    starts.push((i128::from(w[1]) - i128::from(t[before + 1])) as f64);
                 }
+                parting.push(iv);
                 last = Some(k);
             } else {
-                inside += iv;
-                squares += iv * iv;
-                within += 1;
+                within.push(iv);
             }
         }
+        // The run lengths' 5th, 50th and 95th percentiles.
         let measured: u64 = runs.values().sum();
-        let (&samples, &most) = runs.iter().max_by_key(|&(_, &n)| n)?;
-        if samples < 2
-            || parted < 16
-            || 100 * parted < t.len() as u64
-            || 10 * most < 9 * measured
-            || within == 0
-        {
+        let at = |q: u64| {
+            let mut seen = 0;
+            runs.iter()
+                .find(|&(_, &n)| {
+                    seen += n;
+                    100 * seen >= q * measured
+                })
+                .map(|(&k, _)| k)
+        };
+        let (Some(low), Some(middle), Some(high)) = (at(5), at(50), at(95)) else {
+            return None;
+        };
+        if middle < 2 || parted < 16 || 100 * parted < t.len() as u64 || within.is_empty() {
             return None;
         }
-        let mean = inside / within as f64;
-        let jitter = (squares / within as f64 - mean * mean).max(0.0).sqrt() / mean;
-        let inside = mean;
+        // A FIFO read on a timer starts its runs at the timer's period, however many samples
+        // each holds; pauses and samples lost at random places start them anywhere.
+        let middle_of = |v: &mut Vec<f64>| {
+            let mid = (v.len() - 1) / 2;
+            *v.select_nth_unstable_by(mid, f64::total_cmp).1
+        };
+        let period = middle_of(&mut starts);
+        let steady = starts
+            .iter()
+            .filter(|&&d| (d / period - 1.0).abs() <= 0.3)
+            .count();
+        if 10 * steady < 6 * starts.len() {
+            return None;
+        }
+        // Stamps floored to a quantum `q` coarse against the runs' interval part the runs of
+        // a slower clock by one quantum more: rounding's, not runs.
+        let parts = middle_of(&mut parting);
+        // The runs' interval and jitter, robustly: their median, and the median deviation
+        // from it (a read's end a little short of the interval is no jitter of the clock's).
+        let inside = middle_of(&mut within);
+        let mut deviations: Vec<f64> = within.iter().map(|iv| (iv - inside).abs()).collect();
+        let jitter = 1.4826 * middle_of(&mut deviations) / inside;
         // Samples lost leave intervals of whole periods: where most of the longer intervals
         // are (within 2 % and four times the runs' jitter), the runs are a clock's with
         // samples lost at a steady count.
@@ -2084,8 +2113,12 @@ impl Timing {
         }
         // (Not where they would lose more samples than the runs hold: the reads of a host
         // stamping samples as they reach it, a whole number of their spacing apart.)
-        let lost = 2 * whole >= parted && missing < (samples * parted) as f64;
-        (!lost).then_some((samples, inside))
+        let lost = 2 * whole >= parted && missing < t.len() as f64;
+        let rounding = quantum.is_some_and(|q| {
+            let q = q as f64;
+            10.0 * q > inside && parts - inside <= 1.5 * q
+        });
+        (!lost && !rounding).then_some(((low, high), inside))
     }
 
     /// How many samples nearly every stamp holds, where eight in ten distinct stamps or more
@@ -3204,10 +3237,10 @@ pub struct TimingSummary {
     /// Stamps that come in runs of the same number of samples at an interval of their own,
     /// each run parted from the next by a longer one, where that interval's rate is more than
     /// 1 % from the span's: a driver stamping each read of its FIFO at a period not the
-    /// samples'. The samples a run holds and its interval, s; `rate_hz` is then the span's,
+    /// samples'. The samples a run holds (5th and 95th percentiles) and its interval, s; `rate_hz` is then the span's,
     /// and [`TimingSummary::batch_refusal`] names them.
     #[serde(skip)]
-    pub batched: Option<(u64, f64)>,
+    pub batched: Option<((u64, u64), f64)>,
 }
 
 impl TimingSummary {
@@ -3255,7 +3288,12 @@ impl TimingSummary {
     /// samples' ([`TimingSummary::batched`]): their intervals tell no rate, the span tells
     /// the samples' mean rate where none was lost.
     pub fn batch_refusal(&self) -> Option<String> {
-        let (samples, inside) = self.batched?;
+        let ((low, high), inside) = self.batched?;
+        let samples = if low == high {
+            low.to_string()
+        } else {
+            format!("{low} to {high}")
+        };
         Some(format!(
             "the timestamps come in runs of {samples} samples {} s apart ({} Hz), each run \
              parted from the next by a longer interval: a driver stamping each read of its \
@@ -3444,6 +3482,28 @@ mod tests {
         t
     }
 
+    /// A 1000 Hz clock read on a timer every `poll` ns (late by up to `late` ns), each read's
+    /// samples stamped `spacing` ns apart back from it; `lost` in a thousand samples lost at
+    /// random.
+    fn timer_reads(n: usize, poll: i64, spacing: i64, late: u64, lost: u64) -> Vec<i64> {
+        let mut next = crate::xorshift(0x2545_f491_4f6c_dd1d);
+        let (mut t, mut taken) = (Vec::with_capacity(n), 0i64);
+        let mut read = 0i64;
+        while (taken as usize) < n {
+            read += 1;
+            let at = read * poll + (next() % (late + 1)) as i64;
+            // The samples taken by then (one a ms).
+            let count = (at / 1_000_000 + 1 - taken).max(0);
+            for k in 0..count {
+                if next() % 1000 >= lost {
+                    t.push(1_600_000_000_000_000_000 + at - (count - 1 - k) * spacing);
+                }
+            }
+            taken += count;
+        }
+        t
+    }
+
     #[test]
     fn stamps_put_on_a_fifos_reads_at_another_period_tell_no_rate() {
         // A driver stamping each read of 16 samples 952 us apart (1062.5 Hz with a sample
@@ -3461,7 +3521,7 @@ mod tests {
         ] {
             let s = summary_of(&reads(60_000, per, spacing, late, 0));
             let (samples, inside) = s.batched.expect("batched");
-            assert_eq!(samples, per as u64, "{per} x {spacing}");
+            assert_eq!(samples, (per as u64, per as u64), "{per} x {spacing}");
             assert!(
                 (inside / (spacing as f64 * 1e-9) - 1.0).abs() < 1e-3,
                 "{inside}"
@@ -3473,6 +3533,21 @@ mod tests {
             assert_eq!((s.gaps, s.missing_samples), (0, 0));
             let e = s.batch_refusal().expect("refused");
             assert!(e.contains(&format!("runs of {per} samples")), "{e}");
+        }
+        // Reads on a timer that is no whole number of samples (9 or 10 a read), jittered
+        // (16 a read, 0.3 ms), or with 1 % of the samples lost: 1052.6, 1051.8 and 1062.5 Hz
+        // before, exit 0, and the right --rate refused.
+        for (poll, spacing, late, lost) in [
+            (9_500_000, 970_000, 0, 0),
+            (16_000_000, 950_000, 300_000, 0),
+            (16_000_000, 950_000, 0, 10),
+            (10_000_000, 200_000, 2_000_000, 0),
+        ] {
+            let s = summary_of(&timer_reads(60_000, poll, spacing, late, lost));
+            let (_, inside) = s.batched.expect("batched");
+            assert!((inside / (spacing as f64 * 1e-9) - 1.0).abs() < 1e-3, "{inside}");
+            let truth = 1000.0 * (1.0 - lost as f64 / 1000.0);
+            assert!((s.rate_hz / truth - 1.0).abs() < 2e-3, "{poll}: {s:?}");
         }
         // Reads stamped at the samples' own period: one clock, no runs.
         let s = summary_of(&reads(60_000, 16, 1_000_000, 0, 0));

@@ -372,8 +372,11 @@ pub fn run(args: &Args) -> Result<Thermal, Fail> {
         });
     }
     let (noise_bands, worst, noise_bands_note) = noise_bands(args, &warm, &fits, ranges, &config)?;
-    std::fs::create_dir_all(&args.out)
-        .map_err(|e| Fail(format!("--out {}: cannot create: {e}", args.out.display())))?;
+    // Made where the first file is written: a refusal before leaves no folder behind.
+    let create_out = || {
+        std::fs::create_dir_all(&args.out)
+            .map_err(|e| Fail(format!("--out {}: cannot create: {e}", args.out.display())))
+    };
     let mut thermal = Thermal {
         n: warm.sensors[0].celsius.len(),
         instance: warm.instance,
@@ -471,12 +474,14 @@ pub fn run(args: &Args) -> Result<Thermal, Fail> {
                 origin.join(", ")
             )),
         };
+        create_out()?;
         let written =
             crate::characterise::write_all(&noise_formats, &imu, None, &args.out, &|_| {
                 Ok(Vec::new())
             })?;
         thermal.files.extend(written);
     }
+    create_out()?;
     for format in formats {
         let text = match format {
             Format::Px4 => match &px4 {
