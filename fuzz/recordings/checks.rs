@@ -23,6 +23,78 @@ pub fn csv_column(data: &[u8]) {
     }
 }
 
+/// The stamps' statistics on a clock shaped by the bytes: the first eight set its period (1 us
+/// to 65 ms), the quantum its stamps are floored to (none, 1 us, 1 ms), the epoch (0 or past
+/// 2001) and a drift; each further byte is one sample's fate (stamped on time, jittered by up
+/// to a quarter period, lost, repeated, a gap of some periods, or caught up a few at once, as
+/// hosts do), its stamps pushed as a reader pushes them (repeats kept, stopping at the first
+/// stamp back, which a reader refuses). The summary is an error, or a rate and a span rate
+/// that are finite and positive, samples missing no more than the span holds; never a panic.
+pub fn timing_summary(data: &[u8]) {
+    use imu_ar_recordings::timing::{Step, TimeUnit, Timing};
+    let Some((head, fates)) = data.split_first_chunk::<8>() else {
+        return;
+    };
+    let period = 1e3 + 1e3 * f64::from(u16::from_le_bytes([head[0], head[1]]));
+    let quantum = [1i64, 1_000, 1_000_000, 1][usize::from(head[2] & 3)];
+    let epoch = if head[2] & 4 == 0 {
+        0
+    } else {
+        1_600_000_000_000_000_000
+    };
+    let drift = f64::from(i8::from_le_bytes([head[3]])) * 1e-5;
+    let mut timing = Timing::new();
+    let (mut place, mut late) = (1.0f64, 0.0f64);
+    let mut last = None;
+    for &fate in fates {
+        let now = place * period * (1.0 + drift * place / (fates.len() as f64 + 1.0));
+        let jitter = f64::from(fate & 0x3f) / 256.0 * period;
+        let t = match fate >> 6 {
+            0 => now + late,
+            1 => now + late + jitter,
+            2 if fate & 1 == 0 => {
+                // A gap of 1 to 31 periods.
+                place += f64::from((fate >> 1) & 31);
+                continue;
+            }
+            2 => last.map_or(now, |l: f64| l),
+            _ => {
+                // A host's stall of up to 63 periods, caught up on by the samples after it.
+                late = f64::from(fate & 0x3f) * period;
+                now + late
+            }
+        };
+        late = (late - 0.8 * period).max(0.0);
+        place += 1.0;
+        let stamp = epoch + (t as i64).div_euclid(quantum) * quantum;
+        last = Some(t);
+        match timing.push(stamp) {
+            Step::Forward => {}
+            Step::Repeat => timing.keep_repeat(),
+            Step::Backward { .. } => break,
+        }
+    }
+    if let Ok(s) = timing.summary(TimeUnit::Nanoseconds) {
+        assert!(s.rate_hz.is_finite() && s.rate_hz > 0.0, "{s:?}");
+        assert!(s.span_rate_hz.is_finite() && s.span_rate_hz > 0.0, "{s:?}");
+        assert!(s.span_s.is_finite() && s.span_s > 0.0, "{s:?}");
+        assert!(
+            (s.missing_samples as f64) <= s.span_s * s.rate_hz + 1.0,
+            "{s:?}: {} missing over {} s at {} Hz",
+            s.missing_samples,
+            s.span_s,
+            s.rate_hz
+        );
+        assert!(
+            (s.missing_samples as f64) <= s.span_s * s.rate_hz + 1.0,
+            "{} missing over {} s at {} Hz",
+            s.missing_samples,
+            s.span_s,
+            s.rate_hz
+        );
+    }
+}
+
 /// A cell as the CSV reader reads it, against the standard library: every text that
 /// `str::parse::<f64>` reads to a finite number is read to the same bits (the reader's own
 /// parser of plain decimals, or fast-float2 for the rest); anything it reads is finite.

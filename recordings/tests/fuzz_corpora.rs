@@ -50,6 +50,11 @@ fn the_decimal_corpus_reads_as_the_standard_library_reads_it() {
 }
 
 #[test]
+fn the_timing_corpus_gives_rates_and_gaps_the_span_holds() {
+    replay("timing_summary", 1, checks::timing_summary);
+}
+
+#[test]
 fn the_ros_corpus_reads_without_a_panic() {
     replay("ros_read", 290, checks::ros_read);
 }

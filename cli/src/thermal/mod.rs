@@ -316,6 +316,22 @@ pub fn run(args: &Args) -> Result<Thermal, Fail> {
         }
     }
     let ranges = [fits[0].range, fits[3].range];
+    // ArduPilot documents INS_TCALn_TMAX from -70 to 80 deg C; MEMS dies run to 85.
+    let top = ranges[0].1.max(ranges[1].1);
+    if top > 80.0 {
+        eprintln!(
+            "imu-ar: warning: {}",
+            with_file(
+                &args.files,
+                format!(
+                    "the temperatures reach {top:.1} deg C, past ArduPilot's INS_TCALn_TMAX range \
+                     (-70 to 80 deg C): a column in deg F (a cold soak from -20 to 30 deg C reads \
+                     -4 to 86)? the temperature is read in deg C"
+                )
+            )
+            .0
+        );
+    }
     let polys = |from: usize| [fits[from].poly, fits[from + 1].poly, fits[from + 2].poly];
     let (gyro, accel) = (polys(0), polys(3));
     let px4 = device.map(|[g, a]| {

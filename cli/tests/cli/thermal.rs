@@ -1557,6 +1557,27 @@ fn a_warm_up_in_fahrenheit_is_refused() {
         "{e}"
     );
     assert!(!out.exists());
+    // A cold soak, -20 to 30 deg C, in deg F (-4 to 86, its median under 85): read, with a
+    // warning naming ArduPilot's TMAX range (nothing was said, before).
+    let file = stamped_warm_up(
+        "cold-fahrenheit.csv",
+        |k| k as f64 * 0.01,
+        |_| true,
+        |c| 1.8 * (1.25 * c - 45.0) + 32.0,
+    );
+    let run = imu_ar(&[
+        "thermal",
+        path_str(&file),
+        "--out",
+        path_str(&out),
+        "--format",
+        "ardupilot",
+    ]);
+    let e = crate::common::stderr(&run);
+    assert!(
+        e.contains("warning") && e.contains("past ArduPilot's INS_TCALn_TMAX range"),
+        "{e}"
+    );
     // The same in deg C is read.
     let file = stamped_warm_up("celsius.csv", |k| k as f64 * 0.01, |_| true, |c| c);
     let run = imu_ar(&[
@@ -1573,4 +1594,5 @@ fn a_warm_up_in_fahrenheit_is_refused() {
         "{}",
         crate::common::stderr(&run)
     );
+    assert!(!crate::common::stderr(&run).contains("warning"));
 }
