@@ -1917,7 +1917,7 @@ impl Timing {
         if self.repeats == 0
             && self.dropped == 0
             && (summary.rate_hz / summary.span_rate_hz - 1.0).abs() > 0.01
-            && let Some((samples, inside)) = self.batches(median, resolution)
+            && let Some((samples, inside, ticked)) = self.batches(median, resolution)
         {
             return Ok(TimingSummary {
                 rate_hz: summary.span_rate_hz,
@@ -1925,7 +1925,7 @@ impl Timing {
                 missing_samples: 0,
                 short_intervals: 0,
                 other_rate_hz: None,
-                batched: Some((samples, inside * 1e-9)),
+                batched: Some((samples, inside * 1e-9, ticked)),
                 ..summary
             });
         }
@@ -2039,7 +2039,7 @@ impl Timing {
     /// slower clock's rounding). Samples lost leave intervals of whole periods; a FIFO read
     /// on a timer and stamped at a period not the samples' parts runs by intervals of any
     /// length.
-    fn batches(&self, median: f64, quantum: Option<i64>) -> Option<((u64, u64), f64)> {
+    fn batches(&self, median: f64, quantum: Option<i64>) -> Option<((u64, u64), f64, bool)> {
         let t = &self.stamps;
         if t.len() < 64 || median <= 0.0 {
             return None;
@@ -2122,7 +2122,20 @@ impl Timing {
             let q = q as f64;
             10.0 * q > inside && parts - inside <= 1.5 * q
         });
-        (!lost && !rounding).then_some(((low, high), inside))
+        // Each run parted by exactly one interval more, runs starting evenly (within 5 %),
+        // the interval steady: a clock slower than a tick its stamps are rounded to (a binary
+        // one, 1/1024 s, that no power of ten tells), or one sample lost at a steady count,
+        // which no logger does; either way the intervals tell no rate.
+        let evenly = starts
+            .iter()
+            .filter(|&&d| (d / period - 1.0).abs() <= 0.05)
+            .count();
+        let ticked =
+            lost && missing == parted as f64 && 10 * evenly >= 9 * starts.len() && jitter < 1e-3;
+        if ticked && !rounding {
+            return Some(((low, high), inside, true));
+        }
+        (!lost && !rounding).then_some(((low, high), inside, false))
     }
 
     /// How many samples nearly every stamp holds, where eight in ten distinct stamps or more
@@ -3241,10 +3254,12 @@ pub struct TimingSummary {
     /// Stamps that come in runs of the same number of samples at an interval of their own,
     /// each run parted from the next by a longer one, where that interval's rate is more than
     /// 1 % from the span's: a driver stamping each read of its FIFO at a period not the
-    /// samples'. The samples a run holds (5th and 95th percentiles) and its interval, s; `rate_hz` is then the span's,
+    /// samples'. The samples a run holds (5th and 95th percentiles), its interval, s, and
+    /// whether each run is parted by exactly one interval more, evenly (a clock rounded to a
+    /// tick its stamps do not tell); `rate_hz` is then the span's,
     /// and [`TimingSummary::batch_refusal`] names them.
     #[serde(skip)]
-    pub batched: Option<((u64, u64), f64)>,
+    pub batched: Option<((u64, u64), f64, bool)>,
 }
 
 impl TimingSummary {
@@ -3292,7 +3307,19 @@ impl TimingSummary {
     /// samples' ([`TimingSummary::batched`]): their intervals tell no rate, the span tells
     /// the samples' mean rate where none was lost.
     pub fn batch_refusal(&self) -> Option<String> {
-        let ((low, high), inside) = self.batched?;
+        let ((low, high), inside, ticked) = self.batched?;
+        if ticked {
+            return Some(format!(
+                "the timestamps step by {} s ({} Hz), one step in {} or so twice that, evenly: a \
+                 clock slower than a tick its stamps are rounded to (a float's seconds, a \
+                 1024 Hz counter), not samples lost; their intervals tell no rate, their span \
+                 gives {} Hz; give --rate",
+                short(inside),
+                short(1.0 / inside),
+                (low + high) / 2,
+                short(self.span_rate_hz)
+            ));
+        }
         let samples = if low == high {
             low.to_string()
         } else {
@@ -3524,8 +3551,9 @@ mod tests {
             (10, 200_000, 300_000),
         ] {
             let s = summary_of(&reads(60_000, per, spacing, late, 0));
-            let (samples, inside) = s.batched.expect("batched");
+            let (samples, inside, ticked) = s.batched.expect("batched");
             assert_eq!(samples, (per as u64, per as u64), "{per} x {spacing}");
+            assert!(!ticked);
             assert!(
                 (inside / (spacing as f64 * 1e-9) - 1.0).abs() < 1e-3,
                 "{inside}"
@@ -3548,7 +3576,7 @@ mod tests {
             (10_000_000, 200_000, 2_000_000, 0),
         ] {
             let s = summary_of(&timer_reads(60_000, poll, spacing, late, lost));
-            let (_, inside) = s.batched.expect("batched");
+            let (_, inside, _) = s.batched.expect("batched");
             assert!(
                 (inside / (spacing as f64 * 1e-9) - 1.0).abs() < 1e-3,
                 "{inside}"
@@ -3556,6 +3584,23 @@ mod tests {
             let truth = 1000.0 * (1.0 - lost as f64 / 1000.0);
             assert!((s.rate_hz / truth - 1.0).abs() < 2e-3, "{poll}: {s:?}");
         }
+        // A 1000 Hz clock stamped in float seconds past 8192 s (a tick of 1/1024 s, which no
+        // power of ten tells): 1024 Hz with 7200 samples missing in 300 s, exit 0, before.
+        let t: Vec<i64> = (0..120_000)
+            .map(|k| {
+                let ticks = ((8_200.0 + f64::from(k) / 1000.0) * 1024.0).floor();
+                (ticks / 1024.0 * 1e9).round() as i64
+            })
+            .collect();
+        let s = summary_of(&t);
+        let (_, inside, ticked) = s.batched.expect("ticked");
+        assert!(ticked && (inside * 1024.0 - 1.0).abs() < 1e-6, "{s:?}");
+        assert!((s.rate_hz / 1000.0 - 1.0).abs() < 1e-4, "{s:?}");
+        assert!(
+            s.batch_refusal()
+                .unwrap()
+                .contains("a clock slower than a tick")
+        );
         // Reads stamped at the samples' own period: one clock, no runs.
         let s = summary_of(&reads(60_000, 16, 1_000_000, 0, 0));
         assert_eq!(s.batched, None, "{s:?}");
