@@ -1917,12 +1917,16 @@ impl Timing {
         if self.repeats == 0
             && self.dropped == 0
             && (summary.rate_hz / summary.span_rate_hz - 1.0).abs() > 0.01
-            && let Some((samples, inside, ticked)) = self.batches(median, resolution)
+            && let Some((samples, inside, ticked, paused)) = self.batches(median, resolution)
+            && paused < 0.5 * span
         {
+            let rate = 1e9 * intervals as f64 / (span - paused);
+            let pauses = self.batch_pauses(median);
             return Ok(TimingSummary {
-                rate_hz: summary.span_rate_hz,
-                gaps: 0,
-                missing_samples: 0,
+                rate_hz: rate,
+                // The pauses between runs, as gaps: the samples their time would hold.
+                gaps: pauses,
+                missing_samples: (paused * 1e-9 * rate).round() as u64,
                 short_intervals: 0,
                 other_rate_hz: None,
                 batched: Some((samples, inside * 1e-9, ticked)),
@@ -2039,7 +2043,7 @@ impl Timing {
     /// slower clock's rounding). Samples lost leave intervals of whole periods; a FIFO read
     /// on a timer and stamped at a period not the samples' parts runs by intervals of any
     /// length.
-    fn batches(&self, median: f64, quantum: Option<i64>) -> Option<((u64, u64), f64, bool)> {
+    fn batches(&self, median: f64, quantum: Option<i64>) -> Option<((u64, u64), f64, bool, f64)> {
         let t = &self.stamps;
         if t.len() < 64 || median <= 0.0 {
             return None;
@@ -2095,6 +2099,12 @@ impl Timing {
         if 10 * steady < 6 * starts.len() {
             return None;
         }
+        // Pauses: the time runs start late by, past half a period more than usual.
+        let paused: f64 = starts
+            .iter()
+            .filter(|&&d| d > 1.5 * period)
+            .map(|&d| d - period)
+            .sum();
         // Stamps floored to a quantum `q` coarse against the runs' interval part the runs of
         // a slower clock by one quantum more: rounding's, not runs.
         let parts = middle_of(&mut parting);
@@ -2133,9 +2143,33 @@ impl Timing {
         let ticked =
             lost && missing == parted as f64 && 10 * evenly >= 9 * starts.len() && jitter < 1e-3;
         if ticked && !rounding {
-            return Some(((low, high), inside, true));
+            return Some(((low, high), inside, true, paused));
         }
-        (!lost && !rounding).then_some(((low, high), inside, false))
+        (!lost && !rounding).then_some(((low, high), inside, false, paused))
+    }
+
+    /// The pauses between the runs [`Timing::batches`] finds: runs starting more than half a
+    /// usual start-to-start time late.
+    fn batch_pauses(&self, median: f64) -> u64 {
+        let t = &self.stamps;
+        let long = 1.25 * median;
+        let mut starts = Vec::new();
+        let mut last: Option<usize> = None;
+        for (k, w) in t.windows(2).enumerate() {
+            if (i128::from(w[1]) - i128::from(w[0])) as f64 > long {
+                if let Some(before) = last {
+                    starts.push((i128::from(w[1]) - i128::from(t[before + 1])) as f64);
+                }
+                last = Some(k);
+            }
+        }
+        if starts.is_empty() {
+            return 0;
+        }
+        let mut sorted = starts.clone();
+        let mid = (sorted.len() - 1) / 2;
+        let period = *sorted.select_nth_unstable_by(mid, f64::total_cmp).1;
+        starts.iter().filter(|&&d| d > 1.5 * period).count() as u64
     }
 
     /// How many samples nearly every stamp holds, where eight in ten distinct stamps or more
@@ -3256,7 +3290,8 @@ pub struct TimingSummary {
     /// 1 % from the span's: a driver stamping each read of its FIFO at a period not the
     /// samples'. The samples a run holds (5th and 95th percentiles), its interval, s, and
     /// whether each run is parted by exactly one interval more, evenly (a clock rounded to a
-    /// tick its stamps do not tell); `rate_hz` is then the span's,
+    /// tick its stamps do not tell); `rate_hz` is then the span's less the pauses (runs
+    /// starting more than half a usual start-to-start time late),
     /// and [`TimingSummary::batch_refusal`] names them.
     #[serde(skip)]
     pub batched: Option<((u64, u64), f64, bool)>,
@@ -3304,8 +3339,8 @@ impl TimingSummary {
     }
 
     /// The refusal of stamps a driver put on each read of its FIFO at a period not the
-    /// samples' ([`TimingSummary::batched`]): their intervals tell no rate, the span tells
-    /// the samples' mean rate where none was lost.
+    /// samples' ([`TimingSummary::batched`]): their intervals tell no rate, the span less the
+    /// pauses between runs tells the samples' mean rate where none was lost.
     pub fn batch_refusal(&self) -> Option<String> {
         let ((low, high), inside, ticked) = self.batched?;
         if ticked {
@@ -3313,11 +3348,11 @@ impl TimingSummary {
                 "the timestamps step by {} s ({} Hz), one step in {} or so twice that, evenly: a \
                  clock slower than a tick its stamps are rounded to (a float's seconds, a \
                  1024 Hz counter), not samples lost; their intervals tell no rate, their span \
-                 gives {} Hz; give --rate",
+                 less its pauses gives {} Hz (the sensor's, where none was lost); give --rate",
                 short(inside),
                 short(1.0 / inside),
                 (low + high) / 2,
-                short(self.span_rate_hz)
+                short(self.rate_hz)
             ));
         }
         let samples = if low == high {
@@ -3329,11 +3364,11 @@ impl TimingSummary {
             "the timestamps come in runs of {samples} samples {} s apart ({} Hz), each run \
              parted from the next by a longer interval: a driver stamping each read of its \
              FIFO at a period not the samples', or stamping the samples as they reach the \
-             host; their intervals tell no rate, their span gives {} Hz (the samples' mean \
-             rate where none was lost); give --rate",
+             host; their intervals tell no rate, their span less its pauses gives {} Hz (the \
+             sensor's, where none was lost); give --rate",
             short(inside),
             short(1.0 / inside),
-            short(self.span_rate_hz)
+            short(self.rate_hz)
         ))
     }
 
@@ -3584,6 +3619,21 @@ mod tests {
             let truth = 1000.0 * (1.0 - lost as f64 / 1000.0);
             assert!((s.rate_hz / truth - 1.0).abs() < 2e-3, "{poll}: {s:?}");
         }
+        // The same runs with a logger paused for 10 s half way: the span's rate was offered
+        // (833 Hz for 1000) and the sensor's refused; the pause is left out of the span.
+        let mut t = timer_reads(60_000, 16_000_000, 950_000, 0, 0);
+        let half = t.len() / 2;
+        for s in &mut t[half..] {
+            *s += 10_000_000_000;
+        }
+        let s = summary_of(&t);
+        assert!(
+            s.batched.is_some() && (s.rate_hz / 1000.0 - 1.0).abs() < 1e-3,
+            "{s:?}"
+        );
+        // Its pause is a gap of the 10,000 samples its time would hold.
+        assert_eq!(s.gaps, 1, "{s:?}");
+        assert!(s.missing_samples.abs_diff(10_000) < 20, "{s:?}");
         // A 1000 Hz clock stamped in float seconds past 8192 s (a tick of 1/1024 s, which no
         // power of ten tells): 1024 Hz with 7200 samples missing in 300 s, exit 0, before.
         let t: Vec<i64> = (0..120_000)

@@ -1828,7 +1828,7 @@ fn stamps_put_on_a_fifos_reads_at_another_period_need_the_rate() {
         let e = stderr(&run);
         assert!(
             e.contains("runs of 16 samples 0.00952 s apart")
-                && e.contains("their span gives 100.0")
+                && e.contains("their span less its pauses gives 100.0")
                 && e.ends_with("give --rate\n"),
             "{args:?}: {e}"
         );
