@@ -528,6 +528,10 @@ pub struct Timing {
     stamps: Vec<i64>,
 }
 
+/// Runs of a FIFO's reads ([`Timing::batches`]): their lengths (5th and 95th percentiles),
+/// their interval (ns), whether a clock rounded to a tick, and the pauses (ns, how many).
+type Runs = ((u64, u64), f64, bool, (f64, u64));
+
 /// A lattice the stamps fold on: its fit, the rate (Hz), the rate's relative standard error,
 /// and the times (s) it was fitted to.
 type Lattice = (fold::Fit, f64, f64, Vec<f64>);
@@ -1917,11 +1921,11 @@ impl Timing {
         if self.repeats == 0
             && self.dropped == 0
             && (summary.rate_hz / summary.span_rate_hz - 1.0).abs() > 0.01
-            && let Some((samples, inside, ticked, paused)) = self.batches(median, resolution)
+            && let Some((samples, inside, ticked, (paused, pauses))) =
+                self.batches(median, resolution)
             && paused < 0.5 * span
         {
             let rate = 1e9 * intervals as f64 / (span - paused);
-            let pauses = self.batch_pauses(median);
             return Ok(TimingSummary {
                 rate_hz: rate,
                 // The pauses between runs, as gaps: the samples their time would hold.
@@ -2037,13 +2041,15 @@ impl Timing {
     /// an interval over 1.25 times the `median` (ns), at least 16 of them and one in a hundred
     /// intervals or more, half of those intervals or more no whole number of the runs' interval
     /// (or so many that the samples they would miss outnumber those kept): the runs' lengths
-    /// (5th and 95th percentiles) and their mean interval, ns; six runs in ten or more
+    /// (5th and 95th percentiles), their median interval, ns, whether they are a clock rounded
+    /// to a tick, and the pauses (their time, ns, and count: runs starting more than half a
+    /// usual start-to-start time late); six runs in ten or more
     /// starting within 30 % of the median time from one run's start to the next, and not
     /// parted by one `quantum` more where that is over a tenth of the runs' interval (a
     /// slower clock's rounding). Samples lost leave intervals of whole periods; a FIFO read
     /// on a timer and stamped at a period not the samples' parts runs by intervals of any
     /// length.
-    fn batches(&self, median: f64, quantum: Option<i64>) -> Option<((u64, u64), f64, bool, f64)> {
+    fn batches(&self, median: f64, quantum: Option<i64>) -> Option<Runs> {
         let t = &self.stamps;
         if t.len() < 64 || median <= 0.0 {
             return None;
@@ -2100,11 +2106,12 @@ impl Timing {
             return None;
         }
         // Pauses: the time runs start late by, past half a period more than usual.
-        let paused: f64 = starts
+        let (paused, pauses) = starts
             .iter()
             .filter(|&&d| d > 1.5 * period)
-            .map(|&d| d - period)
-            .sum();
+            .fold((0.0, 0u64), |(time, count), &d| {
+                (time + d - period, count + 1)
+            });
         // Stamps floored to a quantum `q` coarse against the runs' interval part the runs of
         // a slower clock by one quantum more: rounding's, not runs.
         let parts = middle_of(&mut parting);
@@ -2150,33 +2157,9 @@ impl Timing {
             && 10 * evenly >= 9 * starts.len()
             && jitter < 1e-3;
         if ticked && !rounding {
-            return Some(((low, high), inside, true, paused));
+            return Some(((low, high), inside, true, (paused, pauses)));
         }
-        (!lost && !rounding).then_some(((low, high), inside, false, paused))
-    }
-
-    /// The pauses between the runs [`Timing::batches`] finds: runs starting more than half a
-    /// usual start-to-start time late.
-    fn batch_pauses(&self, median: f64) -> u64 {
-        let t = &self.stamps;
-        let long = 1.25 * median;
-        let mut starts = Vec::new();
-        let mut last: Option<usize> = None;
-        for (k, w) in t.windows(2).enumerate() {
-            if (i128::from(w[1]) - i128::from(w[0])) as f64 > long {
-                if let Some(before) = last {
-                    starts.push((i128::from(w[1]) - i128::from(t[before + 1])) as f64);
-                }
-                last = Some(k);
-            }
-        }
-        if starts.is_empty() {
-            return 0;
-        }
-        let mut sorted = starts.clone();
-        let mid = (sorted.len() - 1) / 2;
-        let period = *sorted.select_nth_unstable_by(mid, f64::total_cmp).1;
-        starts.iter().filter(|&&d| d > 1.5 * period).count() as u64
+        (!lost && !rounding).then_some(((low, high), inside, false, (paused, pauses)))
     }
 
     /// How many samples nearly every stamp holds, where eight in ten distinct stamps or more

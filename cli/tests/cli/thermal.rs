@@ -1542,14 +1542,17 @@ fn a_warm_up_in_fahrenheit_is_refused() {
         |c| 1.8 * c + 32.0,
     );
     let out = temp_path("fahrenheit");
-    let run = imu_ar(&[
-        "thermal",
-        path_str(&file),
-        "--out",
-        path_str(&out),
-        "--format",
-        "ardupilot",
-    ]);
+    let calibrate = |file: &Path| {
+        imu_ar(&[
+            "thermal",
+            path_str(file),
+            "--out",
+            path_str(&out),
+            "--format",
+            "ardupilot",
+        ])
+    };
+    let run = calibrate(&file);
     assert_one_line_failure(&run);
     let e = crate::common::stderr(&run);
     assert!(
@@ -1565,14 +1568,7 @@ fn a_warm_up_in_fahrenheit_is_refused() {
         |_| true,
         |c| 1.8 * (1.25 * c - 45.0) + 32.0,
     );
-    let run = imu_ar(&[
-        "thermal",
-        path_str(&file),
-        "--out",
-        path_str(&out),
-        "--format",
-        "ardupilot",
-    ]);
+    let run = calibrate(&file);
     let e = crate::common::stderr(&run);
     assert!(
         e.contains("warning") && e.contains("past ArduPilot's INS_TCALn_TMAX range"),
@@ -1580,14 +1576,7 @@ fn a_warm_up_in_fahrenheit_is_refused() {
     );
     // The same in deg C is read.
     let file = stamped_warm_up("celsius.csv", |k| k as f64 * 0.01, |_| true, |c| c);
-    let run = imu_ar(&[
-        "thermal",
-        path_str(&file),
-        "--out",
-        path_str(&out),
-        "--format",
-        "ardupilot",
-    ]);
+    let run = calibrate(&file);
     assert_eq!(
         run.status.code(),
         Some(0),
