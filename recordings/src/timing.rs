@@ -526,7 +526,15 @@ pub struct Timing {
     /// The stamp of every sample kept, in order (repeats too): folded on the clock's
     /// period where the intervals do not tell it ([`fold`]).
     stamps: Vec<i64>,
+    /// Each sample dropped: the stamps kept before it, and whether its stamp repeated the
+    /// one before (else it was behind it).
+    drops: Vec<(usize, bool)>,
 }
+
+/// The most samples, relative, a rate given for runs of a FIFO's reads
+/// ([`TimingSummary::batched`]) may take lost within them (their stamps leave no mark of
+/// them) past those the runs' span less its pauses holds.
+pub const HIDDEN_LOSS: f64 = 0.05;
 
 /// Runs of a FIFO's reads ([`Timing::batches`]): their lengths (5th and 95th percentiles),
 /// their interval (ns), whether a clock rounded to a tick, and the pauses (ns, how many).
@@ -1269,6 +1277,7 @@ impl Timing {
 
     /// Counts a sample dropped for its backward (or repeated) stamp.
     pub fn drop_one(&mut self) {
+        self.drops.push((self.stamps.len(), false));
         self.dropped += 1;
         self.drop_run.0 += 1;
         if self.drop_run.0 > self.longest_drop.0 {
@@ -1308,6 +1317,7 @@ impl Timing {
     /// Drops the sample whose stamp was a [`Step::Repeat`] (counted as dropped): the summary
     /// refuses such drops where the stamps are a clock coarser than its samples.
     pub fn drop_repeat(&mut self) {
+        self.drops.push((self.stamps.len(), true));
         self.dropped += 1;
         self.dropped_repeats += 1;
         self.place_repeat(true);
@@ -1635,6 +1645,98 @@ impl Timing {
     /// The summary of the stamps taken; an error when they give no rate (fewer than two) or
     /// several (less than 90 % of the intervals within 25 % of the median).
     pub fn summary(&self, unit: TimeUnit) -> Result<TimingSummary, String> {
+        // Stamps within a thousandth of a tick coarser than they resolve (whole ms written
+        // through a float's epoch ns, a binary tick in ns) are read on that tick, as stamps
+        // rounded to it exactly are.
+        let Some(tick) = self.tick() else {
+            return self.read(unit);
+        };
+        let on_tick = self.snapped(tick);
+        match (on_tick.read(unit), tick.scale()) {
+            (read, None) => read,
+            (Ok(s), Some(scale)) => Ok(tick.real(s, scale, self.first.unwrap_or(0))),
+            (Err(_), Some(_)) => Err(format!(
+                "the timestamps lie on a tick of {} s ({:e} s: a float's seconds, a counter \
+                 of that rate), and on it they tell no one rate; their span gives {} Hz (the \
+                 sensor's, where none was lost); give --rate",
+                tick.name(),
+                tick.seconds(),
+                short(self.span_rate())
+            )),
+        }
+    }
+
+    /// The samples kept over the span, Hz (0 for no span).
+    fn span_rate(&self) -> f64 {
+        let span = self.span_ns();
+        if span > 0.0 {
+            1e9 * (self.kept - 1) as f64 / span
+        } else {
+            0.0
+        }
+    }
+
+    /// The coarsest [`Tick`] every stamp lies on to within a thousandth of it, counted from
+    /// the first, where that is coarser than the stamps resolve, no finer than an eighth of
+    /// their median interval nor coarser than it, from 64 stamps kept on.
+    fn tick(&self) -> Option<Tick> {
+        let t = &self.stamps;
+        if t.len() < 64 || self.bits < 64 {
+            return None;
+        }
+        let buckets = self.histogram();
+        let resolution = resolution(&buckets, self.bits)? as f64;
+        let intervals: u64 = buckets.iter().map(|b| b.count).sum();
+        let mut seen = 0;
+        let median = buckets.iter().find_map(|b| {
+            seen += b.count;
+            (2 * seen >= intervals).then(|| b.mean())
+        })?;
+        let first = t[0];
+        Tick::CANDIDATES
+            .into_iter()
+            .filter(|k| {
+                let q = k.ns();
+                q > 2.0 * resolution && q >= median / 8.0 && q <= 1.01 * median
+            })
+            .find(|k| t.iter().all(|&s| k.near(i128::from(s) - i128::from(first))))
+    }
+
+    /// A timing of the stamps put on `tick` (counted from the first; on a binary tick, a
+    /// decimal one in its place, [`Tick::decimal`]), as the record's calls made them: the
+    /// samples kept and those dropped, in order.
+    fn snapped(&self, tick: Tick) -> Timing {
+        let first = self.first.unwrap_or(0);
+        let mut on = Timing::new();
+        let mut drops = self.drops.iter().peekable();
+        let drop = |on: &mut Timing, repeat: bool| {
+            // (Behind or equal to the last stamp kept, as it was.)
+            let last = on.last;
+            if repeat {
+                on.push(last);
+                on.drop_repeat();
+            } else {
+                on.push(last.saturating_sub(1));
+                on.drop_one();
+            }
+        };
+        for (i, &s) in self.stamps.iter().enumerate() {
+            while let Some(&(_, repeat)) = drops.next_if(|d| d.0 == i) {
+                drop(&mut on, repeat);
+            }
+            let v = first.saturating_add(tick.place(i128::from(s) - i128::from(first)));
+            if on.push(v) == Step::Repeat {
+                on.keep_repeat();
+            }
+        }
+        for &(_, repeat) in drops {
+            drop(&mut on, repeat);
+        }
+        on
+    }
+
+    /// The summary of the stamps as they are.
+    fn read(&self, unit: TimeUnit) -> Result<TimingSummary, String> {
         // In the order of the intervals: the median, and sums that do not depend on the
         // order the stamps came in.
         let buckets = self.histogram();
@@ -2058,8 +2160,9 @@ impl Timing {
         let mut runs = std::collections::BTreeMap::<u64, u64>::new();
         let (mut last, mut parted) = (None, 0u64);
         let mut within = Vec::new();
-        // The times from one run's start to the next's, and the intervals parting runs.
-        let (mut starts, mut parting) = (Vec::new(), Vec::new());
+        // The times from one run's start to the next's (and the samples the run holds), and
+        // the intervals parting runs.
+        let (mut starts, mut held, mut parting) = (Vec::new(), Vec::new(), Vec::new());
         for (k, w) in t.windows(2).enumerate() {
             let iv = (i128::from(w[1]) - i128::from(w[0])) as f64;
             if iv > long {
@@ -2067,6 +2170,7 @@ impl Timing {
                 if let Some(before) = last {
                     *runs.entry((k - before) as u64).or_default() += 1;
                     starts.push((i128::from(w[1]) - i128::from(t[before + 1])) as f64);
+                    held.push((k - before) as f64);
                 }
                 parting.push(iv);
                 last = Some(k);
@@ -2097,6 +2201,8 @@ impl Timing {
             let mid = (v.len() - 1) / 2;
             *v.select_nth_unstable_by(mid, f64::total_cmp).1
         };
+        // (The runs' own, in order, before the median reorders them.)
+        let runs_in_order: Vec<(f64, f64)> = starts.iter().copied().zip(held).collect();
         let period = middle_of(&mut starts);
         let steady = starts
             .iter()
@@ -2105,13 +2211,16 @@ impl Timing {
         if 10 * steady < 6 * starts.len() {
             return None;
         }
-        // Pauses: the time runs start late by, past half a period more than usual.
-        let (paused, pauses) = starts
+        // Pauses: the time runs start late by, past the time their samples take at the
+        // usual time a sample (two reads' samples in one run take two periods), and half a
+        // period more.
+        let mut each: Vec<f64> = runs_in_order.iter().map(|(d, n)| d / n).collect();
+        let sample = middle_of(&mut each);
+        let (paused, pauses) = runs_in_order
             .iter()
-            .filter(|&&d| d > 1.5 * period)
-            .fold((0.0, 0u64), |(time, count), &d| {
-                (time + d - period, count + 1)
-            });
+            .map(|(d, n)| d - n * sample)
+            .filter(|&late| late > 0.5 * period)
+            .fold((0.0, 0u64), |(time, count), late| (time + late, count + 1));
         // Stamps floored to a quantum `q` coarse against the runs' interval part the runs of
         // a slower clock by one quantum more: rounding's, not runs.
         let parts = middle_of(&mut parting);
@@ -2965,6 +3074,115 @@ fn resolution(buckets: &[Bucket], bits: u32) -> Option<i64> {
     Some(q)
 }
 
+/// A tick stamps may lie on: `num / den` ns, a power of ten (`den` 1) or a second over a
+/// power of two (a float's seconds past a power of two, a counter of a binary rate).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Tick {
+    num: i128,
+    den: i128,
+}
+
+impl Tick {
+    /// From 1 s down, powers of ten to 10 ns and a second over 2 to 2^24, coarsest first.
+    const CANDIDATES: [Tick; 33] = {
+        let mut all = [Tick { num: 0, den: 1 }; 33];
+        let (mut i, mut ten, mut two) = (0, 1_000_000_000i128, 2i128);
+        while i < 33 {
+            // The coarser of the next power of ten and the next binary fraction.
+            if ten >= 10 && (ten * two >= 1_000_000_000 || two > 1 << 24) {
+                all[i] = Tick { num: ten, den: 1 };
+                ten /= 10;
+            } else {
+                all[i] = Tick {
+                    num: 1_000_000_000,
+                    den: two,
+                };
+                two *= 2;
+            }
+            i += 1;
+        }
+        all
+    };
+
+    fn ns(self) -> f64 {
+        self.num as f64 / self.den as f64
+    }
+
+    fn seconds(self) -> f64 {
+        self.ns() * 1e-9
+    }
+
+    /// `1/1024`, `0.001`.
+    fn name(self) -> String {
+        if self.den == 1 {
+            format!("{:e}", self.seconds())
+        } else {
+            format!("1/{}", self.den)
+        }
+    }
+
+    /// The nearest whole number of ticks to `r` ns, and how far `r` lies from it, in ns
+    /// times `den`.
+    fn split(self, r: i128) -> (i128, i128) {
+        let scaled = r * self.den;
+        let n = (scaled + self.num / 2).div_euclid(self.num);
+        (n, scaled - n * self.num)
+    }
+
+    /// Whether `r` ns lies within a thousandth of a tick of a whole number of them.
+    fn near(self, r: i128) -> bool {
+        let off = self.split(r).1;
+        1000 * off.abs() <= self.num
+    }
+
+    /// A binary tick's decimal stand-in: the power of ten at or above it, ns.
+    fn decimal(self) -> i128 {
+        let mut v = 1i128;
+        while v * self.den < self.num {
+            v *= 10;
+        }
+        v
+    }
+
+    /// `r` ns on the tick, or for a binary tick, on its [`Tick::decimal`] stand-in (ns,
+    /// saturated).
+    fn place(self, r: i128) -> i64 {
+        let n = self.split(r).0;
+        let v = if self.den == 1 {
+            self.num
+        } else {
+            self.decimal()
+        };
+        i64::try_from(n.saturating_mul(v)).unwrap_or(if n < 0 { i64::MIN } else { i64::MAX })
+    }
+
+    /// For a binary tick, real ns over stand-in ns.
+    fn scale(self) -> Option<f64> {
+        (self.den > 1).then(|| self.ns() / self.decimal() as f64)
+    }
+
+    /// A summary read on the stand-in, in real time (`scale` real ns per stand-in ns, the
+    /// stamps counted from `first`).
+    fn real(self, s: TimingSummary, scale: f64, first: i64) -> TimingSummary {
+        TimingSummary {
+            rate_hz: s.rate_hz / scale,
+            median_interval_s: s.median_interval_s * scale,
+            span_s: s.span_s * scale,
+            resolution_s: Some(self.seconds()),
+            span_rate_hz: s.span_rate_hz / scale,
+            other_rate_hz: s.other_rate_hz.map(|r| r / scale),
+            unexplained_repeat: s.unexplained_repeat.map(|(at, stamp, left)| {
+                let real = first as f64 + (stamp as f64 - first as f64) * scale;
+                (at, real.round() as i64, left)
+            }),
+            batched: s
+                .batched
+                .map(|(runs, inside, ticked)| (runs, inside * scale, ticked)),
+            ..s
+        }
+    }
+}
+
 /// How a histogram's intervals were judged: their classes, the clock's period (ns), the
 /// repeated stamps counted as its samples, and the window.
 struct Judged {
@@ -3248,7 +3466,9 @@ pub struct TimingSummary {
     /// From the first stamp to the last, s.
     pub span_s: f64,
     /// The largest power of ten that divides every interval, s: the stamps' resolution (none
-    /// known past 65,536 distinct intervals).
+    /// known past 65,536 distinct intervals); or the coarser tick they lie on to within a
+    /// thousandth of it (a power of ten, or a second over a power of two), on which they
+    /// were read.
     pub resolution_s: Option<f64>,
     /// The rate of the samples over the span (every stamp kept, repeats too, less one, over
     /// it), Hz: the rate, where no sample is missing.
@@ -3354,11 +3574,13 @@ impl TimingSummary {
             "the timestamps come in runs of {samples} samples {} s apart ({} Hz), each run \
              parted from the next by a longer interval: a driver stamping each read of its \
              FIFO at a period not the samples', or stamping the samples as they reach the \
-             host; their intervals tell no rate, their span less its pauses gives {} Hz (the \
-             sensor's, where none was lost); give --rate",
+             host; their intervals tell no rate, their span less its pauses gives {} Hz, the \
+             sensor's where none was lost (samples lost within a run leave no mark: a --rate \
+             up to {} % above it is taken); give --rate",
             short(inside),
             short(1.0 / inside),
-            short(self.rate_hz)
+            short(self.rate_hz),
+            100.0 * HIDDEN_LOSS
         ))
     }
 
@@ -3610,30 +3832,59 @@ mod tests {
             assert!((s.rate_hz / truth - 1.0).abs() < 2e-3, "{poll}: {s:?}");
         }
         // The same runs with a logger paused for 10 s half way: the span's rate was offered
-        // (833 Hz for 1000) and the sensor's refused; the pause is left out of the span.
-        let mut t = timer_reads(60_000, 16_000_000, 950_000, 0, 0);
-        let half = t.len() / 2;
-        for s in &mut t[half..] {
-            *s += 10_000_000_000;
+        // (833 Hz for 1000) and the sensor's refused; the pause is left out of the span. On
+        // a timer late by up to 0.6 ms, a read of 17 samples runs on into the next (runs of
+        // 33 starting two reads apart): 1156.7 Hz with a 60 s pause, before, each such run
+        // counted a pause.
+        for late in [0, 600_000] {
+            let mut t = timer_reads(60_000, 16_000_000, 950_000, late, 0);
+            let half = t.len() / 2;
+            for s in &mut t[half..] {
+                *s += 10_000_000_000;
+            }
+            let s = summary_of(&t);
+            assert!(
+                s.batched.is_some() && (s.rate_hz / 1000.0 - 1.0).abs() < 1e-3,
+                "{s:?}"
+            );
+            // Its pause is a gap of the 10,000 samples its time would hold.
+            assert_eq!(s.gaps, 1, "{s:?}");
+            assert!(s.missing_samples.abs_diff(10_000) < 20, "{s:?}");
         }
-        let s = summary_of(&t);
-        assert!(
-            s.batched.is_some() && (s.rate_hz / 1000.0 - 1.0).abs() < 1e-3,
-            "{s:?}"
-        );
-        // Its pause is a gap of the 10,000 samples its time would hold.
-        assert_eq!(s.gaps, 1, "{s:?}");
-        assert!(s.missing_samples.abs_diff(10_000) < 20, "{s:?}");
         // A 1000 Hz clock stamped in float seconds past 8192 s (a tick of 1/1024 s, which no
         // power of ten tells): 1024 Hz with 7200 samples missing in 300 s, exit 0, before.
-        let t: Vec<i64> = (0..120_000)
+        // Read on its tick ([`Timing::tick`], `stamps_on_a_tick_they_do_not_resolve_are_read_on_it`),
+        // a sample dropped for a stamp behind the one before or not; where a stamp lies off
+        // the tick (10 us), it is not taken, and the runs are told.
+        let mut t: Vec<i64> = (0..120_000)
             .map(|k| {
                 let ticks = ((8_200.0 + f64::from(k) / 1000.0) * 1024.0).floor();
                 (ticks / 1024.0 * 1e9).round() as i64
             })
             .collect();
         let s = summary_of(&t);
-        let (_, inside, ticked) = s.batched.expect("ticked");
+        // (To a tick over the span: 8e-6.)
+        assert!(
+            s.batched.is_none() && (s.rate_hz / 1000.0 - 1.0).abs() < 1e-5,
+            "{s:?}"
+        );
+        let mut behind = t.clone();
+        behind.insert(60_000, t[59_990]);
+        let mut timing = Timing::new();
+        for &stamp in &behind {
+            if let Step::Backward { .. } = timing.push(stamp) {
+                timing.drop_one();
+            }
+        }
+        let s = timing.summary(TimeUnit::Nanoseconds).unwrap();
+        assert!(
+            s.batched.is_none() && (s.rate_hz / 1000.0 - 1.0).abs() < 1e-5,
+            "{s:?}"
+        );
+        assert_eq!((s.dropped_backward, s.gaps), (1, 0), "{s:?}");
+        t[60_000] += 10_000;
+        let s = summary_of(&t);
+        let (_, inside, ticked) = s.batched.unwrap_or_else(|| panic!("{s:?}"));
         assert!(ticked && (inside * 1024.0 - 1.0).abs() < 1e-6, "{s:?}");
         assert!((s.rate_hz / 1000.0 - 1.0).abs() < 1e-4, "{s:?}");
         assert!(
@@ -3641,14 +3892,15 @@ mod tests {
                 .unwrap()
                 .contains("a clock slower than a tick")
         );
-        // 950 Hz on the same tick (runs of 12 or 13): 1024 Hz with 11,099 missing, exit 0,
-        // before.
-        let t: Vec<i64> = (0..120_000)
+        // 950 Hz on the same tick (runs of 12 or 13), a stamp off it: 1024 Hz with 11,099
+        // missing, exit 0, before.
+        let mut t: Vec<i64> = (0..120_000)
             .map(|k| {
                 let ticks = ((8_200.0 + f64::from(k) / 950.0) * 1024.0).floor();
                 (ticks / 1024.0 * 1e9).round() as i64
             })
             .collect();
+        t[60_000] += 10_000;
         let s = summary_of(&t);
         assert!(s.batched.is_some_and(|b| b.2), "{s:?}");
         assert!((s.rate_hz / 950.0 - 1.0).abs() < 1e-4, "{s:?}");
@@ -3889,6 +4141,91 @@ mod tests {
             }
         }
         timing
+    }
+
+    /// A `rate` Hz clock from `start` s, `n` samples, each late by up to `jitter` periods
+    /// (uniform), `lost` in a thousand lost at random, `pause` s added from the third of the
+    /// record on, its time floored to `1/den` s, written as ns exactly or (`float`) as epoch
+    /// ns through a float64 (1.6e18 + t * 1e9: within 128 ns).
+    fn on_tick(
+        (rate, n, start): (f64, usize, f64),
+        (jitter, lost, pause): (f64, u64, f64),
+        den: i128,
+        float: bool,
+    ) -> Vec<i64> {
+        let mut next = crate::xorshift(0x7a1c_e5ee_d00d_f00d);
+        let mut uniform = move || (next() >> 11) as f64 / (1u64 << 53) as f64;
+        (0..n)
+            .filter_map(|k| {
+                let late = jitter * uniform() / rate;
+                let keep = uniform() * 1000.0 >= lost as f64;
+                let paused = if 3 * k >= n { pause } else { 0.0 };
+                let t = start + k as f64 / rate + late + paused;
+                let ticks = (t * den as f64).floor() as i128;
+                keep.then(|| {
+                    if float {
+                        (1.6e18 + ticks as f64 / den as f64 * 1e9) as i64
+                    } else {
+                        ((ticks * 1_000_000_000 + den / 2) / den) as i64
+                    }
+                })
+            })
+            .collect()
+    }
+
+    #[test]
+    fn stamps_on_a_tick_they_do_not_resolve_are_read_on_it() {
+        let read = |t: Vec<i64>| pushed(&t, true).summary(TimeUnit::Nanoseconds);
+        // (rate, start s, jitter, lost in 1000, pause s, 1/den s, float64 epoch ns): the rate
+        // and the samples missing. Before: 1024 Hz with 5070 missing (1 % lost, 1000 Hz on
+        // 1/1024 s), 1024 Hz with 12,319 missing (a 5 s pause); 950 Hz on whole ms through a
+        // float64 read 1000 Hz with jitter, loss or a pause; 1000 Hz on 1/2048 s refused as
+        // runs, on 1/512 s as a FIFO read two samples at a time.
+        for (rate, start, jitter, lost, pause, den, float) in [
+            (1000.0, 8200.0, 0.0, 10, 0.0, 1024, false),
+            (1000.0, 8200.0, 0.0, 0, 5.0, 1024, false),
+            (950.0, 8200.0, 0.0, 0, 0.0, 1024, false),
+            (950.0, 8200.0, 0.0, 10, 0.0, 1024, false),
+            (1000.0, 8200.0, 0.0, 0, 0.0, 2048, false),
+            (1000.0, 16400.0, 0.0, 0, 0.0, 512, false),
+            (950.0, 0.0, 0.02, 0, 0.0, 1000, true),
+            (950.0, 0.0, 0.0, 1, 0.0, 1000, true),
+            (950.0, 0.0, 0.0, 0, 3.0, 1000, true),
+            (800.0, 0.0, 0.0, 0, 0.0, 1000, true),
+        ] {
+            let n = 120_000;
+            let t = on_tick((rate, n, start), (jitter, lost, pause), den, float);
+            let case = format!("{rate} Hz on 1/{den} s, {lost} lost, {pause} s paused");
+            let s = read(t.clone()).unwrap_or_else(|e| panic!("{case}: {e}"));
+            assert!((s.rate_hz / rate - 1.0).abs() < 1e-4, "{case}: {s:?}");
+            let missing = (n - t.len()) as f64 + (pause * rate).round();
+            assert!(
+                (s.missing_samples as f64 - missing).abs() <= 0.01 * missing + 2.0,
+                "{case}: {} missing, {missing} expected",
+                s.missing_samples
+            );
+            assert_eq!(s.resolution_s, Some(1.0 / den as f64), "{case}");
+        }
+    }
+
+    #[test]
+    fn ticks_come_coarsest_first() {
+        let ns: Vec<f64> = Tick::CANDIDATES.iter().map(|k| k.ns()).collect();
+        assert!(ns.windows(2).all(|w| w[0] > w[1]), "{ns:?}");
+        assert_eq!(ns[0], 1e9);
+        assert!(Tick::CANDIDATES.contains(&Tick { num: 10, den: 1 }));
+        assert!(Tick::CANDIDATES.contains(&Tick {
+            num: 1_000_000_000,
+            den: 1 << 24
+        }));
+        // 1/1024 s stands in as 1 ms, 1/2048 s too.
+        let k = Tick {
+            num: 1_000_000_000,
+            den: 2048,
+        };
+        assert_eq!(k.decimal(), 1_000_000);
+        assert_eq!(k.place(976_563), 2_000_000);
+        assert!(k.near(976_563) && !k.near(976_000));
     }
 
     #[test]

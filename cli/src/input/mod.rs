@@ -208,8 +208,10 @@ pub fn check_packed(given: Option<f64>, stamped: Option<(u64, f64)>) -> Result<(
 pub const MAX_STAMPED_RATE: f64 = 10_000.0;
 
 /// The sample rate: `given` (`--rate`) when there is one (an error when it is more than 1 %
-/// from the timestamps' rate and from the other reading of stamps rounded to a quantum), else the timestamps' (an error above [`MAX_STAMPED_RATE`]: such
-/// a rate is more often a time unit mistaken).
+/// from the timestamps' rate and from the other reading of stamps rounded to a quantum, or
+/// for runs of a FIFO's reads, below it or more than [`timing::HIDDEN_LOSS`] above it), else
+/// the timestamps'
+/// (an error above [`MAX_STAMPED_RATE`]: such a rate is more often a time unit mistaken).
 pub fn resolve_rate(given: Option<f64>, timing: Option<&TimingSummary>) -> Result<f64, Fail> {
     match (given, timing) {
         (Some(r), Some(t)) => {
@@ -217,7 +219,13 @@ pub fn resolve_rate(given: Option<f64>, timing: Option<&TimingSummary>) -> Resul
             // The stamps' rate, or for stamps rounded to a quantum, the other reading of their
             // intervals (rounding, or samples missing).
             let agrees = |v: f64| (r / v - 1.0).abs() <= 0.01;
-            if !(agrees(t.rate_hz) || t.other_rate_hz.is_some_and(agrees)) {
+            // Runs of a FIFO's reads stamped at a period not the samples' hide the samples
+            // lost within them: their rate is the least the sensor's may be, and a little
+            // more is samples lost.
+            let lost = t.batched.is_some()
+                && r >= 0.99 * t.rate_hz
+                && r <= (1.0 + timing::HIDDEN_LOSS) * t.rate_hz;
+            if !(agrees(t.rate_hz) || t.other_rate_hz.is_some_and(agrees) || lost) {
                 return Err(Fail(format!(
                     "--rate {}: {} give {} Hz ({} Hz over their span)",
                     number(r),

@@ -1853,4 +1853,14 @@ fn stamps_put_on_a_fifos_reads_at_another_period_need_the_rate() {
         "{}",
         stderr(&run)
     );
+    // Samples lost within the runs leave no mark: a rate up to 5 % above the span's is
+    // taken, with the warning (2 % lost: the right --rate refused, before); one below it is
+    // not.
+    let run = imu_ar(&["noise", path(&reads), "--column", "gx", "--rate", "102"]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    assert!(stderr(&run).contains("a --rate up to 5 % above it is taken"));
+    for rate in ["98", "105.5"] {
+        let run = imu_ar(&["noise", path(&reads), "--column", "gx", "--rate", rate]);
+        assert_one_line_failure(&run);
+    }
 }
