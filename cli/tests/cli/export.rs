@@ -63,7 +63,7 @@ fn model() -> &'static ImuModel {
 
 /// A fresh temp directory for one test.
 fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("imu-ar-export-{}-{name}", std::process::id()));
+    let dir = crate::common::temp_root().join(format!("export-{name}"));
     std::fs::create_dir_all(&dir).unwrap();
     dir
 }

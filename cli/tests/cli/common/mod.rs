@@ -5,6 +5,7 @@
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+use std::sync::OnceLock;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// The `imu-ar` binary of this package, to be given arguments.
@@ -17,12 +18,36 @@ pub fn imu_ar(args: &[&str]) -> Output {
     command().args(args).output().expect("run imu-ar")
 }
 
-/// A path in the temp directory ending in `name`, not given out before in this process (the
-/// tests share one process and run in parallel).
+/// This process's folder for the tests' files, in cargo's folder for them (`target/tmp`,
+/// which `cargo clean` empties): the folders of test processes no longer running are removed
+/// the first time (where `/proc` tells which run).
+pub fn temp_root() -> &'static Path {
+    static ROOT: OnceLock<PathBuf> = OnceLock::new();
+    ROOT.get_or_init(|| {
+        let base = Path::new(env!("CARGO_TARGET_TMPDIR")).join("imu-ar-cli");
+        let proc = Path::new("/proc/self");
+        for entry in std::fs::read_dir(&base).into_iter().flatten().flatten() {
+            let gone = entry
+                .file_name()
+                .to_str()
+                .and_then(|n| n.parse::<u32>().ok())
+                .is_some_and(|pid| proc.exists() && !Path::new(&format!("/proc/{pid}")).exists());
+            if gone {
+                let _ = std::fs::remove_dir_all(entry.path());
+            }
+        }
+        let dir = base.join(std::process::id().to_string());
+        std::fs::create_dir_all(&dir).expect("the tests' folder");
+        dir
+    })
+}
+
+/// A path in [`temp_root`] ending in `name`, not given out before in this process (the tests
+/// share one process and run in parallel).
 pub fn temp_path(name: &str) -> PathBuf {
     static CALLS: AtomicUsize = AtomicUsize::new(0);
     let call = CALLS.fetch_add(1, Ordering::Relaxed);
-    std::env::temp_dir().join(format!("imu-ar-cli-{}-{call}-{name}", std::process::id()))
+    temp_root().join(format!("{call}-{name}"))
 }
 
 /// A file in the temp directory with the given contents.
