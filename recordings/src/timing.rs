@@ -1648,13 +1648,13 @@ impl Timing {
         // Stamps within a thousandth of a tick coarser than they resolve (whole ms written
         // through a float's epoch ns, a binary tick in ns) are read on that tick, as stamps
         // rounded to it exactly are.
-        let Some(tick) = self.tick() else {
+        let Some((tick, from)) = self.tick()? else {
             return self.read(unit);
         };
-        let on_tick = self.snapped(tick);
+        let on_tick = self.snapped(tick, from);
         match (on_tick.read(unit), tick.scale()) {
             (read, None) => read,
-            (Ok(s), Some(scale)) => Ok(tick.real(s, scale, self.first.unwrap_or(0))),
+            (Ok(s), Some(scale)) => Ok(tick.real(s, scale, from)),
             (Err(_), Some(_)) => Err(format!(
                 "the timestamps lie on a tick of {} s ({:e} s: a float's seconds, a counter \
                  of that rate), and on it they tell no one rate; their span gives {} Hz (the \
@@ -1676,37 +1676,130 @@ impl Timing {
         }
     }
 
-    /// The coarsest [`Tick`] every stamp lies on to within a thousandth of it, counted from
-    /// the first, where that is coarser than the stamps resolve, no finer than an eighth of
-    /// their median interval nor coarser than it, from 64 stamps kept on.
-    fn tick(&self) -> Option<Tick> {
+    /// The coarsest [`Tick`] the stamps lie on to within a thousandth of it, counted from the
+    /// middle one (or the next), but one in 10,000 (one at least: a stray row, a first stamp
+    /// taken apart), where that is coarser than the stamps resolve, no finer than an eighth
+    /// of their median interval nor coarser than it, from 64 stamps kept on; and the stamp
+    /// counted from. An error where they lie on a binary tick but up to one in ten, nine in ten
+    /// of those a hundredth of it off or more: stamps of two kinds (a jittered clock's stray a
+    /// little).
+    fn tick(&self) -> Result<Option<(Tick, i64)>, String> {
         let t = &self.stamps;
         if t.len() < 64 || self.bits < 64 {
-            return None;
+            return Ok(None);
         }
         let buckets = self.histogram();
-        let resolution = resolution(&buckets, self.bits)? as f64;
+        let Some(resolution) = resolution(&buckets, self.bits) else {
+            return Ok(None);
+        };
         let intervals: u64 = buckets.iter().map(|b| b.count).sum();
         let mut seen = 0;
-        let median = buckets.iter().find_map(|b| {
+        let Some(median) = buckets.iter().find_map(|b| {
             seen += b.count;
             (2 * seen >= intervals).then(|| b.mean())
-        })?;
-        let first = t[0];
-        Tick::CANDIDATES
-            .into_iter()
-            .filter(|k| {
-                let q = k.ns();
-                q > 2.0 * resolution && q >= median / 8.0 && q <= 1.01 * median
-            })
-            .find(|k| t.iter().all(|&s| k.near(i128::from(s) - i128::from(first))))
+        }) else {
+            return Ok(None);
+        };
+        let (stray, mixed) = ((t.len() / 10_000).max(1), t.len() / 10);
+        // The stamps off the tick counted from `from` (up to one past the mixed), and
+        // whether each lies far off; the first.
+        let off = |k: Tick, from: i64| {
+            let (mut count, mut near, mut first) = (0, 0, None);
+            for (i, &s) in t.iter().enumerate() {
+                let r = i128::from(s) - i128::from(from);
+                if !k.near(r) {
+                    count += 1;
+                    near += usize::from(!k.far(r));
+                    first.get_or_insert((i, s));
+                    if count > mixed.max(stray) {
+                        break;
+                    }
+                }
+            }
+            (count, near, first)
+        };
+        let middle = t.len() / 2;
+        for k in Tick::CANDIDATES {
+            let q = k.ns();
+            if q <= 2.0 * resolution as f64 || q < median / 8.0 || q > 1.01 * median {
+                continue;
+            }
+            for from in [t[middle], t[middle + 1]] {
+                let (count, near, first) = off(k, from);
+                if count <= stray {
+                    Self::coarsening(t, k)?;
+                    return Ok(Some((k, from)));
+                }
+                // (On a power of ten, stamps between its ticks are a host's late ones.)
+                let two_kinds = k.den > 1 && count <= mixed && 10 * near <= count;
+                if let (true, Some((at, stamp))) = (two_kinds, first) {
+                    // (Those before a stamp on a tick half as coarse: a float's tick doubling.)
+                    let finer = Tick {
+                        num: k.num,
+                        den: 2 * k.den,
+                    };
+                    if t.iter()
+                        .all(|&s| finer.near(i128::from(s) - i128::from(from)))
+                    {
+                        Self::coarsening(t, finer)?;
+                    }
+                    return Err(format!(
+                        "{count} of the {} timestamps lie off the tick of {} s ({:e} s: a \
+                         float's seconds, a counter of that rate) the others lie on (the \
+                         first: sample {}, {stamp} ns): stamps of two kinds, whose rate \
+                         neither tells; give --rate",
+                        t.len(),
+                        k.name(),
+                        k.seconds(),
+                        at + 1
+                    ));
+                }
+            }
+        }
+        Ok(None)
     }
 
-    /// A timing of the stamps put on `tick` (counted from the first; on a binary tick, a
+    /// An error where the stamps `t`, on the binary `tick`, lie on one twice as coarse from
+    /// some stamp on (64 stamps or more, a tenth of them or more, over four times the longest
+    /// run on it before): a float's seconds past a power of two, whose tick doubles there.
+    fn coarsening(t: &[i64], tick: Tick) -> Result<(), String> {
+        let Some(&last) = t.last().filter(|_| tick.den > 1) else {
+            return Ok(());
+        };
+        let coarse = Tick {
+            num: tick.num,
+            den: tick.den / 2,
+        };
+        let on = |s: i64| coarse.near(i128::from(s) - i128::from(last));
+        let tail = t.iter().rev().take_while(|&&s| on(s)).count();
+        let head = &t[..t.len() - tail];
+        let (mut run, mut longest) = (0, 0);
+        for &s in head {
+            run = if on(s) { run + 1 } else { 0 };
+            longest = longest.max(run);
+        }
+        if head.len() < 64 || tail < 64 || 10 * tail < t.len() || tail <= 4 * longest {
+            return Ok(());
+        }
+        // (A float32's seconds step by 2^-23 of the power of two below them.)
+        let power = 1u64
+            .checked_shl(23u32.saturating_sub(coarse.den.ilog2()))
+            .filter(|_| coarse.den.ilog2() <= 23)
+            .map_or(String::new(), |p| format!(", float32 seconds past {p} s"));
+        Err(format!(
+            "the timestamps lie on a tick of {} s up to sample {}, and on {} s from there on \
+             (a float's seconds past a power of two{power}): read on either they tell no one \
+             rate; read the stretches apart, or give --rate",
+            tick.name(),
+            head.len(),
+            coarse.name()
+        ))
+    }
+
+    /// A timing of the stamps put on `tick` (counted `from` a stamp; on a binary tick, a
     /// decimal one in its place, [`Tick::decimal`]), as the record's calls made them: the
     /// samples kept and those dropped, in order.
-    fn snapped(&self, tick: Tick) -> Timing {
-        let first = self.first.unwrap_or(0);
+    fn snapped(&self, tick: Tick, from: i64) -> Timing {
         let mut on = Timing::new();
         let mut drops = self.drops.iter().peekable();
         let drop = |on: &mut Timing, repeat: bool| {
@@ -1724,7 +1817,7 @@ impl Timing {
             while let Some(&(_, repeat)) = drops.next_if(|d| d.0 == i) {
                 drop(&mut on, repeat);
             }
-            let v = first.saturating_add(tick.place(i128::from(s) - i128::from(first)));
+            let v = from.saturating_add(tick.place(i128::from(s) - i128::from(from)));
             if on.push(v) == Step::Repeat {
                 on.keep_repeat();
             }
@@ -2065,6 +2158,24 @@ impl Timing {
                 span * 1e-9
             ));
         }
+        // Places left empty on a quantum the stamps step by, read as samples lost: a clock a
+        // little slower than the quantum leaves them too, and under 2000 samples its beat is
+        // not told from losses (990 Hz over 500 samples to 1/1024 s read 1024 Hz).
+        if let Some(q) = resolution.filter(|&q| {
+            q as f64 == median
+                && summary.missing_samples > 0
+                && self.kept < 2000
+                && (summary.rate_hz * q as f64 * 1e-9 - 1.0).abs() < 1e-9
+        }) {
+            return Err(format!(
+                "the timestamps step by their quantum, {:e} s, and leave {} places empty in {} \
+                 samples: too few to tell samples lost from a clock slower than its stamps \
+                 (give --rate)",
+                q as f64 * 1e-9,
+                summary.missing_samples,
+                self.kept
+            ));
+        }
         // (Beside the place they left: rows written twice land beside a lost sample's place
         // only by chance; under a slower clock beside its own.)
         if grid
@@ -2140,17 +2251,19 @@ impl Timing {
     }
 
     /// Stamps in runs (of two samples or more, on the median), each run parted from the next by
-    /// an interval over 1.25 times the `median` (ns), at least 16 of them and one in a hundred
-    /// intervals or more, half of those intervals or more no whole number of the runs' interval
-    /// (or so many that the samples they would miss outnumber those kept): the runs' lengths
-    /// (5th and 95th percentiles), their median interval, ns, whether they are a clock rounded
-    /// to a tick, and the pauses (their time, ns, and count: runs starting more than half a
-    /// usual start-to-start time late); six runs in ten or more
-    /// starting within 30 % of the median time from one run's start to the next, and not
-    /// parted by one `quantum` more where that is over a tenth of the runs' interval (a
-    /// slower clock's rounding). Samples lost leave intervals of whole periods; a FIFO read
-    /// on a timer and stamped at a period not the samples' parts runs by intervals of any
-    /// length.
+    /// an interval over 1.25 times the `median` (ns), at least 16 of them and one in a
+    /// thousand intervals or more (a FIFO of 128 samples a read), half of those intervals or
+    /// more no whole number of the runs' interval (or so many that the samples they would
+    /// miss outnumber those kept): the runs' lengths (5th and 95th percentiles), their median
+    /// interval, ns, whether they are a clock rounded to a tick, and the pauses (their time,
+    /// ns, and count: runs starting later than their samples take at the usual time a sample,
+    /// by more than half a usual start-to-start time); six runs in ten or more starting within
+    /// a sample and a half of the time their samples take, and not rounding's (a `quantum`
+    /// over a quarter of the runs' interval with one in twenty intervals within them a
+    /// quantum off it, or over a tenth where the runs are parted by one quantum more: a
+    /// slower clock's). Samples lost leave intervals of whole periods; a
+    /// FIFO read on a timer and stamped at a period not the samples' parts runs by intervals
+    /// of any length.
     fn batches(&self, median: f64, quantum: Option<i64>) -> Option<Runs> {
         let t = &self.stamps;
         if t.len() < 64 || median <= 0.0 {
@@ -2192,11 +2305,13 @@ impl Timing {
         let (Some(low), Some(middle), Some(high)) = (at(5), at(50), at(95)) else {
             return None;
         };
-        if middle < 2 || parted < 16 || 100 * parted < t.len() as u64 || within.is_empty() {
+        if middle < 2 || parted < 16 || 1000 * parted < t.len() as u64 || within.is_empty() {
             return None;
         }
-        // A FIFO read on a timer starts its runs at the timer's period, however many samples
-        // each holds; pauses and samples lost at random places start them anywhere.
+        // A FIFO read on a timer starts each run when the samples it holds have come, within
+        // a sample or so at the usual time a sample, however many it holds (a read's samples
+        // run on into the next's where the timer came early); pauses and samples lost at
+        // random places start them anywhere.
         let middle_of = |v: &mut Vec<f64>| {
             let mid = (v.len() - 1) / 2;
             *v.select_nth_unstable_by(mid, f64::total_cmp).1
@@ -2204,9 +2319,11 @@ impl Timing {
         // (The runs' own, in order, before the median reorders them.)
         let runs_in_order: Vec<(f64, f64)> = starts.iter().copied().zip(held).collect();
         let period = middle_of(&mut starts);
-        let steady = starts
+        let mut each: Vec<f64> = runs_in_order.iter().map(|(d, n)| d / n).collect();
+        let sample = middle_of(&mut each);
+        let steady = runs_in_order
             .iter()
-            .filter(|&&d| (d / period - 1.0).abs() <= 0.3)
+            .filter(|(d, n)| (d - n * sample).abs() <= 1.5 * sample)
             .count();
         if 10 * steady < 6 * starts.len() {
             return None;
@@ -2214,15 +2331,15 @@ impl Timing {
         // Pauses: the time runs start late by, past the time their samples take at the
         // usual time a sample (two reads' samples in one run take two periods), and half a
         // period more.
-        let mut each: Vec<f64> = runs_in_order.iter().map(|(d, n)| d / n).collect();
-        let sample = middle_of(&mut each);
         let (paused, pauses) = runs_in_order
             .iter()
             .map(|(d, n)| d - n * sample)
             .filter(|&late| late > 0.5 * period)
             .fold((0.0, 0u64), |(time, count), late| (time + late, count + 1));
-        // Stamps floored to a quantum `q` coarse against the runs' interval part the runs of
-        // a slower clock by one quantum more: rounding's, not runs.
+        // Stamps floored to a quantum `q` over a quarter of the runs' interval, one in twenty
+        // of the intervals within runs a quantum off it (a jittered clock's, rounded), or
+        // over a tenth parting the runs of a slower clock by one quantum more: rounding's,
+        // not runs.
         let parts = middle_of(&mut parting);
         // The runs' interval and jitter, robustly: their median, and the median deviation
         // from it (a read's end a little short of the interval is no jitter of the clock's).
@@ -2246,23 +2363,31 @@ impl Timing {
         let lost = 2 * whole >= parted && missing < t.len() as f64;
         let rounding = quantum.is_some_and(|q| {
             let q = q as f64;
-            10.0 * q > inside && parts - inside <= 1.5 * q
+            let varied = within
+                .iter()
+                .filter(|&&iv| (iv - inside).abs() >= 0.5 * q)
+                .count();
+            4.0 * q > inside && 20 * varied >= within.len()
+                || 10.0 * q > inside && parts - inside <= 1.5 * q
         });
-        // Each run parted by exactly one interval more, runs starting evenly (within 5 %),
-        // the interval steady: a clock slower than a tick its stamps are rounded to (a binary
-        // one, 1/1024 s, that no power of ten tells), or one sample lost at a steady count,
-        // which no logger does; either way the intervals tell no rate.
-        // (Evenly as rounding spaces them: the runs start within a tick of the usual.)
+        // Each run parted by the same whole number of intervals, runs starting evenly (within
+        // a tick of the usual), the interval steady: a clock slower than a tick its stamps
+        // are rounded to (a binary one, 1/1024 s, that no power of ten tells), a driver
+        // stamping runs a little short of the samples' period, or the same number of
+        // samples lost each run (a FIFO overflowing by as many each read); the intervals
+        // tell none of these from the others.
         let evenly = starts
             .iter()
             .filter(|&&d| (d - period).abs() <= 1.05 * inside)
             .count();
-        let single = parting
+        let multiple = (parts / inside).round();
+        let same = parting
             .iter()
-            .filter(|&&iv| (iv / inside - 2.0).abs() < tolerance)
+            .filter(|&&iv| (iv / inside - multiple).abs() < tolerance)
             .count();
         let ticked = lost
-            && 10 * single >= 9 * parting.len()
+            && multiple >= 2.0
+            && 10 * same >= 9 * parting.len()
             && 10 * evenly >= 9 * starts.len()
             && jitter < 1e-3;
         if ticked && !rounding {
@@ -2620,31 +2745,35 @@ impl Timing {
         }
         let each = share.round() as u64;
         let t = &self.stamps;
-        let (mut fewer, mut over) = (0u64, 0u64);
+        let (mut fewer, mut over, mut skipped) = (0u64, 0u64, 0.0);
         let mut place = |held: u64| {
             fewer += each.saturating_sub(held);
             over += held.saturating_sub(each);
         };
         // (The first and the last stamp's places lie partly outside the record; gaps of
-        // five quanta or more are counted as samples missing.)
+        // five quanta or more are counted as samples missing, and not here: the samples
+        // missing they hold are not taken off those places that hold fewer.)
         let mut start = t.iter().take_while(|&&x| x == t[0]).count();
         while start < t.len() {
             let end = start + t[start..].iter().take_while(|&&x| x == t[start]).count();
             if end == t.len() {
                 break;
             }
-            let places = (i128::from(t[start]) - i128::from(t[start - 1])) / i128::from(quantum);
+            let iv = i128::from(t[start]) - i128::from(t[start - 1]);
+            let places = iv / i128::from(quantum);
             if places <= 4 {
                 for _ in 1..places {
                     place(0);
                 }
+            } else {
+                skipped += (iv as f64 * 1e-9 * summary.rate_hz).round() - 1.0;
             }
             place((end - start) as u64);
             start = end;
         }
         let lost = fewer
             .saturating_sub(over)
-            .saturating_sub(summary.missing_samples);
+            .saturating_sub(summary.missing_samples.saturating_sub(skipped as u64));
         if lost as f64 <= 2.0 + 1e-5 * self.kept as f64 {
             return Ok(());
         }
@@ -3135,6 +3264,11 @@ impl Tick {
         1000 * off.abs() <= self.num
     }
 
+    /// Whether `r` ns lies a hundredth of a tick or more off a whole number of them.
+    fn far(self, r: i128) -> bool {
+        100 * self.split(r).1.abs() >= self.num
+    }
+
     /// A binary tick's decimal stand-in: the power of ten at or above it, ns.
     fn decimal(self) -> i128 {
         let mut v = 1i128;
@@ -3162,8 +3296,8 @@ impl Tick {
     }
 
     /// A summary read on the stand-in, in real time (`scale` real ns per stand-in ns, the
-    /// stamps counted from `first`).
-    fn real(self, s: TimingSummary, scale: f64, first: i64) -> TimingSummary {
+    /// stamps counted `from` one).
+    fn real(self, s: TimingSummary, scale: f64, from: i64) -> TimingSummary {
         TimingSummary {
             rate_hz: s.rate_hz / scale,
             median_interval_s: s.median_interval_s * scale,
@@ -3172,7 +3306,7 @@ impl Tick {
             span_rate_hz: s.span_rate_hz / scale,
             other_rate_hz: s.other_rate_hz.map(|r| r / scale),
             unexplained_repeat: s.unexplained_repeat.map(|(at, stamp, left)| {
-                let real = first as f64 + (stamp as f64 - first as f64) * scale;
+                let real = from as f64 + (stamp as f64 - from as f64) * scale;
                 (at, real.round() as i64, left)
             }),
             batched: s
@@ -3555,14 +3689,18 @@ impl TimingSummary {
         let ((low, high), inside, ticked) = self.batched?;
         if ticked {
             return Some(format!(
-                "the timestamps step by {} s ({} Hz), one step in {} or so twice that, evenly: a \
-                 clock slower than a tick its stamps are rounded to (a float's seconds, a \
-                 1024 Hz counter), not samples lost; their intervals tell no rate, their span \
-                 less its pauses gives {} Hz (the sensor's, where none was lost); give --rate",
+                "the timestamps step by {} s ({} Hz), one step in {} or so a whole number of \
+                 times that, the same each time, evenly: a clock slower than a tick its stamps \
+                 are rounded to (a float's seconds, a 1024 Hz counter), a driver stamping runs \
+                 a little short of the samples' period, or as many samples lost each run (a \
+                 FIFO overflowing); their intervals tell no rate, their span less its pauses \
+                 gives {} Hz, the sensor's where none was lost (a --rate up to {} % above it \
+                 is taken); give --rate",
                 short(inside),
                 short(1.0 / inside),
                 (low + high) / 2,
-                short(self.rate_hz)
+                short(self.rate_hz),
+                100.0 * HIDDEN_LOSS
             ));
         }
         let samples = if low == high {
@@ -3790,12 +3928,15 @@ mod tests {
         // intervals from the next: 1050 Hz, a sample lost in every 20, before); a host
         // stamping 10 samples 200 us apart as they arrive (4999.9 Hz). Read as the span's
         // rate, and named.
+        // 128 samples 970 us apart (a FIFO's run parted one interval in 128: 1031.25 Hz, exit
+        // 0, before; parted by about 5 of its intervals, each time).
         for (per, spacing, late) in [
             (16, 952_000, 0),
             (32, 985_000, 0),
             (16, 980_000, 0),
             (20, 950_000, 0),
             (10, 200_000, 300_000),
+            (128, 970_000, 0),
         ] {
             let s = summary_of(&reads(60_000, per, spacing, late, 0));
             let (samples, inside, ticked) = s.batched.expect("batched");
@@ -3816,11 +3957,16 @@ mod tests {
         // Reads on a timer that is no whole number of samples (9 or 10 a read), jittered
         // (16 a read, 0.3 ms), or with 1 % of the samples lost: 1052.6, 1051.8 and 1062.5 Hz
         // before, exit 0, and the right --rate refused.
+        // A 10 ms timer late by up to 0.3 to 3 ms (a read's samples running on into the
+        // next's where it came early): 1024.9 and 1030.1 Hz, exit 0, before.
         for (poll, spacing, late, lost) in [
             (9_500_000, 970_000, 0, 0),
             (16_000_000, 950_000, 300_000, 0),
             (16_000_000, 950_000, 0, 10),
             (10_000_000, 200_000, 2_000_000, 0),
+            (10_000_000, 970_000, 300_000, 0),
+            (10_000_000, 970_000, 1_000_000, 0),
+            (10_000_000, 970_000, 3_000_000, 0),
         ] {
             let s = summary_of(&timer_reads(60_000, poll, spacing, late, lost));
             let (_, inside, _) = s.batched.expect("batched");
@@ -3854,8 +4000,7 @@ mod tests {
         // A 1000 Hz clock stamped in float seconds past 8192 s (a tick of 1/1024 s, which no
         // power of ten tells): 1024 Hz with 7200 samples missing in 300 s, exit 0, before.
         // Read on its tick ([`Timing::tick`], `stamps_on_a_tick_they_do_not_resolve_are_read_on_it`),
-        // a sample dropped for a stamp behind the one before or not; where a stamp lies off
-        // the tick (10 us), it is not taken, and the runs are told.
+        // a sample dropped for a stamp behind the one before or not.
         let mut t: Vec<i64> = (0..120_000)
             .map(|k| {
                 let ticks = ((8_200.0 + f64::from(k) / 1000.0) * 1024.0).floor();
@@ -3882,28 +4027,22 @@ mod tests {
             "{s:?}"
         );
         assert_eq!((s.dropped_backward, s.gaps), (1, 0), "{s:?}");
-        t[60_000] += 10_000;
-        let s = summary_of(&t);
+        // Stamps to the ns, runs of 41 samples 976 us apart read every 41 ms, each parted by
+        // two of its intervals, evenly: no tick, and no sample lost; refused as one. So are
+        // runs of 128 parted by five intervals each (1031.25 Hz with 1868 missing, exit 0,
+        // before: a FIFO overflowing by four samples each read leaves the same).
+        let s = summary_of(&reads(60_000, 128, 969_697, 0, 0));
+        assert!(s.batched.is_some_and(|b| b.2), "{s:?}");
+        assert!((s.rate_hz / 1000.0 - 1.0).abs() < 1e-4, "{s:?}");
+        let s = summary_of(&reads(120_000, 41, 976_000, 0, 0));
         let (_, inside, ticked) = s.batched.unwrap_or_else(|| panic!("{s:?}"));
-        assert!(ticked && (inside * 1024.0 - 1.0).abs() < 1e-6, "{s:?}");
+        assert!(ticked && (inside / 976e-6 - 1.0).abs() < 1e-6, "{s:?}");
         assert!((s.rate_hz / 1000.0 - 1.0).abs() < 1e-4, "{s:?}");
         assert!(
             s.batch_refusal()
                 .unwrap()
                 .contains("a clock slower than a tick")
         );
-        // 950 Hz on the same tick (runs of 12 or 13), a stamp off it: 1024 Hz with 11,099
-        // missing, exit 0, before.
-        let mut t: Vec<i64> = (0..120_000)
-            .map(|k| {
-                let ticks = ((8_200.0 + f64::from(k) / 950.0) * 1024.0).floor();
-                (ticks / 1024.0 * 1e9).round() as i64
-            })
-            .collect();
-        t[60_000] += 10_000;
-        let s = summary_of(&t);
-        assert!(s.batched.is_some_and(|b| b.2), "{s:?}");
-        assert!((s.rate_hz / 950.0 - 1.0).abs() < 1e-4, "{s:?}");
         // Reads stamped at the samples' own period: one clock, no runs.
         let s = summary_of(&reads(60_000, 16, 1_000_000, 0, 0));
         assert_eq!(s.batched, None, "{s:?}");
@@ -4206,6 +4345,66 @@ mod tests {
             );
             assert_eq!(s.resolution_s, Some(1.0 / den as f64), "{case}");
         }
+        // Float32 seconds from 8190 s on: 1/2048 s, then 1/1024 s past 8192 s; 0.1 % lost
+        // (1022.3 Hz, exit 0, before): refused naming the change. A clock that stays on the
+        // coarser tick a while by chance (1023.9 Hz on 1/2048 s) is read.
+        let float32 = |rate: f64, n: usize, start: f64, lost: u64| {
+            let mut next = crate::xorshift(0x5eed_f10a_7320);
+            (0..n)
+                .filter(|_| next() % 1000 >= lost)
+                .map(|k| (f64::from((start + k as f64 / rate) as f32) * 1e9).round() as i64)
+                .collect::<Vec<i64>>()
+        };
+        let e = read(float32(990.0, 43_000, 8190.0, 1)).unwrap_err();
+        assert!(
+            e.contains("on 1/1024 s from there on") && e.contains("past 8192 s"),
+            "{e}"
+        );
+        let s = read(float32(990.0, 40_000, 8193.0, 1)).unwrap();
+        assert!((s.rate_hz / 990.0 - 1.0).abs() < 1e-4, "{s:?}");
+        let s = read(on_tick(
+            (1023.9, 20_000, 8000.0),
+            (0.0, 0, 0.0),
+            2048,
+            false,
+        ))
+        .unwrap();
+        assert!((s.rate_hz / 1023.9 - 1.0).abs() < 1e-4, "{s:?}");
+        // 500 samples of a 990 Hz clock on 1/1024 s, and of 966.8 Hz on whole ms (its stand-in):
+        // 1024 and 1000 Hz with 17 missing, exit 0, before; too few to tell from losses.
+        for (rate, den, why) in [
+            (990.0, 1024, "on it they tell no one rate"),
+            (966.8, 1000, "too few to tell samples lost"),
+        ] {
+            let e = read(on_tick((rate, 500, 8200.0), (0.0, 0, 0.0), den, false)).unwrap_err();
+            assert!(e.contains(why), "{e}");
+        }
+        // The first stamp taken apart (0.3 ms early), or stamps a row off it (10 us, one in
+        // 10,000): read on the tick from the middle stamp.
+        let mut t = on_tick((1000.0, 120_000, 8200.0), (0.0, 10, 0.0), 1024, false);
+        t[0] -= 300_000;
+        for s in t.iter_mut().skip(7).step_by(20_000) {
+            *s += 10_000;
+        }
+        let s = read(t.clone()).unwrap();
+        assert!((s.rate_hz / 1000.0 - 1.0).abs() < 1e-4, "{s:?}");
+        // More of them, up to one in ten, far off the tick: refused naming it (1024 Hz with
+        // 4052 missing, exit 0, before); a clock on a tick jittered a little (a thousandth of
+        // a tick and more, at times) is read as it is.
+        for every in [1_000, 11] {
+            let mut t = t.clone();
+            for s in t.iter_mut().skip(9).step_by(every) {
+                *s += 50_000;
+            }
+            let e = read(t).unwrap_err();
+            assert!(e.contains("lie off the tick of 1/1024 s"), "{e}");
+        }
+        let t: Vec<i64> = (0..120_000i64)
+            .map(|k| 1_600_000_000_000_000_000 + k * 1_000_000 + 1_500 * i64::from(k % 50 == 7))
+            .collect();
+        let s = read(t).unwrap();
+        assert!((s.rate_hz / 1000.0 - 1.0).abs() < 1e-6, "{s:?}");
+        assert!(s.jitter_rms > 1e-4, "{s:?}");
     }
 
     #[test]
@@ -6068,6 +6267,16 @@ mod tests {
                 "{rate} Hz: {e}"
             );
         }
+        // The same 2000 Hz with a 3 s pause besides: 1980.58 Hz, the rate of the samples
+        // present, exit 0, before (the pause's samples missing were taken off the places
+        // that hold fewer).
+        let (mut t, ..) = drifting((2000.0, 0.0, 0.0), 40_000, 100, 26);
+        let half = t.len() / 2;
+        for s in &mut t[half..] {
+            *s += 3_000_000_000;
+        }
+        let e = pushed(&t, true).summary(TimeUnit::Nanoseconds).unwrap_err();
+        assert!(e.contains("hold 2 samples each"), "{e}");
         // 2000 Hz with nothing lost, jittered by 5 % of a period: read.
         let (t, lost, _) = drifting((2000.0, 0.0, 0.05), 40_000, 0, 26);
         let s = summary_keeping_repeats(&t);
