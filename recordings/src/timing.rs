@@ -4001,7 +4001,7 @@ mod tests {
         // power of ten tells): 1024 Hz with 7200 samples missing in 300 s, exit 0, before.
         // Read on its tick ([`Timing::tick`], `stamps_on_a_tick_they_do_not_resolve_are_read_on_it`),
         // a sample dropped for a stamp behind the one before or not.
-        let mut t: Vec<i64> = (0..120_000)
+        let t: Vec<i64> = (0..120_000)
             .map(|k| {
                 let ticks = ((8_200.0 + f64::from(k) / 1000.0) * 1024.0).floor();
                 (ticks / 1024.0 * 1e9).round() as i64
