@@ -531,6 +531,23 @@ pub struct Timing {
     drops: Vec<(usize, bool)>,
 }
 
+/// The difference of the two commonest `values` (ns, those within 2 ns and 1e-5 of each other
+/// taken as one: a tick's multiples rounded to the ns) where they lie a tenth apart or less,
+/// each a tenth of them or more and together nine in ten.
+fn two_values(values: &[f64]) -> Option<f64> {
+    let mut sorted = values.to_vec();
+    sorted.sort_unstable_by(f64::total_cmp);
+    let mut counts: Vec<(usize, f64)> = sorted
+        .chunk_by(|a, b| b - a <= (1e-5 * a).max(2.0))
+        .map(|run| (run.len(), run.iter().sum::<f64>() / run.len() as f64))
+        .collect();
+    counts.sort_unstable_by(|a, b| b.0.cmp(&a.0));
+    let (&(n1, a), &(n2, b)) = (counts.first()?, counts.get(1)?);
+    let (n, all) = (n1 + n2, sorted.len());
+    let (low, high) = (a.min(b), a.max(b));
+    (10 * n2 >= all && 10 * n >= 9 * all && 10.0 * (high - low) <= low).then_some(high - low)
+}
+
 /// The most samples, relative, a rate given for runs of a FIFO's reads
 /// ([`TimingSummary::batched`]) may take lost within them (their stamps leave no mark of
 /// them) past those the runs' span less its pauses holds.
@@ -2346,14 +2363,21 @@ impl Timing {
         let inside = middle_of(&mut within);
         let mut deviations: Vec<f64> = within.iter().map(|iv| (iv - inside).abs()).collect();
         let jitter = 1.4826 * middle_of(&mut deviations) / inside;
+        // Intervals within runs of two values a tenth apart or less, each a tenth of them or
+        // more and together nine in ten: a clock rounded to a tick of their difference (a
+        // 32768 Hz counter's), whose losses are whole numbers of their mean, give or take a
+        // tick.
+        let (spacing, tick) = two_values(&within).map_or((inside, 0.0), |tick| {
+            (within.iter().sum::<f64>() / within.len() as f64, tick)
+        });
         // Samples lost leave intervals of whole periods: where most of the longer intervals
         // are (within 2 % and four times the runs' jitter), the runs are a clock's with
         // samples lost at a steady count.
-        let tolerance = 0.02 + 4.0 * jitter;
+        let tolerance = 0.02 + 4.0 * jitter + tick / spacing;
         let (mut whole, mut missing) = (0u64, 0.0);
         for w in t.windows(2) {
-            let periods = (i128::from(w[1]) - i128::from(w[0])) as f64 / inside;
-            if periods * inside > long {
+            let periods = (i128::from(w[1]) - i128::from(w[0])) as f64 / spacing;
+            if periods * spacing > long {
                 whole += u64::from((periods - periods.round()).abs() < tolerance);
                 missing += periods.round() - 1.0;
             }
@@ -2731,8 +2755,9 @@ impl Timing {
     /// Where several samples share each stamp (one and a half to four, within a tenth of a
     /// whole number), each place on the quantum holds that many: a place holding fewer
     /// (less those holding more: jitter moves a sample to the next place) is a sample lost,
-    /// which the span's rate does not count. More than one in 100,000 (and two) past the
-    /// samples missing, where no fold reads the rate again: refused. (Off a whole number,
+    /// which the span's rate does not count. Two or more past the samples missing (and more
+    /// than one in 100,000), where no fold reads the rate again: refused (one is not told
+    /// from the record's ends). (Off a whole number,
     /// jitter and a lost sample leave alike places that hold fewer, a beat's pattern of
     /// places that hold one more beside them.)
     fn short_places(&self, summary: &TimingSummary, resolution: Option<i64>) -> Result<(), String> {
@@ -2774,7 +2799,7 @@ impl Timing {
         let lost = fewer
             .saturating_sub(over)
             .saturating_sub(summary.missing_samples.saturating_sub(skipped as u64));
-        if lost as f64 <= 2.0 + 1e-5 * self.kept as f64 {
+        if lost <= 1 || lost as f64 <= 1e-5 * self.kept as f64 {
             return Ok(());
         }
         Err(format!(
@@ -4046,6 +4071,16 @@ mod tests {
         // Reads stamped at the samples' own period: one clock, no runs.
         let s = summary_of(&reads(60_000, 16, 1_000_000, 0, 0));
         assert_eq!(s.batched, None, "{s:?}");
+        // So do those of a clock on a 32768 Hz counter, whose intervals alternate between 20
+        // and 21 ticks (1600 Hz with 3 % lost: refused as runs, before).
+        for (rate, lost) in [(1600.0, 30), (1200.0, 15), (2000.0, 20)] {
+            let t = on_tick((rate, 48_000, 100.0), (0.0, lost, 0.0), 32_768, false);
+            let s = summary_of(&t);
+            assert!(
+                s.batched.is_none() && (s.rate_hz / rate - 1.0).abs() < 1e-4,
+                "{rate} Hz: {s:?}"
+            );
+        }
         // Samples lost at random part runs of every length: gaps, not batches.
         let s = summary_of(&reads(60_000, 1, 0, 0, 20));
         assert_eq!(s.batched, None, "{s:?}");
@@ -6277,6 +6312,16 @@ mod tests {
         }
         let e = pushed(&t, true).summary(TimeUnit::Nanoseconds).unwrap_err();
         assert!(e.contains("hold 2 samples each"), "{e}");
+        // Two lost in 5000 samples (1999.2 Hz, exit 0, before); one is not told from the
+        // record's ends (up to one sample in the record: 2e-4 here).
+        for (lost, refused) in [(&[1234, 3001][..], true), (&[1234][..], false)] {
+            let t: Vec<i64> = (0..5_000i64)
+                .filter(|k| !lost.contains(k))
+                .map(|k| 1_600_000_000_000_000_000 + k / 2 * 1_000_000)
+                .collect();
+            let s = pushed(&t, true).summary(TimeUnit::Nanoseconds);
+            assert_eq!(s.is_err(), refused, "{lost:?}: {s:?}");
+        }
         // 2000 Hz with nothing lost, jittered by 5 % of a period: read.
         let (t, lost, _) = drifting((2000.0, 0.0, 0.05), 40_000, 0, 26);
         let s = summary_keeping_repeats(&t);
