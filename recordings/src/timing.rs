@@ -541,7 +541,7 @@ fn two_values(values: &[f64]) -> Option<f64> {
         .chunk_by(|a, b| b - a <= (1e-5 * a).max(2.0))
         .map(|run| (run.len(), run.iter().sum::<f64>() / run.len() as f64))
         .collect();
-    counts.sort_unstable_by(|a, b| b.0.cmp(&a.0));
+    counts.sort_unstable_by_key(|c| std::cmp::Reverse(c.0));
     let (&(n1, a), &(n2, b)) = (counts.first()?, counts.get(1)?);
     let (n, all) = (n1 + n2, sorted.len());
     let (low, high) = (a.min(b), a.max(b));
