@@ -2726,16 +2726,20 @@ impl Timing {
         // a quantum of the window's reach, which a drifting clock's mean period moves.)
         let u = 1.0 / (q * summary.rate_hz);
         let hidden = u >= 1.0 && (2.0 * u).floor() <= (1.5 * u + 0.5).max(u + 1.25) + 0.1;
-        if !(0.8..1.45).contains(&(q * summary.rate_hz)) && !hidden {
+        let near = (0.8..1.45).contains(&(q * summary.rate_hz));
+        if !near && !hidden {
             return Ok(());
         }
         // The places left empty (gaps of five quanta or more are counted as samples
-        // missing).
+        // missing); where the period is a quantum and a half or more, those of intervals
+        // longer than any the clock's rounding leaves (two at 505 Hz on whole ms: three and
+        // four quanta).
+        let shortest = if near { 2 } else { u.ceil() as u64 + 1 };
         let empty: u64 = self
             .stamps
             .windows(2)
             .map(|w| ((i128::from(w[1]) - i128::from(w[0])) / i128::from(quantum)) as u64)
-            .filter(|places| (2..=4).contains(places))
+            .filter(|places| (shortest..=4).contains(places))
             .map(|places| places - 1)
             .sum();
         if empty as f64 <= 2.0 + 1e-5 * self.kept as f64 {
@@ -4405,6 +4409,15 @@ mod tests {
         ))
         .unwrap();
         assert!((s.rate_hz / 1023.9 - 1.0).abs() < 1e-4, "{s:?}");
+        // Clocks just over half the quantum's rate, nothing lost (500.5 to 508 Hz on whole
+        // ms, 50.5 Hz on 10 ms): refused as a clock slower than its stamps, each of its own
+        // two-quanta intervals counted a place a lost sample may have left, before.
+        for (rate, den) in [(500.5, 1000), (505.0, 1000), (508.0, 1000), (50.5, 100)] {
+            let t = on_tick((rate, 30_000, 0.0), (0.0, 0, 0.0), den, false);
+            let s = read(t).unwrap_or_else(|e| panic!("{rate} Hz: {e}"));
+            // (To a quantum over the span: 1.7e-5.)
+            assert!((s.rate_hz / rate - 1.0).abs() < 3e-5, "{s:?}");
+        }
         // 500 samples of a 990 Hz clock on 1/1024 s, and of 966.8 Hz on whole ms (its stand-in):
         // 1024 and 1000 Hz with 17 missing, exit 0, before; too few to tell from losses.
         for (rate, den, why) in [
