@@ -13,9 +13,19 @@ pub fn font() -> Result<(), Fail> {
         .map_err(|_| Fail("cannot load the embedded font".into()))
 }
 
+/// The bitmap `path` is drawn into, `size` pixels, once a file can be created there (an error
+/// naming its file and the system's reason, where the drawing would name neither well).
+pub fn bitmap(path: &std::path::Path, size: (u32, u32)) -> Result<BitMapBackend<'_>, Fail> {
+    std::fs::File::create(path).map_err(|e| {
+        let name = path.file_name().unwrap_or(path.as_os_str());
+        Fail(format!("{}: cannot be written: {e}", name.display()))
+    })?;
+    Ok(BitMapBackend::new(path, size))
+}
+
 /// A drawing error as the tool's error.
-pub fn draw_err(e: impl std::fmt::Debug) -> Fail {
-    Fail(format!("drawing failed: {e:?}"))
+pub fn draw_err(e: impl std::fmt::Display) -> Fail {
+    Fail(format!("drawing failed: {e}"))
 }
 
 /// A chart on `root` with a caption, margins and label areas.

@@ -173,26 +173,15 @@ pub fn run(args: &Args) -> Result<Characterisation, Fail> {
     let columns = columns(args)?;
     // Created now, so that a folder that cannot be made fails before the record is read;
     // removed again with the parents it needed (while still empty) when the run fails.
-    let created: Vec<&Path> = args
-        .out
-        .ancestors()
-        .take_while(|p| !p.as_os_str().is_empty() && !p.exists())
-        .collect();
     if args.out.exists() && !args.out.is_dir() {
         return Err(Fail(format!(
             "--out {}: is a file, not a folder",
             args.out.display()
         )));
     }
-    std::fs::create_dir_all(&args.out)
-        .map_err(|e| Fail(format!("--out {}: cannot create: {e}", args.out.display())))?;
+    make_output(&args.out)?;
     let result = characterise(args, &config, given, &formats, &columns);
-    if result.is_err() {
-        // Deepest first; a folder something else has filled since stays.
-        for dir in created {
-            let _ = std::fs::remove_dir(dir);
-        }
-    }
+    output_done(result.is_ok());
     result
 }
 
@@ -433,24 +422,37 @@ fn characterise(
     })
 }
 
-/// The fresh folder [`write_all`] writes into while it does (made while this is held),
-/// and whether the process is ending: [`remove_staging`] removes it (a signal's handler,
-/// before the process ends), and the moves into `out` hold it.
-static STAGING: Mutex<(Option<PathBuf>, bool)> = Mutex::new((None, false));
+/// The output folders a run writes into, for a signal's handler ([`remove_staging`]).
+struct Staging {
+    /// The fresh folder [`write_staged`] writes into while it does (made while this is held).
+    folder: Option<PathBuf>,
+    /// The folders made for the output (the output folder and those above it that were not
+    /// there), deepest first, while the run may still fail.
+    made: Vec<PathBuf>,
+    /// Whether the process is ending: no folder is made after.
+    ending: bool,
+}
 
-/// The folder being written, and whether the process is ending, locked.
-fn staging() -> MutexGuard<'static, (Option<PathBuf>, bool)> {
+/// The run's output folders; the moves into `out` hold it.
+static STAGING: Mutex<Staging> = Mutex::new(Staging {
+    folder: None,
+    made: Vec::new(),
+    ending: false,
+});
+
+/// The run's output folders, locked.
+fn staging() -> MutexGuard<'static, Staging> {
     STAGING.lock().unwrap_or_else(PoisonError::into_inner)
 }
 
-/// Removes the folder `write_all` is writing into, if any, once the moves into `out` are
-/// done: for a process that ends on a signal (SIGINT, SIGTERM, SIGHUP), which leaves `out`
-/// as it was, or holding the whole new set. The lock stays taken, so no folder is made after
-/// this; the caller ends the process.
+/// Removes the folder `write_staged` is writing into, if any, once the moves into `out` are
+/// done, and the folders made for the output that are left empty: for a process that ends on
+/// a signal (SIGINT, SIGTERM, SIGHUP), which leaves `out` as it was, or holding the whole new
+/// set. The lock stays taken, so no folder is made after this; the caller ends the process.
 pub fn remove_staging() {
     let mut held = staging();
-    held.1 = true;
-    if let Some(folder) = held.0.take() {
+    held.ending = true;
+    if let Some(folder) = held.folder.take() {
         // A file the run creates between a removal's listing and its end leaves the folder
         // standing: again, until it is gone (no file can be created in it after that).
         for _ in 0..1000 {
@@ -460,7 +462,48 @@ pub fn remove_staging() {
             }
         }
     }
+    remove_empty(&held.made);
     std::mem::forget(held);
+}
+
+/// Makes the folder `out` and those above it that are missing, which [`output_done`] (and a
+/// signal's handler) removes again while they are empty; an error naming `out`.
+pub(crate) fn make_output(out: &Path) -> Result<(), Fail> {
+    let mut held = staging();
+    if held.ending {
+        return Err(Fail("ended by a signal".into()));
+    }
+    let made: Vec<PathBuf> = out
+        .ancestors()
+        .filter(|p| !p.as_os_str().is_empty())
+        .take_while(|p| p.symlink_metadata().is_err())
+        .map(Path::to_path_buf)
+        .collect();
+    let made_now = std::fs::create_dir_all(out);
+    held.made.extend(made.iter().cloned());
+    made_now.map_err(|e| {
+        remove_empty(&made);
+        Fail(format!("--out {}: cannot create: {e}", out.display()))
+    })
+}
+
+/// The run is over: the folders [`make_output`] made are kept where it wrote (`ok`), else
+/// removed while they are empty.
+pub(crate) fn output_done(ok: bool) {
+    let mut held = staging();
+    if !ok {
+        remove_empty(&held.made);
+    }
+    held.made.clear();
+}
+
+/// Removes the folders `made` (deepest first) that are empty, up to the first that is not.
+fn remove_empty(made: &[PathBuf]) {
+    for folder in made {
+        if std::fs::remove_dir(folder).is_err() {
+            break;
+        }
+    }
 }
 
 /// Removes the folders `.imu-ar-PID` in `out` whose process no longer runs (killed before it
@@ -487,8 +530,8 @@ fn sweep(out: &Path) {
     }
 }
 
-/// Writes every file of `formats` and the plots `draw` makes, or none: each into a fresh
-/// folder in `out` first, moved into `out` once all are written ([`commit`]).
+/// Writes every file of `formats` and the plots `draw` makes, or none ([`write_staged`]); the
+/// files of the other formats an earlier run left in `out` are set aside.
 pub(crate) fn write_all(
     formats: &[Format],
     imu: &ImuModel,
@@ -496,47 +539,72 @@ pub(crate) fn write_all(
     out: &Path,
     draw: &dyn Fn(&Path) -> Result<Vec<PathBuf>, Fail>,
 ) -> Result<Vec<String>, Fail> {
-    sweep(out);
-    let staging_folder = out.join(format!(".imu-ar-{}", std::process::id()));
-    let staging_folder = &staging_folder;
-    let cannot = |e: std::io::Error| Fail(format!("{}: {e}", out.display()));
-    {
-        let mut held = staging();
-        if held.1 {
-            return Err(Fail("ended by a signal".into()));
-        }
-        held.0 = Some(staging_folder.clone());
-        std::fs::create_dir_all(staging_folder).map_err(cannot)?;
-    }
-    let written = formats
-        .iter()
-        .map(|f| write(*f, imu, horizon, staging_folder))
-        .collect::<Result<Vec<PathBuf>, Fail>>()
-        .and_then(|mut paths| {
-            paths.extend(draw(staging_folder)?);
-            Ok(paths)
-        });
-    // The files of the formats not asked for, an earlier run's: set aside with the commit,
-    // so that the folder holds one run's files (a file of such a name that no export wrote
-    // is left as it is).
-    let stale: Vec<&str> = Format::ALL
+    write_staged(out, &stale(formats), &|folder| {
+        let mut paths = formats
+            .iter()
+            .map(|f| write(*f, imu, horizon, folder))
+            .collect::<Result<Vec<PathBuf>, Fail>>()?;
+        paths.extend(draw(folder)?);
+        Ok(paths)
+    })
+}
+
+/// The files of the formats not in `formats`: an earlier run's, where an export wrote them.
+pub(crate) fn stale(formats: &[Format]) -> Vec<&'static str> {
+    Format::ALL
         .iter()
         .filter(|f| !formats.contains(f))
         .map(|f| f.file_name())
-        .collect();
+        .collect()
+}
+
+/// Writes the files `write` writes into a folder, or none: into a fresh folder in `out`
+/// first, moved into `out` once all are written ([`commit`]), the files named `stale` there
+/// that an export wrote set aside with them (so that the folder holds one run's files; a file
+/// of such a name that no export wrote is left as it is). The paths written, in `out`.
+pub(crate) fn write_staged(
+    out: &Path,
+    stale: &[&str],
+    write: &dyn Fn(&Path) -> Result<Vec<PathBuf>, Fail>,
+) -> Result<Vec<String>, Fail> {
+    let made = !out.is_dir();
+    make_output(out)?;
+    sweep(out);
+    let staging_folder = out.join(format!(".imu-ar-{}", std::process::id()));
+    let staging_folder = &staging_folder;
+    {
+        let mut held = staging();
+        if held.ending {
+            return Err(Fail("ended by a signal".into()));
+        }
+        held.folder = Some(staging_folder.clone());
+        if let Err(e) = std::fs::create_dir_all(staging_folder) {
+            held.folder = None;
+            drop(held);
+            if made {
+                output_done(false);
+            }
+            return Err(Fail(format!("{}: {e}", out.display())));
+        }
+    }
+    let written = write(staging_folder);
     // A signal's handler waits for the moves and the folder's removal.
     let mut held = staging();
     let moved = written.and_then(|paths| {
         commit(
             &paths,
-            &stale,
+            stale,
             out,
             &staging_folder.join("kept"),
             &|from, to| std::fs::rename(from, to),
         )
     });
     let _ = std::fs::remove_dir_all(staging_folder);
-    held.0 = None;
+    held.folder = None;
+    drop(held);
+    if made {
+        output_done(moved.is_ok());
+    }
     moved
 }
 

@@ -293,11 +293,31 @@ pub fn unchecked(given: Option<f64>, why: Option<&str>) -> Option<String> {
     let (Some(r), Some(why)) = (given, why) else {
         return None;
     };
-    let why = why
-        .trim_end_matches(" (or give --rate)")
-        .trim_end_matches("; give --rate")
-        .trim_end_matches(" (give --rate)");
-    Some(format!("read at --rate {}, but {why}", number(r)))
+    Some(format!(
+        "read at --rate {}, but {}",
+        number(r),
+        without_rate(why)
+    ))
+}
+
+/// A refusal's reason without its way past (the last "give --rate" and what follows, with
+/// the words that lead to it), a parenthesis it opened closed.
+fn without_rate(why: &str) -> String {
+    let Some(at) = why.rfind("give --rate") else {
+        return why.into();
+    };
+    let mut head = why[..at].trim_end();
+    while let Some(rest) = ["(or", " or", "(", ";", ":", ","]
+        .iter()
+        .find_map(|s| head.strip_suffix(s))
+    {
+        head = rest.trim_end();
+    }
+    let open = head
+        .matches('(')
+        .count()
+        .saturating_sub(head.matches(')').count());
+    format!("{head}{}", ")".repeat(open))
 }
 
 /// The factor from a column in `from` (where known) to `--unit` `to`, and the unit of the result.
@@ -585,6 +605,44 @@ pub fn default_delta(x: &[f64]) -> Result<f64, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_warning_for_a_rate_given_does_not_ask_for_it() {
+        // The refusals' ways past, as the timing gives them ("... phase tells neither: give
+        // --rate" was read at --rate 4000 with that ending, before).
+        for (why, kept) in [
+            (
+                "their phase tells neither: give --rate",
+                "their phase tells neither",
+            ),
+            (
+                "one record must have one rate (or give --rate)",
+                "one record must have one rate",
+            ),
+            ("the rate is not told; give --rate", "the rate is not told"),
+            (
+                "read the stretches apart, or give --rate",
+                "read the stretches apart",
+            ),
+            (
+                "samples repeated? give --rate (--drop-backward would drop the others too)",
+                "samples repeated?",
+            ),
+            (
+                "drops them (a faster clock repeats them evenly: give --rate)",
+                "drops them (a faster clock repeats them evenly)",
+            ),
+            (
+                "too few to tell the rate to 1 % (give --rate)",
+                "too few to tell the rate to 1 %",
+            ),
+            ("no way past", "no way past"),
+        ] {
+            let w = unchecked(Some(4000.0), Some(why)).unwrap();
+            assert_eq!(w, format!("read at --rate 4000, but {kept}"));
+        }
+        assert_eq!(unchecked(None, Some("x: give --rate")), None);
+    }
 
     #[test]
     fn numbers_are_shown_as_written_unless_long() {

@@ -19,7 +19,13 @@ pub(super) fn check_path(path: &Path) -> Result<(), Fail> {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
-    if !png || path.is_dir() {
+    if path.is_dir() {
+        return Err(Fail(format!(
+            "--plot {}: is a directory; name a .png file",
+            path.display()
+        )));
+    }
+    if !png {
         return Err(Fail(format!(
             "--plot {}: must name a .png file",
             path.display()
@@ -88,7 +94,9 @@ pub(crate) fn png(
     paint: &[(&super::Paint, String)],
 ) -> Result<(), String> {
     font().map_err(|Fail(e)| e)?;
-    let root = BitMapBackend::new(path, size).into_drawing_area();
+    let root = crate::chart::bitmap(path, size)
+        .map_err(|Fail(e)| e)?
+        .into_drawing_area();
     let panels = root.split_evenly((1, paint.len().max(1)));
     for (area, (p, caption)) in panels.iter().zip(paint) {
         p(area, caption)?;

@@ -104,9 +104,12 @@ pub fn run(args: &Args) -> Result<Summary, Fail> {
         unit: run.record.input.unit.as_deref().unwrap_or("units"),
         reference,
         prior: prior_a.map(|a| (a, args.prior.prior_weight.unwrap_or(delta))),
-        out: &args.out,
     };
-    with_order!(run.record.order, report(&r)).map_err(|Fail(e)| run.record.input.fail(e))
+    let (mut summary, draw) =
+        with_order!(run.record.order, report(&r)).map_err(|Fail(e)| run.record.input.fail(e))?;
+    // All the plots or none, as characterise writes its files.
+    summary.files = crate::characterise::write_staged(&args.out, &[], &*draw)?;
+    Ok(summary)
 }
 
 /// Whether `out` can be a directory: it is one, or its nearest existing ancestor is one.
@@ -169,7 +172,6 @@ struct Report<'a> {
     reference: Option<Vec<(f64, f64)>>,
     /// `--prior-a` and its weight, the `delta` of the lattice that starts from it.
     prior: Option<(&'a [f64], f64)>,
-    out: &'a Path,
 }
 
 /// Fewest samples a report is drawn from: enough for a periodogram of 8-sample segments.
@@ -218,8 +220,11 @@ impl<const P: usize> FromPrior<P> {
     }
 }
 
-/// Writes the four PNGs (five with a prior) and returns the summary.
-fn report<const P: usize>(r: &Report) -> Result<Summary, Fail> {
+/// The plots of a report, drawn into a folder: their paths.
+type Draw<'r> = Box<dyn Fn(&Path) -> Result<Vec<PathBuf>, Fail> + 'r>;
+
+/// The summary (its files left empty), and what draws the four PNGs (five with a prior).
+fn report<'r, const P: usize>(r: &'r Report) -> Result<(Summary, Draw<'r>), Fail> {
     let x = r.x;
     if x.len() < MIN_SAMPLES {
         return Err(Fail(format!(
@@ -236,9 +241,6 @@ fn report<const P: usize>(r: &Report) -> Result<Summary, Fail> {
 
     // The recursive estimators over the whole record; their errors and coefficients sampled.
     let (config, channel) = (Config::new(r.lambda, dt)?, Channel::new(r.delta)?);
-    // Only once the input has passed every check.
-    std::fs::create_dir_all(r.out)
-        .map_err(|e| Fail(format!("{}: cannot create: {e}", r.out.display())))?;
     let stride = (x.len() / POINTS).max(1);
     let mut coef = (Vec::new(), Vec::new());
     let mut se = [vec![], vec![], vec![]];
@@ -306,16 +308,7 @@ fn report<const P: usize>(r: &Report) -> Result<Summary, Fail> {
         ),
         None => None,
     };
-    let mut files = vec![
-        coefficients_png::<P>(r, &coef, &train_fit)?,
-        error_png(r, &se, &mse, n_train as f64 * dt)?,
-        psd_png(r, &whole_fit)?,
-        adev_png(r, &whole_fit)?,
-    ];
-    if let Some(p) = &from_prior {
-        files.push(prior_png(r, p, &coef.1)?);
-    }
-    Ok(Summary {
+    let summary = Summary {
         order: P,
         lambda: r.lambda,
         rate_hz: r.rate,
@@ -330,6 +323,20 @@ fn report<const P: usize>(r: &Report) -> Result<Summary, Fail> {
         batch_a: train_fit.a().to_vec(),
         lattice_a: lattice.coefficients(P).map(|a| a.to_vec()),
         prior_lattice_a,
-        files: files.iter().map(|f| f.display().to_string()).collect(),
-    })
+        files: Vec::new(),
+    };
+    let t_train = n_train as f64 * dt;
+    let draw = move |dir: &Path| {
+        let mut files = vec![
+            coefficients_png::<P>(r, dir, &coef, &train_fit)?,
+            error_png(r, dir, &se, &mse, t_train)?,
+            psd_png(r, dir, &whole_fit)?,
+            adev_png(r, dir, &whole_fit)?,
+        ];
+        if let Some(p) = &from_prior {
+            files.push(prior_png(r, dir, p, &coef.1)?);
+        }
+        Ok(files)
+    };
+    Ok((summary, Box::new(draw)))
 }

@@ -1,6 +1,6 @@
 //! The PNG plots of `imu-ar report`: four, and prior.png with `--prior-a`.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use imu_ar::ArModel;
 use imu_ar::allan::overlapping_avar;
@@ -97,11 +97,12 @@ fn level<'a, 'b, DB: DrawingBackend + 'a>(
 
 pub(super) fn coefficients_png<const P: usize>(
     r: &Report,
+    dir: &Path,
     coef: &(Track<P>, Track<P>),
     batch: &ArModel<f64, P>,
 ) -> Result<PathBuf, Fail> {
-    let path = r.out.join("coefficients.png");
-    let root = BitMapBackend::new(&path, SIZE).into_drawing_area();
+    let path = dir.join("coefficients.png");
+    let root = crate::chart::bitmap(&path, SIZE)?.into_drawing_area();
     root.fill(&WHITE).map_err(draw_err)?;
     let t_end = coef.0.last().map_or(1.0, |c| c.0);
     let (lo, hi) = span(
@@ -157,12 +158,13 @@ pub(super) fn coefficients_png<const P: usize>(
 
 pub(super) fn error_png(
     r: &Report,
+    dir: &Path,
     se: &[Vec<(f64, f64)>; 3],
     mse: &[f64; 3],
     t_train: f64,
 ) -> Result<PathBuf, Fail> {
-    let path = r.out.join("prediction_error.png");
-    let root = BitMapBackend::new(&path, SIZE).into_drawing_area();
+    let path = dir.join("prediction_error.png");
+    let root = crate::chart::bitmap(&path, SIZE)?.into_drawing_area();
     root.fill(&WHITE).map_err(draw_err)?;
     let t_end = se[0].last().map_or(1.0, |p| p.0);
     // The first tenth of the record is the recursive estimators' start: leave it out of the range.
@@ -253,9 +255,10 @@ fn welch(x: &[f64], rate: f64) -> Vec<(f64, f64)> {
 
 pub(super) fn psd_png<const P: usize>(
     r: &Report,
+    dir: &Path,
     model: &ArModel<f64, P>,
 ) -> Result<PathBuf, Fail> {
-    let path = r.out.join("psd.png");
+    let path = dir.join("psd.png");
     let data = welch(r.x, r.rate);
     let psd = |f: f64| {
         model
@@ -266,7 +269,7 @@ pub(super) fn psd_png<const P: usize>(
         .iter()
         .map(|&(f, _)| Ok((f, 2.0 * psd(f)?)))
         .collect::<Result<Vec<(f64, f64)>, Fail>>()?;
-    let root = BitMapBackend::new(&path, SIZE).into_drawing_area();
+    let root = crate::chart::bitmap(&path, SIZE)?.into_drawing_area();
     root.fill(&WHITE).map_err(draw_err)?;
     let (f_lo, f_hi) = (data[0].0, data[data.len() - 1].0);
     let values = data.iter().chain(&fitted).map(|p| p.1).filter(|v| *v > 0.0);
@@ -304,9 +307,10 @@ pub(super) fn psd_png<const P: usize>(
 
 pub(super) fn adev_png<const P: usize>(
     r: &Report,
+    dir: &Path,
     model: &ArModel<f64, P>,
 ) -> Result<PathBuf, Fail> {
-    let path = r.out.join("adev.png");
+    let path = dir.join("adev.png");
     let dt = 1.0 / r.rate;
     let ms: Vec<usize> = (0..)
         .map(|k| 1usize << k)
@@ -334,7 +338,7 @@ pub(super) fn adev_png<const P: usize>(
         .map(|p| p.1)
         .filter(|v| *v > 0.0)
         .fold((f64::INFINITY, 0.0f64), |(l, h), v| (l.min(v), h.max(v)));
-    let root = BitMapBackend::new(&path, SIZE).into_drawing_area();
+    let root = crate::chart::bitmap(&path, SIZE)?.into_drawing_area();
     root.fill(&WHITE).map_err(draw_err)?;
     let mut chart = builder(
         &root,
@@ -459,11 +463,12 @@ fn prior_panel<const P: usize, DB: DrawingBackend>(
 /// [`HEAD`]: super::HEAD
 pub(super) fn prior_png<const P: usize>(
     r: &Report,
+    dir: &Path,
     prior: &FromPrior<P>,
     plain: &Track<P>,
 ) -> Result<PathBuf, Fail> {
-    let path = r.out.join("prior.png");
-    let root = BitMapBackend::new(&path, SIZE).into_drawing_area();
+    let path = dir.join("prior.png");
+    let root = crate::chart::bitmap(&path, SIZE)?.into_drawing_area();
     root.fill(&WHITE).map_err(draw_err)?;
     // A long prior is cut after four coefficients.
     let mut a0: Vec<String> = prior.a0.iter().take(4).map(|v| v.to_string()).collect();

@@ -388,11 +388,6 @@ pub fn run(args: &Args) -> Result<Thermal, Fail> {
         });
     }
     let (noise_bands, worst, noise_bands_note) = noise_bands(args, &warm, &fits, ranges, &config)?;
-    // Made where the first file is written: a refusal before leaves no folder behind.
-    let create_out = || {
-        std::fs::create_dir_all(&args.out)
-            .map_err(|e| Fail(format!("--out {}: cannot create: {e}", args.out.display())))
-    };
     let mut thermal = Thermal {
         n: warm.sensors[0].celsius.len(),
         instance: warm.instance,
@@ -449,77 +444,102 @@ pub fn run(args: &Args) -> Result<Thermal, Fail> {
              bias (check the columns' units)",
         ));
     }
-    if let Some(noise_formats) = noise_formats {
-        let Some((axes, rate)) = worst else {
-            let why = thermal.noise_bands_note.clone().unwrap_or_else(|| {
-                let missing: Vec<String> = thermal
-                    .noise_bands
-                    .iter()
-                    .filter(|a| a.worst.is_none())
-                    .map(|a| {
-                        let reason = a
-                            .bands
-                            .iter()
-                            .find_map(|b| b.note.clone())
-                            .unwrap_or_default();
-                        format!("{} ({reason})", a.axis)
-                    })
-                    .collect();
-                format!("no band of {} has a noise model", missing.join(", "))
-            });
-            return Err(with_file(&args.files, format!("--noise-format: {why}")));
-        };
-        let origin: Vec<String> = thermal
-            .noise_bands
-            .iter()
-            .filter_map(|a| {
-                let b = &a.bands[a.worst?];
-                Some(format!("{} {:.1} to {:.1} deg C", a.axis, b.from_c, b.to_c))
-            })
-            .collect();
-        let imu = ImuModel {
-            axes,
-            rate_hz: rate,
-            topic: None,
-            filter_rate_hz: args.model.filter_rate,
-            loop_rate_hz: None,
-            sysid: None,
-            origin: Some(format!(
-                "Each axis from its worst temperature band (the largest N), the thermal bias \
-                 taken out (imu-ar thermal): {}.",
-                origin.join(", ")
-            )),
-        };
-        create_out()?;
-        let written =
-            crate::characterise::write_all(&noise_formats, &imu, None, &args.out, &|_| {
-                Ok(Vec::new())
-            })?;
-        thermal.files.extend(written);
-    }
-    create_out()?;
-    for format in formats {
-        let text = match format {
-            Format::Px4 => match &px4 {
-                Some(p) => px4_file(p, px4_slot.into(), &thermal),
-                None => continue,
-            },
-            Format::ArduPilot => ardupilot_file(&ardupilot, imu.into(), &thermal),
-            Format::Json => format!("{}\n", serde_json::to_value(&thermal)?),
-            Format::Png => {
-                let path = args.out.join(format.file_name());
-                let units = [warm.sensors[0].unit, warm.sensors[1].unit];
-                plot::png(&path, &fits, units)
-                    .map_err(|Fail(e)| Fail(format!("{}: {e}", path.display())))?;
-                thermal.files.push(path.display().to_string());
-                continue;
+    let noise = match noise_formats {
+        None => None,
+        Some(noise_formats) => Some((noise_formats, noise_model(args, &thermal, worst)?)),
+    };
+    // The files of the set, all written or none (the noise files of the formats not asked
+    // for, an earlier run's, set aside with them).
+    let in_out = |name: &str| args.out.join(name).display().to_string();
+    let noise_files = noise
+        .iter()
+        .flat_map(|(f, _)| f.iter().map(|f| f.file_name()));
+    let own = formats
+        .iter()
+        .filter(|f| **f != Format::Px4 || px4.is_some())
+        .map(|f| f.file_name());
+    thermal.files = noise_files.chain(own).map(in_out).collect();
+    let stale = noise
+        .as_ref()
+        .map_or(Vec::new(), |(f, _)| crate::characterise::stale(f));
+    let units = [warm.sensors[0].unit, warm.sensors[1].unit];
+    crate::characterise::write_staged(&args.out, &stale, &|folder| {
+        let mut paths = Vec::new();
+        if let Some((noise_formats, imu)) = &noise {
+            for f in noise_formats {
+                paths.push(export::write(*f, imu, None, folder)?);
             }
-        };
-        let path = args.out.join(format.file_name());
-        std::fs::write(&path, text).map_err(|e| Fail(format!("{}: {e}", path.display())))?;
-        thermal.files.push(path.display().to_string());
-    }
+        }
+        for format in &formats {
+            let path = folder.join(format.file_name());
+            let text = match format {
+                Format::Px4 => match &px4 {
+                    Some(p) => px4_file(p, px4_slot.into(), &thermal),
+                    None => continue,
+                },
+                Format::ArduPilot => ardupilot_file(&ardupilot, imu.into(), &thermal),
+                Format::Json => format!("{}\n", serde_json::to_value(&thermal)?),
+                Format::Png => {
+                    plot::png(&path, &fits, units)?;
+                    paths.push(path);
+                    continue;
+                }
+            };
+            std::fs::write(&path, text).map_err(|e| Fail(format!("{}: {e}", path.display())))?;
+            paths.push(path);
+        }
+        Ok(paths)
+    })?;
     Ok(thermal)
+}
+
+/// The six axes' noise models from their worst temperature bands (`worst`, and the rate), for
+/// `--noise-format`; an error saying why there are none.
+fn noise_model(
+    args: &Args,
+    thermal: &Thermal,
+    worst: Option<([export::AxisModel; 6], f64)>,
+) -> Result<ImuModel, Fail> {
+    let Some((axes, rate)) = worst else {
+        let why = thermal.noise_bands_note.clone().unwrap_or_else(|| {
+            let missing: Vec<String> = thermal
+                .noise_bands
+                .iter()
+                .filter(|a| a.worst.is_none())
+                .map(|a| {
+                    let reason = a
+                        .bands
+                        .iter()
+                        .find_map(|b| b.note.clone())
+                        .unwrap_or_default();
+                    format!("{} ({reason})", a.axis)
+                })
+                .collect();
+            format!("no band of {} has a noise model", missing.join(", "))
+        });
+        return Err(with_file(&args.files, format!("--noise-format: {why}")));
+    };
+    let origin: Vec<String> = thermal
+        .noise_bands
+        .iter()
+        .filter_map(|a| {
+            let b = &a.bands[a.worst?];
+            Some(format!("{} {:.1} to {:.1} deg C", a.axis, b.from_c, b.to_c))
+        })
+        .collect();
+    Ok(ImuModel {
+        axes,
+        rate_hz: rate,
+        topic: None,
+        filter_rate_hz: args.model.filter_rate,
+        loop_rate_hz: None,
+        sysid: None,
+        origin: Some(format!(
+            "Each axis from its worst temperature band (the largest N), the thermal bias \
+             taken out (imu-ar thermal): {}.",
+            origin.join(", ")
+        )),
+    })
 }
 
 /// Each axis's noise model per temperature band ([`bands`]); with the worst band's models of

@@ -32,7 +32,7 @@ fn span(values: impl Iterator<Item = f64>) -> (f64, f64) {
 /// accelerometer's.
 pub fn png(path: &Path, fits: &[AxisFit], units: [&str; 2]) -> Result<(), Fail> {
     font()?;
-    let root = BitMapBackend::new(path, SIZE).into_drawing_area();
+    let root = crate::chart::bitmap(path, SIZE)?.into_drawing_area();
     root.fill(&WHITE).map_err(draw_err)?;
     let panels = root.split_evenly((4, 3));
     for (i, fit) in fits.iter().enumerate().take(6) {

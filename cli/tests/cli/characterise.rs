@@ -451,12 +451,7 @@ fn a_run_ended_by_a_signal_leaves_no_folder_behind() {
     // SIGTERM while the files are being written (or, if the run is done by then, after).
     let signalled = dir.join("signalled");
     std::fs::create_dir_all(&signalled).unwrap();
-    let mut child = common::command()
-        .args(["characterise", path(&file), "--out", path(&signalled)])
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
+    let mut child = spawned(&file, &signalled);
     let start = std::time::Instant::now();
     while leftovers(&signalled).is_empty() && start.elapsed().as_secs() < 60 {
         if child.try_wait().unwrap().is_some() {
@@ -464,10 +459,7 @@ fn a_run_ended_by_a_signal_leaves_no_folder_behind() {
         }
         std::thread::sleep(std::time::Duration::from_micros(200));
     }
-    let kill = std::process::Command::new("kill")
-        .args(["-TERM", &child.id().to_string()])
-        .status()
-        .unwrap();
+    let kill = terminated(&child);
     let status = child.wait().unwrap();
     assert!(
         !kill.success() || status.code() == Some(130) || status.success(),
@@ -478,6 +470,43 @@ fn a_run_ended_by_a_signal_leaves_no_folder_behind() {
         "{:?}",
         leftovers(&signalled)
     );
+    // SIGTERM while the record is read into folders the run made for --out: they go too
+    // (fresh/a/b was left, empty, before).
+    let fresh = dir.join("fresh");
+    let deep = fresh.join("a").join("b");
+    let mut child = spawned(&file, &deep);
+    let start = std::time::Instant::now();
+    while !deep.exists() && start.elapsed().as_secs() < 60 && child.try_wait().unwrap().is_none() {
+        std::thread::sleep(std::time::Duration::from_micros(200));
+    }
+    let kill = terminated(&child);
+    let status = child.wait().unwrap();
+    if kill.success() && status.code() == Some(130) {
+        assert!(!fresh.exists(), "{:?}", std::fs::read_dir(&fresh).ok());
+    } else {
+        assert!(
+            status.success() && deep.join("imu.yaml").is_file(),
+            "{status:?}"
+        );
+    }
+}
+
+/// `characterise` of `file` into `out`, running, its output discarded.
+fn spawned(file: &Path, out: &Path) -> std::process::Child {
+    common::command()
+        .args(["characterise", path(file), "--out", path(out)])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap()
+}
+
+/// Whether SIGTERM reached `child` (not if it had ended).
+fn terminated(child: &std::process::Child) -> std::process::ExitStatus {
+    std::process::Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap()
 }
 
 fn refused(args: &[&str], want: &str) {

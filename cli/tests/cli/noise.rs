@@ -345,6 +345,18 @@ fn refuses_bad_input_with_one_line_and_nothing_on_stdout() {
     );
     plot_refused(Path::new("/tmp/plot.txt"), "must name a .png file");
     plot_refused(Path::new("/nonexistent/folder/plot.png"), "does not exist");
+    // A folder in the way is named so ("must name a .png file", before).
+    let folder = crate::common::temp_path("plot-folder.png");
+    std::fs::create_dir_all(&folder).unwrap();
+    plot_refused(&folder, "is a directory; name a .png file");
+    // A plot that cannot be created is named with the system's reason (a plotting library's
+    // nested error values, before).
+    if Path::new("/proc/self").exists() {
+        with(
+            &["--plot", "/proc/x.png"],
+            "--plot /proc/x.png: cannot draw: x.png: cannot be written: No such file or directory",
+        );
+    }
 }
 
 /// `column` of a temp file: a white-noise record of 4096 samples times `scale`.

@@ -224,6 +224,29 @@ fn kalman_refuses_a_filter_step_beyond_u32() {
     std::fs::remove_file(file).unwrap();
 }
 
+/// `report` writes every plot or none: with a folder in the way of one, the plots before it
+/// were left (exit 2, "drawing failed: BackendError(...)" naming the input, before).
+#[test]
+fn report_writes_every_plot_or_none() {
+    let file = drift_record("report-blocked.csv", "2000");
+    for blocked in ["psd.png", "adev.png"] {
+        let out = crate::common::temp_path("cli-report-blocked");
+        std::fs::create_dir_all(out.join(blocked)).unwrap();
+        let (f, o) = (file.to_str().unwrap(), out.to_str().unwrap());
+        let run = imu_ar(&[
+            "report", f, "--column", "x", "--order", "2", "--rate", "100", "--out", o,
+        ]);
+        common::assert_one_line_failure(&run);
+        let err = common::stderr(&run);
+        assert!(
+            err.contains(&out.join(blocked).display().to_string())
+                && err.contains("is a directory; no file was written"),
+            "{blocked}: {err}"
+        );
+        assert_eq!(crate::common::names_in(&out), [blocked], "{blocked}");
+    }
+}
+
 /// Issue 23 item 12: `report` creates `--out` only after its input passed every check.
 #[test]
 fn report_creates_out_only_for_good_input() {

@@ -171,6 +171,78 @@ fn the_written_parameters_cancel_a_simulated_bias() {
     assert_cancelled(&px4, &ap, 0, 1);
 }
 
+/// A thermal run that cannot write one of its files writes none: with a folder in the way of
+/// the plot, the JSON or the ArduPilot file (the files before it were left, exit 2, before),
+/// and of a noise file; a run that writes them all lists them all in its JSON.
+#[test]
+fn a_thermal_run_writes_every_file_or_none() {
+    let record = warm_up("all-or-none.csv", 0.0);
+    let ids = [
+        "--device-id",
+        "2359330,2359331",
+        "--noise-format",
+        "kalibr",
+        "--rate",
+        "100",
+    ];
+    for blocked in [
+        "thermal.png",
+        "thermal.json",
+        "ardupilot_tcal.parm",
+        "imu.yaml",
+    ] {
+        let out = temp_path("thermal-blocked");
+        std::fs::create_dir_all(out.join(blocked)).unwrap();
+        let run = imu_ar(
+            &[
+                &[
+                    "thermal",
+                    record.to_str().unwrap(),
+                    "--out",
+                    out.to_str().unwrap(),
+                ][..],
+                &ids[..],
+            ]
+            .concat(),
+        );
+        assert_one_line_failure(&run);
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert!(
+            err.contains(blocked) && err.contains("is a directory; no file was written"),
+            "{blocked}: {err}"
+        );
+        assert_eq!(crate::common::names_in(&out), [blocked], "{blocked}");
+    }
+    let out = temp_path("thermal-all").join("new");
+    let o = out.to_str().unwrap();
+    let run = imu_ar(
+        &[
+            &["thermal", record.to_str().unwrap(), "--out", o, "--json"][..],
+            &ids[..],
+        ]
+        .concat(),
+    );
+    let files = json(&run)["files"].clone();
+    let names = [
+        "imu.yaml",
+        "px4_thermal.params",
+        "ardupilot_tcal.parm",
+        "thermal.json",
+        "thermal.png",
+    ];
+    let want: Vec<String> = names
+        .iter()
+        .map(|n| out.join(n).display().to_string())
+        .collect();
+    assert_eq!(files, serde_json::json!(want));
+    for name in names {
+        assert!(out.join(name).is_file(), "{name}");
+    }
+    let written: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("thermal.json")).unwrap()).unwrap();
+    assert_eq!(written["files"], files);
+}
+
 /// The parameters of PX4 slot `slot` and ArduPilot IMU `imu`, applied through each
 /// autopilot's formula, cancel the simulated bias across 20 to 60 deg C: gyros to 1e-4 rad/s,
 /// accelerometers to 1e-3 m/s^2 (an accelerometer's constant, and ArduPilot's, left to the

@@ -186,3 +186,11 @@ pub fn fit_burg(file: &Path) -> Output {
         "1",
     ])
 }
+
+/// The names in the folder `dir`.
+pub fn names_in(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect()
+}
