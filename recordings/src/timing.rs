@@ -533,8 +533,9 @@ pub struct Timing {
 
 /// The difference of the two commonest `values` (ns, those within 2 ns and 1e-5 of each other
 /// taken as one: a tick's multiples rounded to the ns) where they lie a tenth apart or less,
-/// each a tenth of them or more and together nine in ten.
-fn two_values(values: &[f64]) -> Option<f64> {
+/// or one `quantum` apart (a clock between two of its multiples, rounded to it), each a tenth
+/// of them or more and together nine in ten.
+fn two_values(values: &[f64], quantum: Option<f64>) -> Option<f64> {
     let mut sorted = values.to_vec();
     sorted.sort_unstable_by(f64::total_cmp);
     let mut counts: Vec<(usize, f64)> = sorted
@@ -545,7 +546,9 @@ fn two_values(values: &[f64]) -> Option<f64> {
     let (&(n1, a), &(n2, b)) = (counts.first()?, counts.get(1)?);
     let (n, all) = (n1 + n2, sorted.len());
     let (low, high) = (a.min(b), a.max(b));
-    (10 * n2 >= all && 10 * n >= 9 * all && 10.0 * (high - low) <= low).then_some(high - low)
+    let close =
+        10.0 * (high - low) <= low || quantum.is_some_and(|q| (high - low - q).abs() <= 2.0);
+    (10 * n2 >= all && 10 * n >= 9 * all && close).then_some(high - low)
 }
 
 /// The most samples, relative, a rate given for runs of a FIFO's reads
@@ -1979,6 +1982,7 @@ impl Timing {
                     missing,
                     mut regular,
                     sum: mut regular_sum,
+                    ..
                 },
             mut period,
             repeats,
@@ -2256,7 +2260,59 @@ impl Timing {
             return Ok(summary);
         }
         self.refold(&mut summary, resolution, median, rounded)?;
+        if rounded {
+            self.crossings_hide_losses(&summary, resolution)?;
+        }
         Ok(summary)
+    }
+
+    /// An error where a clock near two quanta (`resolution`, ns) a period, not pinned to an
+    /// edge ([`Timing::on_an_edge`]), crosses a quantum's edge often enough that the samples
+    /// its gaps miss hide two more or more, a ten-thousandth of those kept or more: a lost
+    /// sample whose next crosses back leaves three quanta, as the clock's own crossing does,
+    /// and the intervals read the rate low by those. The lost samples hidden are reckoned as
+    /// the gaps' share of the crossings: the samples missing times the crossings back (one
+    /// quantum) over the other intervals between distinct stamps.
+    fn crossings_hide_losses(
+        &self,
+        summary: &TimingSummary,
+        resolution: Option<i64>,
+    ) -> Result<(), String> {
+        let Some(q) = resolution else {
+            return Ok(());
+        };
+        let period = 2.0 * q as f64;
+        if (summary.rate_hz * period * 1e-9 - 1.0).abs() > 0.02 || summary.missing_samples == 0 {
+            return Ok(());
+        }
+        let (mut crossings, mut intervals) = (0u64, 0u64);
+        for w in self.stamps.windows(2).filter(|w| w[1] > w[0]) {
+            intervals += 1;
+            crossings += u64::from(i128::from(w[1]) - i128::from(w[0]) == i128::from(q));
+        }
+        let others = intervals.saturating_sub(crossings);
+        if others == 0 {
+            return Ok(());
+        }
+        let hidden = summary.missing_samples as f64 * crossings as f64 / others as f64;
+        let kept = self.kept as f64;
+        if hidden < 2.0 || hidden < 1e-4 * kept {
+            return Ok(());
+        }
+        let hz = summary.rate_hz;
+        Err(format!(
+            "the timestamps, stamped to {:e} s, step by about two quanta, one interval in {} \
+             a quantum (samples jittered across a quantum's edge), with {} samples missing: a \
+             sample lost where the next crosses back leaves three quanta, as the clock's own \
+             crossing does, so some {} more were lost and leave no gap; the rate lies between \
+             {} Hz and {} Hz; give --rate",
+            q as f64 * 1e-9,
+            (intervals as f64 / crossings as f64).round(),
+            summary.missing_samples,
+            hidden.round(),
+            short(hz * (1.0 - hidden / kept)),
+            short(hz * (1.0 + 3.0 * hidden / kept))
+        ))
     }
 
     /// A clock of exactly two quanta (`resolution`, ns) a period whose samples lie on a
@@ -2397,13 +2453,14 @@ impl Timing {
         let inside = middle_of(&mut within);
         let mut deviations: Vec<f64> = within.iter().map(|iv| (iv - inside).abs()).collect();
         let jitter = 1.4826 * middle_of(&mut deviations) / inside;
-        // Intervals within runs of two values a tenth apart or less, each a tenth of them or
-        // more and together nine in ten: a clock rounded to a tick of their difference (a
-        // 32768 Hz counter's), whose losses are whole numbers of their mean, give or take a
-        // tick.
-        let (spacing, tick) = two_values(&within).map_or((inside, 0.0), |tick| {
-            (within.iter().sum::<f64>() / within.len() as f64, tick)
-        });
+        // Intervals within runs of two values a tenth apart or less, or a quantum apart, each
+        // a tenth of them or more and together nine in ten: a clock rounded to a tick of
+        // their difference (a 32768 Hz counter's; whole ms at 180.2 Hz, 5 and 6 ms), whose
+        // losses are whole numbers of their mean, give or take a tick.
+        let (spacing, tick) = two_values(&within, quantum.map(|q| q as f64))
+            .map_or((inside, 0.0), |tick| {
+                (within.iter().sum::<f64>() / within.len() as f64, tick)
+            });
         // Samples lost leave intervals of whole periods: where most of the longer intervals
         // are (within 2 % and four times the runs' jitter), the runs are a clock's with
         // samples lost at a steady count.
@@ -3519,6 +3576,13 @@ fn judged(
                     (time, held)
                 }
             }
+            // Where no stamp repeats and none comes short, the gaps' time over the periods
+            // they span too: a clock between two multiples of the quantum steps across one
+            // now and then, and the steps a gap holds are its own (the regular intervals
+            // alone read 496.29 Hz for 496.156 with 3 % lost).
+            _ if counted == 0 && c.short == 0 => {
+                (c.sum + c.gap_sum, c.regular + c.gaps + c.missing)
+            }
             _ => (
                 c.sum - end_sum,
                 (c.regular + counted).saturating_sub(end_samples),
@@ -3604,6 +3668,7 @@ fn classes(buckets: &[Bucket], window: &Window) -> Classes {
             Ordering::Less => c.short += n,
             Ordering::Greater => {
                 c.gaps += n;
+                c.gap_sum += b.total() - n as f64 * skip;
                 // Each gap misses the periods it spans less one: per interval where the
                 // bucket's intervals all round alike, else from their sum.
                 let periods = |iv: i64| ((iv as f64 - skip) / reference).round();
@@ -3647,6 +3712,8 @@ struct Classes {
     missing: u64,
     regular: u64,
     sum: f64,
+    /// The gaps' time, ns, less the skip of each.
+    gap_sum: f64,
 }
 
 /// What a record's timestamps show.
@@ -6325,6 +6392,65 @@ mod tests {
             assert!(
                 (s.rate_hz / rate - 1.0).abs() < 1e-4 && s.missing_samples.abs_diff(lost) <= 2,
                 "{rate} Hz: {lost} lost, {s:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_clock_near_two_quanta_whose_crossings_hide_losses_is_refused_with_its_rates() {
+        // 499.8, 500.05 and 495 Hz on whole ms jittered by 100 us (a twentieth of a period),
+        // 1 % lost: a lost sample whose next crosses back leaves three quanta, and the
+        // intervals read the rate low by the samples hidden so (read with exit 0 before:
+        // 499.719, 499.885 and 494.856 Hz on other draws); the range named holds the rate.
+        for rate in [499.8, 500.05, 495.0] {
+            let (t, _) = jittered_on((rate, 1e5, 1_000_000), 20_000, (100, 0..0), 7);
+            let e = pushed(&t, false)
+                .summary(TimeUnit::Nanoseconds)
+                .map(|s| format!("{s:?}"))
+                .unwrap_err();
+            assert!(e.contains("leave no gap"), "{rate} Hz: {e}");
+            let range: Vec<f64> = e
+                .split("between ")
+                .nth(1)
+                .and_then(|r| r.split(" Hz; give").next())
+                .map(|r| r.split(" Hz and ").map(|v| v.parse().unwrap()).collect())
+                .unwrap();
+            assert!(range[0] <= rate && rate <= range[1], "{rate} Hz: {e}");
+        }
+        // Crossings too few to hide two (the same clock, 2 us of jitter; 100 us with 0.1 %
+        // lost): read.
+        for (rate, sd, one_in) in [(499.8, 2e3, 100), (499.8, 1e5, 1_000)] {
+            let (t, lost) = jittered_on((rate, sd, 1_000_000), 20_000, (one_in, 0..0), 7);
+            let s = pushed(&t, false).summary(TimeUnit::Nanoseconds).unwrap();
+            assert!(
+                (s.rate_hz / rate - 1.0).abs() < 1e-4 && s.missing_samples.abs_diff(lost) <= 2,
+                "{rate} Hz, {sd} ns: {lost} lost, {s:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_clock_between_two_quanta_multiples_losing_samples_is_read_at_its_rate() {
+        // 180.2 and 220.4 Hz on whole ms (5 and 6 ms, 4 and 5 ms) with 1 and 3 % lost:
+        // refused as a FIFO's runs of 6 ms and 5 ms, before (its gaps, 11 ms, no whole
+        // number of the commoner interval); 496.156 Hz (2 and 3 ms) with 3 % lost over 10
+        // s: 496.291 Hz, before (the regular intervals' mean, without the steps across a
+        // quantum the gaps hold).
+        for (rate, n, one_in) in [
+            (180.2, 7_208, 100),
+            (180.2, 7_208, 33),
+            (220.4, 8_816, 100),
+            (220.4, 8_816, 33),
+            (496.156, 4_962, 33),
+            (496.156, 19_846, 33),
+        ] {
+            let (t, lost) = jittered_on((rate, 0.0, 1_000_000), n, (one_in, 0..0), 3);
+            let s = pushed(&t, false)
+                .summary(TimeUnit::Nanoseconds)
+                .unwrap_or_else(|e| panic!("{rate} Hz, 1 in {one_in}: {e}"));
+            assert!(
+                (s.rate_hz / rate - 1.0).abs() < 1e-4 && s.missing_samples.abs_diff(lost) <= 2,
+                "{rate} Hz, 1 in {one_in}: {lost} lost, {s:?}"
             );
         }
     }
