@@ -16,10 +16,21 @@ pub fn font() -> Result<(), Fail> {
 /// The bitmap `path` is drawn into, `size` pixels, once a file can be created there (an error
 /// naming its file and the system's reason, where the drawing would name neither well).
 pub fn bitmap(path: &std::path::Path, size: (u32, u32)) -> Result<BitMapBackend<'_>, Fail> {
-    std::fs::File::create(path).map_err(|e| {
-        let name = path.file_name().unwrap_or(path.as_os_str());
-        Fail(format!("{}: cannot be written: {e}", name.display()))
-    })?;
+    // Opened as the drawing will open it, its text left as it is until then; a file made
+    // only for the check removed again (a drawing that fails leaves none).
+    let new = path.symlink_metadata().is_err();
+    std::fs::OpenOptions::new()
+        .write(true)
+        .create(true)
+        .truncate(false)
+        .open(path)
+        .map_err(|e| {
+            let name = path.file_name().unwrap_or(path.as_os_str());
+            Fail(format!("{}: cannot be written: {e}", name.display()))
+        })?;
+    if new {
+        let _ = std::fs::remove_file(path);
+    }
     Ok(BitMapBackend::new(path, size))
 }
 
