@@ -668,7 +668,8 @@ impl Channels {
         };
         Err(format!(
             "topic '{topic}' carries {IMU_SCHEMA} (channel {}) and {}: one topic, one type of \
-             message",
+             message; copy the IMU's channel into a file of its own (the mcap library's reader \
+             and writer) and read that",
             ids(&mut self.wanted.iter().copied()),
             self.others
                 .iter()

@@ -377,9 +377,15 @@ fn read_db3_compressed(
             let list = |ids: &mut dyn Iterator<Item = i64>| {
                 ids.map(|id| id.to_string()).collect::<Vec<_>>().join(", ")
             };
+            let rows = others
+                .iter()
+                .map(|(_, id)| id.to_string())
+                .collect::<Vec<_>>()
+                .join(", ");
             format!(
                 "topic '{topic}' carries {IMU_SCHEMA} (topic row {}) and {}: one topic, one \
-                 type of message",
+                 type of message; in a copy of the file, delete the others' messages (sqlite3: \
+                 DELETE FROM messages WHERE topic_id IN ({rows})) and read the copy",
                 list(&mut ids.iter().copied()),
                 others
                     .iter()

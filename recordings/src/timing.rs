@@ -2262,16 +2262,63 @@ impl Timing {
         self.refold(&mut summary, resolution, median, rounded)?;
         if rounded {
             self.crossings_hide_losses(&summary, resolution)?;
+            self.jitter_reaches_gaps(&summary, resolution)?;
         }
         Ok(summary)
     }
 
+    /// An error where stamps rounded to a quantum (`resolution`, ns) with gaps come short of
+    /// the period by as much as a gap's margin over it (a gap is half a period and half a
+    /// quantum past it), two of them or more: a sample that late and the next on time leave
+    /// an interval a gap's length, and the gaps are not told from jitter (a driver spacing
+    /// a FIFO read's samples by the period rounded to the quantum, its reads jittered, read
+    /// 300.53 Hz for 300 with 12 samples missing where none was).
+    fn jitter_reaches_gaps(
+        &self,
+        summary: &TimingSummary,
+        resolution: Option<i64>,
+    ) -> Result<(), String> {
+        let Some(q) = resolution.map(|q| q as f64) else {
+            return Ok(());
+        };
+        if summary.gaps == 0 || self.repeats > 0 || summary.rate_hz <= 0.0 {
+            return Ok(());
+        }
+        let period = 1e9 / summary.rate_hz;
+        let reach = 0.5 * period - 0.5 * q;
+        let (mut close, mut closest) = (0u64, f64::INFINITY);
+        for w in self.stamps.windows(2) {
+            let iv = (i128::from(w[1]) - i128::from(w[0])) as f64;
+            if iv > 0.0 && iv <= reach {
+                close += 1;
+                closest = closest.min(iv);
+            }
+        }
+        if close < 2 {
+            return Ok(());
+        }
+        Err(format!(
+            "the timestamps, stamped to {:e} s, come {close} times within {} s of the one \
+             before (the closest {} s), a period of {} s, and leave {} gaps: a sample as \
+             late as that one is early leaves an interval a gap's length, so the gaps ({} \
+             samples missing) are not told from jitter (a driver spacing a FIFO read's \
+             samples by the period rounded, its reads jittered?); give --rate",
+            q * 1e-9,
+            short(reach * 1e-9),
+            short(closest * 1e-9),
+            short(period * 1e-9),
+            summary.gaps,
+            summary.missing_samples
+        ))
+    }
+
     /// An error where a clock near two quanta (`resolution`, ns) a period, not pinned to an
     /// edge ([`Timing::on_an_edge`]), crosses a quantum's edge often enough that the samples
-    /// its gaps miss hide two more or more, a ten-thousandth of those kept or more: a lost
-    /// sample whose next crosses back leaves three quanta, as the clock's own crossing does,
-    /// and the intervals read the rate low by those. The lost samples hidden are reckoned as
-    /// the gaps' share of the crossings: the samples missing times the crossings back (one
+    /// its gaps miss may hide more than the rate allows (a ten-thousandth of those kept, or
+    /// one quantum over the span), one time in twenty or more: a lost sample whose next
+    /// crosses back leaves three quanta, as the clock's own crossing does, and the intervals
+    /// read the rate low by those. The lost samples hidden are a Poisson count about the
+    /// gaps' share of the crossings: the samples missing times the crossings back (one
     /// quantum) over the other intervals between distinct stamps.
     fn crossings_hide_losses(
         &self,
@@ -2296,22 +2343,35 @@ impl Timing {
         }
         let hidden = summary.missing_samples as f64 * crossings as f64 / others as f64;
         let kept = self.kept as f64;
-        if hidden < 2.0 || hidden < 1e-4 * kept {
+        // The samples the rate may miss by: a ten-thousandth of those kept, or one quantum
+        // over the span, whichever is more; refused where the lost samples hidden (of a
+        // Poisson count about the reckoning) pass that one time in twenty or more.
+        let allowed = (1e-4 * kept).max(q as f64 * 1e-9 * summary.rate_hz);
+        let beyond = {
+            let (mut term, mut below) = ((-hidden).exp(), 0.0);
+            for k in 0..=(allowed.floor() as u64) {
+                below += term;
+                term *= hidden / (k + 1) as f64;
+            }
+            1.0 - below
+        };
+        if beyond < 0.05 {
             return Ok(());
         }
         let hz = summary.rate_hz;
+        let (under, over) = (hidden + 1.0, hidden + 3.0 * hidden.sqrt() + 3.0);
         Err(format!(
             "the timestamps, stamped to {:e} s, step by about two quanta, one interval in {} \
              a quantum (samples jittered across a quantum's edge), with {} samples missing: a \
              sample lost where the next crosses back leaves three quanta, as the clock's own \
-             crossing does, so some {} more were lost and leave no gap; the rate lies between \
+             crossing does, so some {:.1} more were lost and leave no gap; the rate lies between \
              {} Hz and {} Hz; give --rate",
             q as f64 * 1e-9,
             (intervals as f64 / crossings as f64).round(),
             summary.missing_samples,
-            hidden.round(),
-            short(hz * (1.0 - hidden / kept)),
-            short(hz * (1.0 + 3.0 * hidden / kept))
+            hidden,
+            short(hz * (1.0 - under / kept)),
+            short(hz * (1.0 + over / kept))
         ))
     }
 
@@ -2326,13 +2386,17 @@ impl Timing {
     /// each stamp's side afresh (the sides change between neighbours as often as independent
     /// draws do, within five standard deviations, with 50 stamps on each side at least) and
     /// keeps each side's share in every stretch of 64 stamps; a slower or faster one stays on
-    /// a side for stretches of its beat.
+    /// a side for stretches of its beat. Only where samples are missing (the intervals read
+    /// a clock that lost none) and the span is 10,000 quanta or more: a clock off that rate
+    /// by less than a quantum over the span crosses no more than it would, pinned.
     fn on_an_edge(&self, summary: &TimingSummary, resolution: Option<i64>) -> Option<(f64, u64)> {
         let (t, q) = (&self.stamps, i128::from(resolution?));
         let period = 2.0 * q as f64;
         if t.len() < 512
             || self.repeats > 0
             || self.dropped > 0
+            || summary.missing_samples == 0
+            || self.span_ns() < 1e4 * q as f64
             || (summary.rate_hz * period * 1e-9 - 1.0).abs() > 0.02
         {
             return None;
@@ -2367,8 +2431,10 @@ impl Timing {
     /// by more than half a usual start-to-start time); six runs in ten or more starting within
     /// a sample and a half of the time their samples take, and not rounding's (a `quantum`
     /// over a quarter of the runs' interval with one in twenty intervals within them a
-    /// quantum off it, or over a tenth where the runs are parted by one quantum more: a
-    /// slower clock's). Samples lost leave intervals of whole periods; a
+    /// quantum off it, or over a tenth where the runs are parted by one quantum more, or all
+    /// but one in twenty of the intervals parting them are whole periods or a quantum more:
+    /// a slower clock's, losing samples or not). Samples lost leave intervals of whole
+    /// periods; a
     /// FIFO read on a timer and stamped at a period not the samples' parts runs by intervals
     /// of any length.
     fn batches(&self, median: f64, quantum: Option<i64>) -> Option<Runs> {
@@ -2445,8 +2511,10 @@ impl Timing {
             .fold((0.0, 0u64), |(time, count), late| (time + late, count + 1));
         // Stamps floored to a quantum `q` over a quarter of the runs' interval, one in twenty
         // of the intervals within runs a quantum off it (a jittered clock's, rounded), or
-        // over a tenth parting the runs of a slower clock by one quantum more: rounding's,
-        // not runs.
+        // over a tenth parting the runs of a slower clock by one quantum more (the median
+        // parting interval), or with all but one in twenty of the intervals parting the runs
+        // whole periods or a quantum more, some a quantum more (a slower clock's, its losses
+        // too, where they miss fewer samples than the runs hold): rounding's, not runs.
         let parts = middle_of(&mut parting);
         // The runs' interval and jitter, robustly: their median, and the median deviation
         // from it (a read's end a little short of the interval is no jitter of the clock's).
@@ -2465,11 +2533,23 @@ impl Timing {
         // are (within 2 % and four times the runs' jitter), the runs are a clock's with
         // samples lost at a steady count.
         let tolerance = 0.02 + 4.0 * jitter + tick / spacing;
-        let (mut whole, mut missing) = (0u64, 0.0);
+        // Stamps whose quantum is over a tenth of the spacing: a clock a little slower than
+        // it steps one quantum more now and then, lost samples or not (497.5 Hz on whole ms:
+        // 3 ms, and 5 ms for a sample lost there).
+        let coarse = quantum.map(|q| q as f64).filter(|&q| 10.0 * q > spacing);
+        let (mut whole, mut stepped_more, mut missing) = (0u64, 0u64, 0.0);
         for w in t.windows(2) {
-            let periods = (i128::from(w[1]) - i128::from(w[0])) as f64 / spacing;
+            let iv = (i128::from(w[1]) - i128::from(w[0])) as f64;
+            let periods = iv / spacing;
             if periods * spacing > long {
-                whole += u64::from((periods - periods.round()).abs() < tolerance);
+                let near = |p: f64| (p - p.round()).abs() < tolerance;
+                if near(periods) {
+                    whole += 1;
+                } else if coarse
+                    .is_some_and(|q| (iv - q) / spacing >= 0.5 && near((iv - q) / spacing))
+                {
+                    stepped_more += 1;
+                }
                 missing += periods.round() - 1.0;
             }
         }
@@ -2484,6 +2564,10 @@ impl Timing {
                 .count();
             4.0 * q > inside && 20 * varied >= within.len()
                 || 10.0 * q > inside && parts - inside <= 1.5 * q
+                || coarse.is_some()
+                    && stepped_more > 0
+                    && 20 * parted.saturating_sub(whole + stepped_more) <= parted
+                    && missing < t.len() as f64
         });
         // Each run parted by the same whole number of intervals, runs starting evenly (within
         // a tick of the usual), the interval steady: a clock slower than a tick its stamps
@@ -6399,34 +6483,45 @@ mod tests {
     #[test]
     fn a_clock_near_two_quanta_whose_crossings_hide_losses_is_refused_with_its_rates() {
         // 499.8, 500.05 and 495 Hz on whole ms jittered by 100 us (a twentieth of a period),
-        // 1 % lost: a lost sample whose next crosses back leaves three quanta, and the
-        // intervals read the rate low by the samples hidden so (read with exit 0 before:
-        // 499.719, 499.885 and 494.856 Hz on other draws); the range named holds the rate.
-        for rate in [499.8, 500.05, 495.0] {
-            let (t, _) = jittered_on((rate, 1e5, 1_000_000), 20_000, (100, 0..0), 7);
-            let e = pushed(&t, false)
-                .summary(TimeUnit::Nanoseconds)
-                .map(|s| format!("{s:?}"))
-                .unwrap_err();
-            assert!(e.contains("leave no gap"), "{rate} Hz: {e}");
-            let range: Vec<f64> = e
-                .split("between ")
-                .nth(1)
-                .and_then(|r| r.split(" Hz; give").next())
-                .map(|r| r.split(" Hz and ").map(|v| v.parse().unwrap()).collect())
-                .unwrap();
-            assert!(range[0] <= rate && rate <= range[1], "{rate} Hz: {e}");
+        // 1 % or 0.1 % lost, and 500.05 Hz over 4 s jittered 40 us with 3 % lost: a lost
+        // sample whose next crosses back leaves three quanta, and the intervals read the rate
+        // low by the samples hidden so (read with exit 0 before: 499.719, 499.885 and 494.856
+        // Hz on other draws; 499.50 and 498.75 Hz over 4 s); the range named holds the rate.
+        for (rate, sd, n, one_in) in [
+            (499.8, 1e5, 20_000, 100),
+            (500.05, 1e5, 20_000, 100),
+            (495.0, 1e5, 20_000, 100),
+            (499.8, 1e5, 20_000, 1_000),
+            (500.05, 4e4, 2_000, 33),
+        ] {
+            for seed in [7, 8] {
+                let (t, _) = jittered_on((rate, sd, 1_000_000), n, (one_in, 0..0), seed);
+                let e = pushed(&t, false)
+                    .summary(TimeUnit::Nanoseconds)
+                    .map(|s| format!("{s:?}"))
+                    .unwrap_err();
+                // (Over 4 s, some draws are refused as places a slower clock leaves empty.)
+                assert!(
+                    e.contains("leave no gap") || n < 20_000 && e.contains("places empty"),
+                    "{rate} Hz, {n}: {e}"
+                );
+                let range: Vec<f64> = e
+                    .split("between ")
+                    .nth(1)
+                    .and_then(|r| r.split(" Hz; give").next())
+                    .map(|r| r.split(" Hz and ").map(|v| v.parse().unwrap()).collect())
+                    .unwrap();
+                assert!(range[0] <= rate && rate <= range[1], "{rate} Hz, {n}: {e}");
+            }
         }
-        // Crossings too few to hide two (the same clock, 2 us of jitter; 100 us with 0.1 %
-        // lost): read.
-        for (rate, sd, one_in) in [(499.8, 2e3, 100), (499.8, 1e5, 1_000)] {
-            let (t, lost) = jittered_on((rate, sd, 1_000_000), 20_000, (one_in, 0..0), 7);
-            let s = pushed(&t, false).summary(TimeUnit::Nanoseconds).unwrap();
-            assert!(
-                (s.rate_hz / rate - 1.0).abs() < 1e-4 && s.missing_samples.abs_diff(lost) <= 2,
-                "{rate} Hz, {sd} ns: {lost} lost, {s:?}"
-            );
-        }
+        // Crossings too few to hide a sample the rate would show (the same clock, 2 us of
+        // jitter, 1 % lost): read.
+        let (t, lost) = jittered_on((499.8, 2e3, 1_000_000), 20_000, (100, 0..0), 7);
+        let s = pushed(&t, false).summary(TimeUnit::Nanoseconds).unwrap();
+        assert!(
+            (s.rate_hz / 499.8 - 1.0).abs() < 1e-4 && s.missing_samples.abs_diff(lost) <= 2,
+            "{lost} lost, {s:?}"
+        );
     }
 
     #[test]
@@ -6453,6 +6548,58 @@ mod tests {
                 "{rate} Hz, 1 in {one_in}: {lost} lost, {s:?}"
             );
         }
+    }
+
+    #[test]
+    fn a_clock_a_little_slower_than_two_quanta_losing_samples_is_no_fifos_runs() {
+        // 497.5 Hz on whole ms (2 ms, 3 ms a step across a quantum, 4 and 5 ms a sample
+        // lost) and 49.75 Hz on 10 ms, 1 % lost: refused on some draws as a FIFO's runs of
+        // 2 ms, naming the samples kept over the span (492.54 Hz) as the sensor's, before.
+        for (rate, q) in [(497.5, 1_000_000), (49.75, 10_000_000)] {
+            for seed in [1, 2, 3, 9, 59] {
+                let (t, lost) = jittered_on((rate, 0.0, q), 19_900, (100, 0..0), seed);
+                let s = pushed(&t, false)
+                    .summary(TimeUnit::Nanoseconds)
+                    .unwrap_or_else(|e| panic!("{rate} Hz, seed {seed}: {e}"));
+                assert!(
+                    s.batched.is_none()
+                        && (s.rate_hz / rate - 1.0).abs() < 1e-4
+                        && s.missing_samples.abs_diff(lost) <= 2,
+                    "{rate} Hz, seed {seed}: {lost} lost, {s:?}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn a_fifos_reads_spaced_by_the_period_rounded_and_jittered_are_no_clock() {
+        // A 300 Hz sensor read 10 ms after the last read and up to a ms or so more, each
+        // read's samples stamped back from the read by 3 ms (1/300 s to whole ms), floored to
+        // ms: read as a jittered clock with samples missing where none was (300.53 Hz, exit
+        // 0, before).
+        let mut late = gaussian(3);
+        let (mut t, mut taken, mut at) = (Vec::new(), 0i64, 0.0);
+        while at < 20.0 {
+            at += 10e-3 + 0.5e-3 * late().abs();
+            let due = (at * 300.0).floor() as i64 + 1;
+            for k in 0..(due - taken) {
+                let stamp = at + 2e-4 - (due - taken - 1 - k) as f64 * 3e-3;
+                t.push((stamp * 1e3).floor() as i64 * 1_000_000);
+            }
+            taken = due;
+        }
+        let t: Vec<i64> = t
+            .iter()
+            .scan(i64::MIN, |last, &s| {
+                *last = (*last).max(s);
+                Some(*last)
+            })
+            .collect();
+        let e = pushed(&t, false)
+            .summary(TimeUnit::Nanoseconds)
+            .map(|s| format!("{s:?}"))
+            .unwrap_err();
+        assert!(e.contains("not told from jitter"), "{e}");
     }
 
     #[test]

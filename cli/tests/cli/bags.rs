@@ -204,7 +204,9 @@ fn a_topic_of_two_types_names_both() {
             problem(&path, mcap_reader::read(&path, "/imu", &mut |_| {})),
             format!(
                 "topic '/imu' carries sensor_msgs/msg/Imu (channel {imu}) and \
-                 std_msgs/msg/String (channel {string}): one topic, one type of message"
+                 std_msgs/msg/String (channel {string}): one topic, one type of message; copy \
+                 the IMU's channel into a file of its own (the mcap library's reader and \
+                 writer) and read that"
             )
         );
     }

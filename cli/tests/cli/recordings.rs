@@ -719,7 +719,9 @@ fn a_database_topic_of_two_types_names_both() {
             result,
             Err(format!(
                 "topic '/imu0' carries sensor_msgs/msg/Imu (topic row {imu}) and \
-                 std_msgs/msg/String (topic row 2): one topic, one type of message"
+                 std_msgs/msg/String (topic row 2): one topic, one type of message; in a copy \
+                 of the file, delete the others' messages (sqlite3: DELETE FROM messages WHERE \
+                 topic_id IN (2)) and read the copy"
             )),
             "{name}"
         );
