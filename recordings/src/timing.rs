@@ -2926,8 +2926,9 @@ impl Timing {
             "the timestamps, stamped to {q:e} s near the clock's period, leave {empty} places \
              empty that a clock slower than its stamps leaves and samples lost leave alike, \
              and their phase tells neither: the rate lies between {} Hz and {} Hz; give --rate",
-            short(summary.rate_hz.min(summary.span_rate_hz)),
-            short(most)
+            // (The span's rate is known to a quantum over the span.)
+            short(summary.rate_hz.min(summary.span_rate_hz) * (1.0 - q / summary.span_s)),
+            short(most * (1.0 + q / summary.span_s))
         ))
     }
 
@@ -6548,6 +6549,35 @@ mod tests {
                 "{rate} Hz, 1 in {one_in}: {lost} lost, {s:?}"
             );
         }
+    }
+
+    #[test]
+    fn the_rates_a_clock_just_over_two_quanta_allows_hold_it_to_a_quantum_over_the_span() {
+        // 507.693 Hz on whole ms jittered by a twentieth of a period, nothing lost, 40 s:
+        // refused on some draws with a range from the samples' rate over the span, which
+        // lies a quantum over the span either side of the clock's (from 507.700385 Hz,
+        // before).
+        let mut refused = 0;
+        for seed in 1..=12 {
+            let (t, _) = jittered_on((507.693, 98_500.0, 1_000_000), 20_308, (0, 0..0), seed);
+            let Err(e) = pushed(&t, false).summary(TimeUnit::Nanoseconds) else {
+                continue;
+            };
+            let Some(range) = e.split("between ").nth(1) else {
+                continue;
+            };
+            refused += 1;
+            let bounds: Vec<f64> = range
+                .trim_end_matches(" Hz; give --rate")
+                .split(" Hz and ")
+                .map(|v| v.parse().unwrap())
+                .collect();
+            assert!(
+                bounds[0] <= 507.693 && 507.693 <= bounds[1],
+                "seed {seed}: {e}"
+            );
+        }
+        assert!(refused > 0);
     }
 
     #[test]
