@@ -89,10 +89,12 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    // Ended by a signal: the folder `characterise` writes into goes first (status 130).
+    // Ended by a signal: the folder `characterise` writes into goes first (status 130); once
+    // the output is in place, the run ends as it would have.
     let _ = ctrlc::set_handler(|| {
-        characterise::remove_staging();
-        std::process::exit(130);
+        if characterise::remove_staging() {
+            std::process::exit(130);
+        }
     });
     let args: Vec<OsString> = std::env::args_os().collect();
     let cli = match Cli::try_parse_from(&args) {

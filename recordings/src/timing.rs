@@ -2820,6 +2820,24 @@ impl Timing {
         } else {
             rate
         };
+        // Fine stamps whose regular intervals keep to a thousandth of their mean while the
+        // fold's rate lies more than a thousandth from it: no one clock's (a driver stamping
+        // each read's samples back from the read at their period, the reads on a timer of
+        // their own: 1000 Hz read at 60 Hz folds on 1020 Hz, 17 samples a read).
+        if !coarse && summary.jitter_rms < 1e-3 && (rate / hz - 1.0).abs() > 1e-3 {
+            return Err(format!(
+                "the timestamps step by {} s ({} Hz) to within {:.1e} of it, but they keep \
+                 the phase of a clock at {} Hz: stamps of two clocks (a driver stamping each \
+                 read of its FIFO back from the read at the samples' period, the reads on a \
+                 timer of their own?); their span gives {} Hz, the sensor's where none was \
+                 lost; give --rate",
+                short(1.0 / hz),
+                short(hz),
+                summary.jitter_rms,
+                short(rate),
+                short(summary.span_rate_hz)
+            ));
+        }
         summary.rate_hz = rate;
         // (The first stamp's repeats are samples before it, a host's stall at the record's
         // start; no more missing than the end stamps' quanta explain, and no more kept than
@@ -6598,6 +6616,30 @@ mod tests {
                     "{rate} Hz, seed {seed}: {lost} lost, {s:?}"
                 );
             }
+        }
+    }
+
+    #[test]
+    fn a_fifos_reads_stamped_back_at_the_period_on_a_timer_of_their_own_are_no_clock() {
+        // 1000 and 2000 Hz read at 60 Hz, each read's samples stamped back from the read at
+        // their period, to the ns: folded on 1020 and 1980 Hz (17 and 33 samples a read),
+        // exit 0, before.
+        for (rate, per_read) in [(1000.0, 60.0), (2000.0, 60.0)] {
+            let (mut t, mut taken) = (Vec::new(), 0i64);
+            for read in 1..=1_800i64 {
+                let at = read as f64 / per_read;
+                let due = (at * rate).floor() as i64 + 1;
+                for k in 0..(due - taken) {
+                    let stamp = at + 2e-4 - (due - taken - 1 - k) as f64 / rate;
+                    t.push((stamp * 1e9).round() as i64);
+                }
+                taken = due;
+            }
+            let e = pushed(&t, false)
+                .summary(TimeUnit::Nanoseconds)
+                .map(|s| format!("{s:?}"))
+                .unwrap_err();
+            assert!(e.contains("stamps of two clocks"), "{rate} Hz: {e}");
         }
     }
 

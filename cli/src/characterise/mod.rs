@@ -431,6 +431,9 @@ struct Staging {
     made: Vec<PathBuf>,
     /// Whether the process is ending: no folder is made after.
     ending: bool,
+    /// Whether the output is in place: the run is done but for its report, and a signal
+    /// then lets it end as it would have.
+    written: bool,
 }
 
 /// The run's output folders; the moves into `out` hold it.
@@ -438,6 +441,7 @@ static STAGING: Mutex<Staging> = Mutex::new(Staging {
     folder: None,
     made: Vec::new(),
     ending: false,
+    written: false,
 });
 
 /// The run's output folders, locked.
@@ -447,10 +451,15 @@ fn staging() -> MutexGuard<'static, Staging> {
 
 /// Removes the folder `write_staged` is writing into, if any, once the moves into `out` are
 /// done, and the folders made for the output that are left empty: for a process that ends on
-/// a signal (SIGINT, SIGTERM, SIGHUP), which leaves `out` as it was, or holding the whole new
-/// set. The lock stays taken, so no folder is made after this; the caller ends the process.
-pub fn remove_staging() {
+/// a signal (SIGINT, SIGTERM, SIGHUP), which leaves `out` as it was. Whether the process is
+/// to end: not once the whole new set is in place (the run then ends as it would have, its
+/// report written, rather than in a failure that left its output); else the lock stays
+/// taken, so no folder is made after this, and the caller ends the process.
+pub fn remove_staging() -> bool {
     let mut held = staging();
+    if held.written {
+        return false;
+    }
     held.ending = true;
     if let Some(folder) = held.folder.take() {
         // A file the run creates between a removal's listing and its end leaves the folder
@@ -464,6 +473,7 @@ pub fn remove_staging() {
     }
     remove_empty(&held.made);
     std::mem::forget(held);
+    true
 }
 
 /// Makes the folder `out` and those above it that are missing, which [`output_done`] (and a
@@ -601,6 +611,7 @@ pub(crate) fn write_staged(
     });
     let _ = std::fs::remove_dir_all(staging_folder);
     held.folder = None;
+    held.written = moved.is_ok();
     drop(held);
     if made {
         output_done(moved.is_ok());
