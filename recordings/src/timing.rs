@@ -2838,7 +2838,6 @@ impl Timing {
                 short(summary.span_rate_hz)
             ));
         }
-        summary.rate_hz = rate;
         // (The first stamp's repeats are samples before it, a host's stall at the record's
         // start; no more missing than the end stamps' quanta explain, and no more kept than
         // they hold.)
@@ -2846,6 +2845,69 @@ impl Timing {
         let kept = (self.kept - self.leading_repeats) as i64;
         let past = span * rate + 1.0 - kept as f64;
         let ends = (q * rate).max(0.5);
+        // Intervals that hold every sample (none missing, none repeated or dropped: their
+        // rate is the span's) while the fold keeps the phase of another rate, further off
+        // than the end stamps' quanta and jitter allow: a slower one has fewer places than
+        // the samples kept, and a faster one would have lost samples that leave no gap
+        // (but where a lost sample's interval rounds like the clock's own). No one clock's:
+        // a driver stamping each read of its FIFO back from the read, the reads on a timer
+        // of their own (1024 Hz read every 10 ms folds on 1000 Hz, 400 Hz on whole ms read
+        // at 60 Hz on 420 Hz).
+        let whole = self.dropped == 0 && summary.gaps == 0 && summary.missing_samples == 0;
+        // (A lost sample's interval rounds like the clock's own, where the fold may tell the
+        // samples lost, but for a clock of its stamps' quantum or faster, where a lost
+        // sample leaves a place holding fewer, or one of two quanta whose samples cross a
+        // quantum's edge, where its three quanta are a crossing's: there, places left empty
+        // evenly, as the reads' pattern leaves them, are no losses'. Off in both halves of
+        // the record, a quarter of it each at least: a host's stall caught up on at one end
+        // holds its samples in the span short of their places.)
+        let slack = 2.0 + ends + 2.0 * summary.jitter_max + 1e-5 * kept as f64;
+        let hides = q > 0.0
+            && (q * rate >= 0.8
+                || losses_look_regular(q, rate)
+                || (2.0 * q * rate - 1.0).abs() < 0.02);
+        let halves = || {
+            let m = t.len() / 2;
+            let off = |a: usize, b: usize| {
+                (i128::from(t[b]) - i128::from(t[a])) as f64 * 1e-9 * rate - (b - a) as f64
+            };
+            [off(0, m), off(m, t.len() - 1)]
+                .iter()
+                .all(|&half| half * past >= 0.25 * past * past)
+        };
+        let fewer = self.repeats == 0 && past < -slack;
+        let lost = past > slack;
+        let evenly = || {
+            let (count, every, spread) = empty_places(t, rate);
+            (count >= 20 && every >= 3.0 && spread < 0.5).then_some(every)
+        };
+        if whole && (fewer || lost) && halves() {
+            let found = if fewer {
+                Some(format!("{:.0} fewer places than the samples kept", -past))
+            } else if !hides {
+                Some(format!("{past:.0} samples lost that leave no gap"))
+            } else {
+                evenly().map(|every| {
+                    format!(
+                        "{past:.0} samples lost that leave no gap, places left empty evenly, \
+                         one every {} (losses come at random)",
+                        every.round()
+                    )
+                })
+            };
+            if let Some(found) = found {
+                return Err(format!(
+                    "the timestamps' intervals hold every sample, at {} Hz (their span's \
+                     rate), but the stamps keep the phase of a clock at {} Hz, which has \
+                     {found}: stamps of two clocks (a driver stamping each read of its FIFO \
+                     back from the read, the reads on a timer of their own?); their span gives \
+                     the sensor's rate where none was lost; give --rate",
+                    short(summary.span_rate_hz),
+                    short(rate),
+                ));
+            }
+        }
+        summary.rate_hz = rate;
         summary.missing_samples = if past <= ends { 0 } else { past.round() as u64 };
         if kept > room + 2 + ends.ceil() as i64 {
             summary.unexplained_repeat = self
@@ -2915,14 +2977,11 @@ impl Timing {
             return Ok(());
         };
         let q = quantum as f64 * 1e-9;
-        // (A lost sample's interval, two periods floored to the quantum, within a tenth of
-        // a quantum of the window's reach, which a drifting clock's mean period moves.)
-        let u = 1.0 / (q * summary.rate_hz);
-        let hidden = u >= 1.0 && (2.0 * u).floor() <= (1.5 * u + 0.5).max(u + 1.25) + 0.1;
-        let near = (0.8..1.45).contains(&(q * summary.rate_hz));
-        if !near && !hidden {
+        if !losses_look_regular(q, summary.rate_hz) {
             return Ok(());
         }
+        let near = (0.8..1.45).contains(&(q * summary.rate_hz));
+        let u = 1.0 / (q * summary.rate_hz);
         // The places left empty (gaps of five quanta or more are counted as samples
         // missing); where the period is a quantum and a half or more, those of intervals
         // longer than any the clock's rounding leaves (two at 505 Hz on whole ms: three and
@@ -3420,6 +3479,51 @@ impl Window {
 
 /// The median interval, ns: the mean of the bucket that holds it (exact for a clock with few
 /// distinct intervals, within 0.1 % for any); none for no interval.
+/// The places a clock at `rate` Hz leaves empty among the stamps `t` (ns; each stamp's place
+/// the nearest on the lattice through the stamps' mean phase): how many, their mean spacing
+/// (places) and the spacing's coefficient of variation (about one for losses at random,
+/// near zero for a pattern that repeats).
+fn empty_places(t: &[i64], rate: f64) -> (u64, f64, f64) {
+    let x = |s: i64| (i128::from(s) - i128::from(t[0])) as f64 * 1e-9 * rate;
+    let (sin, cos) = t.iter().fold((0.0, 0.0), |(sin, cos), &s| {
+        let a = std::f64::consts::TAU * x(s).fract();
+        (sin + a.sin(), cos + a.cos())
+    });
+    let phase = f64::atan2(sin, cos) / std::f64::consts::TAU;
+    let (mut count, mut last, mut sum, mut squares, mut spacings) = (0u64, None, 0.0, 0.0, 0.0);
+    for w in t.windows(2) {
+        let (a, b) = ((x(w[0]) - phase).round(), (x(w[1]) - phase).round());
+        // (The first empty place's spacing from the last, then spacings of one.)
+        let empty = (b - a - 1.0).max(0.0);
+        if empty > 0.0 {
+            if let Some(before) = last {
+                let d: f64 = a + 1.0 - before;
+                (sum, squares, spacings) = (sum + d, squares + d * d, spacings + 1.0);
+            }
+            let ones = empty - 1.0;
+            (sum, squares, spacings) = (sum + ones, squares + ones, spacings + ones);
+            (last, count) = (Some(b - 1.0), count + empty as u64);
+        }
+    }
+    if spacings < 1.0 {
+        return (count, 0.0, 0.0);
+    }
+    let mean = sum / spacings;
+    let spread = (squares / spacings - mean * mean).max(0.0).sqrt() / mean;
+    (count, mean, spread)
+}
+
+/// Whether a clock at `hz` stamped to `q` (s) leaves a lost sample's interval rounded like
+/// its own: a period within a quarter of the quantum or so (0.8 to 1.45 quanta's rate), or
+/// one whose lost sample's interval, two periods floored to the quantum, lies within a
+/// tenth of a quantum of the reach of its own rounded intervals (which a drifting clock's
+/// mean period moves).
+fn losses_look_regular(q: f64, hz: f64) -> bool {
+    let u = 1.0 / (q * hz);
+    let hidden = u >= 1.0 && (2.0 * u).floor() <= (1.5 * u + 0.5).max(u + 1.25) + 0.1;
+    hidden || (0.8..1.45).contains(&(q * hz))
+}
+
 fn median(buckets: &[Bucket]) -> Option<f64> {
     let intervals: u64 = buckets.iter().map(|b| b.count).sum();
     let mut seen = 0;
@@ -6619,27 +6723,71 @@ mod tests {
         }
     }
 
+    /// A FIFO of a `rate` Hz sensor read at the times `reads` (s), each read's samples (those
+    /// due by then) stamped back from the read (0.2 ms after it) `spacing` s apart, floored
+    /// to `q` ns.
+    fn stamped_back(
+        rate: f64,
+        reads: impl IntoIterator<Item = f64>,
+        spacing: f64,
+        q: i64,
+    ) -> Vec<i64> {
+        let (mut t, mut taken) = (Vec::new(), 0i64);
+        for at in reads {
+            let due = (at * rate).floor() as i64 + 1;
+            for k in 0..(due - taken) {
+                let stamp = at + 2e-4 - (due - taken - 1 - k) as f64 * spacing;
+                t.push((stamp * 1e9 / q as f64).floor() as i64 * q);
+            }
+            taken = taken.max(due);
+        }
+        t
+    }
+
     #[test]
     fn a_fifos_reads_stamped_back_at_the_period_on_a_timer_of_their_own_are_no_clock() {
         // 1000 and 2000 Hz read at 60 Hz, each read's samples stamped back from the read at
         // their period, to the ns: folded on 1020 and 1980 Hz (17 and 33 samples a read),
         // exit 0, before.
-        for (rate, per_read) in [(1000.0, 60.0), (2000.0, 60.0)] {
-            let (mut t, mut taken) = (Vec::new(), 0i64);
-            for read in 1..=1_800i64 {
-                let at = read as f64 / per_read;
-                let due = (at * rate).floor() as i64 + 1;
-                for k in 0..(due - taken) {
-                    let stamp = at + 2e-4 - (due - taken - 1 - k) as f64 / rate;
-                    t.push((stamp * 1e9).round() as i64);
-                }
-                taken = due;
-            }
+        for rate in [1000.0, 2000.0] {
+            let t = stamped_back(rate, (1..=1_800).map(|r| r as f64 / 60.0), 1.0 / rate, 1);
             let e = pushed(&t, false)
                 .summary(TimeUnit::Nanoseconds)
                 .map(|s| format!("{s:?}"))
                 .unwrap_err();
             assert!(e.contains("stamps of two clocks"), "{rate} Hz: {e}");
+        }
+    }
+
+    #[test]
+    fn a_fifos_reads_whose_samples_a_read_fold_on_another_rate_are_no_clock() {
+        // Stamped back from reads on a timer, each read's samples fold on a whole number a
+        // read at the reads' rate, and the intervals hold every sample: 1024 Hz read every
+        // 10 ms (ns), 776.4 Hz every 20 ms (whole ms), 400.5 Hz every 5 ms stamped 2 ms apart
+        // (us) and 400 Hz at 60 Hz (whole ms) read 1000, 750 or 800, 400 and 420 Hz with exit
+        // 0, before. Folded faster, the samples lost are not there to leave a gap, or where a
+        // lost sample's interval would round like the clock's own, leave places empty
+        // evenly, a read's pattern.
+        for (rate, every, spacing, q, seconds) in [
+            (1024.0, 10e-3, 1.0 / 1024.0, 1, 30.0),
+            (776.4, 20e-3, 1.288e-3, 1_000_000, 30.0),
+            (400.5, 5e-3, 2e-3, 1_000, 60.0),
+            (400.0, 1.0 / 60.0, 2.5e-3, 1_000_000, 30.0),
+        ] {
+            let reads = (1..=(seconds / every) as usize).map(|r| r as f64 * every);
+            let t = stamped_back(rate, reads, spacing, q);
+            let e = pushed(&t, true)
+                .summary(TimeUnit::Nanoseconds)
+                .map(|s| format!("{s:?}"))
+                .unwrap_err();
+            assert!(
+                e.contains("stamps of two clocks") && e.contains("their span's rate"),
+                "{rate} Hz: {e}"
+            );
+            // The span's rate, named, is the sensor's.
+            let named = e.split(" Hz (their span's rate)").next().unwrap();
+            let named: f64 = named.rsplit(' ').next().unwrap().parse().unwrap();
+            assert!((named / rate - 1.0).abs() < 1e-4, "{rate} Hz: {e}");
         }
     }
 
@@ -6650,16 +6798,10 @@ mod tests {
         // ms: read as a jittered clock with samples missing where none was (300.53 Hz, exit
         // 0, before).
         let mut late = gaussian(3);
-        let (mut t, mut taken, mut at) = (Vec::new(), 0i64, 0.0);
-        while at < 20.0 {
-            at += 10e-3 + 0.5e-3 * late().abs();
-            let due = (at * 300.0).floor() as i64 + 1;
-            for k in 0..(due - taken) {
-                let stamp = at + 2e-4 - (due - taken - 1 - k) as f64 * 3e-3;
-                t.push((stamp * 1e3).floor() as i64 * 1_000_000);
-            }
-            taken = due;
-        }
+        let reads = std::iter::successors(Some(0.0), |at| Some(at + 10e-3 + 0.5e-3 * late().abs()))
+            .skip(1)
+            .take_while(|&at| at < 20.0);
+        let t = stamped_back(300.0, reads, 3e-3, 1_000_000);
         let t: Vec<i64> = t
             .iter()
             .scan(i64::MIN, |last, &s| {
