@@ -2264,7 +2264,87 @@ impl Timing {
             self.crossings_hide_losses(&summary, resolution)?;
             self.jitter_reaches_gaps(&summary, resolution)?;
         }
+        self.bulk_off_period(&summary, resolution)?;
         Ok(summary)
+    }
+
+    /// An error where half the intervals or more lie within two quanta (`resolution`, ns, a
+    /// quarter of the period or less) or a ten-thousandth of their median, whose mean the
+    /// period read lies more than a quantum and a half (and a millionth) from: a set spacing
+    /// no clock keeps at another period, but for a tick's (a 32768 Hz counter's intervals of
+    /// 27 and 28 ticks, a clock on whole ms in a float's ns: the mean of the commonest value
+    /// past the period, and those as near it, a step from the first mean that divides it, to
+    /// a thousandth and the widest spread of the two, a quantum at least, in steps, the two
+    /// groups' mean within a tenth of the offset of the period). A driver spacing each read of its
+    /// FIFO by a set period, the reads on a timer of their own, gathers them on that spacing
+    /// while the reads move the rate (997.3 Hz read every 20 ms, 19 or 20 a read, read 1000
+    /// Hz with a sample missing at each read of 19).
+    fn bulk_off_period(
+        &self,
+        summary: &TimingSummary,
+        resolution: Option<i64>,
+    ) -> Result<(), String> {
+        let (t, Some(q)) = (&self.stamps, resolution.map(i128::from)) else {
+            return Ok(());
+        };
+        let period = 1e9 / summary.rate_hz;
+        if t.len() < 64 || self.repeats > 0 || 4.0 * q as f64 > period {
+            return Ok(());
+        }
+        let mut intervals: Vec<i128> = t
+            .windows(2)
+            .map(|w| i128::from(w[1]) - i128::from(w[0]))
+            .filter(|&iv| iv > 0)
+            .collect();
+        let n = intervals.len();
+        intervals.sort_unstable();
+        let middle = intervals[n / 2];
+        // The intervals within two quanta (or a ten-thousandth) of a value: how many, their
+        // mean, and their spread (a quantum at least).
+        let reach = (2 * q).max(middle / 10_000);
+        let near = |value: i128| {
+            let (count, sum, low, high) = intervals
+                .iter()
+                .filter(|iv| (*iv - value).abs() <= reach)
+                .fold((0, 0.0, value, value), |(count, sum, low, high), &iv| {
+                    (count + 1, sum + iv as f64, low.min(iv), high.max(iv))
+                });
+            (count, sum / count.max(1) as f64, (high - low).max(q))
+        };
+        let (bulk, spacing, spread) = near(middle);
+        let off = spacing - period;
+        if 2 * bulk < n || off.abs() <= 1.5 * q as f64 + 1e-6 * period {
+            return Ok(());
+        }
+        let other = intervals
+            .chunk_by(|a, b| a == b)
+            .filter(|run| (run[0] - middle).abs() > reach && (run[0] as f64 - period) * off < 0.0)
+            .max_by_key(|run| run.len())
+            .map(|run| near(run[0]));
+        if let Some((count, other, other_spread)) = other {
+            let step = (other - spacing).abs();
+            let ticks = spacing / step;
+            let known = spread.max(other_spread) as f64;
+            // (The two values make the period between them, as a tick's do.)
+            let mix = (bulk as f64 * spacing + count as f64 * other) / (bulk + count) as f64;
+            if (ticks - ticks.round()).abs() <= 1e-3 + ticks.round() * known / step
+                && (mix - period).abs() <= 0.1 * off.abs()
+            {
+                return Ok(());
+            }
+        }
+        Err(format!(
+            "{bulk} of the timestamps' {n} intervals lie within {:e} s of {} s, but the rate \
+             read from them, {} Hz, is a period of {} s, which they do not keep: stamps of \
+             two clocks (a driver spacing each read of its FIFO by a set period, the reads on \
+             a timer of their own?); their span gives {} Hz, the sensor's rate where none was \
+             lost; give --rate",
+            reach as f64 / 1e9,
+            short(spacing * 1e-9),
+            short(summary.rate_hz),
+            short(period * 1e-9),
+            short(summary.span_rate_hz)
+        ))
     }
 
     /// An error where stamps rounded to a quantum (`resolution`, ns) with gaps come short of
@@ -2328,8 +2408,7 @@ impl Timing {
         let Some(q) = resolution else {
             return Ok(());
         };
-        let period = 2.0 * q as f64;
-        if (summary.rate_hz * period * 1e-9 - 1.0).abs() > 0.02 || summary.missing_samples == 0 {
+        if !two_quanta(q as f64, summary.rate_hz) || summary.missing_samples == 0 {
             return Ok(());
         }
         let (mut crossings, mut intervals) = (0u64, 0u64);
@@ -2397,7 +2476,7 @@ impl Timing {
             || self.dropped > 0
             || summary.missing_samples == 0
             || self.span_ns() < 1e4 * q as f64
-            || (summary.rate_hz * period * 1e-9 - 1.0).abs() > 0.02
+            || !two_quanta(q as f64, summary.rate_hz)
         {
             return None;
         }
@@ -2863,9 +2942,7 @@ impl Timing {
         // holds its samples in the span short of their places.)
         let slack = 2.0 + ends + 2.0 * summary.jitter_max + 1e-5 * kept as f64;
         let hides = q > 0.0
-            && (q * rate >= 0.8
-                || losses_look_regular(q, rate)
-                || (2.0 * q * rate - 1.0).abs() < 0.02);
+            && (q * rate >= 0.8 || losses_look_regular(q, rate) || two_quanta(q * 1e9, rate));
         let halves = || {
             let m = t.len() / 2;
             let off = |a: usize, b: usize| {
@@ -2878,6 +2955,9 @@ impl Timing {
         let fewer = self.repeats == 0 && past < -slack;
         let lost = past > slack;
         let evenly = || {
+            if q * rate >= 0.9 {
+                return None;
+            }
             let (count, every, spread) = empty_places(t, rate);
             (count >= 20 && every >= 3.0 && spread < 0.5).then_some(every)
         };
@@ -3479,6 +3559,12 @@ impl Window {
 
 /// The median interval, ns: the mean of the bucket that holds it (exact for a clock with few
 /// distinct intervals, within 0.1 % for any); none for no interval.
+/// Whether a clock at `hz` lies within 2 % of two quanta (`quantum`, ns) a period, where its
+/// samples cross a quantum's edge and a lost sample's three quanta are a crossing's.
+fn two_quanta(quantum: f64, hz: f64) -> bool {
+    (2.0 * quantum * 1e-9 * hz - 1.0).abs() <= 0.02
+}
+
 /// The places a clock at `rate` Hz leaves empty among the stamps `t` (ns; each stamp's place
 /// the nearest on the lattice through the stamps' mean phase): how many, their mean spacing
 /// (places) and the spacing's coefficient of variation (about one for losses at random,
@@ -4579,12 +4665,17 @@ mod tests {
 
     #[test]
     fn intervals_either_side_of_a_threshold_and_the_samples_gaps_miss_are_counted_one_by_one() {
-        // A 1 kHz clock; 500 intervals 1 ns under 1.25 periods and 500 1 ns over.
+        // A 1 kHz clock; 500 intervals 1 ns under 1.25 periods and 500 1 ns over. (The others
+        // jittered by a us either way, as a clock's are, summing to none: intervals of one
+        // spacing exactly, stepping off it for good now and then, are no clock's, see
+        // `a_fifos_reads_spaced_by_a_set_period_off_the_rate_read_are_no_clock`.)
         let mut t = vec![0i64];
         for i in 0..20_000 {
             let iv = match i % 40 {
                 0 => 1_249_999,
                 1 => 1_250_001,
+                2..14 => 999_000,
+                14..26 => 1_001_000,
                 _ => 1_000_000,
             };
             t.push(t[t.len() - 1] + iv);
@@ -4750,11 +4841,7 @@ mod tests {
         for rate in [505.0, 508.0] {
             let t = on_tick((rate, 20_200, 0.0), (0.0, 1, 0.0), 1000, false);
             let e = read(t).unwrap_err();
-            let number = |after: &str| -> f64 {
-                let rest = &e[e.find(after).unwrap() + after.len()..];
-                rest[..rest.find(' ').unwrap()].parse().unwrap()
-            };
-            let (lo, hi) = (number("between "), number(" Hz and "));
+            let (lo, hi) = range_named(&e).unwrap_or_else(|| panic!("{e}"));
             assert!(lo <= rate && rate <= hi, "{e}");
         }
         // 62 stamps of 510.93 Hz on whole ms through a float64's epoch ns (under the 64 a
@@ -6628,13 +6715,8 @@ mod tests {
                     e.contains("leave no gap") || n < 20_000 && e.contains("places empty"),
                     "{rate} Hz, {n}: {e}"
                 );
-                let range: Vec<f64> = e
-                    .split("between ")
-                    .nth(1)
-                    .and_then(|r| r.split(" Hz; give").next())
-                    .map(|r| r.split(" Hz and ").map(|v| v.parse().unwrap()).collect())
-                    .unwrap();
-                assert!(range[0] <= rate && rate <= range[1], "{rate} Hz, {n}: {e}");
+                let (lo, hi) = range_named(&e).unwrap_or_else(|| panic!("{e}"));
+                assert!(lo <= rate && rate <= hi, "{rate} Hz, {n}: {e}");
             }
         }
         // Crossings too few to hide a sample the rate would show (the same clock, 2 us of
@@ -6685,19 +6767,11 @@ mod tests {
             let Err(e) = pushed(&t, false).summary(TimeUnit::Nanoseconds) else {
                 continue;
             };
-            let Some(range) = e.split("between ").nth(1) else {
+            let Some((lo, hi)) = range_named(&e) else {
                 continue;
             };
             refused += 1;
-            let bounds: Vec<f64> = range
-                .trim_end_matches(" Hz; give --rate")
-                .split(" Hz and ")
-                .map(|v| v.parse().unwrap())
-                .collect();
-            assert!(
-                bounds[0] <= 507.693 && 507.693 <= bounds[1],
-                "seed {seed}: {e}"
-            );
+            assert!(lo <= 507.693 && 507.693 <= hi, "seed {seed}: {e}");
         }
         assert!(refused > 0);
     }
@@ -6723,25 +6797,45 @@ mod tests {
         }
     }
 
+    /// The rates a refusal names ("between X Hz and Y Hz"), where it names them.
+    fn range_named(e: &str) -> Option<(f64, f64)> {
+        let (_, rest) = e.split_once("between ")?;
+        let (lo, rest) = rest.split_once(" Hz and ")?;
+        let (hi, _) = rest.split_once(" Hz")?;
+        Some((lo.parse().ok()?, hi.parse().ok()?))
+    }
+
     /// A FIFO of a `rate` Hz sensor read at the times `reads` (s), each read's samples (those
-    /// due by then) stamped back from the read (0.2 ms after it) `spacing` s apart, floored
-    /// to `q` ns.
+    /// due by then, but `lost` in 1000 lost at random) stamped back from the read (0.2 ms
+    /// after it) `spacing` s apart, floored to `q` ns.
     fn stamped_back(
         rate: f64,
         reads: impl IntoIterator<Item = f64>,
-        spacing: f64,
+        (spacing, lost): (f64, u64),
         q: i64,
     ) -> Vec<i64> {
+        let mut next = crate::xorshift(0x5851_f42d_4c95_7f2d);
         let (mut t, mut taken) = (Vec::new(), 0i64);
         for at in reads {
             let due = (at * rate).floor() as i64 + 1;
-            for k in 0..(due - taken) {
-                let stamp = at + 2e-4 - (due - taken - 1 - k) as f64 * spacing;
+            let kept = (taken..due).filter(|_| next() % 1000 >= lost).count() as i64;
+            for k in 0..kept {
+                let stamp = at + 2e-4 - (kept - 1 - k) as f64 * spacing;
                 t.push((stamp * 1e9 / q as f64).floor() as i64 * q);
             }
             taken = taken.max(due);
         }
         t
+    }
+
+    /// The refusal of [`stamped_back`]'s stamps of a FIFO read `every` s for `seconds` s.
+    fn read_on_a_timer(rate: f64, (every, seconds): (f64, f64), spacing: f64, q: i64) -> String {
+        let reads = (1..=(seconds / every) as usize).map(|r| r as f64 * every);
+        let t = stamped_back(rate, reads, (spacing, 0), q);
+        pushed(&t, true)
+            .summary(TimeUnit::Nanoseconds)
+            .map(|s| format!("{s:?}"))
+            .unwrap_err()
     }
 
     #[test]
@@ -6750,7 +6844,12 @@ mod tests {
         // their period, to the ns: folded on 1020 and 1980 Hz (17 and 33 samples a read),
         // exit 0, before.
         for rate in [1000.0, 2000.0] {
-            let t = stamped_back(rate, (1..=1_800).map(|r| r as f64 / 60.0), 1.0 / rate, 1);
+            let t = stamped_back(
+                rate,
+                (1..=1_800).map(|r| r as f64 / 60.0),
+                (1.0 / rate, 0),
+                1,
+            );
             let e = pushed(&t, false)
                 .summary(TimeUnit::Nanoseconds)
                 .map(|s| format!("{s:?}"))
@@ -6774,12 +6873,7 @@ mod tests {
             (400.5, 5e-3, 2e-3, 1_000, 60.0),
             (400.0, 1.0 / 60.0, 2.5e-3, 1_000_000, 30.0),
         ] {
-            let reads = (1..=(seconds / every) as usize).map(|r| r as f64 * every);
-            let t = stamped_back(rate, reads, spacing, q);
-            let e = pushed(&t, true)
-                .summary(TimeUnit::Nanoseconds)
-                .map(|s| format!("{s:?}"))
-                .unwrap_err();
+            let e = read_on_a_timer(rate, (every, seconds), spacing, q);
             assert!(
                 e.contains("stamps of two clocks") && e.contains("their span's rate"),
                 "{rate} Hz: {e}"
@@ -6788,6 +6882,46 @@ mod tests {
             let named = e.split(" Hz (their span's rate)").next().unwrap();
             let named: f64 = named.rsplit(' ').next().unwrap().parse().unwrap();
             assert!((named / rate - 1.0).abs() < 1e-4, "{rate} Hz: {e}");
+        }
+    }
+
+    #[test]
+    fn a_fifos_reads_spaced_by_a_set_period_off_the_rate_read_are_no_clock() {
+        // Stamped back from reads on a timer at the sensor's period, the reads' pattern
+        // leaving gaps or moving the intervals' mean: 997.3 Hz read every 20 ms (19 or 20 a
+        // read, us) read 1000 Hz with 162 samples missing, and 299.21 Hz read at 60 Hz (ns)
+        // 300 Hz, exit 0, before.
+        for (rate, every, q, seconds) in
+            [(997.3, 20e-3, 1_000, 60.0), (299.21, 1.0 / 60.0, 1, 30.0)]
+        {
+            let e = read_on_a_timer(rate, (every, seconds), 1.0 / rate, q);
+            assert!(
+                e.contains("stamps of two clocks") && e.contains("which they do not keep"),
+                "{rate} Hz: {e}"
+            );
+        }
+        // Its reads jittered by 0.2 ms, 1 % lost, on us: 991.2 Hz, exit 0, before.
+        let mut late = gaussian(5);
+        let reads = std::iter::successors(Some(0.0), |at| Some(at + 10e-3 + 2e-4 * late().abs()))
+            .skip(1)
+            .take_while(|&at| at < 30.0);
+        let t = stamped_back(997.3, reads, (1.0 / 997.3, 10), 1_000);
+        let e = pushed(&t, true)
+            .summary(TimeUnit::Nanoseconds)
+            .map(|s| format!("{s:?}"))
+            .unwrap_err();
+        assert!(e.contains("stamps of two clocks"), "{e}");
+        // A 32768 Hz counter's intervals of 27 and 28 ticks (1200 Hz), to the ns and to the
+        // us, are a clock's: their median is a tick from the period.
+        for q in [1, 1_000] {
+            let t: Vec<i64> = on_tick((1200.0, 48_000, 100.0), (0.0, 0, 0.0), 32_768, false)
+                .iter()
+                .map(|s| s / q * q)
+                .collect();
+            let s = pushed(&t, true)
+                .summary(TimeUnit::Nanoseconds)
+                .unwrap_or_else(|e| panic!("{q} ns: {e}"));
+            assert!((s.rate_hz / 1200.0 - 1.0).abs() < 1e-4, "{q} ns: {s:?}");
         }
     }
 
@@ -6801,7 +6935,7 @@ mod tests {
         let reads = std::iter::successors(Some(0.0), |at| Some(at + 10e-3 + 0.5e-3 * late().abs()))
             .skip(1)
             .take_while(|&at| at < 20.0);
-        let t = stamped_back(300.0, reads, 3e-3, 1_000_000);
+        let t = stamped_back(300.0, reads, (3e-3, 0), 1_000_000);
         let t: Vec<i64> = t
             .iter()
             .scan(i64::MIN, |last, &s| {
