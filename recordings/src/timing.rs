@@ -2329,7 +2329,19 @@ impl Timing {
             // (Where the step is known too loosely to tell much, a tick's other value is one
             // the clock keeps, one interval in a hundred or more, not one of a scatter.)
             let within = 1e-3 + ticks.round() * known / step;
-            if (ticks - ticks.round()).abs() <= within && (within <= 0.05 || 100 * count >= n) {
+            // (A counter's: a power of two a second, or one, two or five of a power of ten,
+            // to the step's own precision: 995 Hz read every 5 ms at its period lies on a
+            // tick of 25.126 us, 40 and 39 of them, which no counter keeps.)
+            let hz = 1e9 / step;
+            let counter = (hz.log2() - hz.log2().round()).abs() <= (within / ticks).max(2e-3)
+                || [1.0, 2.0, 5.0].iter().any(|&m| {
+                    let decade = (hz / m).log10();
+                    (decade - decade.round()).abs() <= (within / ticks).max(2e-3)
+                });
+            if counter
+                && (ticks - ticks.round()).abs() <= within
+                && (within <= 0.05 || 100 * count >= n)
+            {
                 return Ok(());
             }
         }
@@ -2903,7 +2915,11 @@ impl Timing {
         // fold's rate lies more than a thousandth from it: no one clock's (a driver stamping
         // each read's samples back from the read at their period, the reads on a timer of
         // their own: 1000 Hz read at 60 Hz folds on 1020 Hz, 17 samples a read).
-        if !coarse && summary.jitter_rms < 1e-3 && (rate / hz - 1.0).abs() > 1e-3 {
+        if !coarse
+            && summary.jitter_rms < 1e-3
+            && (rate / hz - 1.0).abs() > 1e-3
+            && off_in_halves(t, rate, span * rate + 1.0 - self.kept as f64)
+        {
             return Err(format!(
                 "the timestamps step by {} s ({} Hz) to within {:.1e} of it, but they keep \
                  the phase of a clock at {} Hz: stamps of two clocks (a driver stamping each \
@@ -2943,15 +2959,7 @@ impl Timing {
         let slack = 2.0 + ends + 2.0 * summary.jitter_max + 1e-5 * kept as f64;
         let hides = q > 0.0
             && (q * rate >= 0.8 || losses_look_regular(q, rate) || two_quanta(q * 1e9, rate));
-        let halves = || {
-            let m = t.len() / 2;
-            let off = |a: usize, b: usize| {
-                (i128::from(t[b]) - i128::from(t[a])) as f64 * 1e-9 * rate - (b - a) as f64
-            };
-            [off(0, m), off(m, t.len() - 1)]
-                .iter()
-                .all(|&half| half * past >= 0.25 * past * past)
-        };
+        let halves = || off_in_halves(t, rate, past);
         let fewer = self.repeats == 0 && past < -slack;
         let lost = past > slack;
         let evenly = || {
@@ -3559,6 +3567,19 @@ impl Window {
 
 /// The median interval, ns: the mean of the bucket that holds it (exact for a clock with few
 /// distinct intervals, within 0.1 % for any); none for no interval.
+/// Whether the stamps `t` (ns) hold `past` more places at `rate` Hz than samples (fewer
+/// where negative) in both halves of the record, a quarter of them each at least: not a
+/// host's stall caught up on at one end, or a burst of samples there.
+fn off_in_halves(t: &[i64], rate: f64, past: f64) -> bool {
+    let m = t.len() / 2;
+    let off = |a: usize, b: usize| {
+        (i128::from(t[b]) - i128::from(t[a])) as f64 * 1e-9 * rate - (b - a) as f64
+    };
+    [off(0, m), off(m, t.len() - 1)]
+        .iter()
+        .all(|&half| half * past >= 0.25 * past * past)
+}
+
 /// Whether a clock at `hz` lies within 2 % of two quanta (`quantum`, ns) a period, where its
 /// samples cross a quantum's edge and a lost sample's three quanta are a crossing's.
 fn two_quanta(quantum: f64, hz: f64) -> bool {
@@ -6906,6 +6927,13 @@ mod tests {
                 "{rate} Hz: {e}"
             );
         }
+        // A sensor a little slower than five samples a read, read every 5 ms at its period
+        // (ns): stamps on a tick of 25.126 us, 40 and 39 of them, no counter's; read as 1000
+        // Hz with 150 samples lost, exit 0, before. So 1980 Hz.
+        for rate in [995.0, 1980.0] {
+            let e = read_on_a_timer(rate, (5e-3, 30.0), 1.0 / rate, 1);
+            assert!(e.contains("stamps of two clocks"), "{rate} Hz: {e}");
+        }
         // Its reads jittered by 0.2 ms, 1 % lost, on us: 991.2 Hz, exit 0, before.
         let mut late = gaussian(5);
         let reads = std::iter::successors(Some(0.0), |at| Some(at + 10e-3 + 2e-4 * late().abs()))
@@ -6952,6 +6980,32 @@ mod tests {
             let last = f64::from(n - 1);
             let mean = last / ((last + 0.5 * drift * last * last / f64::from(n)) / rate);
             read_with_its_losses(pushed(&t, true), mean, lost);
+        }
+        // 100 Hz whose last 10 samples come flushed at once, 20 us apart from the first's
+        // time, and 200 Hz whose first 30 came 1 us apart just before the 30th's: the span's
+        // rate moved by them, the fold's one clock (refused as stamps of two clocks, before).
+        for (rate, burst, end) in [(100.0, 10, true), (200.0, 30, false)] {
+            let n = (60.0 * rate) as i64;
+            let t: Vec<i64> = (0..n)
+                .map(|k| {
+                    let on_time = (k as f64 / rate * 1e9) as i64 + 300_000;
+                    match end {
+                        true if k >= n - burst => {
+                            ((n - burst) as f64 / rate * 1e9) as i64
+                                + 300_000
+                                + (k - (n - burst)) * 20_000
+                        }
+                        false if k < burst => {
+                            (burst as f64 / rate * 1e9) as i64 - (burst - k) * 1_000
+                        }
+                        _ => on_time,
+                    }
+                })
+                .collect();
+            let s = pushed(&t, true)
+                .summary(TimeUnit::Nanoseconds)
+                .unwrap_or_else(|e| panic!("{rate} Hz: {e}"));
+            assert!((s.rate_hz / rate - 1.0).abs() < 1e-4, "{rate} Hz: {s:?}");
         }
         // 100 Hz slowing by 1e-3 over 500 samples on whole ms through a float's epoch ns
         // (intervals 128 ns either side of 10 ms, two of 11 ms): a tick's two values.
