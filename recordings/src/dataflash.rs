@@ -530,6 +530,10 @@ pub fn read_surveyed(
         }
         each(Sample { temperature, ..s });
     };
+    // The last complete batch's first and last sample times and its count; the first batch
+    // that starts within it.
+    let mut previous: Option<(f64, f64, usize)> = None;
+    let mut overlap: Option<Overlap> = None;
     let mut batch = |c: Closed,
                      interp: &mut Option<Interp<Sample>>,
                      deliver: &mut dyn FnMut(Sample, Option<f64>)| {
@@ -539,6 +543,21 @@ pub fn read_surveyed(
         if !c.complete {
             dropped += 1;
             return;
+        }
+        if let Some((first, last, count)) = previous
+            && c.sample_us > first
+            && c.sample_us <= last
+        {
+            overlap.get_or_insert(Overlap {
+                first,
+                last,
+                count,
+                next: c.sample_us,
+                rate: c.rate,
+            });
+        }
+        if c.count > 0 {
+            previous = Some((c.sample_us, c.time(c.count - 1), c.count));
         }
         for (j, raw) in c.samples.iter().enumerate().take(c.count) {
             let xyz = raw.map(|r| f64::from(r) / c.mul);
@@ -598,6 +617,9 @@ pub fn read_surveyed(
         batch(c, &mut interp, &mut deliver);
     }
     let held = interp.map_or(0, |i| i.finish(&mut deliver));
+    if let Some(o) = overlap {
+        return Err(data_error(path, o.to_string()));
+    }
     if delivered == 0 {
         return Err(data_error(
             path,
@@ -629,6 +651,36 @@ pub fn read_surveyed(
             0
         },
     })
+}
+
+/// A batch whose samples, placed at its header's rate, run past the first sample of the
+/// next batch of the same sensor.
+struct Overlap {
+    /// Its first and last sample times (µs) and its samples.
+    first: f64,
+    last: f64,
+    count: usize,
+    /// The next batch's first sample time (µs) and its header's rate (Hz).
+    next: f64,
+    rate: f64,
+}
+
+impl fmt::Display for Overlap {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "a batch of {} samples from {:.0} us runs to {:.0} us at the batch header's sample \
+             rate, {} Hz, past the next batch's first sample at {:.0} us: the headers' rate is not the \
+             one their sample times keep (the batch's samples and the next one's start give \
+             {} Hz or more); the batches cannot be placed in time",
+            self.count,
+            self.first,
+            self.last,
+            self.rate,
+            self.next,
+            ((self.count - 1) as f64 * 1e6 / (self.next - self.first) * 1e3).round() / 1e3
+        )
+    }
 }
 
 /// The instance `select` reads, or why none.
@@ -1675,7 +1727,20 @@ mod tests {
         // Two gyro batches of 32 samples at 1 kHz (ISBH, one ISBD block each): the first good,
         // the second's SampleUS the garbage of a corrupt header. Two corrupt IMU messages
         // besides, which a batch read does not count (it counted them before).
-        let mut bytes = imu_log(&[(u64::MAX, 0), (5_000_000, 107)]);
+        let mut bytes = batch_log(&[(u64::MAX, 0), (5_000_000, 107)]);
+        gyro_batches(
+            &mut bytes,
+            &[(5_000_000, 1000.0), (14_047_262_688_061_562_948, 1000.0)],
+        );
+        let (times, report) = gyro_batch_times(&bytes).expect("a batch");
+        assert_eq!((report.delivered, report.undecodable_batches), (32, 1));
+        assert_eq!(report.corrupt, 0);
+        assert_eq!(times.last(), Some(&(5e6 + 31_000.0)));
+    }
+
+    /// [`imu_log`] with the formats of `ISBH` (151) and `ISBD` (152) after its messages.
+    fn batch_log(imus: &[(u64, u8)]) -> Vec<u8> {
+        let mut bytes = imu_log(imus);
         fmt_message(
             &mut bytes,
             151,
@@ -1684,7 +1749,13 @@ mod tests {
             "TimeUS,N,type,instance,mul,smp_cnt,SampleUS,smp_rate",
         );
         fmt_message(&mut bytes, 152, "ISBD", "QHHaaa", "TimeUS,N,seqno,x,y,z");
-        for (n, sample_us) in [(1u16, 5_000_000u64), (2, 14_047_262_688_061_562_948)] {
+        bytes
+    }
+
+    /// Gyro batches of instance 0 (`ISBH` 151, `ISBD` 152, formats of [`batch_log`]), 32
+    /// samples each (one block), each at its SampleUS and smp_rate.
+    fn gyro_batches(bytes: &mut Vec<u8>, batches: &[(u64, f32)]) {
+        for (n, &(sample_us, rate)) in (1u16..).zip(batches) {
             bytes.extend_from_slice(&[HEAD[0], HEAD[1], 151]);
             bytes.extend_from_slice(&5_100_000u64.to_le_bytes());
             bytes.extend_from_slice(&n.to_le_bytes());
@@ -1692,7 +1763,7 @@ mod tests {
             bytes.extend_from_slice(&1u16.to_le_bytes());
             bytes.extend_from_slice(&32u16.to_le_bytes());
             bytes.extend_from_slice(&sample_us.to_le_bytes());
-            bytes.extend_from_slice(&1000f32.to_le_bytes());
+            bytes.extend_from_slice(&rate.to_le_bytes());
             bytes.extend_from_slice(&[HEAD[0], HEAD[1], 152]);
             bytes.extend_from_slice(&5_100_000u64.to_le_bytes());
             bytes.extend_from_slice(&n.to_le_bytes());
@@ -1701,16 +1772,38 @@ mod tests {
                 bytes.extend_from_slice(&(v % 13 - 6).to_le_bytes());
             }
         }
-        let file = Scratch::new(&bytes, "bin");
+    }
+
+    /// The sample times of the gyro batches of instance 0 in the log `bytes`, and the report.
+    fn gyro_batch_times(bytes: &[u8]) -> Result<(Vec<f64>, Report), DataError> {
+        let file = Scratch::new(bytes, "bin");
         let select = Select {
             kind: Kind::BatchGyro,
             instance: Some(0),
         };
         let mut times = Vec::new();
-        let report = read(&file.0, &select, &mut |s| times.push(s.time_us)).expect("a batch");
-        assert_eq!((report.delivered, report.undecodable_batches), (32, 1));
-        assert_eq!(report.corrupt, 0);
-        assert_eq!(times.last(), Some(&(5e6 + 31_000.0)));
+        let report = read(&file.0, &select, &mut |s| times.push(s.time_us))?;
+        Ok((times, report))
+    }
+
+    #[test]
+    fn batches_whose_rate_runs_one_into_the_next_are_refused_naming_the_rate() {
+        // Two batches of 32 at a header rate of 1 kHz, the second starting 30.5 ms after the
+        // first, whose last sample lies at 31 ms: its samples interleaved the next's, refused
+        // as "not after" with the --drop-backward hint, which dropped half a batch, before.
+        let mut bytes = batch_log(&[(5_000_000, 0)]);
+        let mut apart = bytes.clone();
+        gyro_batches(&mut bytes, &[(5_000_000, 1000.0), (5_030_500, 1000.0)]);
+        let e = gyro_batch_times(&bytes).unwrap_err().to_string();
+        assert!(
+            e.contains("runs to 5031000 us") && e.contains("1016.393 Hz or more"),
+            "{e}"
+        );
+        // A sample's length apart, or just past the last sample, they are read.
+        gyro_batches(&mut apart, &[(5_000_000, 1000.0), (5_031_001, 1000.0)]);
+        let (times, report) = gyro_batch_times(&apart).expect("two batches");
+        assert_eq!(report.delivered, 64);
+        assert!(times.windows(2).all(|w| w[1] > w[0]));
     }
 
     #[test]

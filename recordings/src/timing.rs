@@ -1699,11 +1699,11 @@ impl Timing {
 
     /// The coarsest [`Tick`] the stamps lie on to within a thousandth of it, counted from the
     /// middle one (or the next), but one in 10,000 (one at least: a stray row, a first stamp
-    /// taken apart), where that is coarser than the stamps resolve, no finer than an eighth
-    /// of their median interval nor coarser than it, from 16 stamps kept on; and the stamp
-    /// counted from. An error where they lie on a binary tick but up to one in ten, nine in ten
-    /// of those a hundredth of it off or more: stamps of two kinds (a jittered clock's stray a
-    /// little).
+    /// taken apart), a power of ten or a second over a power of two, where that is coarser
+    /// than the stamps resolve, no finer than an eighth of their median interval nor coarser
+    /// than it, from 16 stamps kept on; and the stamp counted from. An error where they lie
+    /// on a binary tick but up to one in ten, nine in ten of those a hundredth of it off or
+    /// more: stamps of two kinds (a jittered clock's stray a little).
     fn tick(&self, buckets: &[Bucket]) -> Result<Option<(Tick, i64)>, String> {
         let t = &self.stamps;
         if t.len() < 16 || self.bits < 64 {
@@ -1736,7 +1736,10 @@ impl Timing {
         let middle = t.len() / 2;
         for k in Tick::CANDIDATES {
             let q = k.ns();
-            if q <= 2.0 * resolution as f64 || q < median / 8.0 || q > 1.01 * median {
+            // (Two or five of a power of ten, a counter's tick, is a quantum only: see
+            // `Timing::quantum`.)
+            let counter = k.den > 1 && !k.binary();
+            if counter || q <= 2.0 * resolution as f64 || q < median / 8.0 || q > 1.01 * median {
                 continue;
             }
             for from in [t[middle], t[middle + 1]] {
@@ -1746,7 +1749,7 @@ impl Timing {
                     return Ok(Some((k, from)));
                 }
                 // (On a power of ten, stamps between its ticks are a host's late ones.)
-                let two_kinds = k.den > 1 && count <= mixed && 10 * near <= count;
+                let two_kinds = k.binary() && count <= mixed && 10 * near <= count;
                 if let (true, Some((at, stamp))) = (two_kinds, first) {
                     // (Those before a stamp on a tick half as coarse: a float's tick doubling.)
                     let finer = Tick {
@@ -1778,7 +1781,7 @@ impl Timing {
     /// some stamp on (64 stamps or more, a tenth of them or more, over four times the longest
     /// run on it before): a float's seconds past a power of two, whose tick doubles there.
     fn coarsening(t: &[i64], tick: Tick) -> Result<(), String> {
-        let Some(&last) = t.last().filter(|_| tick.den > 1) else {
+        let Some(&last) = t.last().filter(|_| tick.binary()) else {
             return Ok(());
         };
         let coarse = Tick {
@@ -2268,15 +2271,11 @@ impl Timing {
         Ok(summary)
     }
 
-    /// An error where half the intervals or more lie within two quanta (`resolution`, ns, a
-    /// quarter of the period or less) or a ten-thousandth of their median, whose mean the
-    /// period read lies more than a quantum and a half (and a millionth) from: a set spacing
-    /// no clock keeps at another period, but for a tick's (a 32768 Hz counter's intervals of
-    /// 27 and 28 ticks, a clock on whole ms in a float's ns: the mean of the commonest value
-    /// past the period, and those as near it, a step from the first mean that divides it, to
-    /// a thousandth and the widest spread of the two, a quantum at least, in steps; where
-    /// that allows more than a twentieth, that value and those as near it one interval in a
-    /// hundred or more). A driver spacing each read of its FIFO by a set period, the reads on
+    /// An error where half the intervals or more lie within two quanta (the stamps'
+    /// [`Timing::quantum`], ns, a quarter of the period or less) or a ten-thousandth of their
+    /// median, whose mean the period read lies more than a quantum and a half (and a
+    /// millionth) from: a set spacing no clock keeps at another period (a 32768 Hz counter's
+    /// intervals of 27 and 28 ticks lie within two of its ticks). A driver spacing each read of its FIFO by a set period, the reads on
     /// a timer of their own, gathers them on that spacing while the reads move the rate
     /// (997.3 Hz read every 20 ms, 19 or 20 a read, read 1000 Hz with a sample missing at
     /// each read of 19).
@@ -2285,11 +2284,10 @@ impl Timing {
         summary: &TimingSummary,
         resolution: Option<i64>,
     ) -> Result<(), String> {
-        let (t, Some(q)) = (&self.stamps, resolution.map(i128::from)) else {
+        let (t, Some(resolution)) = (&self.stamps, resolution) else {
             return Ok(());
         };
-        let period = 1e9 / summary.rate_hz;
-        if t.len() < 64 || self.repeats > 0 || 4.0 * q as f64 > period {
+        if t.len() < 64 || self.repeats > 0 {
             return Ok(());
         }
         let mut intervals: Vec<i128> = t
@@ -2298,53 +2296,28 @@ impl Timing {
             .filter(|&iv| iv > 0)
             .collect();
         let n = intervals.len();
-        intervals.sort_unstable();
-        let middle = intervals[n / 2];
-        // The intervals within two quanta (or a ten-thousandth) of a value: how many, their
-        // mean, and their spread (a quantum at least).
+        if n == 0 {
+            return Ok(());
+        }
+        let middle = *intervals.select_nth_unstable(n / 2).1;
+        let period = 1e9 / summary.rate_hz;
+        let q = self.quantum(resolution, middle as f64);
+        if 4.0 * q as f64 > period {
+            return Ok(());
+        }
+        // The intervals within two quanta (or a ten-thousandth) of the median (one at least):
+        // how many, and their mean.
         let reach = (2 * q).max(middle / 10_000);
-        let near = |value: i128| {
-            let (count, sum, low, high) = intervals
-                .iter()
-                .filter(|iv| (*iv - value).abs() <= reach)
-                .fold((0, 0.0, value, value), |(count, sum, low, high), &iv| {
-                    (count + 1, sum + iv as f64, low.min(iv), high.max(iv))
-                });
-            (count, sum / count.max(1) as f64, (high - low).max(q))
-        };
-        let (bulk, spacing, spread) = near(middle);
+        let (bulk, sum) = intervals
+            .iter()
+            .filter(|iv| (*iv - middle).abs() <= reach)
+            .fold((0, 0.0), |(count, sum), &iv| (count + 1, sum + iv as f64));
+        let spacing = sum / bulk as f64;
         let off = spacing - period;
         if 2 * bulk < n || off.abs() <= 1.5 * q as f64 + 1e-6 * period {
             return Ok(());
         }
-        let other = intervals
-            .chunk_by(|a, b| a == b)
-            .filter(|run| (run[0] - middle).abs() > reach && (run[0] as f64 - period) * off < 0.0)
-            .max_by_key(|run| run.len())
-            .map(|run| near(run[0]));
-        if let Some((count, other, other_spread)) = other {
-            let step = (other - spacing).abs();
-            let ticks = spacing / step;
-            let known = spread.max(other_spread) as f64;
-            // (Where the step is known too loosely to tell much, a tick's other value is one
-            // the clock keeps, one interval in a hundred or more, not one of a scatter.)
-            let within = 1e-3 + ticks.round() * known / step;
-            // (A counter's: a power of two a second, or one, two or five of a power of ten,
-            // to the step's own precision: 995 Hz read every 5 ms at its period lies on a
-            // tick of 25.126 us, 40 and 39 of them, which no counter keeps.)
-            let hz = 1e9 / step;
-            let counter = (hz.log2() - hz.log2().round()).abs() <= (within / ticks).max(2e-3)
-                || [1.0, 2.0, 5.0].iter().any(|&m| {
-                    let decade = (hz / m).log10();
-                    (decade - decade.round()).abs() <= (within / ticks).max(2e-3)
-                });
-            if counter
-                && (ticks - ticks.round()).abs() <= within
-                && (within <= 0.05 || 100 * count >= n)
-            {
-                return Ok(());
-            }
-        }
+        let (spaced, kept) = apart(spacing * 1e-9, period * 1e-9);
         Err(format!(
             "{bulk} of the timestamps' {n} intervals lie within {:e} s of {} s, but the rate \
              read from them, {} Hz, is a period of {} s, which they do not keep: stamps of \
@@ -2352,11 +2325,44 @@ impl Timing {
              a timer of their own?); their span gives {} Hz, the sensor's rate where none was \
              lost; give --rate",
             reach as f64 / 1e9,
-            short(spacing * 1e-9),
+            spaced,
             short(summary.rate_hz),
-            short(period * 1e-9),
+            kept,
             short(summary.span_rate_hz)
         ))
+    }
+
+    /// The stamps' quantum, ns: of the [`Tick`]s finer than an eighth of the `median`
+    /// interval (those coarser are [`Timing::tick`]'s), the coarsest they lie on, counted
+    /// from the middle one, but one in 10,000, to within a thousandth of it and, where their
+    /// unit cannot write it (a 32768 Hz counter's in us, 16 of their `resolution` or more),
+    /// their resolution; their resolution where they lie on none (a counter's tick, a
+    /// float's seconds far from zero).
+    fn quantum(&self, resolution: i64, median: f64) -> i128 {
+        let (t, resolution) = (&self.stamps, i128::from(resolution));
+        let Some(&from) = t.get(t.len() / 2) else {
+            return resolution;
+        };
+        let stray = (t.len() / 10_000).max(1);
+        Tick::CANDIDATES
+            .into_iter()
+            .filter(|k| {
+                let whole = k.whole_in(resolution);
+                let least = if whole { 2 } else { 16 };
+                k.ns() < median / 8.0 && k.ns() > (least * resolution) as f64
+            })
+            .find(|&k| {
+                let rounded = if k.whole_in(resolution) {
+                    0
+                } else {
+                    resolution
+                };
+                t.iter()
+                    .filter(|&&s| !k.near_rounded(i128::from(s) - i128::from(from), rounded))
+                    .nth(stray)
+                    .is_none()
+            })
+            .map_or(resolution, |k| (k.num + k.den - 1) / k.den)
     }
 
     /// An error where stamps rounded to a quantum (`resolution`, ns) with gaps come short of
@@ -3664,18 +3670,51 @@ struct Tick {
 }
 
 impl Tick {
-    /// From 1 s down, powers of ten to 10 ns and a second over 2 to 2^24, coarsest first.
-    const CANDIDATES: [Tick; 33] = {
-        let mut all = [Tick { num: 0, den: 1 }; 33];
-        let (mut i, mut ten, mut two) = (0, 1_000_000_000i128, 2i128);
-        while i < 33 {
-            // The coarser of the next power of ten and the next binary fraction.
-            if ten >= 10 && (ten * two >= 1_000_000_000 || two > 1 << 24) {
-                all[i] = Tick { num: ten, den: 1 };
-                ten /= 10;
+    /// From 1 s down, one, two and five of a power of ten to 10 ns (a float's decimal
+    /// seconds, a counter of a decimal rate: the two and five as a second over a whole
+    /// number) and a second over 2 to 2^24, coarsest first.
+    const CANDIDATES: [Tick; 48] = {
+        let mut all = [Tick { num: 0, den: 1 }; 48];
+        // The decimal ones: 1 s, then 5, 2 and 1 of each power of ten down to 10 ns (500 ms
+        // is 1/2 s, below).
+        let second = 1_000_000_000i128;
+        let mut decimal = [Tick { num: 0, den: 1 }; 24];
+        decimal[0] = Tick {
+            num: second,
+            den: 1,
+        };
+        decimal[1] = Tick {
+            num: second,
+            den: 5,
+        };
+        decimal[2] = Tick {
+            num: second / 10,
+            den: 1,
+        };
+        let (mut i, mut ten) = (3, second / 10);
+        while i < 24 {
+            ten /= 10;
+            decimal[i] = Tick {
+                num: second,
+                den: second / (5 * ten),
+            };
+            decimal[i + 1] = Tick {
+                num: second,
+                den: second / (2 * ten),
+            };
+            decimal[i + 2] = Tick { num: ten, den: 1 };
+            i += 3;
+        }
+        let (mut i, mut d, mut two) = (0, 0, 2i128);
+        while i < 48 {
+            // The coarser of the next decimal tick and the next binary fraction.
+            let coarser = d < 24 && decimal[d].num * two >= second * decimal[d].den;
+            if coarser || two > 1 << 24 {
+                all[i] = decimal[d];
+                d += 1;
             } else {
                 all[i] = Tick {
-                    num: 1_000_000_000,
+                    num: second,
                     den: two,
                 };
                 two *= 2;
@@ -3684,6 +3723,11 @@ impl Tick {
         }
         all
     };
+
+    /// Whether the tick is a second over a power of two.
+    fn binary(self) -> bool {
+        self.den > 1 && self.den.count_ones() == 1
+    }
 
     fn ns(self) -> f64 {
         self.num as f64 / self.den as f64
@@ -3712,13 +3756,24 @@ impl Tick {
 
     /// Whether `r` ns lies within a thousandth of a tick of a whole number of them.
     fn near(self, r: i128) -> bool {
+        self.near_rounded(r, 0)
+    }
+
+    /// Whether `r` ns lies within a thousandth of a tick and `rounded` ns of a whole number
+    /// of them (stamps of a tick their unit cannot write, rounded to it).
+    fn near_rounded(self, r: i128, rounded: i128) -> bool {
         let off = self.split(r).1;
-        1000 * off.abs() <= self.num
+        1000 * off.abs() <= self.num + 1000 * rounded * self.den
     }
 
     /// Whether `r` ns lies a hundredth of a tick or more off a whole number of them.
     fn far(self, r: i128) -> bool {
         100 * self.split(r).1.abs() >= self.num
+    }
+
+    /// Whether the tick is a whole number of `resolution` ns.
+    fn whole_in(self, resolution: i128) -> bool {
+        self.num % (self.den * resolution) == 0
     }
 
     /// A binary tick's decimal stand-in: the power of ten at or above it, ns.
@@ -4218,9 +4273,25 @@ impl TimingSummary {
 
 /// `v` to 7 significant digits, without trailing zeros.
 pub(crate) fn short(v: f64) -> String {
-    let s = format!("{v:.6}");
+    decimals(v, 6)
+}
+
+/// `v` to `places` decimals, without trailing zeros.
+fn decimals(v: f64, places: usize) -> String {
+    let s = format!("{v:.places$}");
     let s = s.trim_end_matches('0').trim_end_matches('.');
     s.to_string()
+}
+
+/// `a` and `b` as [`short`] gives them, or with the decimals that tell them apart (up to 12).
+fn apart(a: f64, b: f64) -> (String, String) {
+    let gap = (a - b).abs();
+    let places = if gap > 0.0 && gap.is_finite() {
+        ((1.0 - gap.log10()).ceil() as usize).clamp(6, 12)
+    } else {
+        6
+    };
+    (decimals(a, places), decimals(b, places))
 }
 
 #[cfg(test)]
@@ -4687,16 +4758,17 @@ mod tests {
     #[test]
     fn intervals_either_side_of_a_threshold_and_the_samples_gaps_miss_are_counted_one_by_one() {
         // A 1 kHz clock; 500 intervals 1 ns under 1.25 periods and 500 1 ns over. (The others
-        // jittered by a us either way, as a clock's are, summing to none: intervals of one
-        // spacing exactly, stepping off it for good now and then, are no clock's, see
-        // `a_fifos_reads_spaced_by_a_set_period_off_the_rate_read_are_no_clock`.)
+        // jittered by a us and a ns either way, as a clock's are, summing to none: intervals
+        // of one spacing exactly, stepping off it for good now and then, are no clock's, see
+        // `a_fifos_reads_spaced_by_a_set_period_off_the_rate_read_are_no_clock`; stamps on
+        // whole us but a ns lie on a tick of 1 us.)
         let mut t = vec![0i64];
         for i in 0..20_000 {
             let iv = match i % 40 {
                 0 => 1_249_999,
                 1 => 1_250_001,
-                2..14 => 999_000,
-                14..26 => 1_001_000,
+                2..14 => 998_999,
+                14..26 => 1_001_001,
                 _ => 1_000_000,
             };
             t.push(t[t.len() - 1] + iv);
@@ -4915,6 +4987,14 @@ mod tests {
         assert!(ns.windows(2).all(|w| w[0] > w[1]), "{ns:?}");
         assert_eq!(ns[0], 1e9);
         assert!(Tick::CANDIDATES.contains(&Tick { num: 10, den: 1 }));
+        for den in [5, 50_000, 20_000, 50_000_000] {
+            let k = Tick {
+                num: 1_000_000_000,
+                den,
+            };
+            assert!(Tick::CANDIDATES.contains(&k) && !k.binary(), "{den}");
+        }
+        assert_eq!(Tick::CANDIDATES[1].den, 2);
         assert!(Tick::CANDIDATES.contains(&Tick {
             num: 1_000_000_000,
             den: 1 << 24
@@ -6934,6 +7014,13 @@ mod tests {
             let e = read_on_a_timer(rate, (5e-3, 30.0), 1.0 / rate, 1);
             assert!(e.contains("stamps of two clocks"), "{rate} Hz: {e}");
         }
+        // So on us stamps, spaced by the period to the us: 1782.92 Hz at 561 us read 1800 Hz,
+        // 1980 Hz at 505 us 2000 Hz, 1188 Hz at 842 us 1200 Hz, exit 0, before (the step
+        // between their two values near a counter's, to the us).
+        for (rate, spacing) in [(1782.92, 561e-6), (1980.0, 505e-6), (1188.0, 842e-6)] {
+            let e = read_on_a_timer(rate, (5e-3, 30.0), spacing, 1_000);
+            assert!(e.contains("stamps of two clocks"), "{rate} Hz: {e}");
+        }
         // Its reads jittered by 0.2 ms, 1 % lost, on us: 991.2 Hz, exit 0, before.
         let mut late = gaussian(5);
         let reads = std::iter::successors(Some(0.0), |at| Some(at + 10e-3 + 2e-4 * late().abs()))
@@ -6946,16 +7033,57 @@ mod tests {
             .unwrap_err();
         assert!(e.contains("stamps of two clocks"), "{e}");
         // A 32768 Hz counter's intervals of 27 and 28 ticks (1200 Hz), to the ns and to the
-        // us, are a clock's: their median is a tick from the period.
-        for q in [1, 1_000] {
-            let t: Vec<i64> = on_tick((1200.0, 48_000, 100.0), (0.0, 0, 0.0), 32_768, false)
+        // us, and a 20 kHz counter's of 16 and 17, are a clock's: read on the counter's tick.
+        for (hz, q) in [(32_768, 1), (32_768, 1_000), (20_000, 1), (20_000, 1_000)] {
+            let t: Vec<i64> = on_tick((1200.0, 48_000, 100.0), (0.0, 0, 0.0), hz, false)
                 .iter()
                 .map(|s| s / q * q)
                 .collect();
             let s = pushed(&t, true)
                 .summary(TimeUnit::Nanoseconds)
-                .unwrap_or_else(|e| panic!("{q} ns: {e}"));
-            assert!((s.rate_hz / 1200.0 - 1.0).abs() < 1e-4, "{q} ns: {s:?}");
+                .unwrap_or_else(|e| panic!("{hz} Hz, {q} ns: {e}"));
+            assert!(
+                (s.rate_hz / 1200.0 - 1.0).abs() < 1e-4,
+                "{hz} Hz, {q} ns: {s:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn two_values_are_written_with_the_decimals_that_tell_them_apart() {
+        assert_eq!(
+            apart(0.000990099, 0.000990398),
+            ("0.0009901".into(), "0.0009904".into())
+        );
+        assert_eq!(
+            apart(0.000561, 0.000555),
+            ("0.000561".into(), "0.000555".into())
+        );
+        assert_eq!(apart(1.0, 1.0), ("1".into(), "1".into()));
+        assert_eq!(apart(1.0, 1.0 + 1e-15).0, "1");
+    }
+
+    #[test]
+    fn a_tick_far_finer_than_the_period_is_the_stamps_quantum() {
+        // A 32768 Hz counter at 199.74 Hz (164 or 165 ticks an interval), float32 seconds
+        // from 10 s at 202.76 Hz (2^-20 s), and from 1000 s at 196.25 Hz, past 1024 s where
+        // their tick doubles (2^-14 s, then 2^-13 s), each interval one of two values a tick
+        // apart that the period lies between: a clock's.
+        let counter = on_tick((199.7421, 60_000, 100.0), (0.0, 0, 0.0), 32_768, false);
+        let float32 = |from: f64, rate: f64, n: u32| -> Vec<i64> {
+            (0..n)
+                .map(|k| ((from + f64::from(k) / rate) as f32 as f64 * 1e9).round() as i64)
+                .collect()
+        };
+        for (rate, t) in [
+            (199.7421, counter),
+            (202.7565, float32(10.0, 202.7565, 2_000)),
+            (196.2544, float32(1000.0, 196.2544, 20_000)),
+        ] {
+            let s = pushed(&t, true)
+                .summary(TimeUnit::Nanoseconds)
+                .unwrap_or_else(|e| panic!("{rate} Hz: {e}"));
+            assert!((s.rate_hz / rate - 1.0).abs() < 1e-4, "{rate} Hz: {s:?}");
         }
     }
 
