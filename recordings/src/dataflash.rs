@@ -234,6 +234,9 @@ pub struct Survey {
     /// Corrupt `IMU` messages (of every instance): a TimeUS past [`MAX_TIME_US`], or an `I`
     /// not below [`MAX_IMUS`]. They are in no source.
     pub corrupt: u64,
+    /// Batch headers of a sensor type that cannot be rebuilt (no samples, mul 0, a sample
+    /// rate that is not a positive number, sample times no clock reaches): in no source.
+    pub undecodable_batches: u64,
 }
 
 impl Survey {
@@ -386,6 +389,7 @@ pub struct Report {
 pub fn survey(path: &Path) -> Result<Survey, DataError> {
     let mut sources: Vec<SourceSurvey> = Vec::new();
     let mut batches = Batches::new(false);
+    let mut undecodable = 0u64;
     let mut visit = |event: Event| {
         let entry = |sources: &mut Vec<SourceSurvey>, kind: Kind, instance: u8| match sources
             .iter()
@@ -442,6 +446,7 @@ pub fn survey(path: &Path) -> Result<Survey, DataError> {
                 }
             }
             Event::Isbh(h) => {
+                undecodable += u64::from(h.kind.is_some() && !h.valid());
                 for c in batches.open(h) {
                     closed(&mut sources, c);
                 }
@@ -487,6 +492,7 @@ pub fn survey(path: &Path) -> Result<Survey, DataError> {
         resyncs: log.resyncs,
         truncated: log.truncated,
         corrupt: log.corrupt,
+        undecodable_batches: undecodable,
     })
 }
 
@@ -1062,10 +1068,11 @@ struct Header {
 }
 
 impl Header {
-    /// Whether its samples can be rebuilt: a sensor type, a multiplier and a sample rate that
-    /// are positive numbers, and sample times up to [`MAX_TIME_US`].
+    /// Whether its samples can be rebuilt: a sensor type, samples, a multiplier and a sample
+    /// rate that are positive numbers, and sample times up to [`MAX_TIME_US`].
     fn valid(&self) -> bool {
         self.kind.is_some()
+            && self.count > 0
             && self.mul > 0.0
             && self.mul.is_finite()
             && self.rate > 0.0
@@ -1784,6 +1791,22 @@ mod tests {
         let mut times = Vec::new();
         let report = read(&file.0, &select, &mut |s| times.push(s.time_us))?;
         Ok((times, report))
+    }
+
+    #[test]
+    fn batch_headers_that_cannot_be_rebuilt_are_counted_in_the_survey() {
+        // Rates of 0, NaN, -1000 and a good one: three undecodable, one batch (the log was
+        // said to hold no ISB gyro batches, before).
+        let mut bytes = batch_log(&[(5_000_000, 0)]);
+        let rates = [0.0, f32::NAN, -1000.0, 1000.0];
+        let batches: Vec<(u64, f32)> = (0..4)
+            .map(|k| (6_000_000 + k * 100_000, rates[k as usize]))
+            .collect();
+        gyro_batches(&mut bytes, &batches);
+        let file = Scratch::new(&bytes, "bin");
+        let survey = survey(&file.0).expect("a survey");
+        assert_eq!(survey.undecodable_batches, 3);
+        assert_eq!(survey.instances(Kind::BatchGyro)[0].batches, 1);
     }
 
     #[test]

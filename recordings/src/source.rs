@@ -414,6 +414,17 @@ fn autopilot_stream(
             .into_iter()
             .map(|(i, n)| (i, format!("{i} ({n} messages)")))
             .collect();
+        if found.is_empty() && survey.undecodable_batches > 0 {
+            return Err(with_file(
+                files,
+                format!(
+                    "its {} ISB batch headers cannot be rebuilt (no samples, a multiplier of 0, \
+                     a sample rate that is not a positive number, or sample times no clock \
+                     reaches), and it has no IMU messages to read instead",
+                    survey.undecodable_batches
+                ),
+            ));
+        }
         if found.is_empty() && !survey.unreadable.is_empty() {
             return Err(with_file(
                 files,

@@ -2268,7 +2268,48 @@ impl Timing {
             self.jitter_reaches_gaps(&summary, resolution)?;
         }
         self.bulk_off_period(&summary, resolution)?;
+        self.losses_on_a_beat(&summary)?;
         Ok(summary)
+    }
+
+    /// An error where the samples counted missing are one a gap, eight gaps or more, come at
+    /// a steady spacing (the coefficient of variation of the times between them under 0.05:
+    /// losses at random spread as widely as their mean): the beat of a FIFO read on a timer
+    /// of its own, its sensor a little slower than a whole number of samples a read, whose
+    /// reads short of one leave a gap where nothing was lost (199.6 Hz read every 10 ms,
+    /// stamped back at the period, read 200 Hz with a sample missing every 2.5 s). A clock
+    /// that loses one sample in so many by design reads the same; `--rate` reads either.
+    fn losses_on_a_beat(&self, summary: &TimingSummary) -> Result<(), String> {
+        let (t, gaps) = (&self.stamps, summary.gaps);
+        if gaps < 8 || summary.missing_samples != gaps || self.repeats > 0 {
+            return Ok(());
+        }
+        let period = 1e9 / summary.rate_hz;
+        let at: Vec<f64> = t
+            .windows(2)
+            .filter(|w| (i128::from(w[1]) - i128::from(w[0])) as f64 > 1.5 * period)
+            .map(|w| w[0] as f64)
+            .collect();
+        if at.len() as u64 != gaps {
+            return Ok(());
+        }
+        let spacings: Vec<f64> = at.windows(2).map(|w| w[1] - w[0]).collect();
+        let n = spacings.len() as f64;
+        let mean = spacings.iter().sum::<f64>() / n;
+        let spread = (spacings.iter().map(|d| (d - mean).powi(2)).sum::<f64>() / n).sqrt();
+        if spread.is_nan() || spread >= 0.05 * mean {
+            return Ok(());
+        }
+        Err(format!(
+            "the timestamps miss one sample in each of {gaps} gaps, one every {} s as steady \
+             as a clock (samples lost at random come unevenly): a FIFO read on a timer of its \
+             own, its sensor a little slower than a whole number of samples a read, leaves \
+             such gaps where nothing was lost; their span gives {} Hz (the sensor's, where \
+             none was lost), the intervals {} Hz with the gaps' samples lost; give --rate",
+            short(mean * 1e-9),
+            short(summary.span_rate_hz),
+            short(summary.rate_hz)
+        ))
     }
 
     /// An error where half the intervals or more lie within two quanta (the stamps'
@@ -2317,6 +2358,26 @@ impl Timing {
         if 2 * bulk < n || off.abs() <= 1.5 * q as f64 + 1e-6 * period {
             return Ok(());
         }
+        // (A counter's two values: the commonest interval past the period, a step from the
+        // median, whose grid the stamps lie on, none counted missing. Sensors slower than a
+        // whole number of samples a read leave stamps on a grid of their own, with a sample
+        // counted missing at each read short of one: 995 Hz read every 5 ms at its period.)
+        if summary.missing_samples == 0 {
+            intervals.sort_unstable();
+            let other = intervals
+                .chunk_by(|a, b| a == b)
+                .filter(|run| {
+                    (run[0] - middle).abs() > reach && (run[0] as f64 - period) * off < 0.0
+                })
+                .max_by_key(|run| run.len())
+                .map(|run| run[0]);
+            if let Some(other) = other {
+                let ticks = (spacing / (other - middle).abs() as f64).round();
+                if ticks >= 2.0 && self.on_grid(spacing / ticks, q) {
+                    return Ok(());
+                }
+            }
+        }
         let (spaced, kept) = apart(spacing * 1e-9, period * 1e-9);
         Err(format!(
             "{bulk} of the timestamps' {n} intervals lie within {:e} s of {} s, but the rate \
@@ -2344,7 +2405,7 @@ impl Timing {
             return resolution;
         };
         let stray = (t.len() / 10_000).max(1);
-        Tick::CANDIDATES
+        let family = Tick::CANDIDATES
             .into_iter()
             .filter(|k| {
                 let whole = k.whole_in(resolution);
@@ -2362,7 +2423,49 @@ impl Timing {
                     .nth(stray)
                     .is_none()
             })
-            .map_or(resolution, |k| (k.num + k.den - 1) / k.den)
+            .map_or(resolution, |k| (k.num + k.den - 1) / k.den);
+        // (Intervals all a whole number of a grid no tick names: ns through a double of epoch
+        // ns, 256 ns; a 125 kHz counter's 8 us.)
+        let whole = t
+            .windows(2)
+            .map(|w| i128::from(w[1]) - i128::from(w[0]))
+            .filter(|&iv| iv > 0)
+            .fold(0, gcd);
+        let whole = if whole > 2 * resolution && (whole as f64) < median / 8.0 {
+            whole
+        } else {
+            resolution
+        };
+        family.max(whole).max(float32_ulp(t, stray))
+    }
+
+    /// Whether the stamps lie on a grid of about `step` ns (refined to a whole number of it
+    /// over their span), but one in 10,000, to within their quantum (`resolution`, ns) and a
+    /// thousandth of it, four quanta or more: a counter whose tick no [`Tick`] names (48 kHz,
+    /// 84 MHz over 64), or whose ticks a float's seconds round.
+    fn on_grid(&self, step: f64, resolution: i128) -> bool {
+        let t = &self.stamps;
+        let (Some(&first), Some(&last)) = (t.first(), t.last()) else {
+            return false;
+        };
+        let span = (i128::from(last) - i128::from(first)) as f64;
+        let resolution = resolution as f64;
+        if step.is_nan() || step <= 4.0 * resolution || span <= 0.0 {
+            return false;
+        }
+        let steps = (span / step).round();
+        if !(steps.is_finite() && steps >= 1.0) {
+            return false;
+        }
+        let step = span / steps;
+        let stray = (t.len() / 10_000).max(1);
+        t.iter()
+            .filter(|&&s| {
+                let r = (i128::from(s) - i128::from(first)) as f64;
+                (r - (r / step).round() * step).abs() > resolution + 1e-3 * step
+            })
+            .nth(stray)
+            .is_none()
     }
 
     /// An error where stamps rounded to a quantum (`resolution`, ns) with gaps come short of
@@ -4160,6 +4263,25 @@ pub struct TimingSummary {
 }
 
 impl TimingSummary {
+    /// The warning for a rate read from stamps that hold samples repeated, their median
+    /// interval four and a half periods or more: a sample lost within a stamp leaves no mark,
+    /// so the rate, the samples kept over the span, is the sensor's only where none was lost
+    /// (a seconds column read without its fraction, 98.88 Hz with 1 % lost: 97.64 Hz).
+    pub fn coarse_warning(&self) -> Option<String> {
+        let share = self.median_interval_s * self.rate_hz;
+        (self.repeated > 0 && share >= 4.5).then(|| {
+            format!(
+                "the timestamps step by {} s and hold some {} samples each: a sample lost \
+                 within a stamp leaves no mark, so the rate read from them, {} Hz, is the \
+                 samples kept over their span, the sensor's only where none was lost (a \
+                 seconds column read without its fraction?); --rate sets it",
+                short(self.median_interval_s),
+                share.round(),
+                short(self.rate_hz)
+            )
+        })
+    }
+
     /// The refusal of stamps that repeat the one before although they resolve the samples'
     /// interval (a record read for its stamps' rate must not have them).
     pub fn repeat_refusal(&self) -> Option<String> {
@@ -4274,6 +4396,29 @@ impl TimingSummary {
 /// `v` to 7 significant digits, without trailing zeros.
 pub(crate) fn short(v: f64) -> String {
     decimals(v, 6)
+}
+
+/// The greatest common divisor of `a` and `b` (non-negative).
+fn gcd(a: i128, b: i128) -> i128 {
+    if b == 0 { a } else { gcd(b, a % b) }
+}
+
+/// Where the stamps `t` (ns), but `stray`, are float32 seconds to the ns: the float32 tick of
+/// the largest, ns (one at least); 1 otherwise.
+fn float32_ulp(t: &[i64], stray: usize) -> i128 {
+    let seconds = |s: i64| s as f64 * 1e-9;
+    let off = t
+        .iter()
+        .filter(|&&s| (f64::from(seconds(s) as f32) * 1e9 - s as f64).abs() > 1.0)
+        .nth(stray);
+    let largest = t.iter().map(|&s| seconds(s).abs()).fold(0.0, f64::max) as f32;
+    if off.is_some() || !largest.is_finite() || t.len() < 16 {
+        return 1;
+    }
+    let next = f32::from_bits(largest.to_bits() + 1);
+    ((f64::from(next) - f64::from(largest)) * 1e9)
+        .ceil()
+        .max(1.0) as i128
 }
 
 /// `v` to `places` decimals, without trailing zeros.
@@ -7061,6 +7206,118 @@ mod tests {
         );
         assert_eq!(apart(1.0, 1.0), ("1".into(), "1".into()));
         assert_eq!(apart(1.0, 1.0 + 1e-15).0, "1");
+    }
+
+    #[test]
+    fn stamps_too_coarse_to_show_samples_lost_are_warned_of() {
+        // 98.88 Hz, 1 % lost, stamped to the whole second (a seconds column read without its
+        // nanoseconds): read from the span, 97.64 Hz, with no word that losses leave no mark,
+        // before. On whole ms the gaps show, with no warning.
+        let mut lose = random(3, 100);
+        let truth: Vec<f64> = (0..5_933)
+            .filter(|&k| k == 0 || !lose(k))
+            .map(|k| 0.4 + k as f64 / 98.88)
+            .collect();
+        let on = |q: f64| -> Vec<i64> {
+            truth
+                .iter()
+                .map(|t| ((t / q).floor() * q * 1e9) as i64)
+                .collect()
+        };
+        let s = pushed(&on(1.0), true)
+            .summary(TimeUnit::Nanoseconds)
+            .unwrap();
+        let w = s.coarse_warning().expect("a warning");
+        assert!(
+            w.contains("step by 1 s") && w.contains("some 98 samples each"),
+            "{w}"
+        );
+        let s = pushed(&on(0.001), true)
+            .summary(TimeUnit::Nanoseconds)
+            .unwrap();
+        assert_eq!(s.coarse_warning(), None, "{s:?}");
+    }
+
+    #[test]
+    fn a_grid_no_tick_names_or_a_float_rounds_is_the_stamps_quantum() {
+        // Each refused as a driver's set spacing (the intervals' bulk on one value, a tick
+        // from the period) while its grid was not a power of ten, two or five of one, or a
+        // second over a power of two: ns through a double of epoch ns (256 ns) at 400 Hz;
+        // counters of 125 kHz (us), 48 kHz and 1.3125 MHz (ns); float32 seconds since boot,
+        // whose tick grows; a 10 kHz counter in float32 seconds since boot, and a 50 kHz one
+        // in float64 epoch seconds written to the ns, each rounded off its counter's grid.
+        let double = (0..12_000)
+            .map(|k| (1.7e18 + f64::from(k) / 400.0 * 1e9) as i64)
+            .collect();
+        let counter = |rate: f64, hz: i128, q: i64| -> Vec<i64> {
+            on_tick((rate, 20_000, 100.0), (0.0, 0, 0.0), hz, false)
+                .iter()
+                .map(|s| s / q * q)
+                .collect()
+        };
+        let seconds = |x: f64| -> i64 {
+            let whole = x.floor();
+            whole as i64 * 1_000_000_000 + ((x - whole) * 1e9).round() as i64
+        };
+        let float32 = |rate: f64, hz: f64| -> Vec<i64> {
+            (0..40_000)
+                .map(|k| {
+                    let at = (f64::from(k) / rate * hz).floor() / hz;
+                    seconds(f64::from(at as f32))
+                })
+                .collect()
+        };
+        let epoch = (0..17_332)
+            .map(|k| seconds(1.7e9 + (f64::from(k) / 433.3 * 5e4).floor() / 5e4))
+            .collect();
+        for (rate, t) in [
+            (400.0, double),
+            (952.3, counter(952.3, 125_000, 1_000)),
+            (433.3, counter(433.3, 48_000, 1)),
+            (510.9299, counter(510.9299, 1_312_500, 1)),
+            (1000.0, float32(1000.0, 1e9)),
+            (433.3, float32(433.3, 1e4)),
+            (433.3, epoch),
+        ] {
+            let s = pushed(&t, true)
+                .summary(TimeUnit::Nanoseconds)
+                .unwrap_or_else(|e| panic!("{rate} Hz: {e}"));
+            assert!((s.rate_hz / rate - 1.0).abs() < 1e-5, "{rate} Hz: {s:?}");
+        }
+    }
+
+    #[test]
+    fn samples_missing_one_a_gap_on_a_steady_beat_are_no_clocks_losses() {
+        // Stamped back from reads on a timer at their period, the sensor a little slower than
+        // two, two, five and ten samples a read: 199.6 Hz read every 10 ms (ns), 995 Hz every
+        // 2 ms and 1990 Hz every 5 ms at a nominal 500 us (us), read at the whole number with
+        // a sample missing at each read short of one, exit 0, before.
+        for (rate, every, spacing, q) in [
+            (199.6, 10e-3, 1.0 / 199.6, 1),
+            (995.0, 2e-3, 1.005e-3, 1_000),
+            (1990.0, 5e-3, 500e-6, 1_000),
+        ] {
+            let e = read_on_a_timer(rate, (every, 30.0), spacing, q);
+            assert!(
+                e.contains("as steady as a clock") && e.contains("give --rate"),
+                "{rate} Hz: {e}"
+            );
+        }
+        // Samples lost at random, one in 100, 0.1 % and one a gap, are a clock's.
+        for one_in in [100, 1_000] {
+            let mut lose = random(11, one_in);
+            let t: Vec<i64> = (0..60_000i64)
+                .filter(|&k| k == 0 || !lose(k))
+                .map(|k| 1_000_000 + k * 5_000_000)
+                .collect();
+            let s = pushed(&t, true)
+                .summary(TimeUnit::Nanoseconds)
+                .unwrap_or_else(|e| panic!("one in {one_in}: {e}"));
+            assert!(
+                s.gaps >= 8 && (s.rate_hz / 200.0 - 1.0).abs() < 1e-9,
+                "{s:?}"
+            );
+        }
     }
 
     #[test]

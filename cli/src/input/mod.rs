@@ -180,6 +180,9 @@ impl Series {
         if let Some(w) = unchecked(given, self.unchecked.as_deref()) {
             eprintln!("imu-ar: warning: {}", input.fail(w).0);
         }
+        if let Some(w) = coarse(given, self.timing.as_ref()) {
+            eprintln!("imu-ar: warning: {}", input.fail(w).0);
+        }
         Ok(rate)
     }
 }
@@ -285,6 +288,14 @@ pub fn summary(
             e => Ok((Some(s), e)),
         },
     }
+}
+
+/// The warning, where no rate is `given`, that the stamps are too coarse to show samples
+/// lost ([`TimingSummary::coarse_warning`]).
+pub fn coarse(given: Option<f64>, timing: Option<&TimingSummary>) -> Option<String> {
+    timing
+        .filter(|_| given.is_none())
+        .and_then(TimingSummary::coarse_warning)
 }
 
 /// The warning, where a rate is `given`, of what the stamps show that would refuse them
