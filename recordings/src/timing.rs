@@ -7049,6 +7049,17 @@ mod tests {
         );
     }
 
+    /// Asserts that the stamps `t` (ns, repeats kept) read within `tolerance` of `rate`.
+    fn read_within(t: &[i64], rate: f64, tolerance: f64) {
+        let s = pushed(t, true)
+            .summary(TimeUnit::Nanoseconds)
+            .unwrap_or_else(|e| panic!("{rate} Hz: {e}"));
+        assert!(
+            (s.rate_hz / rate - 1.0).abs() < tolerance,
+            "{rate} Hz: {s:?}"
+        );
+    }
+
     /// The rates a refusal names ("between X Hz and Y Hz"), where it names them.
     fn range_named(e: &str) -> Option<(f64, f64)> {
         let (_, rest) = e.split_once("between ")?;
@@ -7279,10 +7290,7 @@ mod tests {
             (433.3, float32(433.3, 1e4)),
             (433.3, epoch),
         ] {
-            let s = pushed(&t, true)
-                .summary(TimeUnit::Nanoseconds)
-                .unwrap_or_else(|e| panic!("{rate} Hz: {e}"));
-            assert!((s.rate_hz / rate - 1.0).abs() < 1e-5, "{rate} Hz: {s:?}");
+            read_within(&t, rate, 1e-5);
         }
     }
 
@@ -7337,10 +7345,7 @@ mod tests {
             (202.7565, float32(10.0, 202.7565, 2_000)),
             (196.2544, float32(1000.0, 196.2544, 20_000)),
         ] {
-            let s = pushed(&t, true)
-                .summary(TimeUnit::Nanoseconds)
-                .unwrap_or_else(|e| panic!("{rate} Hz: {e}"));
-            assert!((s.rate_hz / rate - 1.0).abs() < 1e-4, "{rate} Hz: {s:?}");
+            read_within(&t, rate, 1e-4);
         }
     }
 
@@ -7387,10 +7392,7 @@ mod tests {
                     }
                 })
                 .collect();
-            let s = pushed(&t, true)
-                .summary(TimeUnit::Nanoseconds)
-                .unwrap_or_else(|e| panic!("{rate} Hz: {e}"));
-            assert!((s.rate_hz / rate - 1.0).abs() < 1e-4, "{rate} Hz: {s:?}");
+            read_within(&t, rate, 1e-4);
         }
         // 100 Hz slowing by 1e-3 over 500 samples on whole ms through a float's epoch ns
         // (intervals 128 ns either side of 10 ms, two of 11 ms): a tick's two values.
