@@ -2260,6 +2260,7 @@ impl Timing {
         {
             summary.rate_hz = hz;
             summary.missing_samples = missing;
+            self.losses_on_a_beat(&summary)?;
             return Ok(summary);
         }
         self.refold(&mut summary, resolution, median, rounded)?;
@@ -2281,7 +2282,12 @@ impl Timing {
     /// that loses one sample in so many by design reads the same; `--rate` reads either.
     fn losses_on_a_beat(&self, summary: &TimingSummary) -> Result<(), String> {
         let (t, gaps) = (&self.stamps, summary.gaps);
-        if gaps < 8 || summary.missing_samples != gaps || self.repeats > 0 {
+        let doubled = summary.missing_samples.saturating_sub(gaps);
+        if gaps < 8
+            || summary.missing_samples < gaps
+            || doubled > 2 && 50 * doubled > gaps
+            || self.repeats > 0
+        {
             return Ok(());
         }
         let period = 1e9 / summary.rate_hz;
@@ -2297,12 +2303,28 @@ impl Timing {
         let n = spacings.len() as f64;
         let mean = spacings.iter().sum::<f64>() / n;
         let spread = (spacings.iter().map(|d| (d - mean).powi(2)).sum::<f64>() / n).sqrt();
-        if spread.is_nan() || spread >= 0.05 * mean {
+        // (Or each spacing near the one before: a beat of K reads or K + 1, whose K a
+        // sensor's drift moves. Within a factor of 1.25, every one, or of 2.2, but one in 50
+        // and 16 gaps or more; of two spacings of losses at random, 8 in 9 lie further apart
+        // than the first, 5 in 8 than the second. The first and last spacings aside: a
+        // record may start or stop within a read.)
+        let inner = &spacings[1..spacings.len() - 1];
+        let uneven = |factor: f64| {
+            inner
+                .windows(2)
+                .filter(|w| !(w[1] <= factor * w[0] && w[0] <= factor * w[1]))
+                .count()
+        };
+        let steady = spread < 0.05 * mean
+            || uneven(1.25) == 0
+            || gaps >= 16 && 50 * uneven(2.2) < inner.len();
+        if !steady {
             return Ok(());
         }
         Err(format!(
-            "the timestamps miss one sample in each of {gaps} gaps, one every {} s as steady \
-             as a clock (samples lost at random come unevenly): a FIFO read on a timer of its \
+            "the timestamps miss one sample in each of {gaps} gaps, one every {} s on \
+             average and each near the spacing before it, a beat (samples lost at random come \
+             unevenly): a FIFO read on a timer of its \
              own, its sensor a little slower than a whole number of samples a read, leaves \
              such gaps where nothing was lost; their span gives {} Hz (the sensor's, where \
              none was lost), the intervals {} Hz with the gaps' samples lost; give --rate",
@@ -2359,10 +2381,12 @@ impl Timing {
             return Ok(());
         }
         // (A counter's two values: the commonest interval past the period, a step from the
-        // median, whose grid the stamps lie on, none counted missing. Sensors slower than a
-        // whole number of samples a read leave stamps on a grid of their own, with a sample
-        // counted missing at each read short of one: 995 Hz read every 5 ms at its period.)
-        if summary.missing_samples == 0 {
+        // median, whose grid the stamps lie on, where the samples counted missing are none or
+        // not on a beat. Sensors slower than a whole number of samples a read leave stamps on
+        // a grid of their own, with a sample counted missing at each read short of one, on a
+        // beat: 995 Hz read every 5 ms at its period.)
+        let beat = summary.missing_samples > 0 && self.losses_on_a_beat(summary).is_err();
+        if summary.short_intervals == 0 && !beat {
             intervals.sort_unstable();
             let other = intervals
                 .chunk_by(|a, b| a == b)
@@ -2372,8 +2396,31 @@ impl Timing {
                 .max_by_key(|run| run.len())
                 .map(|run| run[0]);
             if let Some(other) = other {
-                let ticks = (spacing / (other - middle).abs() as f64).round();
-                if ticks >= 2.0 && self.on_grid(spacing / ticks, q) {
+                // The two values' means and counts, each within half the step of it
+                // (rounded to a unit the tick is not a whole number of, 48 kHz in us, each
+                // value is two).
+                let half = ((other - middle).abs() / 2).max(1);
+                let near = |value: f64| {
+                    intervals
+                        .iter()
+                        .filter(|iv| (**iv as f64 - value).abs() <= half as f64)
+                        .fold((0u64, 0.0), |(c, s), &iv| (c + 1, s + iv as f64))
+                };
+                let ((bulk_n, bulk_sum), (other_n, other_sum)) =
+                    (near(middle as f64), near(other as f64));
+                let (bulk_mean, other_mean) =
+                    (bulk_sum / bulk_n as f64, other_sum / other_n as f64);
+                let step = (other_mean - bulk_mean).abs();
+                let ticks = (spacing / step).round();
+                // (A sample lost from a counter's stamps leaves the sum of two neighbouring
+                // intervals, one of each value in 2f of them, f the rarer value's share; a
+                // FIFO's read short of one leaves one of each in all.)
+                let f = other_n as f64 / (bulk_n + other_n) as f64;
+                let mixed = near(bulk_mean + other_mean).0 as f64;
+                let gaps = (near(2.0 * bulk_mean).0 + near(2.0 * other_mean).0) as f64 + mixed;
+                let p = 2.0 * f.min(1.0 - f);
+                let reads = gaps >= 8.0 && mixed - gaps * p > 4.0 * (gaps * p * (1.0 - p)).sqrt();
+                if ticks >= 2.0 && !reads && self.on_grid(spacing / ticks, q) {
                     return Ok(());
                 }
             }
@@ -2440,24 +2487,35 @@ impl Timing {
     }
 
     /// Whether the stamps lie on a grid of about `step` ns (refined to a whole number of it
-    /// over their span), but one in 10,000, to within their quantum (`resolution`, ns) and a
-    /// thousandth of it, four quanta or more: a counter whose tick no [`Tick`] names (48 kHz,
-    /// 84 MHz over 64), or whose ticks a float's seconds round.
+    /// over stamps twice as far from the first each time, then over their span), but one in
+    /// 10,000, to within their quantum (`resolution`, ns) and a thousandth of it, four quanta
+    /// or more: a counter whose tick no [`Tick`] names (48 kHz, 84 MHz over 64), or whose
+    /// ticks a float's seconds round.
     fn on_grid(&self, step: f64, resolution: i128) -> bool {
         let t = &self.stamps;
-        let (Some(&first), Some(&last)) = (t.first(), t.last()) else {
+        let Some(&first) = t.first() else {
             return false;
         };
-        let span = (i128::from(last) - i128::from(first)) as f64;
         let resolution = resolution as f64;
-        if step.is_nan() || step <= 4.0 * resolution || span <= 0.0 {
+        if !(step.is_finite() && step > 4.0 * resolution) {
             return false;
         }
-        let steps = (span / step).round();
-        if !(steps.is_finite() && steps >= 1.0) {
-            return false;
+        // (A step known to a quantum over a distance D is known to a whole step over twice
+        // D while the step is four quanta or more.)
+        let mut step = step;
+        let mut index = 1usize;
+        loop {
+            let at = index.min(t.len() - 1);
+            let r = (i128::from(t[at]) - i128::from(first)) as f64;
+            let steps = (r / step).round();
+            if steps >= 1.0 {
+                step = r / steps;
+            }
+            if at == t.len() - 1 {
+                break;
+            }
+            index = index.saturating_mul(2);
         }
-        let step = span / steps;
         let stray = (t.len() / 10_000).max(1);
         t.iter()
             .filter(|&&s| {
@@ -7307,7 +7365,7 @@ mod tests {
         ] {
             let e = read_on_a_timer(rate, (every, 30.0), spacing, q);
             assert!(
-                e.contains("as steady as a clock") && e.contains("give --rate"),
+                e.contains("a beat (samples lost at random") && e.contains("give --rate"),
                 "{rate} Hz: {e}"
             );
         }
@@ -7326,6 +7384,90 @@ mod tests {
                 "{s:?}"
             );
         }
+    }
+
+    #[test]
+    fn a_beat_a_sensors_drift_moves_is_no_clocks_losses() {
+        // The sensor drifting 50 ppm to 1000 ppm over the record, stamped back from reads on a
+        // timer (us, ns): 3980 Hz read every 1 ms at 251 us, 995 Hz every 2 ms at its period,
+        // 199.6 Hz every 10 ms at its period, read at the whole number with a sample missing
+        // at each read short of one, exit 0, before (the spacing of the gaps drifts with it).
+        for (rate, every, spacing, q, drift) in [
+            (3980.0, 1e-3, 251e-6, 1_000, 5e-5),
+            (3980.0, 1e-3, 251e-6, 1_000, 5e-4),
+            (995.0, 2e-3, 1.0 / 995.0, 1_000, 5e-4),
+            (199.6, 10e-3, 1.0 / 199.6, 1, 1e-3),
+        ] {
+            // Samples due by each read: the phase of a rate rising by `drift` over 30 s.
+            let due = |at: f64| (rate * at * (1.0 + drift * at / 60.0)).floor() as i64 + 1;
+            let (mut t, mut taken) = (Vec::new(), 0);
+            for r in 1..=(30.0 / every) as i64 {
+                let at = r as f64 * every;
+                let kept = due(at) - taken;
+                for k in 0..kept {
+                    let stamp = at + 2e-4 - (kept - 1 - k) as f64 * spacing;
+                    t.push((stamp * 1e9 / q as f64).floor() as i64 * q);
+                }
+                taken += kept;
+            }
+            let e = pushed(&t, true)
+                .summary(TimeUnit::Nanoseconds)
+                .map(|s| format!("{s:?}"))
+                .unwrap_err();
+            assert!(
+                e.contains("a beat (samples lost"),
+                "{rate} Hz, {drift}: {e}"
+            );
+        }
+    }
+
+    #[test]
+    fn counters_whose_tick_the_unit_cannot_write_or_that_lose_samples_are_clocks() {
+        // Refused as stamps of two clocks: a 48 kHz counter in us (20.83 us a tick) at
+        // 1759.71 and 433.3 Hz, 44.1 kHz in us at 554.13 Hz, 3 MHz in ns at 1103.58 Hz; and
+        // counters no tick names, 1.3125 MHz, 120 kHz and 48 kHz in ns, losing one sample in
+        // 1000 or 100 at random.
+        let counter = |rate: f64, hz: i128, q: i64, lost: u64| -> Vec<i64> {
+            on_tick((rate, 40_000, 100.0), (0.0, lost, 0.0), hz, false)
+                .iter()
+                .map(|s| s / q * q)
+                .collect()
+        };
+        for (rate, hz, q, lost) in [
+            (1759.7102, 48_000, 1_000, 0),
+            (433.3, 48_000, 1_000, 0),
+            (554.1283, 44_100, 1_000, 0),
+            (1103.5788, 3_000_000, 1, 0),
+            (510.9299, 1_312_500, 1, 1),
+            (2096.4557, 120_000, 1, 1),
+            (72.3769, 48_000, 1, 10),
+        ] {
+            read_within(&counter(rate, hz, q, lost), rate, 1e-5);
+        }
+    }
+
+    #[test]
+    fn a_fifos_grid_is_no_counters_where_its_gaps_or_short_intervals_tell_its_reads() {
+        // Stamped back at their period from reads on a 5 ms timer, their stamps on a grid
+        // (5 ms over 199 for 995 Hz, 25.1 us a tick): 995 Hz losing one in 500 at random
+        // beside the gap of each read short of one, whose spacing the random ones break,
+        // but whose gaps each span a read's boundary; 1007 Hz (us), a read of six now and
+        // then, leaving an interval of 35 us.
+        let mut lose = random(5, 500);
+        let reads = (1..=6_000).map(|r| f64::from(r) * 5e-3);
+        let t: Vec<i64> = stamped_back(995.0, reads, (1.0 / 995.0, 0), 1)
+            .into_iter()
+            .enumerate()
+            .filter(|&(k, _)| k == 0 || !lose(k as i64))
+            .map(|(_, s)| s)
+            .collect();
+        let e = pushed(&t, true)
+            .summary(TimeUnit::Nanoseconds)
+            .map(|s| format!("{s:?}"))
+            .unwrap_err();
+        assert!(e.contains("stamps of two clocks"), "995 Hz: {e}");
+        let e = read_on_a_timer(1007.0, (5e-3, 30.0), 1.0 / 1007.0, 1_000);
+        assert!(e.contains("give --rate"), "1007 Hz: {e}");
     }
 
     #[test]
