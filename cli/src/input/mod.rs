@@ -210,11 +210,15 @@ pub fn check_packed(given: Option<f64>, stamped: Option<(u64, f64)>) -> Result<(
 /// The highest rate taken from timestamps without `--rate` to confirm it, Hz.
 pub const MAX_STAMPED_RATE: f64 = 10_000.0;
 
+/// The lowest rate taken from timestamps without `--rate` to confirm it, Hz.
+pub const MIN_STAMPED_RATE: f64 = 5.0;
+
 /// The sample rate: `given` (`--rate`) when there is one (an error when it is more than 1 %
 /// from the timestamps' rate and from the other reading of stamps rounded to a quantum, or
 /// for runs of a FIFO's reads, below it or more than [`timing::HIDDEN_LOSS`] above it), else
 /// the timestamps'
-/// (an error above [`MAX_STAMPED_RATE`]: such a rate is more often a time unit mistaken).
+/// (an error above [`MAX_STAMPED_RATE`], or below [`MIN_STAMPED_RATE`] from a time column:
+/// such a rate is more often a time unit mistaken).
 pub fn resolve_rate(given: Option<f64>, timing: Option<&TimingSummary>) -> Result<f64, Fail> {
     match (given, timing) {
         (Some(r), Some(t)) => {
@@ -253,13 +257,23 @@ pub fn resolve_rate(given: Option<f64>, timing: Option<&TimingSummary>) -> Resul
         ))),
         (None, Some(t)) if t.rate_hz > MAX_STAMPED_RATE => Err(Fail(format!(
             "the timestamps ({}) give {} Hz: an IMU above {} kHz is rare, and stamps in a unit \
-             1000 times finer than the column says (microseconds under [ns], milliseconds \
+             1000 times coarser than the column says (microseconds under [ns], milliseconds \
              under [us]) give a rate 1000 times too high; check the time column's unit, or \
              give --rate {} to confirm the rate",
             t.unit,
             t.rate_hz,
             MAX_STAMPED_RATE / 1e3,
             t.rate_hz
+        ))),
+        // (Header stamps have their unit by the format: a slow stream of them is the
+        // format's own to tell, a logger's subsample.)
+        (None, Some(t)) if t.rate_hz < MIN_STAMPED_RATE && !t.header_stamps => Err(Fail(format!(
+            "the timestamps ({}) give {} Hz: an IMU below {} Hz is rare, and stamps in a \
+                 unit 1000 times finer than the column says (milliseconds under [s], \
+                 microseconds under [ms]), or a clock since boot taken for an epoch time by its \
+                 size, give a rate 1000 times too low; check the time column's unit, or give \
+                 --rate {} to confirm the rate",
+            t.unit, t.rate_hz, MIN_STAMPED_RATE, t.rate_hz
         ))),
         (None, Some(t)) => Ok(t.rate_hz),
         (None, None) => Err(Fail(

@@ -349,44 +349,72 @@ fn a_named_pipe_is_read_once() {
     assert_eq!(got["n"], from_file["n"]);
 }
 
+/// A CSV of `header` and `gx` at stamps `first + i * step` (one a frame) in `file`: refused,
+/// the message holding each of `named`, and read at `rate` where `--rate` confirms it.
+fn refused_until_confirmed(
+    file: &Path,
+    (header, first, step): (&str, u64, u64),
+    rate: f64,
+    named: &[&str],
+) {
+    let mut s = format!("{header},gx\n");
+    for (i, f) in noise(1200, 2).iter().enumerate() {
+        writeln!(s, "{},{:?}", first + i as u64 * step, f.axes[0]).unwrap();
+    }
+    std::fs::write(file, s).unwrap();
+    let out = imu_ar(&["noise", path(file), "--column", "gx"]);
+    assert_one_line_failure(&out);
+    let e = stderr(&out);
+    assert!(named.iter().all(|n| e.contains(n)), "{header}: {e}");
+    let rate_text = rate.to_string();
+    let got = json(&imu_ar(&[
+        "noise",
+        path(file),
+        "--column",
+        "gx",
+        "--rate",
+        &rate_text,
+        "--json",
+    ]));
+    assert_eq!(got["rate_hz"], rate);
+}
+
 #[test]
 fn a_rate_above_10_khz_from_stamps_needs_the_rate_to_confirm_it() {
     let dir = temp_dir("us-as-ns");
     // 400 Hz stamps written in microseconds under a [ns] header: 400 kHz read as is.
-    let frames = noise(1200, 2);
-    let mut s = "t [ns],gx\n".to_string();
-    for (i, f) in frames.iter().enumerate() {
-        writeln!(s, "{},{:?}", 1_000_000 + i as u64 * 2_500, f.axes[0]).unwrap();
-    }
+    // Confirmed, it is read at that rate.
     let file = dir.join("us.csv");
-    std::fs::write(&file, s).unwrap();
-    let out = imu_ar(&["noise", path(&file), "--column", "gx"]);
-    assert_one_line_failure(&out);
-    let e = stderr(&out);
-    assert!(
-        e.contains("give 400000 Hz")
-            && e.contains("microseconds under [ns]")
-            && e.contains("--rate 400000"),
-        "{e}"
+    refused_until_confirmed(
+        &file,
+        ("t [ns]", 1_000_000, 2_500),
+        400_000.0,
+        &["give 400000 Hz", "microseconds under [ns]", "--rate 400000"],
     );
-    // Confirmed, it is read at that rate; and 10 kHz is still taken from the stamps.
-    let got = json(&imu_ar(&[
-        "noise",
-        path(&file),
-        "--column",
-        "gx",
-        "--rate",
-        "400000",
-        "--json",
-    ]));
-    assert_eq!(got["rate_hz"], 400_000.0);
+    // 10 kHz is still taken from the stamps.
     let mut s = "t [ns],gx\n".to_string();
-    for (i, f) in frames.iter().enumerate() {
+    for (i, f) in noise(1200, 2).iter().enumerate() {
         writeln!(s, "{},{:?}", 1_000_000 + i as u64 * 100_000, f.axes[0]).unwrap();
     }
     std::fs::write(&file, s).unwrap();
     let got = json(&imu_ar(&["noise", path(&file), "--column", "gx", "--json"]));
     assert_eq!(got["rate_hz"], 10_000.0);
+}
+
+#[test]
+fn a_rate_below_5_hz_from_stamps_needs_the_rate_to_confirm_it() {
+    // 1000 Hz stamps in ms under a [s] header, and 1000 Hz in us since boot, 20 days up, under
+    // a column that names no unit (1.728e12: an epoch time in ms by its size): 1 Hz, exit 0,
+    // before. Confirmed, each is read at that rate.
+    let dir = temp_dir("ms-as-s");
+    for stamps in [("t [s]", 1_000, 1), ("timestamp", 1_728_000_000_000, 1_000)] {
+        refused_until_confirmed(
+            &dir.join("slow.csv"),
+            stamps,
+            1.0,
+            &["give 1 Hz", "milliseconds under [s]", "--rate 1 "],
+        );
+    }
 }
 
 #[test]
