@@ -1762,13 +1762,18 @@ mod tests {
     /// Gyro batches of instance 0 (`ISBH` 151, `ISBD` 152, formats of [`batch_log`]), 32
     /// samples each (one block), each at its SampleUS and smp_rate.
     fn gyro_batches(bytes: &mut Vec<u8>, batches: &[(u64, f32)]) {
+        gyro_batches_counted(bytes, batches, 32);
+    }
+
+    /// [`gyro_batches`] whose headers say `smp_cnt` samples (one block of 32 each).
+    fn gyro_batches_counted(bytes: &mut Vec<u8>, batches: &[(u64, f32)], smp_cnt: u16) {
         for (n, &(sample_us, rate)) in (1u16..).zip(batches) {
             bytes.extend_from_slice(&[HEAD[0], HEAD[1], 151]);
             bytes.extend_from_slice(&5_100_000u64.to_le_bytes());
             bytes.extend_from_slice(&n.to_le_bytes());
             bytes.extend_from_slice(&[1, 0]);
             bytes.extend_from_slice(&1u16.to_le_bytes());
-            bytes.extend_from_slice(&32u16.to_le_bytes());
+            bytes.extend_from_slice(&smp_cnt.to_le_bytes());
             bytes.extend_from_slice(&sample_us.to_le_bytes());
             bytes.extend_from_slice(&rate.to_le_bytes());
             bytes.extend_from_slice(&[HEAD[0], HEAD[1], 152]);
@@ -1791,6 +1796,20 @@ mod tests {
         let mut times = Vec::new();
         let report = read(&file.0, &select, &mut |s| times.push(s.time_us))?;
         Ok((times, report))
+    }
+
+    #[test]
+    fn batches_their_blocks_leave_short_are_named_where_nothing_else_is_read() {
+        // Headers of 64 samples, one block of 32 each, and no IMU messages: the log was said
+        // to hold no IMU messages, before.
+        let mut bytes = batch_log(&[]);
+        let batches: Vec<(u64, f32)> = (0..4).map(|k| (6_000_000 + k * 100_000, 1000.0)).collect();
+        gyro_batches_counted(&mut bytes, &batches, 64);
+        let e = crate::source::refusal(&bytes, "bin", &["gx", "gy", "gz"]);
+        assert!(
+            e.contains("no finite samples of ISB gyro") && e.contains("4 batches dropped"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -506,8 +506,19 @@ fn fuller_dataflash(
             .map(|s| s.samples)
             .sum()
     };
+    // (Batches none of which is whole are named for it where no `IMU` message is there
+    // either.)
+    let dropped = |k| -> u64 {
+        survey
+            .instances(k)
+            .iter()
+            .filter(|s| s.instance == instance)
+            .map(|s| s.dropped_batches)
+            .sum()
+    };
     match batch {
         Some(b) if samples(b) > samples(dataflash::Kind::Imu) => b,
+        Some(b) if samples(dataflash::Kind::Imu) == 0 && dropped(b) > 0 => b,
         _ => dataflash::Kind::Imu,
     }
 }
@@ -530,7 +541,17 @@ pub fn fuller(
             .map(|i| i.samples)
             .sum()
     };
-    if samples(fifo) > samples(sensor) {
+    // (A FIFO topic none of whose messages decode is named for them where the sensor topic
+    // has no sample either.)
+    let messages = |t| -> u64 {
+        survey
+            .instances(t)
+            .iter()
+            .filter(|i| instance.is_none_or(|n| i.instance == n))
+            .map(|i| i.messages)
+            .sum()
+    };
+    if samples(fifo) > samples(sensor) || samples(sensor) == 0 && messages(fifo) > 0 {
         fifo
     } else {
         sensor
@@ -616,6 +637,9 @@ fn ulog_stream(
             );
         })
         .map_err(fail)?;
+        if let Some(e) = report.fifo_overlap {
+            return Err(Fail(e));
+        }
         skipped.undecodable = report.undecodable;
         skipped.non_finite = report.non_finite;
         return Ok(skipped);
@@ -693,6 +717,9 @@ fn ulog_stream(
         ((join(g), join(x)), pairing)
     });
     let (g, x) = (reports.0.map_err(fail)?, reports.1.map_err(fail)?);
+    if let Some(e) = [&g, &x].into_iter().find_map(|r| r.fifo_overlap.clone()) {
+        return Err(Fail(e));
+    }
     // A sample that is not finite is not delivered, and leaves its partner without one: the
     // row is counted once, as not finite, as a CSV row with a NaN is.
     let non_finite = g.non_finite + x.non_finite;
@@ -1480,10 +1507,29 @@ impl Beside {
     }
 }
 
+/// The refusal of the `columns` of the file `bytes` (its extension `ext`), its stamps read.
+#[cfg(test)]
+pub(crate) fn refusal(bytes: &[u8], ext: &str, columns: &[&str]) -> String {
+    let file = crate::Scratch::new(bytes, ext);
+    let columns: Vec<String> = columns.iter().map(|c| c.to_string()).collect();
+    let request = Request {
+        columns: &columns,
+        topic: None,
+        frame_id: None,
+        time_column: None,
+        want_time: true,
+        drop_backward: false,
+        instance: None,
+    };
+    match stream(std::slice::from_ref(&file.0), &request, &mut |_| {}) {
+        Ok(_) => panic!("read"),
+        Err(e) => e.0,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Scratch;
 
     /// The format PX4 writes for `sensor_gyro_fifo` and `sensor_accel_fifo` (after `name:`).
     const FIFO: &str = concat!(
@@ -1503,6 +1549,11 @@ mod tests {
     /// message: for each, the times (µs) of its messages' last samples and its samples'
     /// spacing (µs).
     fn fifo_log(gyro: (&[u64], u64), accel: (&[u64], u64)) -> Vec<u8> {
+        fifo_log_scaled(gyro, accel, 1e-3)
+    }
+
+    /// [`fifo_log`] with the messages' `scale` field.
+    fn fifo_log_scaled(gyro: (&[u64], u64), accel: (&[u64], u64), scale: f32) -> Vec<u8> {
         let mut bytes = crate::ulog::MAGIC.to_vec();
         bytes.push(1);
         bytes.extend_from_slice(&0u64.to_le_bytes());
@@ -1523,7 +1574,7 @@ mod tests {
             p.extend_from_slice(&t.to_le_bytes());
             p.extend_from_slice(&(7 + u32::from(id)).to_le_bytes());
             p.extend_from_slice(&(dt as f32).to_le_bytes());
-            p.extend_from_slice(&1e-3f32.to_le_bytes());
+            p.extend_from_slice(&scale.to_le_bytes());
             for axis in 0..3u64 {
                 for i in 0..32u64 {
                     // Noise-like values, different for each sample and axis.
@@ -1539,21 +1590,8 @@ mod tests {
 
     /// The refusal of the six axes of the ULog file `bytes`.
     fn six_axis_refusal(bytes: &[u8]) -> String {
-        let file = Scratch::new(bytes, "ulg");
-        let columns: Vec<String> = AXES.iter().map(|a| a.to_string()).collect();
-        let request = Request {
-            columns: &columns,
-            topic: None,
-            frame_id: None,
-            time_column: None,
-            want_time: true,
-            drop_backward: false,
-            instance: None,
-        };
-        match stream(std::slice::from_ref(&file.0), &request, &mut |_| {}) {
-            Ok(_) => panic!("six axes read"),
-            Err(e) => e.0,
-        }
+        let columns: Vec<&str> = AXES.to_vec();
+        refusal(bytes, "ulg", &columns)
     }
 
     /// The times of the last samples of `n` messages of 10 samples `dt` µs apart from 1 s
@@ -1598,6 +1636,37 @@ mod tests {
             "{e}"
         );
         assert!(!e.contains("times of their own"), "{e}");
+    }
+
+    #[test]
+    fn a_fifo_faster_than_its_dt_is_refused_naming_it() {
+        // 10 samples a message every 1 ms, dt 125 us (a sensor at 10 kHz, dt saying 8 kHz):
+        // each message's first sample before the last one's last, refused as stamps "not
+        // after" with the --drop-backward hint, before.
+        let every = messages(1_000, 100, |_| false);
+        let log = fifo_log((&every, 125), (&every, 125));
+        let e = six_axis_refusal(&log);
+        assert!(
+            e.contains("999 of the 1000 sensor_gyro_fifo messages begin before the one before")
+                && e.contains("faster than its dt field says, 8000 Hz")
+                && e.contains("about 10000 Hz"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn fifo_messages_of_no_imus_scale_are_not_read() {
+        // A scale of 1e30, 0, -1e-3 or NaN per LSB: 1e30 read as it is (values of 1e32), the
+        // others said to leave the log without sensor_gyro messages, before.
+        let every = messages(1_000, 500, |_| false);
+        for scale in [1e30, 0.0, -1e-3, f32::NAN] {
+            let e = six_axis_refusal(&fifo_log_scaled((&every, 500), (&every, 500), scale));
+            assert!(
+                e.contains("no finite samples of sensor_gyro_fifo")
+                    && e.contains("1000 messages undecodable (a samples field"),
+                "{scale}: {e}"
+            );
+        }
     }
 
     #[test]

@@ -2286,6 +2286,32 @@ impl Timing {
             return Ok(());
         }
         let period = 1e9 / summary.rate_hz;
+        // (Intervals under half a period on a beat: the sensor a little faster than a whole
+        // number of samples a read, each read of one more putting its first sample a little
+        // after the last read's last.)
+        let crowded: Vec<f64> = t
+            .windows(2)
+            .filter(|w| {
+                let iv = (i128::from(w[1]) - i128::from(w[0])) as f64;
+                iv > 0.0 && iv < 0.5 * period
+            })
+            .map(|w| w[0] as f64)
+            .collect();
+        // (Each a read or more apart, eight periods or more: a burst's come one after another.)
+        if let Some((on, extra, mean)) = beat(&crowded).filter(|b| b.2 >= 8.0 * period) {
+            return Err(format!(
+                "{on} of the timestamps' {} intervals under half the period come one every {} \
+                 s on average, each near the spacing before it: a beat ({extra} lie off it): a \
+                 FIFO read on a timer of its own, its sensor a little faster than a whole \
+                 number of samples a read, stamped back at the period, puts the first sample \
+                 of each read of one more just after the last read's last; their span gives {} \
+                 Hz (the sensor's, where none was lost), the intervals {} Hz; give --rate",
+                crowded.len(),
+                short(mean * 1e-9),
+                short(summary.span_rate_hz),
+                short(summary.rate_hz)
+            ));
+        }
         let at: Vec<f64> = t
             .windows(2)
             .filter(|w| (i128::from(w[1]) - i128::from(w[0])) as f64 > 1.5 * period)
@@ -2301,70 +2327,9 @@ impl Timing {
         {
             return Ok(());
         }
-        // The beat: from the first gap, each next the one nearest a local spacing on (the
-        // median of the 17 spacings about it) of those within one and a half of it; those
-        // passed over, samples lost at random beside it, half as many at most, 16 on the
-        // beat.
-        let all: Vec<f64> = at.windows(2).map(|w| w[1] - w[0]).collect();
-        let local = |i: usize| {
-            let mut near = all[i.saturating_sub(8)..(i + 9).min(all.len())].to_vec();
-            let middle = near.len() / 2;
-            *near.select_nth_unstable_by(middle, f64::total_cmp).1
-        };
-        let (mut beat, mut extra, mut j) = (vec![at[0]], 0usize, 1usize);
-        while j < at.len() {
-            // (Once the beat has three spacings, the median of its last eight.)
-            let last = beat[beat.len() - 1];
-            let spacing = if beat.len() > 3 {
-                let mut recent: Vec<f64> = beat[beat.len().saturating_sub(9)..]
-                    .windows(2)
-                    .map(|w| w[1] - w[0])
-                    .collect();
-                let middle = recent.len() / 2;
-                *recent.select_nth_unstable_by(middle, f64::total_cmp).1
-            } else {
-                local(j - 1)
-            };
-            let within = at[j..]
-                .iter()
-                .take_while(|&&g| g < last + 1.5 * spacing)
-                .count()
-                .max(1);
-            let nearest = (j..j + within)
-                .min_by(|&a, &b| {
-                    let off = |k: usize| (at[k] - last - spacing).abs();
-                    off(a).total_cmp(&off(b))
-                })
-                .unwrap_or(j);
-            beat.push(at[nearest]);
-            extra += nearest - j;
-            j = nearest + 1;
-        }
-        if beat.len() < 8 || extra > 0 && (beat.len() < 16 || 2 * extra > beat.len()) {
+        let Some((on, extra, mean)) = beat(&at) else {
             return Ok(());
-        }
-        let spacings: Vec<f64> = beat.windows(2).map(|w| w[1] - w[0]).collect();
-        let n = spacings.len() as f64;
-        let mean = spacings.iter().sum::<f64>() / n;
-        let spread = (spacings.iter().map(|d| (d - mean).powi(2)).sum::<f64>() / n).sqrt();
-        // (Or each spacing near the one before: a beat of K reads or K + 1, whose K a
-        // sensor's drift moves. Within a factor of 1.25, but one in 50, or, none lost beside
-        // it, of 2.2, but one in 50, and 16 gaps or more; of two spacings of losses at random, 8
-        // in 9 lie further apart than the first, 5 in 8 than the second. The first and last
-        // spacings aside: a record may start or stop within a read.)
-        let inner = &spacings[1..spacings.len() - 1];
-        let uneven = |factor: f64| {
-            inner
-                .windows(2)
-                .filter(|w| !(w[1] <= factor * w[0] && w[0] <= factor * w[1]))
-                .count()
         };
-        let steady = spread < 0.05 * mean
-            || 50 * uneven(1.25) <= inner.len()
-            || extra == 0 && gaps >= 16 && 50 * uneven(2.2) < inner.len();
-        if !steady {
-            return Ok(());
-        }
         Err(format!(
             "{} of the timestamps' {gaps} gaps, each missing a sample, come one every {} s \
              on average, each near the spacing before it: a beat (samples lost at random come \
@@ -2372,7 +2337,7 @@ impl Timing {
              a little slower than a whole number of samples a read, leaves such gaps where \
              nothing was lost; their span gives {} Hz (the sensor's, where none was lost), the \
              intervals {} Hz with the gaps' samples lost; give --rate",
-            beat.len(),
+            on,
             short(mean * 1e-9),
             short(summary.span_rate_hz),
             short(summary.rate_hz)
@@ -4519,6 +4484,88 @@ impl TimingSummary {
 /// `v` to 7 significant digits, without trailing zeros.
 pub(crate) fn short(v: f64) -> String {
     decimals(v, 6)
+}
+
+/// Whether the times `at` (ns, eight or more) come on a beat: from the first, each next the
+/// one nearest a spacing on (the median, 70th or 90th percentile of all, then the median of
+/// the beat's last eight) of those within one and a half of it, nearer the last than half of it
+/// passed over as lost at random, half as many at most; the beat's spacings steady (their
+/// coefficient of variation under 0.05, or each within a factor of 1.25 of the one before,
+/// but one in 50, where none was passed over or 16 or more are on it; or of 2.2, but one in
+/// 50, none passed over and 16 or more). The times on it, those passed over, and the mean
+/// spacing, ns.
+fn beat(at: &[f64]) -> Option<(usize, usize, f64)> {
+    if at.len() < 8 {
+        return None;
+    }
+    // (The first spacing taken at the median, 70th and 90th percentile of all: samples lost
+    // at random split the beat's spacings, and pull the lower ones down.)
+    let mut all: Vec<f64> = at.windows(2).map(|w| w[1] - w[0]).collect();
+    all.sort_unstable_by(f64::total_cmp);
+    [5, 7, 9]
+        .into_iter()
+        .map(|tenths| all[(all.len() - 1) * tenths / 10])
+        .find_map(|first| beat_from(at, first))
+}
+
+/// [`beat`] with the first spacing `first`, ns.
+fn beat_from(at: &[f64], first: f64) -> Option<(usize, usize, f64)> {
+    let (mut beat, mut extra, mut j) = (vec![at[0]], 0usize, 1usize);
+    while j < at.len() {
+        // (Once the beat has three spacings, the median of its last eight.)
+        let last = beat[beat.len() - 1];
+        let spacing = if beat.len() > 3 {
+            let mut recent: Vec<f64> = beat[beat.len().saturating_sub(9)..]
+                .windows(2)
+                .map(|w| w[1] - w[0])
+                .collect();
+            let middle = recent.len() / 2;
+            *recent.select_nth_unstable_by(middle, f64::total_cmp).1
+        } else {
+            first
+        };
+        let within = at[j..]
+            .iter()
+            .take_while(|&&g| g < last + 1.5 * spacing)
+            .count()
+            .max(1);
+        let nearest = (j..j + within)
+            .min_by(|&a, &b| {
+                let off = |k: usize| (at[k] - last - spacing).abs();
+                off(a).total_cmp(&off(b))
+            })
+            .unwrap_or(j);
+        // (Nearer the last than half a spacing on: the record's end, or lost at random.)
+        if at[nearest] >= last + 0.5 * spacing {
+            beat.push(at[nearest]);
+            extra += nearest - j;
+        } else {
+            extra += nearest - j + 1;
+        }
+        j = nearest + 1;
+    }
+    if beat.len() < 8 || 2 * extra > beat.len() {
+        return None;
+    }
+    let spacings: Vec<f64> = beat.windows(2).map(|w| w[1] - w[0]).collect();
+    let n = spacings.len() as f64;
+    let mean = spacings.iter().sum::<f64>() / n;
+    let spread = (spacings.iter().map(|d| (d - mean).powi(2)).sum::<f64>() / n).sqrt();
+    // (Each spacing near the one before: a beat of K reads or K + 1, whose K a sensor's
+    // drift moves; of two spacings of losses at random, 8 in 9 lie further apart than 1.25,
+    // 5 in 8 than 2.2. The first and last spacings aside: a record may start or stop within
+    // a read.)
+    let inner = &spacings[1..spacings.len() - 1];
+    let uneven = |factor: f64| {
+        inner
+            .windows(2)
+            .filter(|w| !(w[1] <= factor * w[0] && w[0] <= factor * w[1]))
+            .count()
+    };
+    let steady = spread < 0.05 * mean
+        || (extra == 0 || beat.len() >= 16) && 50 * uneven(1.25) <= inner.len()
+        || extra == 0 && at.len() >= 16 && 50 * uneven(2.2) < inner.len();
+    steady.then_some((beat.len(), extra, mean))
 }
 
 /// The greatest common divisor of `a` and `b` (non-negative).
@@ -7573,6 +7620,31 @@ mod tests {
             let reads = (1..=15_000).map(|r| f64::from(r) * 4e-3);
             let e = refused_losing(stamped_back(rate, reads, (spacing, 0), 1), (9, one_in));
             assert!(e.contains("a beat (samples lost"), "{rate} Hz: {e}");
+        }
+        // Stamped back at their period from reads every 5 ms, a dozen or twenty gaps on the
+        // beat and two or three lost beside them, the first of those early in the record:
+        // 999.7 Hz for 40 s and 399.8 Hz for 100 s read 1000 and 400 Hz, exit 0, before.
+        for (rate, seconds, one_in) in [(999.7, 40, 10_000), (399.8, 100, 20_000)] {
+            let reads = (1..=seconds * 200).map(|r| f64::from(r) * 5e-3);
+            let t = stamped_back(rate, reads, (1.0 / rate, 0), 1);
+            let e = refused_losing(t, (3, one_in));
+            assert!(e.contains("a beat (samples lost"), "{rate} Hz: {e}");
+        }
+    }
+
+    #[test]
+    fn a_sensor_a_little_faster_than_its_reads_is_no_clock() {
+        // Stamped back at their period from reads every 5 ms, the sensor a little faster
+        // than five or one samples a read: each read of one more puts its first sample 2.5 us
+        // after the last read's last. 1000.5 Hz (us) and 200.1 Hz (ns) for 40 and 100 s, one
+        // sample in 10,000 lost after, read 1000 and 200 Hz, exit 0, before.
+        for (rate, seconds, q) in [(1000.5, 40, 1_000), (200.1, 100, 1)] {
+            let reads = (1..=seconds * 200).map(|r| f64::from(r) * 5e-3);
+            let e = refused_losing(stamped_back(rate, reads, (1.0 / rate, 0), q), (7, 10_000));
+            assert!(
+                e.contains("intervals under half the period come one every"),
+                "{rate} Hz: {e}"
+            );
         }
     }
 

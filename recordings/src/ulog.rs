@@ -308,6 +308,10 @@ pub struct Report {
     pub temperature: Option<Topic>,
     /// The byte offset of the last message when it is cut short by the end of the file.
     pub truncated: Option<u64>,
+    /// Where one FIFO message in ten or more begins before the one before ends (the sensor
+    /// faster than the `dt` field says), why its samples' times cannot be placed: a caller
+    /// refuses the file with it.
+    pub fifo_overlap: Option<String>,
 }
 
 /// What the log holds of IMU data, its parameters and info, read in one pass without
@@ -455,6 +459,12 @@ pub fn read_surveyed(
         .collect();
     let (mut delivered, mut without_temperature) = (0u64, 0u64);
     let (mut undecodable, mut non_finite) = (0u64, 0u64);
+    // Each FIFO device's last sample time; the messages read, those whose first sample comes
+    // before the last one's last, and the first such (its first, the last one's last, dt).
+    let mut ends: Vec<(u32, f64)> = Vec::new();
+    let (mut fifo_messages, mut overlaps) = (0u64, 0u64);
+    let mut overlap: Option<(f64, f64, f64, usize)> = None;
+    let mut first_last: Option<(f64, f64, u64)> = None;
     let mut deliver = |s: Sample, temperature: Option<f64>| {
         delivered += 1;
         if temperature.is_none() {
@@ -520,6 +530,22 @@ pub fn read_surveyed(
                 if !wanted(m.device_id) {
                     return;
                 }
+                if m.n > 0 {
+                    fifo_messages += 1;
+                    let (first, last) = (m.time(0), m.time(m.n - 1));
+                    match ends.iter_mut().find(|(d, _)| *d == m.device_id) {
+                        Some((_, end)) => {
+                            if first <= *end {
+                                overlaps += 1;
+                                overlap.get_or_insert((first, *end, m.dt, m.n));
+                            }
+                            *end = last;
+                        }
+                        None => ends.push((m.device_id, last)),
+                    }
+                    let span = first_last.get_or_insert((m.time_us, m.time_us, 0));
+                    *span = (span.0, m.time_us, span.2 + m.n as u64);
+                }
                 let mut interp = interps
                     .iter_mut()
                     .find(|(d, _, _)| *d == m.device_id)
@@ -545,6 +571,39 @@ pub fn read_surveyed(
         }
     };
     let log = scan(path, &mut visit)?;
+    // A FIFO whose messages run one into the next, one in ten or more: the sensor faster than
+    // dt says (10 kHz at a dt of 125 us), each message's samples spread back too far.
+    let fifo_overlap =
+        overlap
+            .filter(|_| 10 * overlaps >= fifo_messages)
+            .map(|(first, end, dt, n)| {
+                let given = first_last
+                    .filter(|&(a, b, _)| b > a)
+                    .map(|(a, b, samples)| {
+                        let per = samples as f64 / fifo_messages as f64;
+                        format!(
+                            "; the messages give about {} Hz ({:.1} samples a message over {} us)",
+                            crate::timing::short(per * 1e6 * (fifo_messages - 1) as f64 / (b - a)),
+                            per,
+                            crate::timing::short((b - a) / (fifo_messages - 1) as f64)
+                        )
+                    })
+                    .unwrap_or_default();
+                data_error(
+            path,
+            format!(
+                "{overlaps} of the {fifo_messages} {topic} messages begin before the one before \
+                 ends (a message of {n} samples, dt {} us apart, begins at {} us, the one \
+                 before ended at {} us): the sensor runs faster than its dt field says, {} \
+                 Hz{given}, and the samples' times cannot be placed from the messages",
+                crate::timing::short(dt),
+                crate::timing::short(first),
+                crate::timing::short(end),
+                crate::timing::short(1e6 / dt)
+            ),
+        )
+        .to_string()
+            });
     let mut held = 0u64;
     for (_, _, interp) in interps {
         held += interp.finish(&mut deliver);
@@ -553,8 +612,9 @@ pub fn read_surveyed(
         return Err(data_error(
             path,
             format!(
-                "no finite samples of {topic} {} ({undecodable} messages undecodable, \
-                 {non_finite} samples with a NaN or infinite value)",
+                "no finite samples of {topic} {} ({undecodable} messages undecodable (a \
+                 samples field over its arrays, a scale or dt no IMU's), {non_finite} samples \
+                 with a NaN or infinite value)",
                 which_text(select.which)
             ),
         ));
@@ -567,6 +627,7 @@ pub fn read_surveyed(
         held_temperature: held,
         temperature: devices.first().and_then(|&(_, s)| s),
         truncated: log.truncated,
+        fifo_overlap,
     })
 }
 
@@ -1028,7 +1089,8 @@ struct FifoMessage<'a> {
 }
 
 impl FifoLayout {
-    /// The message in `p`: `None` when it claims more samples than its arrays hold.
+    /// The message in `p`: `None` when it claims more samples than its arrays hold, or its
+    /// scale or spacing is no IMU's.
     fn decode<'a>(&self, p: &'a [u8]) -> Option<FifoMessage<'a>> {
         let n = self.samples.read(p)?;
         if n > self.len as f64 {
@@ -1043,6 +1105,11 @@ impl FifoLayout {
             xyz: self.xyz,
             payload: p,
         };
+        // (A scale outside (0, 1] per LSB, or a spacing that is no time, is no IMU's: 1 rad/s
+        // or m/s^2 a count spans some 3000 g.)
+        if !(m.scale > 0.0 && m.scale <= 1.0 && m.dt.is_finite() && m.dt >= 0.0) {
+            return None;
+        }
         // The arrays are inside the payload (its length was checked against the format).
         let last = self.xyz.iter().max().copied().unwrap_or(0);
         p.get(last..last.checked_add(2 * self.len)?)?;
