@@ -498,27 +498,20 @@ fn fuller_dataflash(
     batch: Option<dataflash::Kind>,
     instance: u8,
 ) -> dataflash::Kind {
-    let samples = |k| -> u64 {
+    // The samples and the batches dropped of a kind's sources of `instance`.
+    let of = |k| -> (u64, u64) {
         survey
             .instances(k)
             .iter()
             .filter(|s| s.instance == instance)
-            .map(|s| s.samples)
-            .sum()
+            .fold((0, 0), |(n, d), s| (n + s.samples, d + s.dropped_batches))
     };
     // (Batches none of which is whole are named for it where no `IMU` message is there
     // either.)
-    let dropped = |k| -> u64 {
-        survey
-            .instances(k)
-            .iter()
-            .filter(|s| s.instance == instance)
-            .map(|s| s.dropped_batches)
-            .sum()
-    };
-    match batch {
-        Some(b) if samples(b) > samples(dataflash::Kind::Imu) => b,
-        Some(b) if samples(dataflash::Kind::Imu) == 0 && dropped(b) > 0 => b,
+    let imu = of(dataflash::Kind::Imu).0;
+    match batch.map(|b| (b, of(b))) {
+        Some((b, (samples, _))) if samples > imu => b,
+        Some((b, (_, dropped))) if imu == 0 && dropped > 0 => b,
         _ => dataflash::Kind::Imu,
     }
 }
@@ -533,25 +526,18 @@ pub fn fuller(
     fifo: ulog::Topic,
     instance: Option<u8>,
 ) -> ulog::Topic {
-    let samples = |t| -> u64 {
+    // The samples and the messages of a topic's instances.
+    let of = |t| -> (u64, u64) {
         survey
             .instances(t)
             .iter()
             .filter(|i| instance.is_none_or(|n| i.instance == n))
-            .map(|i| i.samples)
-            .sum()
+            .fold((0, 0), |(n, m), i| (n + i.samples, m + i.messages))
     };
     // (A FIFO topic none of whose messages decode is named for them where the sensor topic
     // has no sample either.)
-    let messages = |t| -> u64 {
-        survey
-            .instances(t)
-            .iter()
-            .filter(|i| instance.is_none_or(|n| i.instance == n))
-            .map(|i| i.messages)
-            .sum()
-    };
-    if samples(fifo) > samples(sensor) || samples(sensor) == 0 && messages(fifo) > 0 {
+    let ((fifo_samples, fifo_messages), (sensor_samples, _)) = (of(fifo), of(sensor));
+    if fifo_samples > sensor_samples || sensor_samples == 0 && fifo_messages > 0 {
         fifo
     } else {
         sensor
