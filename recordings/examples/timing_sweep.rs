@@ -9,10 +9,12 @@
 //! 1000 ppm, whose FIFO is read on a timer of its own (1 to 50 ms, jittered up to 1 ms), each
 //! read's samples stamped back from the read at the sensor's period or a nominal one, ns, us
 //! or ms, up to 1 % of the messages lost after stamping. Each record is `ok` (read within
-//! 3e-4 of the rate it was made at), `refused`, `warned` (read further off, with a warning
-//! that losses may leave no mark: runs of a FIFO's reads, stamps far coarser than the
-//! period) or `WRONG` (read further off, no error and no warning); the records not `ok` are
-//! listed, then the counts. INDEX reads that record alone.
+//! 3e-4 of the rate it was made at), `refused`, `warned` (read further off, with the warning
+//! that losses within stamps far coarser than the period leave no mark) or `WRONG` (read
+//! further off, no error and no warning), as the host tool reads a time column without
+//! `--rate`; the records not `ok` are
+//! listed, then the counts. INDEX reads that record alone, and CSV (after it) writes its stamps
+//! there, a `t_ns,gx` CSV the host tool reads.
 
 use imu_ar_recordings::timing::{Step, TimeUnit, Timing};
 
@@ -170,8 +172,10 @@ fn fifo(r: &mut Rng) -> (Vec<i64>, f64, String) {
     (t, made, what)
 }
 
-/// The rate read from `t` and whether it comes with a warning, or the refusal.
-fn read(t: &[i64]) -> Result<(f64, bool), String> {
+/// The rate read from `t` and whether it comes with a warning, or the refusal, as the host
+/// tool reads a time column without `--rate`: repeats kept, the summary's refusals (runs of a
+/// FIFO's reads, repeats the stamps resolve) refusals, the coarse stamps' warning a warning.
+fn read(t: &[i64]) -> Result<(f64, bool, String), String> {
     let mut timing = Timing::new();
     for &s in t {
         match timing.push(s) {
@@ -180,19 +184,30 @@ fn read(t: &[i64]) -> Result<(f64, bool), String> {
             Step::Backward { .. } => return Err("a stamp before the last".into()),
         }
     }
-    timing.summary(TimeUnit::Nanoseconds).map(|s| {
-        (
+    let s = timing.summary(TimeUnit::Nanoseconds)?;
+    match s.batch_refusal().or_else(|| s.repeat_refusal()) {
+        Some(e) => Err(e),
+        None => Ok((
             s.rate_hz,
-            s.batched.is_some() || s.coarse_warning().is_some(),
-        )
-    })
+            s.coarse_warning().is_some(),
+            format!(
+                "{} kept, {} gaps, {} missing, {} short, jitter {:.2e}, span's {:.4} Hz",
+                t.len(),
+                s.gaps,
+                s.missing_samples,
+                s.short_intervals,
+                s.jitter_rms,
+                s.span_rate_hz
+            ),
+        )),
+    }
 }
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let number = |i: usize| args.get(i).and_then(|a| a.parse::<u64>().ok());
     let (Some(kind), Some(seed), Some(count)) = (args.first(), number(1), number(2)) else {
-        eprintln!("usage: timing_sweep clock|fifo SEED COUNT [INDEX]");
+        eprintln!("usage: timing_sweep clock|fifo SEED COUNT [INDEX [CSV]]");
         std::process::exit(2);
     };
     let only = number(3);
@@ -207,11 +222,11 @@ fn main() {
             clock(&mut r)
         };
         let (verdict, shown) = match read(&t) {
-            Ok((hz, _)) if (hz / made - 1.0).abs() < 3e-4 => {
+            Ok((hz, _, _)) if (hz / made - 1.0).abs() < 3e-4 => {
                 ok += 1;
                 ("ok", format!("{hz:.4} Hz"))
             }
-            Ok((hz, warning)) => {
+            Ok((hz, warning, what)) => {
                 let verdict = if warning {
                     warned += 1;
                     "warned"
@@ -219,13 +234,24 @@ fn main() {
                     wrong += 1;
                     "WRONG"
                 };
-                (verdict, format!("{hz:.4} Hz ({:+.1e})", hz / made - 1.0))
+                (
+                    verdict,
+                    format!("{hz:.4} Hz ({:+.1e}; {what})", hz / made - 1.0),
+                )
             }
             Err(e) => {
                 refused += 1;
                 ("refused", e.chars().take(100).collect())
             }
         };
+        if let (Some(_), Some(path)) = (only, args.get(4)) {
+            let mut noise = Rng(0x2545_F491_4F6C_DD1D);
+            let rows: String = t
+                .iter()
+                .map(|s| format!("{s},{:.6}\n", noise.uniform() - 0.5))
+                .collect();
+            std::fs::write(path, format!("t_ns,gx\n{rows}")).expect("the CSV is written");
+        }
         if verdict != "ok" || only.is_some() {
             println!("#{i} {verdict}: made at {made:.4} Hz, {what}: {shown}");
         }

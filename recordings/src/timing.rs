@@ -2274,6 +2274,21 @@ impl Timing {
         }
         self.bulk_off_period(&summary, resolution)?;
         self.losses_on_a_beat(&summary)?;
+        // Reads of a FIFO stamped back at a set spacing whose boundaries fall off its grid
+        // at offsets of many sizes: a timer of the driver's own, no clock's tick.
+        if self.repeats == 0
+            && self.dropped == 0
+            && let Some((spacing, low, high, within)) = self.reads_off_grid(resolution)
+        {
+            return Ok(TimingSummary {
+                rate_hz: 1e9 * (intervals as f64 + within as f64) / span,
+                missing_samples: within,
+                short_intervals: 0,
+                other_rate_hz: None,
+                batched: Some(((low, high), spacing * 1e-9, false)),
+                ..summary
+            });
+        }
         Ok(summary)
     }
 
@@ -2717,6 +2732,78 @@ impl Timing {
         let past = self.span_ns() / period - (self.kept - 1) as f64;
         (drawn && steady && past > -1.0)
             .then(|| (1e9 / period, (past - 0.5).ceil().max(0.0) as u64))
+    }
+
+    /// Reads of a FIFO stamped back from each read at a set spacing, on a timer of their
+    /// own: half the intervals or more lie within a quantum (`quantum`, ns) of one value, the
+    /// spacing, and 16 or more, one in 500 or more, are a read's boundary: off the spacing's
+    /// grid, further from a whole number `k` of spacings than a quarter spacing and `k + 1`
+    /// quanta (a timer no whole number of spacings), by an offset no whole number of which
+    /// makes the spacing (a tick coarser than a quarter spacing, a counter's or a float's,
+    /// gives those), under two spacings and a half (longer ones are pauses), between two
+    /// intervals on the grid (a stamp late and the next on time, a host catching up on late
+    /// samples, leave intervals off it side by side). The spacing (ns), the samples a
+    /// run between boundaries holds (5th and 95th percentiles), and the samples missing
+    /// within the runs (intervals of whole spacings, to `k + 1` quanta): losses at a read's ends and reads short
+    /// of a sample leave no mark, so the sensor's rate is at least the span's with those.
+    fn reads_off_grid(&self, quantum: Option<i64>) -> Option<(f64, u64, u64, u64)> {
+        let t = &self.stamps;
+        if t.len() < 64 {
+            return None;
+        }
+        let q = quantum.unwrap_or(1).max(1);
+        let intervals: Vec<i64> = t.windows(2).map(|w| w[1].saturating_sub(w[0])).collect();
+        let mut sorted = intervals.clone();
+        sorted.sort_unstable();
+        let (mut spacing, mut most, mut at) = (sorted[0], 0, 0);
+        while at < sorted.len() {
+            let same = sorted[at..]
+                .iter()
+                .take_while(|&&d| d == sorted[at])
+                .count();
+            if same > most {
+                (spacing, most) = (sorted[at], same);
+            }
+            at += same;
+        }
+        let near = intervals
+            .iter()
+            .filter(|&&d| d.abs_diff(spacing) <= q as u64)
+            .count();
+        if spacing <= 4 * q || 2 * near < intervals.len() {
+            return None;
+        }
+        // The whole number of spacings `d` is nearest, and whether it lies off their grid.
+        let whole = |d: i64| (d as f64 / spacing as f64).round().max(1.0) as i64;
+        let off = |d: i64| {
+            let k = whole(d);
+            (d - k * spacing).abs() > ((k + 1) * q).max(spacing / 4)
+        };
+        // An offset `m` of which make the spacing, to `m + 1` quanta: a tick.
+        let tick = |d: i64| {
+            let r = (d - whole(d) * spacing).abs();
+            let m = (spacing as f64 / r as f64).round() as i64;
+            (spacing - m * r).abs() <= (m + 1) * q
+        };
+        let (mut boundaries, mut runs, mut run, mut within) = (0usize, Vec::new(), 0u64, 0);
+        for (i, &d) in intervals.iter().enumerate() {
+            run += 1;
+            let on = |j: Option<usize>| j.and_then(|j| intervals.get(j)).is_none_or(|&e| !off(e));
+            if (d - whole(d) * spacing).abs() <= (whole(d) + 1) * q {
+                within += whole(d) as u64 - 1;
+            } else if !off(d) {
+            } else if !tick(d) && 2 * d < 5 * spacing && on(Some(i + 1)) && on(i.checked_sub(1)) {
+                boundaries += 1;
+                runs.push(run);
+                run = 0;
+            }
+        }
+        if boundaries < 16 || 500 * boundaries < intervals.len() {
+            return None;
+        }
+        runs.sort_unstable();
+        let at = |p: usize| runs[(runs.len() - 1) * p / 100];
+        Some((spacing as f64, at(5), at(95), within))
     }
 
     /// Stamps in runs (of two samples or more, on the median), each run parted from the next by
@@ -7703,6 +7790,61 @@ mod tests {
             (3199.8, 25_600.0, 1.0, 1_000),
         ] {
             read_within(&stamped(rate, hz, q, one_in), rate, 1e-5);
+        }
+    }
+
+    #[test]
+    fn a_fifos_reads_whose_boundaries_fall_off_its_spacings_grid_are_runs() {
+        // A sensor's FIFO read on a timer of the driver's own, late by up to `late` s, each
+        // read's samples stamped back from the read at a set spacing, to `unit` ns, one
+        // message in `one_in` lost after stamping: the reads' boundaries fall off the
+        // spacing's grid by offsets of every size, and a read short of a sample leaves a gap
+        // no loss made (read 500, 1596, 3200 and 800 Hz with exit 0, before).
+        for (rate, every, late, spacing, unit, one_in) in [
+            (500.434, 4e-3, 1e-4, 2e-3, 1, 0),
+            (1587.279, 4e-3, 1e-3, 626e-6, 1000, 1000),
+            (3193.01, 50e-3, 1e-3, 312.5e-6, 1000, 100),
+            (798.884, 10e-3, 1e-3, 1.25e-3, 1000, 0),
+        ] {
+            let mut next_random = crate::xorshift(7);
+            let mut uniform = || (next_random() >> 11) as f64 / (1u64 << 53) as f64;
+            let (mut t, mut next, mut read) = (Vec::new(), 1u32, every);
+            while read < 30.0 {
+                let at = read + late * uniform();
+                let first = next;
+                while f64::from(next) / rate <= at {
+                    next += 1;
+                }
+                for k in first..next {
+                    let s = at + 2e-4 - f64::from(next - 1 - k) * spacing;
+                    if one_in == 0 || uniform() * one_in as f64 >= 1.0 {
+                        t.push((s * 1e9 / unit as f64).floor() as i64 * unit);
+                    }
+                }
+                read += every;
+            }
+            let s = summary_of(&t);
+            let (_, inside, stepped) = s.batched.unwrap_or_else(|| panic!("{rate}: {s:?}"));
+            // The spacing, to the stamps' unit.
+            let unit_s = 1e-9 * unit as f64;
+            assert!(
+                (inside - spacing).abs() <= 1.01 * unit_s && !stepped,
+                "{rate}: {s:?}"
+            );
+            // The least the rate may be: the span's with the losses within the runs counted
+            // (not those at a read's ends; the span's ends lie a read's time from the
+            // samples').
+            let lost = if one_in == 0 {
+                0.0
+            } else {
+                2.0 / one_in as f64
+            };
+            assert!(
+                (s.rate_hz / rate - 1.0).abs() < 1e-4 + lost,
+                "{rate}: {s:?}"
+            );
+            let e = s.batch_refusal().expect("refused");
+            assert!(e.contains("runs of") && e.contains("give --rate"), "{e}");
         }
     }
 
