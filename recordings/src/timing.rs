@@ -568,6 +568,89 @@ type Runs = ((u64, u64), f64, bool, (f64, u64));
 /// and the times (s) it was fitted to.
 type Lattice = (fold::Fit, f64, f64, Vec<f64>);
 
+/// The samples between intervals marked as boundaries (each run's count, sorted), the
+/// samples before the first and after the last left out.
+fn runs_between(boundaries: impl Iterator<Item = bool>) -> Vec<u64> {
+    let (mut runs, mut run, mut first) = (Vec::new(), 0u64, true);
+    for boundary in boundaries {
+        run += 1;
+        if boundary {
+            if !first {
+                runs.push(run);
+            }
+            (run, first) = (0, false);
+        }
+    }
+    runs.sort_unstable();
+    runs
+}
+
+/// Reads of a FIFO stamped back at a set `spacing` (ns) on a timer within a quarter spacing
+/// of a whole number of them (or jittered by less): each read's first interval lies more than
+/// two quanta `q` outside the spread of the intervals within a quantum of the spacing, and
+/// less than a quarter spacing from it, between two within a quantum of it (16 or more such, and half or more of those off it: a drifting or jittered
+/// clock's lie off side by side), and a read short of a sample leaves two spacings off by as
+/// much, as a sample lost beside a read's boundary does. Samples lost at random leave that
+/// in 2f of their gaps of two spacings or fewer (f the share of the intervals of one spacing
+/// lying off it, under 0.45: a jittered clock's pairs of intervals lie off as often as its
+/// intervals do); more, by four standard deviations and four, are reads short of a sample:
+/// the record is runs. As [`Timing::reads_off_grid`] gives.
+fn reads_short(intervals: &[i64], spacing: i64, q: i64) -> Option<(f64, u64, u64, u64)> {
+    let near = |d: i64| d.abs_diff(spacing) <= q as u64;
+    // The spread of the values within a quantum of the spacing that hold a fiftieth of
+    // those intervals or more (a spacing the unit cannot write takes two, a jittered clock's
+    // more), and how far `d` lies outside `k` times it.
+    let mut values: Vec<i64> = intervals.iter().copied().filter(|&d| near(d)).collect();
+    values.sort_unstable();
+    let (mut low, mut high, mut at) = (spacing, spacing, 0);
+    while at < values.len() {
+        let same = values[at..]
+            .iter()
+            .take_while(|&&d| d == values[at])
+            .count();
+        if 50 * same >= values.len() {
+            (low, high) = (low.min(values[at]), high.max(values[at]));
+        }
+        at += same;
+    }
+    let outside = |d: i64, k: i64| (k * low - d).max(d - k * high).max(0);
+    // Of the intervals within a quarter spacing of `k` spacings: how many, how many lie more
+    // than two quanta outside.
+    let share = |k: i64| {
+        let reach = |d: i64| 4 * (d - k * spacing).abs() <= spacing;
+        let all = intervals.iter().filter(|&&d| reach(d)).count();
+        let off = intervals
+            .iter()
+            .filter(|&&d| reach(d) && outside(d, k) > 2 * q)
+            .count();
+        (all, off)
+    };
+    let boundary = |w: &[i64]| {
+        near(w[0])
+            && near(w[2])
+            && outside(w[1], 1) > 2 * q
+            && 4 * w[1].abs_diff(spacing) <= spacing as u64
+    };
+    let isolated = intervals.windows(3).filter(|w| boundary(w)).count();
+    let ((ones, parted), (gaps, short)) = (share(1), share(2));
+    let f = parted as f64 / ones.max(1) as f64;
+    let g = gaps as f64;
+    let (expected, sd) = (2.0 * f * g, (g * 2.0 * f * (1.0 - 2.0 * f).max(0.0)).sqrt());
+    if isolated < 16
+        || 2 * isolated < parted
+        || f >= 0.45
+        || short as f64 <= expected + 4.0 * sd + 4.0
+    {
+        return None;
+    }
+    let mut runs = vec![false];
+    runs.extend(intervals.windows(3).map(boundary));
+    let runs = runs_between(runs.into_iter());
+    // The gaps of two spacings on them are samples lost within a read, each one.
+    let (low, high) = (runs[runs.len() / 20], runs[runs.len() * 19 / 20]);
+    Some((spacing as f64, low, high, (gaps - short) as u64))
+}
+
 /// Places `count` repeats from the `at`-th stamp on among those placed (the first's and the
 /// last's place) and the fewest stamps between two (`spacing`).
 fn place(places: &mut Option<(u64, u64)>, spacing: &mut u64, at: u64, count: u64) {
@@ -2740,12 +2823,13 @@ impl Timing {
     /// grid, further from a whole number `k` of spacings than a quarter spacing and `k + 1`
     /// quanta (a timer no whole number of spacings), by an offset no whole number of which
     /// makes the spacing (a tick coarser than a quarter spacing, a counter's or a float's,
-    /// gives those), under two spacings and a half (longer ones are pauses), between two
-    /// intervals on the grid (a stamp late and the next on time, a host catching up on late
-    /// samples, leave intervals off it side by side). The spacing (ns), the samples a
-    /// run between boundaries holds (5th and 95th percentiles), and the samples missing
-    /// within the runs (intervals of whole spacings, to `k + 1` quanta): losses at a read's ends and reads short
-    /// of a sample leave no mark, so the sensor's rate is at least the span's with those.
+    /// gives those), under two spacings and a half (longer ones are pauses, unless the runs
+    /// they part are of a steady length), between two intervals on the grid (a stamp late and the next on time, a host catching up on late
+    /// samples, leave intervals off it side by side); or reads short of a sample
+    /// ([`reads_short`]). The spacing (ns), the samples a run between boundaries holds (5th
+    /// and 95th percentiles), and the samples missing within the runs (intervals of whole
+    /// spacings, to `k + 1` quanta): losses at a read's ends and reads short of a sample
+    /// leave no mark, so the sensor's rate is at least the span's with those.
     fn reads_off_grid(&self, quantum: Option<i64>) -> Option<(f64, u64, u64, u64)> {
         let t = &self.stamps;
         if t.len() < 64 {
@@ -2785,25 +2869,57 @@ impl Timing {
             let m = (spacing as f64 / r as f64).round() as i64;
             (spacing - m * r).abs() <= (m + 1) * q
         };
-        let (mut boundaries, mut runs, mut run, mut within) = (0usize, Vec::new(), 0u64, 0);
-        for (i, &d) in intervals.iter().enumerate() {
-            run += 1;
-            let on = |j: Option<usize>| j.and_then(|j| intervals.get(j)).is_none_or(|&e| !off(e));
-            if (d - whole(d) * spacing).abs() <= (whole(d) + 1) * q {
-                within += whole(d) as u64 - 1;
-            } else if !off(d) {
-            } else if !tick(d) && 2 * d < 5 * spacing && on(Some(i + 1)) && on(i.checked_sub(1)) {
-                boundaries += 1;
-                runs.push(run);
-                run = 0;
-            }
+        let on = |j: Option<usize>| j.and_then(|j| intervals.get(j)).is_none_or(|&e| !off(e));
+        // Off the grid between two on it, no tick's; `long`, two spacings and a half or more.
+        let boundary = |i: usize, d: i64, long: bool| {
+            off(d)
+                && !tick(d)
+                && (2 * d >= 5 * spacing) == long
+                && on(Some(i + 1))
+                && on(i.checked_sub(1))
+        };
+        let within = intervals
+            .iter()
+            .filter(|&&d| (d - whole(d) * spacing).abs() <= (whole(d) + 1) * q)
+            .map(|&d| whole(d) as u64 - 1)
+            .sum();
+        let enough = |runs: &[u64]| runs.len() >= 16 && 500 * runs.len() >= intervals.len();
+        let marked = |long: bool| {
+            runs_between(
+                intervals
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &d)| boundary(i, d, false) || long && boundary(i, d, true)),
+            )
+        };
+        // Longer ones are pauses, or the boundaries of reads stamped back at a spacing well
+        // short of the samples' period: those part runs of a steady length (three in ten
+        // or more within an eighth and two samples of the first quartile, eight or more; a
+        // read whose boundary lies near the grid joins two), pauses at random places do not.
+        let runs = marked(false);
+        let long = marked(true);
+        let steady = |r: &[u64]| {
+            let base = r[r.len() / 4];
+            let like = r
+                .iter()
+                .filter(|&&n| n.abs_diff(base) <= base / 8 + 2)
+                .count();
+            base >= 8 && 10 * like >= 3 * r.len()
+        };
+        let runs = if enough(&long) && steady(&long) {
+            long
+        } else {
+            runs
+        };
+        if enough(&runs) {
+            return Some((
+                spacing as f64,
+                runs[runs.len() / 20],
+                runs[runs.len() * 19 / 20],
+                within,
+            ));
         }
-        if boundaries < 16 || 500 * boundaries < intervals.len() {
-            return None;
-        }
-        runs.sort_unstable();
-        let at = |p: usize| runs[(runs.len() - 1) * p / 100];
-        Some((spacing as f64, at(5), at(95), within))
+        reads_short(&intervals, spacing, q)
     }
 
     /// Stamps in runs (of two samples or more, on the median), each run parted from the next by
@@ -4535,11 +4651,13 @@ impl TimingSummary {
         };
         Some(format!(
             "the timestamps come in runs of {samples} samples {} s apart ({} Hz), each run \
-             parted from the next by a longer interval: a driver stamping each read of its \
-             FIFO at a period not the samples', or stamping the samples as they reach the \
-             host; their intervals tell no rate, their span less its pauses gives {} Hz, the \
-             sensor's where none was lost (samples lost within a run leave no mark: a --rate \
-             up to {} % above it is taken); give --rate",
+             parted from the next by an interval off it: a driver stamping each read of its \
+             FIFO back at a set spacing, not the samples' period or on a timer of its own, or \
+             stamping the samples as they reach the host; their intervals tell no rate, their \
+             span less its pauses gives {} Hz, the sensor's where none was lost but those a \
+             run shows (samples lost at a run's ends, or within it where it is stamped after, \
+             and reads short of a sample leave no mark: a --rate up to {} % above it is \
+             taken); give --rate",
             short(inside),
             short(1.0 / inside),
             short(self.rate_hz),
@@ -7805,6 +7923,16 @@ mod tests {
             (1587.279, 4e-3, 1e-3, 626e-6, 1000, 1000),
             (3193.01, 50e-3, 1e-3, 312.5e-6, 1000, 100),
             (798.884, 10e-3, 1e-3, 1.25e-3, 1000, 0),
+            // A timer within a quarter spacing of a whole number of them: each read's first
+            // interval one offset off the spacing, a read short of a sample two spacings off
+            // by as much, more often than losses beside a boundary leave them (read 400,
+            // 2000 and 3200 Hz with exit 0, before).
+            (396.033, 10e-3, 0.0, 2.501e-3, 1000, 100),
+            (1990.129, 2e-3, 0.0, 501e-6, 1000, 100),
+            (3196.891, 2.5e-3, 0.0, 314e-6, 1000, 1000),
+            // Stamped back at a nominal spacing well short of the period: the boundaries two
+            // spacings and a half or more, parting runs of a steady length (read 6400 Hz).
+            (6285.54, 19.15e-3, 130e-6, 156.25e-6, 1, 100),
         ] {
             let mut next_random = crate::xorshift(7);
             let mut uniform = || (next_random() >> 11) as f64 / (1u64 << 53) as f64;
@@ -7846,6 +7974,30 @@ mod tests {
             let e = s.batch_refusal().expect("refused");
             assert!(e.contains("runs of") && e.contains("give --rate"), "{e}");
         }
+    }
+
+    #[test]
+    fn a_jittered_clock_losing_samples_is_no_fifos_reads() {
+        // 5933.04 Hz on us stamps, jittered by up to a hundredth of a period, one sample in
+        // 100 lost, drifting by 1e-4: its intervals spread over five values about the period,
+        // a lost sample's pair of them as widely, none a read's boundary.
+        let (rate, n) = (5933.04, 190_000u32);
+        let mut next = crate::xorshift(266);
+        let mut uniform = || (next() >> 11) as f64 / (1u64 << 53) as f64;
+        let (mut t, mut phase, mut kept) = (Vec::new(), 0.0, (0.0, 0.0));
+        for k in 0..n {
+            phase += 1.0 / (rate * (1.0 + 1e-4 * f64::from(k) / f64::from(n)));
+            let at = phase + 0.01 * uniform() / rate;
+            if k > 0 && k + 1 < n && uniform() < 0.01 {
+                continue;
+            }
+            kept = (if k == 0 { phase } else { kept.0 }, phase);
+            t.push((at * 1e6).floor() as i64 * 1_000);
+        }
+        let made = f64::from(n - 1) / (kept.1 - kept.0);
+        let s = summary_of(&t);
+        assert!(s.batched.is_none(), "{s:?}");
+        assert!((s.rate_hz / made - 1.0).abs() < 1e-4, "{made}: {s:?}");
     }
 
     #[test]
