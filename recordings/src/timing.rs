@@ -2391,15 +2391,19 @@ impl Timing {
         // (Intervals under half a period on a beat: the sensor a little faster than a whole
         // number of samples a read, each read of one more putting its first sample a little
         // after the last read's last.)
-        let crowded: Vec<f64> = t
-            .windows(2)
-            .filter(|w| {
+        let crowds = |i: usize| {
+            t.get(i..i + 2).is_some_and(|w| {
                 let iv = (i128::from(w[1]) - i128::from(w[0])) as f64;
                 iv > 0.0 && iv < 0.5 * period
             })
-            .map(|w| w[0] as f64)
+        };
+        // (Each between two intervals that are not: a burst's, a host's queue released at
+        // once, come one after another.)
+        let crowded: Vec<f64> = (0..t.len().saturating_sub(1))
+            .filter(|&i| crowds(i) && !crowds(i + 1) && (i == 0 || !crowds(i - 1)))
+            .map(|i| t[i] as f64)
             .collect();
-        // (Each a read or more apart, eight periods or more: a burst's come one after another.)
+        // (Each a read or more apart, eight periods or more.)
         if let Some((on, extra, mean)) = beat(&crowded).filter(|b| b.2 >= 8.0 * period) {
             return Err(format!(
                 "{on} of the timestamps' {} intervals under half the period come one every {} \
@@ -2497,7 +2501,12 @@ impl Timing {
         // bulk is one value.)
         let spread = (squares / bulk as f64 - (spacing - middle as f64).powi(2)).max(0.0);
         let error = (spread / bulk as f64).sqrt();
-        if 2 * bulk < n || off.abs() <= 1.5 * q as f64 + 1e-6 * period + 5.0 * error {
+        // (And the most the span's end stamps move the period read, each by the jitter at
+        // most, up to 2e-5 of it: a driver reading two samples a read on the samples'
+        // interrupt, late by up to 150 us, stamps them back at their exact period, the span
+        // moved by its first and last read's lateness.)
+        let ends = (2.0 * summary.jitter_max * period / n as f64).min(2e-5 * period);
+        if 2 * bulk < n || off.abs() <= 1.5 * q as f64 + 1e-6 * period + 5.0 * error + ends {
             return Ok(());
         }
         // (A counter's two values: the commonest interval past the period, a step from the
@@ -3031,9 +3040,12 @@ impl Timing {
                 (within.iter().sum::<f64>() / within.len() as f64, tick)
             });
         // Samples lost leave intervals of whole periods: where most of the longer intervals
-        // are (within 2 % and four times the runs' jitter), the runs are a clock's with
-        // samples lost at a steady count.
-        let tolerance = 0.02 + 4.0 * jitter + tick / spacing;
+        // are (within 2 % and four times the runs' jitter, and two quanta: a jittered clock's
+        // intervals rounded to a quantum keep to one value where its jitter is under it, and
+        // its gaps' ends round either way), the runs are a clock's with samples lost at a
+        // steady count.
+        let rounded = quantum.map_or(0.0, |q| 2.0 * q as f64);
+        let tolerance = 0.02 + 4.0 * jitter + tick.max(rounded) / spacing;
         // Stamps whose quantum is over a tenth of the spacing: a clock a little slower than
         // it steps one quantum more now and then, lost samples or not (497.5 Hz on whole ms:
         // 3 ms, and 5 ms for a sample lost there).
@@ -7973,6 +7985,86 @@ mod tests {
             );
             let e = s.batch_refusal().expect("refused");
             assert!(e.contains("runs of") && e.contains("give --rate"), "{e}");
+        }
+    }
+
+    #[test]
+    fn clocks_a_driver_or_a_host_stamps_unevenly_are_read() {
+        let uniform = |seed: u64| {
+            let mut next = crate::xorshift(seed);
+            move || (next() >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let read = |t: &[i64], rate: f64, what: &str| {
+            let s = pushed(t, true)
+                .summary(TimeUnit::Nanoseconds)
+                .unwrap_or_else(|e| panic!("{what}: {e}"));
+            assert!(
+                s.batched.is_none() && s.repeat_refusal().is_none(),
+                "{what}: {s:?}"
+            );
+            assert!((s.rate_hz / rate - 1.0).abs() < 1e-5, "{what}: {s:?}");
+        };
+        // Two samples a read on the samples' interrupt, late by 100 to 250 us, stamped back
+        // at their exact period, ns: the span moved by its first and last read's lateness
+        // (refused as stamps of two clocks, before, all but seed 8).
+        for (rate, seed) in [
+            (1000.0, 1),
+            (1000.0, 5),
+            (1000.0, 6),
+            (1000.0, 8),
+            (1600.0, 1),
+        ] {
+            let mut u = uniform(seed);
+            let t: Vec<i64> = (0..10_000)
+                .flat_map(|r| {
+                    let read = f64::from(2 * r + 1) / rate + 1e-4 + 1.5e-4 * u();
+                    [read - 1.0 / rate, read].map(|s| (s * 1e9).round() as i64)
+                })
+                .collect();
+            read(&t, rate, &format!("{rate} Hz, two a read, seed {seed}"));
+        }
+        // A host stamping a 1 kHz and a 400 Hz clock as the samples reach it, 100 to 200 us
+        // late, stalled now and then for some 100 ms, the samples queued meanwhile stamped 5 us
+        // apart as they are let go (refused as a FIFO's beat, before).
+        for (rate, stall, one_in, seed) in [(1000.0, 0.1, 5000, 2), (400.0, 0.3, 2000, 1)] {
+            let mut u = uniform(seed);
+            let (mut t, mut release, mut last) = (Vec::new(), -1.0, -1.0);
+            for i in 0..40_000 {
+                let made = f64::from(i) / rate;
+                if u() * f64::from(one_in) < 1.0 {
+                    release = made - stall * u().max(1e-12).ln();
+                }
+                let mut at = (made + 1e-4 + 1e-4 * u()).max(release);
+                if at <= last {
+                    at = last + 5e-6;
+                }
+                t.push((at * 1e9).round() as i64);
+                last = at;
+            }
+            read(&t, rate, &format!("{rate} Hz from a host that stalls"));
+        }
+        // 200 Hz with 0.5 ms of Gaussian jitter on whole-ms stamps, one sample in 100 lost
+        // (and 100 Hz with 0.1 ms about the ms edge): their intervals keep to the period's
+        // milliseconds and their gaps lie a millisecond either side of whole periods
+        // (the 200 Hz ones refused as runs, before).
+        for (rate, jitter, start, seed) in [
+            (200.0, 5e-4, 3.7e-4, 1),
+            (200.0, 5e-4, 3.7e-4, 2),
+            (100.0, 1e-4, 0.0, 2),
+        ] {
+            let mut u = uniform(seed);
+            let mut t = Vec::new();
+            for i in 0..20_200 {
+                if u() < 0.01 {
+                    continue;
+                }
+                let gauss =
+                    (-2.0 * u().max(1e-300).ln()).sqrt() * (std::f64::consts::TAU * u()).cos();
+                let at = start + f64::from(i) / rate + jitter * gauss;
+                t.push((at * 1e3).floor() as i64 * 1_000_000);
+            }
+            t.sort_unstable();
+            read(&t, rate, &format!("{rate} Hz jittered on whole ms"));
         }
     }
 
