@@ -602,17 +602,12 @@ fn reads_short(intervals: &[i64], spacing: i64, q: i64) -> Option<(f64, u64, u64
     // more), and how far `d` lies outside `k` times it.
     let mut values: Vec<i64> = intervals.iter().copied().filter(|&d| near(d)).collect();
     values.sort_unstable();
-    let (mut low, mut high, mut at) = (spacing, spacing, 0);
-    while at < values.len() {
-        let same = values[at..]
-            .iter()
-            .take_while(|&&d| d == values[at])
-            .count();
-        if 50 * same >= values.len() {
-            (low, high) = (low.min(values[at]), high.max(values[at]));
-        }
-        at += same;
-    }
+    let (low, high) = values
+        .chunk_by(|a, b| a == b)
+        .filter(|run| 50 * run.len() >= values.len())
+        .fold((spacing, spacing), |(l, h), run| {
+            (l.min(run[0]), h.max(run[0]))
+        });
     let outside = |d: i64, k: i64| (k * low - d).max(d - k * high).max(0);
     // Of the intervals within a quarter spacing of `k` spacings: how many, how many lie more
     // than two quanta outside.
@@ -2848,17 +2843,11 @@ impl Timing {
         let intervals: Vec<i64> = t.windows(2).map(|w| w[1].saturating_sub(w[0])).collect();
         let mut sorted = intervals.clone();
         sorted.sort_unstable();
-        let (mut spacing, mut most, mut at) = (sorted[0], 0, 0);
-        while at < sorted.len() {
-            let same = sorted[at..]
-                .iter()
-                .take_while(|&&d| d == sorted[at])
-                .count();
-            if same > most {
-                (spacing, most) = (sorted[at], same);
-            }
-            at += same;
-        }
+        // The commonest value, the first of those as common.
+        let spacing = sorted
+            .chunk_by(|a, b| a == b)
+            .rev()
+            .max_by_key(|run| run.len())?[0];
         let near = intervals
             .iter()
             .filter(|&&d| d.abs_diff(spacing) <= q as u64)
@@ -2893,20 +2882,18 @@ impl Timing {
             .map(|&d| whole(d) as u64 - 1)
             .sum();
         let enough = |runs: &[u64]| runs.len() >= 16 && 500 * runs.len() >= intervals.len();
-        let marked = |long: bool| {
-            runs_between(
-                intervals
-                    .iter()
-                    .enumerate()
-                    .map(|(i, &d)| boundary(i, d, false) || long && boundary(i, d, true)),
-            )
-        };
+        // Each interval's kind once: a boundary under two spacings and a half, or longer.
+        let kinds: Vec<(bool, bool)> = intervals
+            .iter()
+            .enumerate()
+            .map(|(i, &d)| (boundary(i, d, false), boundary(i, d, true)))
+            .collect();
         // Longer ones are pauses, or the boundaries of reads stamped back at a spacing well
         // short of the samples' period: those part runs of a steady length (three in ten
         // or more within an eighth and two samples of the first quartile, eight or more; a
         // read whose boundary lies near the grid joins two), pauses at random places do not.
-        let runs = marked(false);
-        let long = marked(true);
+        let runs = runs_between(kinds.iter().map(|k| k.0));
+        let long = runs_between(kinds.iter().map(|k| k.0 || k.1));
         let steady = |r: &[u64]| {
             let base = r[r.len() / 4];
             let like = r
