@@ -2414,68 +2414,109 @@ impl Timing {
             return Ok(());
         }
         let period = 1e9 / summary.rate_hz;
+        let iv = |i: usize| (i128::from(t[i + 1]) - i128::from(t[i])) as f64;
         // (Intervals under half a period on a beat: the sensor a little faster than a whole
         // number of samples a read, each read of one more putting its first sample a little
         // after the last read's last.)
-        let crowds = |i: usize| {
-            t.get(i..i + 2).is_some_and(|w| {
-                let iv = (i128::from(w[1]) - i128::from(w[0])) as f64;
-                iv > 0.0 && iv < 0.5 * period
-            })
-        };
+        let crowds = |i: usize| i + 1 < t.len() && iv(i) > 0.0 && iv(i) < 0.5 * period;
         // (Each between two intervals that are not: a burst's, a host's queue released at
         // once, come one after another.)
-        let crowded: Vec<f64> = (0..t.len().saturating_sub(1))
+        let lone: Vec<usize> = (0..t.len().saturating_sub(1))
             .filter(|&i| crowds(i) && !crowds(i + 1) && (i == 0 || !crowds(i - 1)))
-            .map(|i| t[i] as f64)
             .collect();
-        // (Each a read or more apart, eight periods or more.)
-        if let Some((on, extra, mean)) = beat(&crowded).filter(|b| b.2 >= 8.0 * period) {
-            return Err(format!(
-                "{on} of the timestamps' {} intervals under half the period come one every {} \
-                 s on average, each near the spacing before it: a beat ({extra} lie off it): a \
-                 FIFO read on a timer of its own, its sensor a little faster than a whole \
-                 number of samples a read, stamped back at the period, puts the first sample \
-                 of each read of one more just after the last read's last; their span gives {} \
-                 Hz (the sensor's, where none was lost), the intervals {} Hz; give --rate",
-                crowded.len(),
-                short(mean * 1e-9),
-                short(summary.span_rate_hz),
-                short(summary.rate_hz)
-            ));
+        let gaps_at: Vec<usize> = (0..t.len().saturating_sub(1))
+            .filter(|&i| iv(i) > 1.5 * period)
+            .collect();
+        // A late read and the next, early, or the other way: a short interval and a gap
+        // together two periods long, within 16 intervals of each other, a sample neither
+        // more nor fewer (each paired with the nearest such).
+        let (mut short_paired, mut gap_paired) =
+            (vec![false; lone.len()], vec![false; gaps_at.len()]);
+        let mut from = 0;
+        for (k, &i) in lone.iter().enumerate() {
+            while from < gaps_at.len() && gaps_at[from] + 16 < i {
+                from += 1;
+            }
+            let pair = (from..gaps_at.len())
+                .take_while(|&g| gaps_at[g] <= i + 16)
+                .filter(|&g| {
+                    !gap_paired[g] && (iv(gaps_at[g]) + iv(i) - 2.0 * period).abs() < 0.5 * period
+                })
+                .min_by_key(|&g| gaps_at[g].abs_diff(i));
+            if let Some(g) = pair {
+                (short_paired[k], gap_paired[g]) = (true, true);
+            }
         }
-        let at: Vec<f64> = t
-            .windows(2)
-            .filter(|w| (i128::from(w[1]) - i128::from(w[0])) as f64 > 1.5 * period)
-            .map(|w| w[0] as f64)
-            .collect();
+        let paired = short_paired.iter().filter(|&&p| p).count() as u64;
+        // The times of the intervals `at`, with those paired left out where `apart`.
+        let times = |at: &[usize], pairs: &[bool], apart: bool| -> Vec<f64> {
+            at.iter()
+                .zip(pairs)
+                .filter(|(_, p)| !(apart && **p))
+                .map(|(&i, _)| t[i] as f64)
+                .collect()
+        };
+        // Each beat sought among all, then (where some are paired) among those not paired.
+        let tries = if paired == 0 { 1 } else { 2 };
+        let besides = |apart: bool, other: &str| {
+            if apart {
+                format!(" (not counting {paired} with {other} beside them, a late read's)")
+            } else {
+                String::new()
+            }
+        };
+        for apart in [false, true].into_iter().take(tries) {
+            let crowded = times(&lone, &short_paired, apart);
+            // (Each a read or more apart, eight periods or more.)
+            if let Some((on, extra, mean)) = beat(&crowded).filter(|b| b.2 >= 8.0 * period) {
+                return Err(format!(
+                    "{on} of the timestamps' {} intervals under half the period{} come one \
+                     every {} s on average, each near the spacing before it: a beat ({extra} \
+                     lie off it): a FIFO read on a timer of its own, its sensor a little faster \
+                     than a whole number of samples a read, stamped back at the period, puts \
+                     the first sample of each read of one more just after the last read's \
+                     last; their span gives {} Hz (the sensor's, where none was lost), the \
+                     intervals {} Hz; give --rate",
+                    crowded.len(),
+                    besides(apart, "a gap"),
+                    short(mean * 1e-9),
+                    short(summary.span_rate_hz),
+                    short(summary.rate_hz)
+                ));
+            }
+        }
         // (Gaps that miss no sample, or more than one, a few: a record's ends, a timer's
-        // late read. A lone short interval, a read of one more after one of one less on
-        // jittered reads, makes up for a gap's sample in the count of those missing.)
+        // late read. A lone short interval, a read of one more, makes up for a gap's sample
+        // in the count of those missing: one paired with a gap, a late read's, or not.)
         let few = |n: u64, of: u64| n <= 2 || 50 * n <= of;
-        let singles = at.len() as u64;
-        let made_up = summary.missing_samples + crowded.len() as u64;
+        let singles = gaps_at.len() as u64;
+        let made_up = summary.missing_samples + lone.len() as u64;
         if singles < 8
             || !few(gaps.saturating_sub(singles), gaps)
             || !few(made_up.abs_diff(singles), singles)
         {
             return Ok(());
         }
-        let Some((on, extra, mean)) = beat(&at) else {
-            return Ok(());
-        };
-        Err(format!(
-            "{} of the timestamps' {gaps} gaps, each missing a sample, come one every {} s \
-             on average, each near the spacing before it: a beat (samples lost at random come \
-             unevenly; {extra} gaps lie off it): a FIFO read on a timer of its own, its sensor \
-             a little slower than a whole number of samples a read, leaves such gaps where \
-             nothing was lost; their span gives {} Hz (the sensor's, where none was lost), the \
-             intervals {} Hz with the gaps' samples lost; give --rate",
-            on,
-            short(mean * 1e-9),
-            short(summary.span_rate_hz),
-            short(summary.rate_hz)
-        ))
+        for apart in [false, true].into_iter().take(tries) {
+            let at = times(&gaps_at, &gap_paired, apart);
+            if let Some((on, extra, mean)) = beat(&at) {
+                return Err(format!(
+                    "{} of the timestamps' {gaps} gaps, each missing a sample{}, come one every \
+                     {} s on average, each near the spacing before it: a beat (samples lost at \
+                     random come unevenly; {extra} gaps lie off it): a FIFO read on a timer of \
+                     its own, its sensor a little slower than a whole number of samples a \
+                     read, leaves such gaps where nothing was lost; their span gives {} Hz \
+                     (the sensor's, where none was lost), the intervals {} Hz with the gaps' \
+                     samples lost; give --rate",
+                    on,
+                    besides(apart, "a short interval"),
+                    short(mean * 1e-9),
+                    short(summary.span_rate_hz),
+                    short(summary.rate_hz)
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// An error where half the intervals or more lie within two quanta (the stamps'
@@ -2895,11 +2936,27 @@ impl Timing {
             (d - k * spacing).abs() > ((k + 1) * q).max(spacing / 4)
         };
         // An offset `m` of which make the spacing, to `m + 1` quanta: a tick.
-        let tick = |d: i64| {
+        let ticks = |d: i64| {
             let r = (d - whole(d) * spacing).abs();
             let m = (spacing as f64 / r as f64).round() as i64;
-            (spacing - m * r).abs() <= (m + 1) * q
+            off(d) && (spacing - m * r).abs() <= (m + 1) * q
         };
+        // A counter's second value lies on one side of the spacing (where its losses join
+        // it and the spacing, 2f of its gaps, on the other): such offsets on both, a quarter
+        // as many on one as on the other and eight or more, are no tick's (a timer of a whole
+        // number of spacings and a half: 312.5 us in us, reads of 106 and 107, boundaries
+        // of 156 and 469 us).
+        let (below, above) = intervals
+            .iter()
+            .filter(|&&d| ticks(d))
+            .fold((0, 0), |(b, a), &d| {
+                (
+                    b + usize::from(d < spacing),
+                    a + usize::from(d > spacing && d < 2 * spacing),
+                )
+            });
+        let two_sided = below.min(above) >= 8 && 4 * below.min(above) >= below.max(above);
+        let tick = |d: i64| !two_sided && ticks(d);
         let on = |j: Option<usize>| j.and_then(|j| intervals.get(j)).is_none_or(|&e| !off(e));
         // Off the grid between two on it, no tick's; `long`, two spacings and a half or more.
         let boundary = |i: usize, d: i64, long: bool| {
@@ -7962,6 +8019,43 @@ mod tests {
     }
 
     #[test]
+    fn a_late_read_and_its_catch_up_hide_no_beat() {
+        // One sample a read, stamped back at a nominal spacing, the sensor 3e-4 or 1e-3 fast,
+        // reads late by 20 or 50 us (Gaussian): a read of two after one of none leaves a
+        // short interval beside a gap, a sample neither more nor fewer, among the reads of
+        // two the sensor's beat gives (200.2 Hz read every 5 ms and 400.12 Hz every 2.5 ms,
+        // 50 us; 1000.3 Hz every 1 ms, 20 us; us stamps: read at the spacing's rate, exit
+        // 0, before, in each of the 8 of these 12 records whose stamps go forward).
+        let mut read = 0;
+        for (rate, every, late) in [
+            (200.2, 5e-3, 5e-5),
+            (400.12, 2.5e-3, 5e-5),
+            (1000.3, 1e-3, 2e-5),
+        ] {
+            for seed in 1..=4 {
+                let mut gauss = gaussian(seed);
+                let reads: Vec<f64> = (1..=(120.0 / every) as usize)
+                    .map(|r| 3.1e-4 + r as f64 * every + late * gauss())
+                    .collect();
+                let t = stamped_back(rate, reads, (every, 0), 1_000);
+                // (A stamp before the one before is refused by the readers.)
+                if t.windows(2).any(|w| w[1] <= w[0]) {
+                    continue;
+                }
+                read += 1;
+                match pushed(&t, true).summary(TimeUnit::Nanoseconds) {
+                    Err(e) => assert!(e.contains("a beat"), "{rate} Hz, {seed}: {e}"),
+                    Ok(s) => assert!(
+                        s.batch_refusal().is_some() || (s.rate_hz / rate - 1.0).abs() < 1e-4,
+                        "{rate} Hz, {seed}: {s:?}"
+                    ),
+                }
+            }
+        }
+        assert!(read >= 6, "{read}");
+    }
+
+    #[test]
     fn a_sensor_a_little_faster_than_its_reads_is_no_clock() {
         // Stamped back at their period from reads every 5 ms, the sensor a little faster
         // than five or one samples a read: each read of one more puts its first sample 2.5 us
@@ -8065,7 +8159,27 @@ mod tests {
                 }
                 read += every;
             }
-            let s = summary_of(&t);
+            let lost = if one_in == 0 {
+                0.0
+            } else {
+                2.0 / one_in as f64
+            };
+            let s = match pushed(&t, true).summary(TimeUnit::Nanoseconds) {
+                Ok(s) => s,
+                // (Or a beat of reads of one more, naming the span's rate.)
+                Err(e) => {
+                    let span: f64 = e
+                        .split_once("their span gives ")
+                        .and_then(|(_, r)| r.split_once(" Hz"))
+                        .and_then(|(hz, _)| hz.parse().ok())
+                        .unwrap_or_else(|| panic!("{rate}: {e}"));
+                    assert!(
+                        e.contains("a beat") && (span / rate - 1.0).abs() < 1e-4 + lost,
+                        "{e}"
+                    );
+                    continue;
+                }
+            };
             let (_, inside, stepped) = s.batched.unwrap_or_else(|| panic!("{rate}: {s:?}"));
             // The spacing, to the stamps' unit.
             let unit_s = 1e-9 * unit as f64;
@@ -8076,11 +8190,6 @@ mod tests {
             // The least the rate may be: the span's with the losses within the runs counted
             // (not those at a read's ends; the span's ends lie a read's time from the
             // samples').
-            let lost = if one_in == 0 {
-                0.0
-            } else {
-                2.0 / one_in as f64
-            };
             assert!(
                 (s.rate_hz / rate - 1.0).abs() < 1e-4 + lost,
                 "{rate}: {s:?}"
@@ -8120,6 +8229,48 @@ mod tests {
                 }
                 Err(e) => assert!(e.contains("give --rate"), "{every}: {e}"),
             }
+        }
+    }
+
+    #[test]
+    fn a_timer_half_a_spacing_off_whole_samples_is_no_counters_tick() {
+        // A FIFO read every 33.28 ms (106.5 samples) or at 30 Hz, stamped back at 312.5 us,
+        // and one read at 15 Hz at 156.25 us, to the us: each read's first interval half a
+        // spacing or a third off it, below it after a read of one more and above after one
+        // of one fewer, as no counter's second value lies (3200 Hz at 30 Hz, 1 % lost
+        // before stamping, and 6400 Hz at 15 Hz read 3210.00 and 6405.00 Hz, exit 0, before;
+        // every 33.28 ms, refused as a beat before and after).
+        for (rate, every, spacing, lost) in [
+            (3200.0, 33.28125e-3, 312.5e-6, 0),
+            (3200.0, 1.0 / 30.0, 312.5e-6, 10),
+            (6400.0, 1.0 / 15.0, 156.25e-6, 1),
+        ] {
+            let reads = (1..=(6.0 / every) as usize).map(|r| 0.0123457 + r as f64 * every);
+            let t = stamped_back(rate, reads, (spacing, lost), 1_000);
+            // Refused as runs, or as a beat (reads of one fewer half the reads), naming the
+            // span's rate.
+            let (e, span) = match pushed(&t, true).summary(TimeUnit::Nanoseconds) {
+                Ok(s) => (
+                    s.batch_refusal()
+                        .unwrap_or_else(|| panic!("{every}: {s:?}")),
+                    s.rate_hz,
+                ),
+                Err(e) => {
+                    let span = e
+                        .split_once("their span gives ")
+                        .and_then(|(_, r)| r.split_once(" Hz"))
+                        .and_then(|(hz, _)| hz.parse().ok())
+                        .unwrap_or_else(|| panic!("{every}: {e}"));
+                    (e, span)
+                }
+            };
+            assert!(
+                (e.contains("runs of") || e.contains("a beat")) && e.contains("give --rate"),
+                "{e}"
+            );
+            // (Samples lost before stamping leave no mark: the least the rate may be.)
+            let hidden = lost as f64 * 2e-3;
+            assert!((-1e-3 - hidden..1e-3).contains(&(span / rate - 1.0)), "{e}");
         }
     }
 
