@@ -2465,10 +2465,26 @@ impl Timing {
                 String::new()
             }
         };
+        let lost: f64 = gaps_at
+            .iter()
+            .zip(&gap_paired)
+            .filter(|(_, p)| !**p)
+            .map(|(&i, _)| (iv(i) / period).round() - 1.0)
+            .sum();
         for apart in [false, true].into_iter().take(tries) {
             let crowded = times(&lone, &short_paired, apart);
-            // (Each a read or more apart, eight periods or more.)
-            if let Some((on, extra, mean)) = beat(&crowded).filter(|b| b.2 >= 8.0 * period) {
+            // (Each a read or more apart, eight periods or more; each a sample the span holds
+            // past the intervals' rate, the samples the gaps not paired miss counted, half of
+            // one at least: a host's stall that delays a sample now and then, its next caught
+            // up on, leaves short intervals on a beat of the stalls and the span's rate the
+            // intervals'.)
+            let past = |on: usize| {
+                let held = summary.span_rate_hz + lost / summary.span_s;
+                held - summary.rate_hz >= 0.5 * on as f64 / summary.span_s
+            };
+            if let Some((on, extra, mean)) =
+                beat(&crowded).filter(|b| b.2 >= 8.0 * period && past(b.0))
+            {
                 return Err(format!(
                     "{on} of the timestamps' {} intervals under half the period{} come one \
                      every {} s on average, each near the spacing before it: a beat ({extra} \
@@ -2487,19 +2503,29 @@ impl Timing {
         }
         // (Gaps that miss no sample, or more than one, a few: a record's ends, a timer's
         // late read. A lone short interval, a read of one more, makes up for a gap's sample
-        // in the count of those missing: one paired with a gap, a late read's, or not.)
+        // in the count of those missing. Or, on stamps finer than a quarter period, where
+        // the window's gaps and the samples it counts missing are moved by late reads, the
+        // gaps of more than one sample a few.)
         let few = |n: u64, of: u64| n <= 2 || 50 * n <= of;
         let singles = gaps_at.len() as u64;
         let made_up = summary.missing_samples + lone.len() as u64;
-        if singles < 8
-            || !few(gaps.saturating_sub(singles), gaps)
-            || !few(made_up.abs_diff(singles), singles)
-        {
+        let fine = summary
+            .resolution_s
+            .is_none_or(|q| 4.0 * q * summary.rate_hz <= 1.0);
+        let more = gaps_at.iter().filter(|&&i| iv(i) > 2.5 * period).count() as u64;
+        let counted =
+            few(gaps.saturating_sub(singles), gaps) && few(made_up.abs_diff(singles), singles);
+        if singles < 8 || !(counted || fine && few(more, singles)) {
             return Ok(());
         }
+        // (Each a sample the span holds fewer than the intervals' rate, half of one at least:
+        // a host's stall that delays a sample or two now and then, stamped as the stall
+        // ends, leaves gaps on a beat of the stalls and the span's rate the intervals'.)
+        let short_of =
+            |on: usize| summary.rate_hz - summary.span_rate_hz >= 0.5 * on as f64 / summary.span_s;
         for apart in [false, true].into_iter().take(tries) {
             let at = times(&gaps_at, &gap_paired, apart);
-            if let Some((on, extra, mean)) = beat(&at) {
+            if let Some((on, extra, mean)) = beat(&at).filter(|b| short_of(b.0)) {
                 return Err(format!(
                     "{} of the timestamps' {gaps} gaps, each missing a sample{}, come one every \
                      {} s on average, each near the spacing before it: a beat (samples lost at \
@@ -3171,15 +3197,22 @@ impl Timing {
             .filter(|&&d| (d - period).abs() <= 1.05 * inside)
             .count();
         let multiple = (parts / inside).round();
-        // (Whole numbers of it, two or more: as many samples each run, the sensor slower than
-        // the spacing its reads are stamped back at, where runs and their gaps vary together.)
-        let same = parting
+        // (Whole numbers of it, two or more, of two neighbouring values at most: as many
+        // samples each run, or the sensor slower than the spacing its reads are stamped back
+        // at, its runs one shorter where their gaps are one longer; a logger losing two to
+        // five samples each time, resuming on a tick of its own, spreads wider.)
+        let mut whole = std::collections::BTreeMap::<i64, usize>::new();
+        for &iv in &parting {
+            let periods = iv / inside;
+            if periods.round() >= 2.0 && (periods - periods.round()).abs() < tolerance {
+                *whole.entry(periods.round() as i64).or_default() += 1;
+            }
+        }
+        let same = whole
             .iter()
-            .filter(|&&iv| {
-                let periods = iv / inside;
-                periods.round() >= 2.0 && (periods - periods.round()).abs() < tolerance
-            })
-            .count();
+            .map(|(k, n)| n + whole.get(&(k + 1)).copied().unwrap_or(0))
+            .max()
+            .unwrap_or(0);
         let stepped = lost
             && multiple >= 2.0
             && 10 * same >= 9 * parting.len()
@@ -3808,12 +3841,31 @@ impl Timing {
                         each.ln().abs(),
                         fit,
                         sure,
+                        (each, error),
                     ))
                 })
                 .filter(|b| !b.0.is_nan())
                 .min_by(|a, b| a.0.total_cmp(&b.0));
-            if let Some((_, fit, true)) = beat {
+            if let Some((_, fit, true, (each, error))) = beat {
                 let rate = share as f64 / q + sign / fit.period;
+                // A slower clock leaves one place empty each time round its beat: a quarter
+                // more, by three standard errors, are samples lost on a beat of their own (a
+                // logger dropping one or two at a flush every 0.25 s, 1000 Hz on whole ms,
+                // reads 996 Hz), whether or not the clock is slower too.
+                if sign < 0.0 && each - 3.0 * error > 1.25 {
+                    return Err(format!(
+                        "the timestamps, stamped to {q:e} s, leave places empty on a beat of {} \
+                         Hz, {} each time round where a clock slower than its stamps leaves \
+                         one: samples lost on a beat of their own (a logger's flush every {} \
+                         s?), the clock slower or not; the rate lies between {} Hz and {} Hz; \
+                         give --rate",
+                        short(1.0 / fit.period),
+                        decimals(each, 2),
+                        short(fit.period),
+                        short(rate),
+                        short(share as f64 / q)
+                    ));
+                }
                 // A beat runs from the record's start to its end.
                 let edge = 4.0 * fit.period + 0.02 * span;
                 if first > edge || span - last > edge {
@@ -8056,6 +8108,34 @@ mod tests {
     }
 
     #[test]
+    fn a_few_late_reads_hide_no_beat_of_reads_short_of_one() {
+        // Stamped back at a nominal spacing from reads every 10 ms, the sensor 0.2 %, 0.1 %
+        // and 0.05 % slow, nothing lost, one read in 200 late by 0.6 to 0.9 spacings: a
+        // late read's gap, a sample neither more nor fewer, moves the gaps and the samples
+        // missing the window counts (998, 799.2 and 999.5 Hz, us stamps, read 1000, 800 and
+        // 1000 Hz, exit 0, before).
+        for (rate, spacing) in [(998.0, 1e-3), (799.2, 1.25e-3), (999.5, 1e-3)] {
+            let mut next = crate::xorshift(5);
+            let mut uniform = move || (next() >> 11) as f64 / (1u64 << 53) as f64;
+            let reads: Vec<f64> = (1..=6_000)
+                .map(|r| {
+                    let late = if uniform() < 0.005 {
+                        (0.6 + 0.3 * uniform()) * spacing
+                    } else {
+                        0.0
+                    };
+                    3.1e-4 + f64::from(r) * 1e-2 + late
+                })
+                .collect();
+            let e = pushed(&stamped_back(rate, reads, (spacing, 0), 1_000), true)
+                .summary(TimeUnit::Nanoseconds)
+                .map(|s| format!("{s:?}"))
+                .unwrap_err();
+            assert!(e.contains("a beat (samples lost"), "{rate} Hz: {e}");
+        }
+    }
+
+    #[test]
     fn a_sensor_a_little_faster_than_its_reads_is_no_clock() {
         // Stamped back at their period from reads every 5 ms, the sensor a little faster
         // than five or one samples a read: each read of one more puts its first sample 2.5 us
@@ -8271,6 +8351,105 @@ mod tests {
             // (Samples lost before stamping leave no mark: the least the rate may be.)
             let hidden = lost as f64 * 2e-3;
             assert!((-1e-3 - hidden..1e-3).contains(&(span / rate - 1.0)), "{e}");
+        }
+    }
+
+    #[test]
+    fn samples_lost_at_a_flush_on_whole_quanta_are_no_slower_clock() {
+        // 1000 Hz stamped on exact whole ms, one or two samples lost every 0.25 s, one to
+        // three every 0.5 s (a logger's flush): places left empty on a beat, more than one
+        // each time round, where a slower clock leaves one (every 0.25 s read 996 Hz, exit
+        // 0, before; every 0.5 s was refused as bunches that come evenly, and is).
+        for (every, most, seed) in [(250, 2, 1), (500, 3, 2), (250, 2, 3)] {
+            let mut next = crate::xorshift(seed);
+            let mut lost = 0;
+            let t: Vec<i64> = (0..40_000i64)
+                .filter(|&k| {
+                    if k % every == 0 {
+                        lost = if k == 0 {
+                            0
+                        } else {
+                            1 + (next() % most) as i64
+                        };
+                    }
+                    k % every >= lost
+                })
+                .map(|k| k * 1_000_000)
+                .collect();
+            let e = pushed(&t, true)
+                .summary(TimeUnit::Nanoseconds)
+                .map(|s| format!("{s:?}"))
+                .unwrap_err();
+            let named = [
+                "samples lost on a beat of their own",
+                "in bunches that come evenly",
+            ];
+            assert!(
+                named.iter().any(|n| e.contains(n)) && e.contains("give --rate"),
+                "{every}: {e}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_logger_losing_samples_before_its_tick_is_a_clock() {
+        // An exact clock on us stamps, a logger losing two to five samples before each tick
+        // of its own every 200 ms: runs starting evenly, parted by gaps of three to six
+        // periods (refused as a clock slower than a tick, or a sensor slower than its reads'
+        // spacing, before: gaps of two neighbouring values at most are those).
+        for (rate, seed) in [(800.0, 1), (400.0, 2), (1660.0, 3)] {
+            let mut next = crate::xorshift(seed);
+            let per = (0.2 * rate) as i64;
+            let mut lost = 0;
+            let t: Vec<i64> = (0..30_000i64)
+                .filter(|&k| {
+                    let at = k % per;
+                    if at == 0 {
+                        lost = 2 + (next() % 4) as i64;
+                    }
+                    k < per || at < per - lost
+                })
+                .map(|k| ((k as f64 / rate) * 1e6).floor() as i64 * 1_000)
+                .collect();
+            read_within(&t, rate, 1e-5);
+        }
+    }
+
+    #[test]
+    fn a_hosts_stalls_on_a_beat_that_delay_a_sample_are_a_clock() {
+        // Samples stamped as they reach a host (Gaussian jitter of 0.2 % of the period), the
+        // host stalling 1.5 ms about every 100 ms (the start within 5 ms), 7 ms every 250
+        // ms: the samples due within a stall stamped as it ends, 20 us apart, nothing lost
+        // (refused as a FIFO's sensor faster, or slower, than its reads, before: the short
+        // intervals or gaps came on the stalls' beat, while the span's rate is the
+        // intervals').
+        for (rate, every, stall, spread, seed) in [
+            (1000.0, 0.1000037, 1.5e-3, 0.05, 1),
+            (200.0, 0.25, 7e-3, 0.0, 2),
+        ] {
+            let mut gauss = gaussian(seed);
+            let mut next = crate::xorshift(seed + 10);
+            let mut uniform = move || (next() >> 11) as f64 / (1u64 << 53) as f64;
+            let n = (30.0 * rate) as usize;
+            let starts: Vec<f64> = (0..=(31.0 / every) as usize)
+                .map(|j| j as f64 * every + (2.0 * uniform() - 1.0) * spread * every)
+                .collect();
+            let mut last = f64::MIN;
+            let t: Vec<i64> = (0..n)
+                .map(|k| {
+                    let x = 0.1234567 + k as f64 / rate + 0.002 * gauss() / rate;
+                    let mut y = starts
+                        .iter()
+                        .find(|&&s| (s..s + stall).contains(&x))
+                        .map_or(x, |&s| s + stall);
+                    if y <= last {
+                        y = last + 20e-6;
+                    }
+                    last = y;
+                    (y * 1e6).floor() as i64 * 1_000
+                })
+                .collect();
+            read_within(&t, rate, 1e-5);
         }
     }
 

@@ -92,6 +92,11 @@ pub struct Args {
     /// it only into that vehicle [default: 1].
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..))]
     sysid: Option<u8>,
+    /// PX4's IMU_INTEG_RATE, Hz (100 to 1000): EKF2 steps whole messages of that rate, so
+    /// the PX4 file's EKF2_PREDICT_US is the whole number of them nearest the filter rate's
+    /// step [default: 200].
+    #[arg(long, allow_negative_numbers = true)]
+    imu_integ_rate: Option<f64>,
     /// Print one JSON object instead of the table.
     #[arg(long)]
     pub json: bool,
@@ -367,6 +372,7 @@ fn characterise(
         filter_rate_hz: args.model.filter_rate,
         loop_rate_hz: args.loop_rate,
         sysid: args.sysid,
+        imu_integ_rate_hz: args.imu_integ_rate,
         origin: None,
     };
     // The two plots drawn side by side, the gyros' on a thread of their own.

@@ -152,6 +152,9 @@ pub struct ImuModel {
     pub loop_rate_hz: Option<f64>,
     /// The vehicle ID of PX4's parameter file (`MAV_SYS_ID`) [default: 1].
     pub sysid: Option<u8>,
+    /// PX4's `IMU_INTEG_RATE`, Hz: the rate of the messages EKF2 steps a whole number of
+    /// ([`params::ekf2_step`]) [default: 200].
+    pub imu_integ_rate_hz: Option<f64>,
     /// What part of the record the models come from, when not the whole of it (a comment
     /// line of every file).
     pub origin: Option<String>,

@@ -20,6 +20,20 @@ pub const ARDUPILOT_LOOP_HZ: f64 = 400.0;
 /// PX4's default vehicle ID (`MAV_SYS_ID`).
 pub const PX4_SYSID: u8 = 1;
 
+/// PX4's default `IMU_INTEG_RATE`, Hz: the rate of the `vehicle_imu` messages EKF2 steps on.
+pub const PX4_IMU_INTEG_RATE: f64 = 200.0;
+
+/// EKF2's prediction step, us, for an `EKF2_PREDICT_US` of `asked` us, IMU samples at
+/// `sample_hz` and an `IMU_INTEG_RATE` of `integ_hz`: `vehicle_imu` integrates the whole
+/// number of samples nearest its interval (`VehicleIMU`, one at least), and EKF2's down-sampler
+/// the whole number of those nearest `asked` (`ImuDownSampler::update`, `required_samples`,
+/// one at least). With the step, the `vehicle_imu` interval.
+pub fn ekf2_step(asked: f64, sample_hz: f64, integ_hz: f64) -> (f64, f64) {
+    let sample = 1e6 / sample_hz;
+    let imu = (1e6 / integ_hz / sample).round().max(1.0) * sample;
+    ((asked / imu).round().max(1.0) * imu, imu)
+}
+
 /// EKF3's prediction step at a main loop of `loop_hz`: it sums IMU samples (one per loop,
 /// `dtIMUavg = 1 / loop_hz`) until `n dtIMUavg >= EKF_TARGET_DT - dtIMUavg / 2`
 /// (`AP_NavEKF3_core.cpp`, `readIMUData`), so `dt` is the smallest such `n` times the loop
@@ -138,18 +152,39 @@ fn range_notes(values: &[Value], filter: &str) -> Vec<String> {
 /// A [`Fail`] for a filter rate outside `EKF2_PREDICT_US`'s range (1000 to 20000 us: 50 to
 /// 1000 Hz), a vehicle id of 0, or a value that is not finite.
 pub fn px4(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
-    let predict_us = match model.filter_rate_hz {
+    let asked = match model.filter_rate_hz {
         Some(f) => (1e6 / f).round(),
         None => PX4_PREDICT_US,
     };
+    let integ = model.imu_integ_rate_hz.unwrap_or(PX4_IMU_INTEG_RATE);
+    if !(100.0..=1000.0).contains(&integ) {
+        return Err(Fail(format!(
+            "PX4: IMU_INTEG_RATE {integ} Hz is outside its range, 100 to 1000 Hz"
+        )));
+    }
+    // (Whole us, as the parameter holds them.)
+    let (step, imu) = ekf2_step(asked, model.rate_hz, integ);
+    let predict_us = step.round();
     if !(1000.0..=20000.0).contains(&predict_us) {
         return Err(Fail(format!(
             "PX4: filter rate {} Hz gives EKF2_PREDICT_US {predict_us}, outside 1000 to 20000 \
              (50 to 1000 Hz)",
-            model.filter_rate_hz.unwrap_or(0.0)
+            model.filter_rate_hz.unwrap_or(1e6 / asked)
         )));
     }
     let dt = predict_us * 1e-6;
+    let stepped = if predict_us == asked {
+        format!(
+            "(EKF2 steps whole vehicle_imu messages, {} us apart at IMU_INTEG_RATE {integ} Hz.)",
+            short(imu)
+        )
+    } else {
+        format!(
+            "(EKF2 steps whole vehicle_imu messages, {} us apart at IMU_INTEG_RATE {integ} Hz: \
+             {asked} us asked, {predict_us} us written.)",
+            short(imu)
+        )
+    };
     let (values, sensors) = autopilot(model, horizon, dt, &PX4_NAMES)?;
     let sysid = model.sysid.unwrap_or(PX4_SYSID);
     if sysid == 0 {
@@ -171,7 +206,7 @@ pub fn px4(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
             &format!(
                 "step dt = EKF2_PREDICT_US = {predict_us} us: value = N / sqrt(dt), K / sqrt(dt)."
             ),
-            "(EKF2 steps an integer number of IMU samples: set EKF2_PREDICT_US to a multiple.)",
+            &stepped,
             &format!(
                 "Vehicle-Id {sysid} (MAV_SYS_ID{}): QGroundControl loads the file only into the",
                 if model.sysid.is_some() {

@@ -534,6 +534,7 @@ fn noise_model(
         filter_rate_hz: args.model.filter_rate,
         loop_rate_hz: None,
         sysid: None,
+        imu_integ_rate_hz: None,
         origin: Some(format!(
             "Each axis from its worst temperature band (the largest N), the thermal bias \
              taken out (imu-ar thermal): {}.",

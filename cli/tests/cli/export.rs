@@ -10,6 +10,7 @@ use std::sync::OnceLock;
 
 use imu_ar::noise::{Estimator, FitConfig, NoiseModel, NoiseType, Octaves};
 use imu_ar::sim::StandardNormal;
+use imu_ar_cli::export::params::ekf2_step;
 use imu_ar_cli::export::{AxisModel, Format, ImuModel, write};
 use imu_ar_host::composite::Composite;
 use rand_chacha::ChaCha8Rng;
@@ -56,6 +57,7 @@ fn model() -> &'static ImuModel {
             filter_rate_hz: None,
             loop_rate_hz: None,
             sysid: None,
+            imu_integ_rate_hz: None,
             origin: None,
         }
     })
@@ -495,23 +497,46 @@ fn a_model_without_random_walk_or_white_noise_writes_no_zero() {
 fn the_filter_rate_sets_the_autopilots_step_and_bad_models_are_refused() {
     let dir = temp_dir("rates");
     let mut imu = model().clone();
-    imu.filter_rate_hz = Some(250.0);
-    let text = std::fs::read_to_string(
-        write(Format::Px4, &imu, None, &dir).unwrap_or_else(|e| panic!("{}", e.0)),
-    )
-    .unwrap();
-    let m = values(&text);
-    assert_eq!(m["EKF2_PREDICT_US"], "4000");
     let kalibr = std::fs::read_to_string(
         write(Format::Kalibr, &imu, None, &dir).unwrap_or_else(|e| panic!("{}", e.0)),
     )
     .unwrap();
     let [(gn, _), (_, ak)] = continuous(Format::Kalibr, &kalibr);
-    assert!(close(
-        number(&m, "EKF2_GYR_NOISE"),
-        gn / 0.004f64.sqrt(),
-        1e-12
-    ));
+    // EKF2 steps whole vehicle_imu messages (IMU_INTEG_RATE, 200 Hz by default, in whole
+    // samples): the step nearest the filter rate's, written, its values at it (a 4 ms step
+    // of a 100 Hz IMU was written as asked, its values 1.58 times too large).
+    for (integ, filter, written, asked) in [
+        (None, 250.0, 10_000, true),
+        (None, 100.0, 10_000, false),
+        (Some(100.0), 50.0, 20_000, false),
+        (Some(1000.0), 60.0, 20_000, true),
+    ] {
+        (imu.imu_integ_rate_hz, imu.filter_rate_hz) = (integ, Some(filter));
+        let text = std::fs::read_to_string(
+            write(Format::Px4, &imu, None, &dir).unwrap_or_else(|e| panic!("{}", e.0)),
+        )
+        .unwrap();
+        let m = values(&text);
+        assert_eq!(m["EKF2_PREDICT_US"], written.to_string(), "{filter}");
+        let dt = f64::from(written) * 1e-6;
+        assert!(close(number(&m, "EKF2_GYR_NOISE"), gn / dt.sqrt(), 1e-12));
+        assert_eq!(text.contains("us asked"), asked, "{text}");
+    }
+    // Faster IMUs: a whole number of samples a vehicle_imu message, of those a step.
+    for (rate, integ, asked, step) in [
+        (1000.0, 200.0, 4000.0, 5000.0),
+        (1000.0, 200.0, 3003.0, 5000.0),
+        (1000.0, 250.0, 4000.0, 4000.0),
+        (952.0, 200.0, 10_000.0, 2.0 * 5e6 / 952.0),
+        (8000.0, 400.0, 1000.0, 2500.0),
+    ] {
+        let (got, _) = ekf2_step(asked, rate, integ);
+        assert!(close(got, step, 1e-12), "{rate} {integ} {asked}: {got}");
+    }
+    imu.imu_integ_rate_hz = Some(50.0);
+    let e = write(Format::Px4, &imu, None, &dir).unwrap_err().0;
+    assert!(e.contains("IMU_INTEG_RATE 50 Hz is outside"), "{e}");
+    (imu.imu_integ_rate_hz, imu.filter_rate_hz) = (None, Some(250.0));
     // EKF3's step is not the filter rate: its loop rate sets it (EKF_TARGET_DT 12 ms less
     // half a loop, in whole loops), 12.5 ms at the default 400 Hz.
     for (loop_rate, dt) in [(None, 0.0125f64), (Some(500.0), 0.012), (Some(50.0), 0.02)] {
