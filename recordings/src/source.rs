@@ -190,6 +190,9 @@ pub struct Read {
     /// Where a log's samples came from when it is not the one its six axes are read from
     /// (a DataFlash log's batch sampler's batches, not its `IMU` messages).
     pub source: Option<String>,
+    /// What the stamps cannot check of the rate they give, to be warned of where no rate is
+    /// given (batches parted by pauses, each stamped at its header's rate).
+    pub caveat: Option<String>,
 }
 
 /// Reads `request` from `files` (one kind, joined in order), passing the values of each row
@@ -392,6 +395,7 @@ fn autopilot_stream(
         each(Some(stamp), &values);
     };
     let mut skipped = Skipped::default();
+    let mut caveat = None;
     if kind == Kind::DataFlash {
         let survey = dataflash::survey(path).map_err(|e| Fail(e.to_string()))?;
         // The instances of the IMU messages and of the batches of the picked sensor; of the two,
@@ -456,13 +460,18 @@ fn autopilot_stream(
             kind: source,
             instance: Some(instance),
         };
+        let mut times = Vec::new();
         let report = dataflash::read_surveyed(path, &survey, &select, &mut |s| {
             // A batch holds one sensor: the other's three axes are never picked.
             let g = s.gyro.unwrap_or([f64::NAN; 3]);
             let a = s.accel.unwrap_or([f64::NAN; 3]);
+            if source != dataflash::Kind::Imu {
+                times.push(s.time_us);
+            }
             take(s.time_us, [g[0], g[1], g[2], a[0], a[1], a[2]]);
         })
         .map_err(|e| Fail(e.to_string()))?;
+        caveat = batches_paused(&times);
         skipped.non_finite = report.non_finite;
         // Corrupt IMU messages (a TimeUS or an instance no IMU has) are undecodable ones.
         skipped.undecodable = report.dropped_batches + report.undecodable_batches + report.corrupt;
@@ -473,7 +482,33 @@ fn autopilot_stream(
     let read = stamped(files, request, &picks, (timing, backward), skipped)?;
     Ok(Read {
         source: from,
+        caveat,
         ..read
+    })
+}
+
+/// The warning for batches of a DataFlash log's batch sampler (their samples' times, us, in
+/// order) parted by pauses, an interval over one and a half of the batches' spacing (the least
+/// interval): each batch's samples are stamped at the header's `smp_rate` from its first, and
+/// the time between batches is the logger's, so no stamp checks that rate (a sensor 0.2 % off
+/// its nominal rate reads as that rate; back to back, the next batch's first sample does).
+fn batches_paused(times: &[f64]) -> Option<String> {
+    let spacing = times
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .filter(|&d| d > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    let pauses = times
+        .windows(2)
+        .filter(|w| w[1] - w[0] > 1.5 * spacing)
+        .count();
+    (pauses > 0).then(|| {
+        format!(
+            "its ISB batches are parted by {pauses} pauses: each batch is stamped at the \
+             header's smp_rate from its first sample and the pauses are the logger's, so the \
+             rate read is that smp_rate, which no stamp checks (a sensor 0.2 % off its nominal \
+             rate reads as it, moving N by 0.1 %); --rate sets the sensor's own"
+        )
     })
 }
 
@@ -994,6 +1029,7 @@ fn stamped(
         timing: Some((timing, TimeUnit::HeaderStamps)),
         skipped,
         source: None,
+        caveat: None,
     })
 }
 
@@ -1143,6 +1179,7 @@ fn messages(
             timing: None,
             skipped,
             source: None,
+            caveat: None,
         });
     }
     stamped(files, request, &picks, (timing, backward), skipped)
@@ -1442,6 +1479,7 @@ fn csv_stream(
             ..Skipped::default()
         },
         source: None,
+        caveat: None,
     })
 }
 

@@ -271,6 +271,9 @@ fn characterise(
     if let Some(w) = crate::input::coarse(args.rate, timing.as_ref()) {
         eprintln!("imu-ar: warning: {}", with_file(&args.files, w).0);
     }
+    if let Some(w) = read.caveat.filter(|_| args.rate.is_none()) {
+        eprintln!("imu-ar: warning: {}", with_file(&args.files, w).0);
+    }
     check_span("--rate", rate, n as usize)?;
     crate::input::check_gaps(timing.as_ref(), n as usize)
         .and_then(|()| crate::input::check_subsampled(&args.files, timing.as_ref()))

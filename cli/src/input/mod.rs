@@ -70,6 +70,8 @@ pub struct Series {
     pub stamped: Option<(u64, f64)>,
     /// What the stamps show that would refuse them without a rate given (see [`summary`]).
     pub unchecked: Option<String>,
+    /// What the stamps cannot check of the rate they give, warned of where no rate is given.
+    pub caveat: Option<String>,
 }
 
 impl Input {
@@ -149,6 +151,7 @@ impl Input {
             skipped: read.skipped,
             stamped,
             unchecked,
+            caveat: read.caveat,
         })
     }
 
@@ -162,6 +165,7 @@ impl Input {
             skipped: Skipped::default(),
             stamped: None,
             unchecked: None,
+            caveat: None,
         }
     }
 
@@ -182,6 +186,9 @@ impl Series {
         }
         if let Some(w) = coarse(given, self.timing.as_ref()) {
             eprintln!("imu-ar: warning: {}", input.fail(w).0);
+        }
+        if let Some(w) = self.caveat.as_ref().filter(|_| given.is_none()) {
+            eprintln!("imu-ar: warning: {}", input.fail(w.clone()).0);
         }
         Ok(rate)
     }

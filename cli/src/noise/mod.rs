@@ -84,8 +84,9 @@ pub struct ModelArgs {
     /// walk as one: `NoiseModel::identify`).
     #[arg(long)]
     curve_fit: bool,
-    /// The filter's rate in Hz for `phi`, `q` and `p0` (and for the PX4 and ArduPilot files)
-    /// [default: the model's rate].
+    /// The filter's rate in Hz for `phi`, `q` and `p0` [default: the model's rate], and the
+    /// step PX4 EKF2 is asked for (the nearest it takes; default 100 Hz, `EKF2_PREDICT_US`
+    /// 10000). ArduPilot EKF3's step is its own (`--loop-rate`).
     #[arg(long, allow_negative_numbers = true)]
     pub filter_rate: Option<f64>,
 }

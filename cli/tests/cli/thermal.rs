@@ -1657,3 +1657,43 @@ fn a_warm_up_in_fahrenheit_is_refused() {
     );
     assert!(!crate::common::stderr(&run).contains("warning"));
 }
+
+/// Gyro batches of a DataFlash log parted by pauses: each is stamped at its header's smp_rate
+/// from its first sample and the pauses are the logger's, so no stamp checks that rate (a
+/// sensor at 1002 Hz under a header's 1000 Hz, batches 10 ms apart, read 1000.04 Hz with exit
+/// 0 and no warning); back to back, nothing is warned of, nor where --rate is given.
+#[test]
+fn batches_parted_by_pauses_warn_that_no_stamp_checks_their_rate() {
+    let mut state = 7u32;
+    let mut noise = move || {
+        state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        (state >> 20) as i16 - 2048
+    };
+    for (sensor, pause_us, warned) in [(1002.0, 10_000.0, true), (1000.0, 0.0, false)] {
+        let mut df = Df::new();
+        let mut start = 1_000_000.0f64;
+        for n in 0..40u16 {
+            let first = start.round() as u64;
+            df.isbh(first, n, 1, 0, 1000, 1024, first, 1000.0);
+            for k in 0..32u16 {
+                let xyz: [[i16; 32]; 3] = std::array::from_fn(|_| std::array::from_fn(|_| noise()));
+                df.isbd(first + 32_000 * u64::from(k), n, k, &xyz);
+            }
+            df.imu(first, 0, [0.0; 3], [0.0; 3], 30.0);
+            start += 1024.0 * 1e6 / sensor + pause_us;
+        }
+        let bin = temp_file(&format!("paused-{warned}.bin"), df.bytes);
+        let path = bin.to_str().unwrap();
+        let run = imu_ar(&["noise", path, "--column", "gx"]);
+        let e = crate::common::stderr(&run);
+        assert!(run.status.success(), "{e}");
+        assert_eq!(
+            e.contains("warning: ") && e.contains("its ISB batches are parted by 39 pauses"),
+            warned,
+            "{e}"
+        );
+        let given = ["noise", path, "--column", "gx", "--rate", "1000"];
+        let e = crate::common::stderr(&imu_ar(&given));
+        assert!(!e.contains("parted by"), "{e}");
+    }
+}
