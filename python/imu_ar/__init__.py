@@ -713,12 +713,14 @@ def characterise(
     horizon: Optional[float] = None,
     loop_rate: Optional[float] = None,
     sysid: Optional[int] = None,
+    imu_integ_rate: Optional[float] = None,
 ) -> Characterisation:
     """All six axes of a recording in one streaming pass, as ``imu-ar characterise``: per axis
     the noise model (with its filter form at ``filter_rate``: ``axes["gx"].kalman()``);
     ``.write(dir, formats=[...])`` writes the parameter files (``loop_rate``: the autopilot's
     loop rate, Hz, that sets EKF3's step in the ArduPilot file; ``sysid``: the vehicle's
-    system id in the PX4 file)."""
+    system id in the PX4 file; ``imu_integ_rate``: PX4's ``IMU_INTEG_RATE``, Hz, whose
+    messages EKF2 steps a whole number of)."""
     argv = ["characterise", *_files(path)]
     if columns is not None:
         argv += ["--columns", ",".join(_names("columns", columns))]
@@ -741,6 +743,8 @@ def characterise(
         argv += ["--loop-rate", _num(loop_rate)]
     if sysid is not None:
         argv += ["--sysid", str(_int("sysid", sysid))]
+    if imu_integ_rate is not None:
+        argv += ["--imu-integ-rate", _num(imu_integ_rate)]
     return _characterised(argv)
 
 

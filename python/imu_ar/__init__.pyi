@@ -157,6 +157,7 @@ def characterise(
     horizon: Optional[float] = ...,
     loop_rate: Optional[float] = ...,
     sysid: Optional[int] = ...,
+    imu_integ_rate: Optional[float] = ...,
 ) -> Characterisation: ...
 
 class ArFit:

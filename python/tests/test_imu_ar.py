@@ -671,16 +671,17 @@ def test_models_pickle_and_estimators_copy(small_csv):
 
 def test_characterise_writes_the_autopilots_steps(adis, tool, tmp_path):
     c = imu_ar.characterise(adis, columns="gx,gy,gz,ax,ay,az", gyro_unit="deg/s",
-                            accel_unit="g", loop_rate=200.0, sysid=7)
+                            accel_unit="g", loop_rate=200.0, sysid=7, imu_integ_rate=250.0)
     c.write(tmp_path / "py", formats=["px4", "ardupilot"])
     tool("characterise", adis, "--columns", "gx,gy,gz,ax,ay,az", "--gyro-unit", "deg/s",
-         "--accel-unit", "g", "--loop-rate", "200", "--sysid", "7", "--out", tmp_path / "tool",
-         "--format", "px4,ardupilot")
+         "--accel-unit", "g", "--loop-rate", "200", "--sysid", "7", "--imu-integ-rate", "250",
+         "--out", tmp_path / "tool", "--format", "px4,ardupilot")
     names = sorted(p.name for p in (tmp_path / "tool").iterdir() if p.suffix != ".png")
     assert names == sorted(p.name for p in (tmp_path / "py").iterdir() if p.suffix != ".png")
     for n in names:
         assert (tmp_path / "py" / n).read_bytes() == (tmp_path / "tool" / n).read_bytes(), n
-    assert "Vehicle 7" in (tmp_path / "py" / "px4.params").read_text()
+    px4 = (tmp_path / "py" / "px4.params").read_text()
+    assert "Vehicle 7" in px4 and "IMU_INTEG_RATE 250 Hz" in px4
 
 
 # --- the third red-team pass ---------------------------------------------------------------
