@@ -7609,6 +7609,12 @@ mod tests {
         );
     }
 
+    /// The span's rate a refusal names ("their span gives X Hz"), where it names one.
+    fn span_named(e: &str) -> Option<f64> {
+        let (_, rest) = e.split_once("their span gives ")?;
+        rest.split_once(" Hz")?.0.parse().ok()
+    }
+
     /// The rates a refusal names ("between X Hz and Y Hz"), where it names them.
     fn range_named(e: &str) -> Option<(f64, f64)> {
         let (_, rest) = e.split_once("between ")?;
@@ -8248,11 +8254,7 @@ mod tests {
                 Ok(s) => s,
                 // (Or a beat of reads of one more, naming the span's rate.)
                 Err(e) => {
-                    let span: f64 = e
-                        .split_once("their span gives ")
-                        .and_then(|(_, r)| r.split_once(" Hz"))
-                        .and_then(|(hz, _)| hz.parse().ok())
-                        .unwrap_or_else(|| panic!("{rate}: {e}"));
+                    let span = span_named(&e).unwrap_or_else(|| panic!("{rate}: {e}"));
                     assert!(
                         e.contains("a beat") && (span / rate - 1.0).abs() < 1e-4 + lost,
                         "{e}"
@@ -8336,11 +8338,7 @@ mod tests {
                     s.rate_hz,
                 ),
                 Err(e) => {
-                    let span = e
-                        .split_once("their span gives ")
-                        .and_then(|(_, r)| r.split_once(" Hz"))
-                        .and_then(|(hz, _)| hz.parse().ok())
-                        .unwrap_or_else(|| panic!("{every}: {e}"));
+                    let span = span_named(&e).unwrap_or_else(|| panic!("{every}: {e}"));
                     (e, span)
                 }
             };
