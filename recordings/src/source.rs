@@ -460,24 +460,35 @@ fn autopilot_stream(
             kind: source,
             instance: Some(instance),
         };
-        let mut times = Vec::new();
         let report = dataflash::read_surveyed(path, &survey, &select, &mut |s| {
             // A batch holds one sensor: the other's three axes are never picked.
             let g = s.gyro.unwrap_or([f64::NAN; 3]);
             let a = s.accel.unwrap_or([f64::NAN; 3]);
-            if source != dataflash::Kind::Imu {
-                times.push(s.time_us);
-            }
             take(s.time_us, [g[0], g[1], g[2], a[0], a[1], a[2]]);
         })
         .map_err(|e| Fail(e.to_string()))?;
-        caveat = batches_paused(&times);
+        if let Some((least, most)) = report.batch_rates {
+            if most > least {
+                return Err(with_file(
+                    files,
+                    format!(
+                        "its ISB batches' headers give sample rates from {least} to {most} Hz:                          each batch's samples are placed at its own, and one record is read                          at one rate"
+                    ),
+                ));
+            }
+            timing.placed_at(least);
+            caveat = Some(batches_unchecked(least));
+        }
         skipped.non_finite = report.non_finite;
         // Corrupt IMU messages (a TimeUS or an instance no IMU has) are undecodable ones.
         skipped.undecodable = report.dropped_batches + report.undecodable_batches + report.corrupt;
         skipped.cut_short = u64::from(survey.truncated.is_some());
     } else {
-        skipped = ulog_stream(files, request, &picks, &mut take)?;
+        let rate;
+        (skipped, rate) = ulog_stream(files, request, &picks, &mut take)?;
+        if let Some(rate) = rate {
+            timing.placed_at(rate);
+        }
     }
     let read = stamped(files, request, &picks, (timing, backward), skipped)?;
     Ok(Read {
@@ -487,29 +498,21 @@ fn autopilot_stream(
     })
 }
 
-/// The warning for batches of a DataFlash log's batch sampler (their samples' times, us, in
-/// order) parted by pauses, an interval over one and a half of the batches' spacing (the least
-/// interval): each batch's samples are stamped at the header's `smp_rate` from its first, and
-/// the time between batches is the logger's, so no stamp checks that rate (a sensor 0.2 % off
-/// its nominal rate reads as that rate; back to back, the next batch's first sample does).
-fn batches_paused(times: &[f64]) -> Option<String> {
-    let spacing = times
-        .windows(2)
-        .map(|w| w[1] - w[0])
-        .filter(|&d| d > 0.0)
-        .fold(f64::INFINITY, f64::min);
-    let pauses = times
-        .windows(2)
-        .filter(|w| w[1] - w[0] > 1.5 * spacing)
-        .count();
-    (pauses > 0).then(|| {
-        format!(
-            "its ISB batches are parted by {pauses} pauses: each batch is stamped at the \
-             header's smp_rate from its first sample and the pauses are the logger's, so the \
-             rate read is that smp_rate, which no stamp checks (a sensor 0.2 % off its nominal \
-             rate reads as it, moving N by 0.1 %); --rate sets the sensor's own"
-        )
-    })
+/// The warning for the samples of a DataFlash log's batch sampler, whose headers give
+/// `rate` (Hz): each batch's samples are placed at it from the batch's first sample, the only
+/// time taken, and between two batches of a sensor the sampler turns to the other sensor and
+/// the other IMUs (`AP_InertialSensor::BatchSampler::rotate_to_next_sensor`) for a time no
+/// stamp counts in samples; so the rate read is the header's, which nothing checks (a sensor
+/// 0.05 % faster, a sample skipped between batches, stamps the batches as one 0.05 % slower
+/// does back to back).
+fn batches_unchecked(rate: f64) -> String {
+    format!(
+        "its samples are ISB batches, each placed at its header's smp_rate, {rate} Hz, from \
+         its first sample, the only one timed: between batches the sampler turns to the other \
+         sensors for a time no stamp counts in samples, so the rate read is that smp_rate, \
+         which nothing checks (a sensor 0.2 % off its nominal rate reads as it, moving N by \
+         0.1 %); --rate sets the sensor's own"
+    )
 }
 
 /// The batches that could hold a DataFlash log's axes `picks`: those of the one sensor they
@@ -583,13 +586,15 @@ pub fn fuller(
 /// microseconds, the six axes): of the sensor topic and its FIFO topic, the [`fuller`]. Gyro and accelerometer are separate topics: read together (on two threads), they are
 /// paired by equal sample times, as PX4's drivers publish the two halves of one FIFO read;
 /// samples without a partner are counted, and more than 1 % of them refused, naming why
-/// ([`Pairing`]): one topic's lost messages, or times of their own.
+/// ([`Pairing`]): one topic's lost messages, or times of their own. With the messages
+/// skipped, the FIFO topic's rate its messages' counts give ([`ulog::Report::fifo_rate`]; of
+/// both topics read, the gyro's), where it is read.
 fn ulog_stream(
     files: &[PathBuf],
     request: &Request,
     picks: &[usize],
     take: &mut dyn FnMut(f64, [f64; 6]),
-) -> Result<Skipped, Fail> {
+) -> Result<(Skipped, Option<f64>), Fail> {
     let path = &files[0];
     let survey = ulog::survey(path).map_err(|e| Fail(e.to_string()))?;
     let mut selects = Vec::with_capacity(2);
@@ -663,7 +668,7 @@ fn ulog_stream(
         }
         skipped.undecodable = report.undecodable;
         skipped.non_finite = report.non_finite;
-        return Ok(skipped);
+        return Ok((skipped, report.fifo_rate));
     };
     type Batch = Vec<(f64, [f64; 3])>;
     let dropouts = survey.dropouts;
@@ -789,7 +794,8 @@ fn ulog_stream(
     skipped.undecodable = g.undecodable + x.undecodable;
     skipped.non_finite = non_finite;
     skipped.unpaired = unpaired;
-    Ok(skipped)
+    // (Paired by equal sample times, the samples are the gyro's.)
+    Ok((skipped, g.fifo_rate.filter(|_| x.fifo_rate.is_some())))
 }
 
 /// The sensor of a sample the pairing of gyro and accelerometer met.
@@ -1531,9 +1537,10 @@ impl Beside {
     }
 }
 
-/// The refusal of the `columns` of the file `bytes` (its extension `ext`), its stamps read.
+/// The read of the `columns` of the file `bytes` (its extension `ext`), its stamps read, or
+/// its refusal.
 #[cfg(test)]
-pub(crate) fn refusal(bytes: &[u8], ext: &str, columns: &[&str]) -> String {
+pub(crate) fn read_bytes(bytes: &[u8], ext: &str, columns: &[&str]) -> Result<Read, String> {
     let file = crate::Scratch::new(bytes, ext);
     let columns: Vec<String> = columns.iter().map(|c| c.to_string()).collect();
     let request = Request {
@@ -1545,9 +1552,15 @@ pub(crate) fn refusal(bytes: &[u8], ext: &str, columns: &[&str]) -> String {
         drop_backward: false,
         instance: None,
     };
-    match stream(std::slice::from_ref(&file.0), &request, &mut |_| {}) {
+    stream(std::slice::from_ref(&file.0), &request, &mut |_| {}).map_err(|e| e.0)
+}
+
+/// The refusal of the `columns` of the file `bytes` (its extension `ext`), its stamps read.
+#[cfg(test)]
+pub(crate) fn refusal(bytes: &[u8], ext: &str, columns: &[&str]) -> String {
+    match read_bytes(bytes, ext, columns) {
         Ok(_) => panic!("read"),
-        Err(e) => e.0,
+        Err(e) => e,
     }
 }
 
@@ -1660,6 +1673,53 @@ mod tests {
             "{e}"
         );
         assert!(!e.contains("times of their own"), "{e}");
+    }
+
+    /// The rate the timestamps of a ULog FIFO log give, and whether they are refused as runs.
+    fn fifo_rate(bytes: &[u8]) -> Result<(f64, bool), String> {
+        let read = read_bytes(bytes, "ulg", &AXES)?;
+        let (timing, unit) = read.timing.ok_or("no stamps")?;
+        let s = timing.summary(unit)?;
+        Ok((s.rate_hz, s.batch_refusal().is_some()))
+    }
+
+    #[test]
+    fn fifo_messages_whose_stamps_jitter_are_read_at_the_rate_their_counts_give() {
+        // 10 samples a message, each message's timestamp_sample jittered alone by up to
+        // `jitter` us (a driver's read scheduled late), messages lost now and then. Each
+        // message's samples stamped back at dt from its stamp part runs by intervals off
+        // the grid: 8000 Hz at 20 us was refused as a FIFO's reads stamped back at a set
+        // spacing (pass 39 F4), and a sensor 0.125 % slower than its dt the same way.
+        let mut state = 11u64;
+        let mut jitter = move |most: f64| {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            ((state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0) * most
+        };
+        for (rate, dt, most, lost) in [
+            (8000.0, 125, 20.0, 0),
+            (8000.0, 125, 40.0, 97),
+            (7990.0, 125, 20.0, 0),
+            (7990.0, 125, 30.0, 61),
+            (2000.0, 500, 60.0, 0),
+            (1999.0, 500, 100.0, 53),
+            // Stamps jittered by up to a quarter of a message's time: a third of the
+            // messages begin before the one before ends where their samples are placed dt
+            // apart back from their stamp, and were refused as a sensor faster than its dt.
+            (8000.0, 125, 300.0, 0),
+        ] {
+            let stamps: Vec<u64> = (0..4_000u64)
+                .filter(|&k| lost == 0 || k % lost != lost / 2)
+                .map(|k| (1e6 + (10 * k + 9) as f64 * 1e6 / rate + jitter(most)).round() as u64)
+                .collect();
+            let (read, runs) = fifo_rate(&fifo_log((&stamps, dt), (&stamps, dt))).unwrap();
+            assert!(
+                (read / rate - 1.0).abs() < 5e-5 && !runs,
+                "{rate} Hz, {most} us: {read} Hz{}",
+                if runs { " (runs)" } else { "" }
+            );
+        }
     }
 
     #[test]

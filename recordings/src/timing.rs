@@ -529,6 +529,8 @@ pub struct Timing {
     /// Each sample dropped: the stamps kept before it, and whether its stamp repeated the
     /// one before (else it was behind it).
     drops: Vec<(usize, bool)>,
+    /// The rate the stamps were placed at by their format, Hz ([`Timing::placed_at`]).
+    placed: Option<f64>,
 }
 
 /// The difference of the two commonest `values` (ns, those within 2 ns and 1e-5 of each other,
@@ -1514,6 +1516,14 @@ impl Timing {
         Some(v > 2.0 + 0.4 * mean)
     }
 
+    /// Says the stamps were placed at `rate_hz` by their format, not taken one by one (a
+    /// batch sampler's batches, each stamped at its header's rate from its first sample):
+    /// [`Timing::summary`] gives that rate, its intervals and the places its gaps leave
+    /// empty, and reads no rate of its own from stamps that could only give it back.
+    pub fn placed_at(&mut self, rate_hz: f64) {
+        self.placed = Some(rate_hz);
+    }
+
     /// The last stamp forward, ns.
     pub fn last(&self) -> i64 {
         self.last
@@ -1778,6 +1788,9 @@ impl Timing {
     /// The summary of the stamps taken; an error when they give no rate (fewer than two) or
     /// several (less than 90 % of the intervals within 25 % of the median).
     pub fn summary(&self, unit: TimeUnit) -> Result<TimingSummary, String> {
+        if let Some(rate) = self.placed {
+            return self.placed_summary(unit, rate);
+        }
         // Stamps within a thousandth of a tick coarser than they resolve (whole ms written
         // through a float's epoch ns, a binary tick in ns) are read on that tick, as stamps
         // rounded to it exactly are.
@@ -1801,6 +1814,69 @@ impl Timing {
     }
 
     /// The samples kept over the span, Hz (0 for no span).
+    /// The summary of stamps placed at `rate` (Hz, [`Timing::placed_at`]): that rate, the
+    /// intervals within a quarter of its period as the regular ones, the longer ones gaps,
+    /// each missing the samples its time holds at the rate less one.
+    fn placed_summary(&self, unit: TimeUnit, rate: f64) -> Result<TimingSummary, String> {
+        let period = 1e9 / rate;
+        if !(0.01..=1e6).contains(&rate) {
+            return Err(format!(
+                "the samples were placed at {rate:.6e} Hz, not an IMU's rate: give --rate"
+            ));
+        }
+        if self.kept < 2 || self.span_ns() <= 0.0 {
+            return Err(format!(
+                "{} samples placed at {rate} Hz span no time: too few to read",
+                self.kept
+            ));
+        }
+        let (mut regular, mut sq, mut worst) = (0u64, 0.0f64, 0.0f64);
+        let (mut gaps, mut missing, mut short) = (0u64, 0u64, 0u64);
+        let mut intervals: Vec<i64> = Vec::with_capacity(self.stamps.len().saturating_sub(1));
+        for w in self.stamps.windows(2) {
+            let iv = w[1].saturating_sub(w[0]);
+            intervals.push(iv);
+            let off = iv as f64 / period - 1.0;
+            if off.abs() <= 0.25 {
+                regular += 1;
+                sq += off * off;
+                worst = worst.max(off.abs());
+            } else if off > 0.0 {
+                gaps += 1;
+                missing += ((iv as f64 / period).round() - 1.0) as u64;
+            } else {
+                short += 1;
+            }
+        }
+        let median = if intervals.is_empty() {
+            period
+        } else {
+            let mid = (intervals.len() - 1) / 2;
+            *intervals.select_nth_unstable(mid).1 as f64
+        };
+        Ok(TimingSummary {
+            unit: unit.name(),
+            header_stamps: unit == TimeUnit::HeaderStamps,
+            rate_hz: rate,
+            median_interval_s: median * 1e-9,
+            jitter_rms: (sq / regular.max(1) as f64).sqrt(),
+            jitter_max: worst,
+            gaps,
+            missing_samples: missing,
+            short_intervals: short,
+            dropped_backward: self.dropped,
+            span_s: self.span_ns() * 1e-9,
+            resolution_s: resolution(&self.histogram(), self.bits).map(|q| q as f64 * 1e-9),
+            span_rate_hz: self.span_rate(),
+            other_rate_hz: None,
+            repeated: self.repeats,
+            unexplained_repeat: None,
+            per_stamp: None,
+            jittered_repeats: 0,
+            batched: None,
+        })
+    }
+
     fn span_rate(&self) -> f64 {
         let span = self.span_ns();
         if span > 0.0 {
@@ -5002,6 +5078,30 @@ mod tests {
                 t
             })
             .collect()
+    }
+
+    #[test]
+    fn stamps_placed_at_a_rate_give_it_and_the_places_their_gaps_leave() {
+        // Ten batches of 100 samples placed 1 ms apart, each starting 103 ms after the one
+        // before: the rate is the one given, and each gap of 4 ms leaves 3 places.
+        let mut timing = Timing::new();
+        for batch in 0..10i64 {
+            for i in 0..100i64 {
+                timing.push(1_000_000_000 + batch * 103_000_000 + i * 1_000_000);
+            }
+        }
+        let mut placed = timing.clone();
+        placed.placed_at(1000.0);
+        let s = placed.summary(TimeUnit::Microseconds).unwrap();
+        assert_eq!(s.rate_hz, 1000.0);
+        assert_eq!((s.gaps, s.missing_samples, s.short_intervals), (9, 27, 0));
+        assert_eq!((s.jitter_rms, s.resolution_s), (0.0, Some(1e-3)));
+        assert!((s.span_rate_hz - 999.0 / 1.026).abs() < 1e-9);
+        // No IMU's rate is refused, as a clock's is.
+        let mut placed = timing;
+        placed.placed_at(1e-3);
+        let e = placed.summary(TimeUnit::Microseconds).unwrap_err();
+        assert!(e.contains("not an IMU's rate"), "{e}");
     }
 
     /// [`Order::step`] tells each stamp's step as [`Timing::push`] does, and a [`Timing`] fed

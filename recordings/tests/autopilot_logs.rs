@@ -331,7 +331,14 @@ fn ulog_fifo_samples_are_unrolled_with_interpolated_temperatures() {
     for (m, (sample, xyz)) in expected.fifo.iter().enumerate() {
         for i in 0..n {
             let s = &samples[m * n + i];
-            let t = *sample as f64 - (n - 1 - i) as f64 * f64::from(DT);
+            // The first message's samples dt apart back from its stamp; the others' spread
+            // evenly from the stamp before (2500 us for 20 samples: 125 us, the sensor's
+            // period, where dt says 124.87).
+            let step = match m {
+                0 => f64::from(DT),
+                _ => (*sample - expected.fifo[m - 1].0) as f64 / n as f64,
+            };
+            let t = *sample as f64 - (n - 1 - i) as f64 * step;
             assert_eq!(s.time_us, t, "message {m} sample {i}");
             let want = [0, 1, 2].map(|a| f64::from(xyz[a][i]) * f64::from(SCALE));
             assert_eq!(s.xyz, want);

@@ -1658,42 +1658,81 @@ fn a_warm_up_in_fahrenheit_is_refused() {
     assert!(!crate::common::stderr(&run).contains("warning"));
 }
 
-/// Gyro batches of a DataFlash log parted by pauses: each is stamped at its header's smp_rate
-/// from its first sample and the pauses are the logger's, so no stamp checks that rate (a
-/// sensor at 1002 Hz under a header's 1000 Hz, batches 10 ms apart, read 1000.04 Hz with exit
-/// 0 and no warning); back to back, nothing is warned of, nor where --rate is given.
+/// Gyro batches of a DataFlash log: each batch's samples are placed at its header's smp_rate
+/// from its first, and the time between batches is the sampler's, so no stamp checks that
+/// rate: it is read, with a warning that says so (not where --rate is given). Before, the
+/// stamps were read as a clock's: a sensor at 1002 Hz under a header's 1000 Hz, batches 10
+/// ms apart, read 1000.04 Hz with no warning; at 1000.5 Hz with a sample skipped between
+/// batches, 1000 Hz with no warning; at 1001 Hz so, 1000.023 Hz as batches back to back;
+/// back to back at 1000.5 Hz with one block lost, 999.52 Hz under a warning of "39898
+/// pauses"; an exact 1000 Hz with a sample skipped, and 1000.5 Hz back to back, refused as a
+/// FIFO's beat or two clocks. Batches whose headers give two rates are refused.
 #[test]
-fn batches_parted_by_pauses_warn_that_no_stamp_checks_their_rate() {
+fn batches_are_read_at_their_headers_rate_with_a_warning_that_no_stamp_checks_it() {
     let mut state = 7u32;
     let mut noise = move || {
         state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
         (state >> 20) as i16 - 2048
     };
-    for (sensor, pause_us, warned) in [(1002.0, 10_000.0, true), (1000.0, 0.0, false)] {
+    // The sensor's rate, the samples skipped between batches (or a pause, us), a block lost
+    // (batch, block), and the second half's header rate.
+    type Case = (f64, f64, f64, Option<(u16, u16)>, f32);
+    let cases: [Case; 7] = [
+        (1002.0, 0.0, 10_000.0, None, 1000.0),
+        (1000.5, 1.0, 0.0, None, 1000.0),
+        (1001.0, 1.0, 0.0, None, 1000.0),
+        (1000.5, 0.0, 0.0, Some((5, 3)), 1000.0),
+        (1000.0, 1.0, 0.0, None, 1000.0),
+        (1000.5, 0.0, 0.0, None, 1000.0),
+        (1000.0, 0.0, 10_000.0, None, 2000.0),
+    ];
+    for (case, (sensor, skipped, pause_us, lost, later)) in cases.into_iter().enumerate() {
         let mut df = Df::new();
         let mut start = 1_000_000.0f64;
         for n in 0..40u16 {
             let first = start.round() as u64;
-            df.isbh(first, n, 1, 0, 1000, 1024, first, 1000.0);
+            let rate = if n < 20 { 1000.0 } else { later };
+            df.isbh(first, n, 1, 0, 1000, 1024, first, rate);
             for k in 0..32u16 {
                 let xyz: [[i16; 32]; 3] = std::array::from_fn(|_| std::array::from_fn(|_| noise()));
-                df.isbd(first + 32_000 * u64::from(k), n, k, &xyz);
+                if lost != Some((n, k)) {
+                    df.isbd(first + 32_000 * u64::from(k), n, k, &xyz);
+                }
             }
             df.imu(first, 0, [0.0; 3], [0.0; 3], 30.0);
-            start += 1024.0 * 1e6 / sensor + pause_us;
+            start += (1024.0 + skipped) * 1e6 / sensor + pause_us;
         }
-        let bin = temp_file(&format!("paused-{warned}.bin"), df.bytes);
+        let bin = temp_file(&format!("batches-{case}.bin"), df.bytes);
         let path = bin.to_str().unwrap();
         let run = imu_ar(&["noise", path, "--column", "gx"]);
-        let e = crate::common::stderr(&run);
-        assert!(run.status.success(), "{e}");
-        assert_eq!(
-            e.contains("warning: ") && e.contains("its ISB batches are parted by 39 pauses"),
-            warned,
-            "{e}"
+        let (out, e) = (crate::common::stdout(&run), crate::common::stderr(&run));
+        if later != 1000.0 {
+            assert_eq!(run.status.code(), Some(2), "case {case}: {out}{e}");
+            assert!(e.contains("sample rates from 1000 to 2000 Hz"), "{e}");
+            continue;
+        }
+        assert!(run.status.success(), "case {case}: {e}");
+        assert!(
+            out.contains("timestamps (ns): rate 1000 Hz"),
+            "case {case}: {out}"
         );
-        let given = ["noise", path, "--column", "gx", "--rate", "1000"];
-        let e = crate::common::stderr(&imu_ar(&given));
-        assert!(!e.contains("parted by"), "{e}");
+        assert!(
+            e.contains("warning: ")
+                && e.contains("placed at its header's smp_rate, 1000 Hz")
+                && e.contains("--rate sets the sensor's own"),
+            "case {case}: {e}"
+        );
+        let given = [
+            "noise",
+            path,
+            "--column",
+            "gx",
+            "--rate",
+            &sensor.to_string(),
+        ];
+        let run = imu_ar(&given);
+        let e = crate::common::stderr(&run);
+        assert!(run.status.success(), "case {case}: {e}");
+        assert!(!e.contains("smp_rate"), "case {case}: {e}");
     }
 }
