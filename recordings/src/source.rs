@@ -486,8 +486,9 @@ fn autopilot_stream(
     } else {
         let rate;
         (skipped, rate) = ulog_stream(files, request, &picks, &mut take)?;
-        if let Some(rate) = rate {
+        if let Some((rate, warning)) = rate {
             timing.placed_at(rate);
+            caveat = warning;
         }
     }
     let read = stamped(files, request, &picks, (timing, backward), skipped)?;
@@ -582,19 +583,22 @@ pub fn fuller(
     }
 }
 
+/// A FIFO topic's rate its messages' counts give, Hz, and the warning it is read with.
+type FifoRate = Option<(f64, Option<String>)>;
+
 /// The samples of a ULog file's gyro or accelerometer, or both (`picks`), to `take` (time in
 /// microseconds, the six axes): of the sensor topic and its FIFO topic, the [`fuller`]. Gyro and accelerometer are separate topics: read together (on two threads), they are
 /// paired by equal sample times, as PX4's drivers publish the two halves of one FIFO read;
 /// samples without a partner are counted, and more than 1 % of them refused, naming why
 /// ([`Pairing`]): one topic's lost messages, or times of their own. With the messages
 /// skipped, the FIFO topic's rate its messages' counts give ([`ulog::Report::fifo_rate`]; of
-/// both topics read, the gyro's), where it is read.
+/// both topics read, the gyro's), where it is read, and its warning.
 fn ulog_stream(
     files: &[PathBuf],
     request: &Request,
     picks: &[usize],
     take: &mut dyn FnMut(f64, [f64; 6]),
-) -> Result<(Skipped, Option<f64>), Fail> {
+) -> Result<(Skipped, FifoRate), Fail> {
     let path = &files[0];
     let survey = ulog::survey(path).map_err(|e| Fail(e.to_string()))?;
     let mut selects = Vec::with_capacity(2);
@@ -668,7 +672,7 @@ fn ulog_stream(
         }
         skipped.undecodable = report.undecodable;
         skipped.non_finite = report.non_finite;
-        return Ok((skipped, report.fifo_rate));
+        return Ok((skipped, report.fifo_rate.map(|r| (r, report.fifo_caveat))));
     };
     type Batch = Vec<(f64, [f64; 3])>;
     let dropouts = survey.dropouts;
@@ -795,7 +799,8 @@ fn ulog_stream(
     skipped.non_finite = non_finite;
     skipped.unpaired = unpaired;
     // (Paired by equal sample times, the samples are the gyro's.)
-    Ok((skipped, g.fifo_rate.filter(|_| x.fifo_rate.is_some())))
+    let rate = g.fifo_rate.filter(|_| x.fifo_rate.is_some());
+    Ok((skipped, rate.map(|r| (r, g.fifo_caveat))))
 }
 
 /// The sensor of a sample the pairing of gyro and accelerometer met.
@@ -1675,12 +1680,13 @@ mod tests {
         assert!(!e.contains("times of their own"), "{e}");
     }
 
-    /// The rate the timestamps of a ULog FIFO log give, and whether they are refused as runs.
-    fn fifo_rate(bytes: &[u8]) -> Result<(f64, bool), String> {
+    /// The rate the timestamps of a ULog FIFO log give, whether they are refused as runs,
+    /// and the warning they are read with.
+    fn fifo_rate(bytes: &[u8]) -> Result<(f64, bool, Option<String>), String> {
         let read = read_bytes(bytes, "ulg", &AXES)?;
         let (timing, unit) = read.timing.ok_or("no stamps")?;
         let s = timing.summary(unit)?;
-        Ok((s.rate_hz, s.batch_refusal().is_some()))
+        Ok((s.rate_hz, s.batch_refusal().is_some(), read.caveat))
     }
 
     #[test]
@@ -1706,18 +1712,28 @@ mod tests {
             (1999.0, 500, 100.0, 53),
             // Stamps jittered by up to a quarter of a message's time: a third of the
             // messages begin before the one before ends where their samples are placed dt
-            // apart back from their stamp, and were refused as a sensor faster than its dt.
+            // apart back from their stamp, and were refused as a sensor faster than its dt;
+            // read, with a warning that a message lost is not told from a late stamp (runs
+            // parted at stamps late by half a message's samples and fitted to their ends
+            // read 8 kHz, 8 samples a message, stamps jittered by 170 us RMS, 8001.75 Hz).
             (8000.0, 125, 300.0, 0),
+            (7996.0, 125, 600.0, 0),
         ] {
             let stamps: Vec<u64> = (0..4_000u64)
                 .filter(|&k| lost == 0 || k % lost != lost / 2)
                 .map(|k| (1e6 + (10 * k + 9) as f64 * 1e6 / rate + jitter(most)).round() as u64)
                 .collect();
-            let (read, runs) = fifo_rate(&fifo_log((&stamps, dt), (&stamps, dt))).unwrap();
+            let (read, runs, warned) =
+                fifo_rate(&fifo_log((&stamps, dt), (&stamps, dt))).unwrap();
             assert!(
                 (read / rate - 1.0).abs() < 5e-5 && !runs,
                 "{rate} Hz, {most} us: {read} Hz{}",
                 if runs { " (runs)" } else { "" }
+            );
+            assert_eq!(
+                warned.is_some_and(|w| w.contains("a message lost is not told from a late")),
+                most >= 300.0,
+                "{rate} Hz, {most} us"
             );
         }
     }
