@@ -74,7 +74,12 @@ pub fn timing_summary(data: &[u8]) {
             Step::Backward { .. } => break,
         }
     }
-    if let Ok(s) = timing.summary(TimeUnit::Nanoseconds) {
+    // The same stamps said to be placed at a rate near the clock's (a batch sampler's,
+    // a FIFO's messages counted): its summary holds the same.
+    let mut placed = timing.clone();
+    placed.placed_at(1e9 / period * (1.0 + f64::from(i8::from_le_bytes([head[4]])) * 1e-3));
+    for s in [&timing, &placed].map(|t| t.summary(TimeUnit::Nanoseconds)) {
+        let Ok(s) = s else { continue };
         assert!(s.rate_hz.is_finite() && s.rate_hz > 0.0, "{s:?}");
         assert!(s.span_rate_hz.is_finite() && s.span_rate_hz > 0.0, "{s:?}");
         assert!(s.span_s.is_finite() && s.span_s > 0.0, "{s:?}");
@@ -239,7 +244,12 @@ pub fn ulog_read(data: &[u8]) {
                         },
                     );
                     match result {
-                        Ok(report) => assert!(samples > 0 && report.delivered == samples),
+                        Ok(report) => {
+                            assert!(samples > 0 && report.delivered == samples);
+                            // A FIFO topic's rate is a rate, its warning one line.
+                            assert!(report.fifo_rate.is_none_or(|r| r.is_finite() && r > 0.0));
+                            assert!(report.fifo_caveat.is_none_or(|c| !c.contains('\n')));
+                        }
                         Err(e) => assert_one_line(&e, &path),
                     }
                 }
@@ -275,7 +285,13 @@ pub fn dataflash_read(data: &[u8]) {
                         samples += 1;
                     });
                     match result {
-                        Ok(report) => assert!(samples > 0 && report.delivered == samples),
+                        Ok(report) => {
+                            assert!(samples > 0 && report.delivered == samples);
+                            // The batches' rates are rates, the least first.
+                            assert!(report.batch_rates.is_none_or(|(least, most)| {
+                                least.is_finite() && least > 0.0 && least <= most
+                            }));
+                        }
                         Err(e) => assert_one_line(&e, &path),
                     }
                 }

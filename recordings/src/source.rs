@@ -1723,8 +1723,7 @@ mod tests {
                 .filter(|&k| lost == 0 || k % lost != lost / 2)
                 .map(|k| (1e6 + (10 * k + 9) as f64 * 1e6 / rate + jitter(most)).round() as u64)
                 .collect();
-            let (read, runs, warned) =
-                fifo_rate(&fifo_log((&stamps, dt), (&stamps, dt))).unwrap();
+            let (read, runs, warned) = fifo_rate(&fifo_log((&stamps, dt), (&stamps, dt))).unwrap();
             assert!(
                 (read / rate - 1.0).abs() < 5e-5 && !runs,
                 "{rate} Hz, {most} us: {read} Hz{}",
