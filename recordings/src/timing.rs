@@ -1815,8 +1815,9 @@ impl Timing {
 
     /// The samples kept over the span, Hz (0 for no span).
     /// The summary of stamps placed at `rate` (Hz, [`Timing::placed_at`]): that rate, the
-    /// intervals within a quarter of its period as the regular ones, the longer ones gaps,
-    /// each missing the samples its time holds at the rate less one.
+    /// intervals within a quarter of its period as the regular ones, the longer ones gaps;
+    /// the samples missing, the places the span holds at the rate past the samples kept
+    /// (where the stamps were placed unevenly, a gap beside short intervals misses none).
     fn placed_summary(&self, unit: TimeUnit, rate: f64) -> Result<TimingSummary, String> {
         let period = 1e9 / rate;
         if !(0.01..=1e6).contains(&rate) {
@@ -1831,7 +1832,7 @@ impl Timing {
             ));
         }
         let (mut regular, mut sq, mut worst) = (0u64, 0.0f64, 0.0f64);
-        let (mut gaps, mut missing, mut short) = (0u64, 0u64, 0u64);
+        let (mut gaps, mut short) = (0u64, 0u64);
         let mut intervals: Vec<i64> = Vec::with_capacity(self.stamps.len().saturating_sub(1));
         for w in self.stamps.windows(2) {
             let iv = w[1].saturating_sub(w[0]);
@@ -1843,7 +1844,6 @@ impl Timing {
                 worst = worst.max(off.abs());
             } else if off > 0.0 {
                 gaps += 1;
-                missing += ((iv as f64 / period).round() - 1.0) as u64;
             } else {
                 short += 1;
             }
@@ -1862,7 +1862,8 @@ impl Timing {
             jitter_rms: (sq / regular.max(1) as f64).sqrt(),
             jitter_max: worst,
             gaps,
-            missing_samples: missing,
+            missing_samples: ((self.span_ns() / period).round() + 1.0 - self.kept as f64).max(0.0)
+                as u64,
             short_intervals: short,
             dropped_backward: self.dropped,
             span_s: self.span_ns() * 1e-9,
