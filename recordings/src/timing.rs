@@ -2454,6 +2454,7 @@ impl Timing {
             return Ok(summary);
         }
         self.refold(&mut summary, resolution, median, rounded)?;
+        self.off_its_span(&summary, intervals, resolution)?;
         if rounded {
             self.crossings_hide_losses(&summary, resolution)?;
             self.jitter_reaches_gaps(&summary, resolution)?;
@@ -2620,6 +2621,41 @@ impl Timing {
             }
         }
         Ok(())
+    }
+
+    /// An error where the stamps, jittered by 5 % or more and rounded to a tenth of the
+    /// period or more (`resolution`, ns), none repeated, give a rate from their regular
+    /// intervals that puts more samples in the span than the stamps hold with those their
+    /// gaps miss (`intervals` of them), or fewer, by more than five and 5e-4 of them: the
+    /// regular intervals' mean, cut by the window of 25 % about the rounded median, is no
+    /// period the span keeps (150 Hz and then 150.5 Hz jittered by a tenth of the period on
+    /// whole-ms stamps: the intervals within 25 % of the median 7 ms, 6 to 8 ms, read 151.2
+    /// Hz; one clock is read again on its phase, [`Timing::refold`]).
+    fn off_its_span(
+        &self,
+        summary: &TimingSummary,
+        intervals: u64,
+        resolution: Option<i64>,
+    ) -> Result<(), String> {
+        let coarse = resolution.is_some_and(|q| 10.0 * q as f64 * 1e-9 * summary.rate_hz > 1.0);
+        if self.repeats > 0 || summary.jitter_rms < 0.05 || !coarse {
+            return Ok(());
+        }
+        let held = (intervals + summary.missing_samples) as f64;
+        let read = summary.rate_hz * summary.span_s;
+        if (read - held).abs() <= 5.0_f64.max(5e-4 * held) {
+            return Ok(());
+        }
+        Err(format!(
+            "the timestamps' regular intervals give {} Hz, which puts {} samples in their \
+             span of {} s, where it holds {} with those its gaps miss ({} Hz): mixed rates, \
+             or a clock jittered past what its stamps' rounding tells; give --rate",
+            short(summary.rate_hz),
+            read.round(),
+            short(summary.span_s),
+            held,
+            short(held / summary.span_s)
+        ))
     }
 
     /// An error where half the intervals or more lie within two quanta (the stamps'
@@ -7509,6 +7545,44 @@ mod tests {
                 "seed {seed}: {}",
                 s.rate_hz
             );
+        }
+    }
+
+    #[test]
+    fn a_jittered_clock_whose_rate_moves_on_whole_ms_is_not_read_off_its_span() {
+        // 150 Hz, then 150.5 Hz, each for 10,000 samples, jittered by a tenth of the period
+        // (Gaussian), rounded to whole ms: the regular intervals' mean, cut about the median
+        // 7 ms, read 151.0 to 151.2 Hz, above both rates (pass 43 F4); refused now, naming
+        // the span's rate. The same clock at one rate is read.
+        for seed in 1..=4u64 {
+            for second in [150.5, 150.0] {
+                let mut jitter = gaussian(seed);
+                let mut t = 1.0;
+                let stamps: Vec<i64> = (0..20_000)
+                    .map(|k| {
+                        let period = 1.0 / if k < 10_000 { 150.0 } else { second };
+                        t += period;
+                        ((t + 0.1 * period * jitter()) * 1e3).round() as i64 * 1_000_000
+                    })
+                    .collect();
+                let mut timing = Timing::new();
+                for &s in &stamps {
+                    timing.push(s);
+                }
+                match timing.summary(TimeUnit::Nanoseconds) {
+                    Ok(s) if second == 150.0 => {
+                        assert!(
+                            (s.rate_hz / 150.0 - 1.0).abs() < 1e-4,
+                            "{seed}: {}",
+                            s.rate_hz
+                        )
+                    }
+                    Err(e) if second != 150.0 => {
+                        assert!(e.contains("mixed rates") && e.contains("Hz)"), "{e}")
+                    }
+                    other => panic!("seed {seed}, {second} Hz: {other:?}"),
+                }
+            }
         }
     }
 
