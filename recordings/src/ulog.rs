@@ -314,7 +314,8 @@ pub struct Report {
     /// The byte offset of the last message when it is cut short by the end of the file.
     pub truncated: Option<u64>,
     /// Where one FIFO message in ten or more begins before the one before ends (the sensor
-    /// faster than the `dt` field says), why its samples' times cannot be placed: a caller
+    /// faster than the `dt` field says), why its samples' times cannot be placed; or where
+    /// the two halves of its messages give two rates ([`Report::fifo_rate`]), that: a caller
     /// refuses the file with it.
     pub fifo_overlap: Option<String>,
     /// A FIFO topic's rate, Hz, where every message gives the same `dt` and the messages
@@ -607,6 +608,17 @@ pub fn read_surveyed(
         }
     };
     let log = scan(path, &mut visit)?;
+    // The FIFO's rate, its warning and whether its halves' rates are apart: of the device with
+    // the most messages (of one sample a message, each sample's stamp is its own, and the
+    // clock's reading weighs each alone).
+    let fitted = stamped
+        .iter()
+        .max_by_key(|(_, m)| m.len())
+        .filter(|_| {
+            dts.is_some_and(|(least, most)| least == most)
+                && first_last.is_some_and(|(_, _, n)| n >= 2 * fifo_messages)
+        })
+        .and_then(|(_, m)| fifo_rate(m));
     // The rate the messages give: their samples over their spacing (and those two).
     let messages_rate = first_last
         .filter(|&(a, b, _)| b > a && fifo_messages > 1)
@@ -675,23 +687,12 @@ pub fn read_surveyed(
         held_temperature: held,
         temperature: devices.first().and_then(|&(_, s)| s),
         truncated: log.truncated,
-        fifo_overlap,
-        // (Of one sample a message, each sample's stamp is its own, and the clock's reading
-        // weighs each alone.) The device with the most messages.
-        fifo_rate: stamped
-            .iter()
-            .max_by_key(|(_, m)| m.len())
-            .filter(|_| {
-                dts.is_some_and(|(least, most)| least == most)
-                    && first_last.is_some_and(|(_, _, n)| n >= 2 * fifo_messages)
-            })
-            .and_then(|(_, m)| fifo_rate(m))
-            .map(|(rate, _)| rate),
-        fifo_caveat: stamped
-            .iter()
-            .max_by_key(|(_, m)| m.len())
-            .and_then(|(_, m)| fifo_rate(m))
-            .and_then(|(_, caveat)| caveat),
+        fifo_overlap: fifo_overlap.or_else(|| {
+            let mixed = fitted.as_ref().and_then(|f| f.2.clone())?;
+            Some(data_error(path, mixed).to_string())
+        }),
+        fifo_rate: fitted.as_ref().map(|f| f.0),
+        fifo_caveat: fitted.and_then(|f| f.1),
     })
 }
 
@@ -709,8 +710,10 @@ pub fn read_surveyed(
 /// meet another leans (8000 Hz read every 1 ms, a fifth of the stamps 550 us late: 8060
 /// Hz). Where that jitter passes half the fewest samples' time, a message lost is not told
 /// from a late stamp, and the warning says so. A run's first and last messages are left
-/// out of the fit too.
-fn fifo_rate(messages: &[(f64, usize)]) -> Option<(f64, Option<String>)> {
+/// out of the fit too. Where the two halves of the messages give rates apart by more than
+/// half a percent and four standard errors, the refusal that says so (a sensor whose rate
+/// steps, its dt field unchanged: 1000.37 and 1050.39 Hz read 1025.69 Hz).
+fn fifo_rate(messages: &[(f64, usize)]) -> Option<(f64, Option<String>, Option<String>)> {
     if messages.len() < 4 {
         return None;
     }
@@ -731,19 +734,38 @@ fn fifo_rate(messages: &[(f64, usize)]) -> Option<(f64, Option<String>)> {
         .fold(0.0f64, f64::max);
     let fewest = messages.iter().map(|m| m.1).min().unwrap_or(1) as f64;
     let parted = (0.5 * fewest * period).max(1.2 * short);
-    let (mut fit, mut run) = (Line::default(), Line::default());
-    let mut before: Option<f64> = None;
-    for &(stamp, n) in messages {
-        if let Some(b) = before
-            && (stamp <= b || stamp - b - n as f64 * period > parted)
-        {
-            fit.pool(std::mem::take(&mut run));
+    let fitted = |messages: &[(f64, usize)]| {
+        let (mut fit, mut run) = (Line::default(), Line::default());
+        let mut before: Option<f64> = None;
+        for &(stamp, n) in messages {
+            if let Some(b) = before
+                && (stamp <= b || stamp - b - n as f64 * period > parted)
+            {
+                fit.pool(std::mem::take(&mut run));
+            }
+            run.point(n as f64, stamp);
+            before = Some(stamp);
         }
-        run.point(n as f64, stamp);
-        before = Some(stamp);
-    }
-    fit.pool(run);
-    let rate = fit.rate()?;
+        fit.pool(run);
+        fit
+    };
+    let rate = fitted(messages).rate()?;
+    // One rate: the two halves' fits within half a percent of each other, or four standard
+    // errors (a sensor whose rate steps, its dt field unchanged, reads between the two).
+    let (first, second) = messages.split_at(messages.len() / 2);
+    let (first, second) = (fitted(first), fitted(second));
+    let mixed = first.rate().zip(second.rate()).and_then(|(a, b)| {
+        let apart = 0.005f64.max(4.0 * (first.relative_error() + second.relative_error()));
+        ((a / b - 1.0).abs() > apart).then(|| {
+            format!(
+                "the FIFO messages' first half gives {} Hz and the second {} Hz, their \
+                 stamps on the samples they count: mixed rates (one record must have one \
+                 rate; give --rate)",
+                crate::timing::short(a),
+                crate::timing::short(b)
+            )
+        })
+    });
     let caveat = (1.2 * short > 0.5 * fewest * period).then(|| {
         format!(
             "the FIFO messages' stamps come up to {} us short of their samples' time from one \
@@ -757,7 +779,7 @@ fn fifo_rate(messages: &[(f64, usize)]) -> Option<(f64, Option<String>)> {
             crate::timing::short(rate)
         )
     });
-    Some((rate, caveat))
+    Some((rate, caveat, mixed))
 }
 
 /// A straight line through the stamps of a run of FIFO messages that follow one another
@@ -779,6 +801,7 @@ struct Line {
     mean: (f64, f64),
     sxx: f64,
     sxy: f64,
+    syy: f64,
 }
 
 impl Line {
@@ -792,11 +815,12 @@ impl Line {
         let before = self.pending.replace((self.count, stamp - origin));
         if let Some((x, y)) = before.filter(|_| !self.first) {
             self.n += 1.0;
-            let dx = x - self.mean.0;
+            let (dx, dy) = (x - self.mean.0, y - self.mean.1);
             self.mean.0 += dx / self.n;
-            self.mean.1 += (y - self.mean.1) / self.n;
+            self.mean.1 += dy / self.n;
             self.sxx += dx * (x - self.mean.0);
             self.sxy += dx * (y - self.mean.1);
+            self.syy += dy * (y - self.mean.1);
         }
         self.first = false;
     }
@@ -806,12 +830,22 @@ impl Line {
     fn pool(&mut self, run: Line) {
         self.sxx += run.sxx;
         self.sxy += run.sxy;
+        self.syy += run.syy;
+        self.n += (run.n - 1.0).max(0.0);
     }
 
     /// The rate of the pooled slope, Hz, where it is one.
     fn rate(&self) -> Option<f64> {
         let rate = 1e6 * self.sxx / self.sxy;
         (self.sxx > 0.0 && self.sxy > 0.0 && rate.is_finite()).then_some(rate)
+    }
+
+    /// The standard error of the pooled slope relative to it (the residuals' spread about
+    /// each run's line, over the points less the runs' offsets and the slope).
+    fn relative_error(&self) -> f64 {
+        let slope = self.sxy / self.sxx;
+        let residual = (self.syy - slope * self.sxy).max(0.0) / (self.n - 1.0).max(1.0);
+        (residual / self.sxx).sqrt() / slope
     }
 }
 
@@ -2068,12 +2102,37 @@ mod tests {
     }
 
     #[test]
+    fn a_fifo_whose_rate_steps_is_two_rates() {
+        // 4 samples a message, 1000.37 Hz, then 1050.39 Hz (or 980.36 Hz) for as many
+        // messages, the dt field unchanged: read 1025.69 (990.42) Hz with no warning, one
+        // line through both halves (pass 44 F1). One rate, jittered, is one.
+        for step in [1.05, 0.98, 1.0] {
+            let mut t = 1e6;
+            let mut next = crate::xorshift(7);
+            let messages: Vec<(f64, usize)> = (0..10_000)
+                .map(|k| {
+                    let rate = 1000.37 * if k < 5_000 { 1.0 } else { step };
+                    t += 4.0 * 1e6 / rate;
+                    let jitter = (next() >> 11) as f64 / (1u64 << 53) as f64 * 40.0;
+                    (t + if step == 1.0 { jitter } else { 0.0 }, 4)
+                })
+                .collect();
+            let (_, _, mixed) = fifo_rate(&messages).unwrap();
+            assert_eq!(
+                mixed.is_some_and(|m| m.contains("mixed rates")),
+                step != 1.0,
+                "{step}"
+            );
+        }
+    }
+
+    #[test]
     fn a_fifos_rate_leans_on_no_late_stamps_and_sees_small_messages_lost() {
         // 8 kHz read 8 samples at a time, a fifth of the stamps 550 us late (and all
         // jittered by up to 8 us), none lost: runs parted at the late stamps lean, as a run
         // that starts late may not meet another late one (pass 43 F1: such logs read 8044 to
         // 8060 Hz). Read with the warning, as a message lost would hide among late stamps.
-        let (rate, warned) = fifo_rate(&fifo_messages(
+        let (rate, warned, _) = fifo_rate(&fifo_messages(
             8000.0,
             |_| 8,
             |u| 8.0 * u + if u < 0.2 { 550.0 } else { 0.0 },
@@ -2086,7 +2145,7 @@ mod tests {
         // one sample, under half the messages' mean, parted no run, its sample not counted
         // (pass 43 F3: such logs read 999.15 and 999.27 Hz). No warning: the stamps jitter by
         // 5 us.
-        let (rate, warned) = fifo_rate(&fifo_messages(
+        let (rate, warned, _) = fifo_rate(&fifo_messages(
             1000.0,
             |u| if u < 0.5 { 1 } else { 15 },
             |u| 5.0 * u,
