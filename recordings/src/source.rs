@@ -1696,12 +1696,9 @@ mod tests {
         // message's samples stamped back at dt from its stamp part runs by intervals off
         // the grid: 8000 Hz at 20 us was refused as a FIFO's reads stamped back at a set
         // spacing (pass 39 F4), and a sensor 0.125 % slower than its dt the same way.
-        let mut state = 11u64;
+        let mut next = crate::xorshift(11);
         let mut jitter = move |most: f64| {
-            state = state
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            ((state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0) * most
+            ((next() >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0) * most
         };
         for (rate, dt, most, lost) in [
             (8000.0, 125, 20.0, 0),
