@@ -1697,9 +1697,8 @@ mod tests {
         // the grid: 8000 Hz at 20 us was refused as a FIFO's reads stamped back at a set
         // spacing (pass 39 F4), and a sensor 0.125 % slower than its dt the same way.
         let mut next = crate::xorshift(11);
-        let mut jitter = move |most: f64| {
-            ((next() >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0) * most
-        };
+        let mut jitter =
+            move |most: f64| ((next() >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0) * most;
         for (rate, dt, most, lost) in [
             (8000.0, 125, 20.0, 0),
             (8000.0, 125, 40.0, 97),
