@@ -187,11 +187,14 @@ fn compressed_folder(is_mcap: bool, bytes: &[u8]) {
     let folder = scratch("bag");
     std::fs::create_dir_all(&folder).expect("a scratch folder in the temporary folder");
     let file = if is_mcap { "a_0.mcap" } else { "a_0.db3" };
+    // (Counting 0 to 3 messages on the topic: a file that holds fewer is refused.)
     let meta = format!(
         "rosbag2_bagfile_information:\n  version: 9\n  storage_identifier: {}\n  \
          relative_file_paths:\n  - {file}\n  compression_format: zstd\n  \
-         compression_mode: MESSAGE\n",
-        if is_mcap { "mcap" } else { "sqlite3" }
+         compression_mode: MESSAGE\n  topics_with_message_count:\n  - message_count: {}\n    \
+         topic_metadata:\n      name: /imu0\n",
+        if is_mcap { "mcap" } else { "sqlite3" },
+        bytes.first().map_or(0, |b| b % 4)
     );
     std::fs::write(folder.join(rosbag2::METADATA), meta).expect("the folder's metadata");
     std::fs::write(folder.join(file), bytes).expect("the folder's storage file");
@@ -214,6 +217,12 @@ pub fn rosbag2_metadata(data: &[u8]) {
     };
     if let Ok(meta) = Metadata::parse(text) {
         assert!(!meta.storage.is_empty());
+        // Each topic counted is named in the text.
+        assert!(
+            meta.topic_counts
+                .iter()
+                .all(|(name, _)| text.contains(name.as_str()))
+        );
     }
 }
 

@@ -67,8 +67,10 @@ pub fn read_selected(
     let topic = select.topic;
     let fail = |problem: String| data_error(path, problem);
     let corrupt = |what: String| fail(format!("truncated or corrupt bag: {what}"));
-    check_header(path)?;
+    let declared = check_header(path)?;
     let bag = RosBag::new(path).map_err(|e| corrupt(e.to_string()))?;
+    // The connection records the index holds.
+    let mut connections = 0u32;
 
     // The connections, from the index section.
     let mut ids = Vec::new();
@@ -92,6 +94,7 @@ pub fn read_selected(
             }
             _ => continue,
         };
+        connections = connections.saturating_add(1);
         let name = c.storage_topic.to_string();
         if c.storage_topic == topic {
             if c.tp != IMU_TYPE {
@@ -114,6 +117,13 @@ pub fn read_selected(
         if !all_topics.contains(&name) {
             all_topics.push(name);
         }
+    }
+    if let Some(n) = declared.filter(|&n| n > connections) {
+        return Err(corrupt(format!(
+            "its header declares {n} connection{} and its index holds {connections}: the index \
+             is damaged (`rosbag reindex` rebuilds it)",
+            if n == 1 { "" } else { "s" }
+        )));
     }
     if let Some(other) = others.first() {
         return Err(fail(if ids.is_empty() {
@@ -241,7 +251,7 @@ fn text(e: &rosbag::Error) -> String {
 
 /// Checks what [`RosBag`] takes on trust, so that it cannot panic: the magic, and an index
 /// position inside the file after the bag header record.
-fn check_header(path: &Path) -> Result<(), DataError> {
+fn check_header(path: &Path) -> Result<Option<u32>, DataError> {
     let fail = |problem: String| data_error(path, problem);
     let corrupt = |what: &str| fail(format!("truncated or corrupt bag: {what}"));
     // The magic, the bag header record's header length; the header record itself is
@@ -278,7 +288,9 @@ fn check_header(path: &Path) -> Result<(), DataError> {
              inside its header"
         )));
     }
-    Ok(())
+    Ok(header_field(fields, b"conn_count")
+        .and_then(|v| <[u8; 4]>::try_from(v).ok())
+        .map(u32::from_le_bytes))
 }
 
 /// The value of field `name` of a record header (`<u32 length><name>=<value>` fields).

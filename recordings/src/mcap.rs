@@ -172,7 +172,15 @@ pub(crate) fn read_compressed(
         Refusal::Channel(e) => fail(e),
     };
     while let Some(event) = reader.next_event() {
-        match event.map_err(|e| corrupt(&e, state.messages))? {
+        let event = event.map_err(|e| match e {
+            ::mcap::McapError::UnexpectedEof => corrupt(
+                &"it ends in the middle of a record: cut short (a recording not closed, or a \
+                  copy cut off; `mcap recover` keeps its whole chunks)",
+                state.messages,
+            ),
+            e => corrupt(&e, state.messages),
+        })?;
+        match event {
             LinearReadEvent::ReadRequest(need) => {
                 let buf = reader.insert(need.max(READ_SIZE));
                 let n = loop {

@@ -42,6 +42,8 @@ pub struct Metadata {
     /// `version`: the metadata's layout (up to 3, the storage files' paths start with the
     /// folder's name).
     pub version: Option<u64>,
+    /// `topics_with_message_count`: each topic's name and the messages recorded on it.
+    pub topic_counts: Vec<(String, u64)>,
 }
 
 impl Metadata {
@@ -54,13 +56,42 @@ impl Metadata {
             compression_mode: String::new(),
             compression_format: String::new(),
             version: None,
+            topic_counts: Vec::new(),
         };
         let mut in_files = false;
         let mut seen_files = false;
+        // Within `topics_with_message_count`: its key's indent, its items' indent, and the
+        // item being read (its topic's name and count, each the first given).
+        let mut topics: Option<(usize, Option<usize>)> = None;
+        let mut entry: (Option<String>, Option<u64>) = (None, None);
         for line in text.lines() {
             let trimmed = line.trim();
             if trimmed.is_empty() || trimmed.starts_with('#') {
                 continue;
+            }
+            let indent = line.len() - line.trim_start().len();
+            if let Some((key, item)) = topics {
+                let inside = indent > key || indent == key && trimmed.starts_with("- ");
+                let begins = trimmed.starts_with("- ") && item.is_none_or(|i| i == indent);
+                if (!inside || begins)
+                    && let (Some(name), Some(count)) = std::mem::take(&mut entry)
+                {
+                    meta.topic_counts.push((name, count));
+                }
+                if inside {
+                    topics = Some((key, item.or(begins.then_some(indent))));
+                    let pair = trimmed.strip_prefix("- ").unwrap_or(trimmed);
+                    if let Some((k, v)) = pair.split_once(':') {
+                        let v = unquoted(v.trim());
+                        match k.trim() {
+                            "name" if entry.0.is_none() => entry.0 = Some(v.to_string()),
+                            "message_count" if entry.1.is_none() => entry.1 = v.parse().ok(),
+                            _ => {}
+                        }
+                    }
+                    continue;
+                }
+                topics = None;
             }
             if in_files && let Some(item) = trimmed.strip_prefix("- ") {
                 meta.files.push(unquoted(item).to_string());
@@ -76,6 +107,7 @@ impl Metadata {
                 "compression_mode" => meta.compression_mode = value.to_string(),
                 "compression_format" => meta.compression_format = value.to_string(),
                 "version" if meta.version.is_none() => meta.version = value.parse().ok(),
+                "topics_with_message_count" if value.is_empty() => topics = Some((indent, None)),
                 "relative_file_paths" => {
                     seen_files = true;
                     if let Some(list) = value.strip_prefix('[').and_then(|v| v.strip_suffix(']')) {
@@ -90,6 +122,9 @@ impl Metadata {
                 }
                 _ => {}
             }
+        }
+        if let (Some(name), Some(count)) = entry {
+            meta.topic_counts.push((name, count));
         }
         if meta.storage.is_empty() {
             return Err("it has no storage_identifier".into());
@@ -124,6 +159,8 @@ struct Storage {
     files: Vec<PathBuf>,
     mcap: bool,
     zstd_messages: bool,
+    /// The messages the metadata counts on each topic.
+    topic_counts: Vec<(String, u64)>,
 }
 
 impl Storage {
@@ -222,12 +259,17 @@ fn storage(dir: &Path) -> Result<Storage, DataError> {
         files,
         mcap,
         zstd_messages,
+        topic_counts: meta.topic_counts,
     })
 }
 
 /// Calls `each` with every finite `sensor_msgs/msg/Imu` message on `select`'s topic (and
 /// frame_id) of the rosbag2 folder `dir`, file after file, and returns what was skipped.
-/// Errors as [`super::mcap::read_selected`] and [`read_db3`], and [`storage_files`]'.
+/// Errors as [`super::mcap::read_selected`] and [`read_db3`], and [`storage_files`]'; and
+/// where a file's first header stamp is before the first of the file listed before it (the
+/// metadata lists them out of order), or the files hold fewer of the topic's messages than
+/// the metadata counts on it (a storage file left off its list, or damaged), naming the
+/// storage files in the folder it does not list.
 pub fn read_folder(
     dir: &Path,
     select: &Select,
@@ -237,19 +279,60 @@ pub fn read_folder(
         files,
         mcap: is_mcap,
         zstd_messages,
+        topic_counts,
     } = storage(dir)?;
+    let meta = folder(dir).join(METADATA);
+    let name =
+        |f: &Path| crate::error::escaped(&f.file_name().unwrap_or_default().to_string_lossy());
     let mut skipped = Skipped::default();
     let mut found = false;
     let mut last_err = None;
+    // The messages on the topic, and the first header stamp of the file before (and its
+    // name).
+    let mut held = 0u64;
+    let mut before: Option<(i64, String)> = None;
     for file in &files {
-        let read = if is_mcap {
-            mcap::read_compressed(file, select, each, zstd_messages)
-        } else {
-            read_db3_compressed(file, select, each, zstd_messages)
+        let mut first: Option<i64> = None;
+        let mut misordered: Option<i64> = None;
+        let mut take = |frame: Frame| {
+            held += 1;
+            if misordered.is_some() {
+                return;
+            }
+            if frame.stamp_ns != 0 && first.is_none() {
+                first = Some(frame.stamp_ns);
+                if let Some((t, _)) = &before
+                    && frame.stamp_ns < *t
+                {
+                    misordered = Some(frame.stamp_ns);
+                    return;
+                }
+            }
+            each(frame);
         };
+        let read = if is_mcap {
+            mcap::read_compressed(file, select, &mut take, zstd_messages)
+        } else {
+            read_db3_compressed(file, select, &mut take, zstd_messages)
+        };
+        if let (Some(t), Some((earlier, listed))) = (misordered, &before) {
+            return Err(data_error(
+                &meta,
+                format!(
+                    "its storage file '{}' begins at {t} ns, before '{listed}', listed before \
+                     it, begins ({earlier} ns): relative_file_paths lists the files out of \
+                     order (rosbag2 reads them in its order)",
+                    name(file)
+                ),
+            ));
+        }
         match read {
             Ok(s) => {
                 found = true;
+                held += s.undecodable + s.other_frame_id;
+                if !select.non_finite {
+                    held += s.non_finite;
+                }
                 skipped.undecodable += s.undecodable;
                 skipped.non_finite += s.non_finite;
                 skipped.other_frame_id += s.other_frame_id;
@@ -260,11 +343,50 @@ pub fn read_folder(
             Err(e) if files.len() > 1 && e.problem.starts_with("no ") => last_err = Some(e),
             Err(e) => return Err(e),
         }
+        if let Some(t) = first {
+            before = Some((t, name(file)));
+        }
     }
-    match (found, last_err) {
-        (false, Some(e)) => Err(e),
-        _ => Ok(skipped),
+    if let (false, Some(e)) = (found, last_err) {
+        return Err(e);
     }
+    let counted = topic_counts
+        .iter()
+        .filter(|(t, _)| t == select.topic)
+        .map(|&(_, n)| n)
+        .max()
+        .unwrap_or(0);
+    if held < counted {
+        let listed: Vec<&Path> = files.iter().map(PathBuf::as_path).collect();
+        let mut others: Vec<String> = std::fs::read_dir(folder(dir))
+            .into_iter()
+            .flatten()
+            .flatten()
+            .map(|e| e.path())
+            .filter(|p| {
+                !listed.contains(&p.as_path())
+                    && p.extension().is_some_and(|x| x == "db3" || x == "mcap")
+            })
+            .map(|p| format!("'{}'", name(&p)))
+            .collect();
+        others.sort();
+        return Err(data_error(
+            &meta,
+            format!(
+                "it counts {counted} messages on '{}' and its storage files hold {held}: {}",
+                crate::error::escaped(select.topic),
+                if others.is_empty() {
+                    "a storage file is damaged or cut short".to_string()
+                } else {
+                    format!(
+                        "the folder holds {}, which relative_file_paths does not list",
+                        others.join(", ")
+                    )
+                }
+            ),
+        ));
+    }
+    Ok(skipped)
 }
 
 /// The first bytes of an SQLite 3 database.

@@ -472,7 +472,9 @@ fn autopilot_stream(
                 return Err(with_file(
                     files,
                     format!(
-                        "its ISB batches' headers give sample rates from {least} to {most} Hz:                          each batch's samples are placed at its own, and one record is read                          at one rate"
+                        "its ISB batches' headers give sample rates from {least} to {most} Hz: \
+                         each batch's samples are placed at its own, and one record is read at \
+                         one rate"
                     ),
                 ));
             }
@@ -1327,6 +1329,7 @@ fn csv_stream(
     let mut firsts: (Option<i64>, Option<i64>, usize) = (None, None, 0);
     // Samples kept, at a given rate, whose stamp is not after the one before.
     let mut backward_kept = 0u64;
+    let mut wraps = Wraps::default();
     let mut select = |header: &[String]| -> Result<Vec<usize>, String> {
         begun.set((begun.get().0 + 1, true));
         let mut picks = request
@@ -1426,6 +1429,7 @@ fn csv_stream(
             }
             None => (cells, None),
         };
+        let stamp = stamp.map(|t| wraps.unwrapped(t, time.get().and_then(|(_, u)| u)));
         if let Some(t) = stamp
             && firsts.2 != files
         {
@@ -1490,8 +1494,68 @@ fn csv_stream(
             ..Skipped::default()
         },
         source: None,
-        caveat: None,
+        caveat: wraps.caveat(),
     })
+}
+
+/// A time column that counts whole units on 32 bits (a microcontroller's `micros()` wraps
+/// every 71.6 minutes, its `millis()` every 49.7 days), read on past each wrap: a stamp
+/// before the last, both within the counter's range, where the counter's modulus puts it
+/// after the last by no more than four intervals (the one before).
+#[derive(Default)]
+struct Wraps {
+    /// The last stamp as read and the interval that reached it, ns.
+    last: Option<(i64, i64)>,
+    /// The time added for the wraps passed, ns, how many, and the unit's name.
+    offset: i64,
+    count: u32,
+    unit: &'static str,
+}
+
+impl Wraps {
+    /// The stamp `t` (ns, as read in `unit`) read on past the wraps passed.
+    fn unwrapped(&mut self, t: i64, unit: Option<TimeUnit>) -> i64 {
+        let (scale, name) = match unit {
+            Some(TimeUnit::Milliseconds) => (1_000_000, "ms"),
+            Some(TimeUnit::Microseconds) => (1_000, "us"),
+            Some(TimeUnit::Nanoseconds) => (1, "ns"),
+            _ => (0, ""),
+        };
+        let modulus = scale << 32;
+        let interval = match self.last {
+            Some((last, interval))
+                if scale > 0
+                    && t < last
+                    && (0..modulus).contains(&t)
+                    && last < modulus
+                    && t % scale == 0
+                    && last % scale == 0
+                    && interval > 0
+                    && t + modulus - last <= interval.saturating_mul(4) =>
+            {
+                self.offset = self.offset.saturating_add(modulus);
+                (self.count, self.unit) = (self.count + 1, name);
+                t + modulus - last
+            }
+            Some((last, _)) => t.saturating_sub(last),
+            None => 0,
+        };
+        self.last = Some((t, interval));
+        t.saturating_add(self.offset)
+    }
+
+    /// The warning that the stamps wrapped, where they did.
+    fn caveat(&self) -> Option<String> {
+        (self.count > 0).then(|| {
+            format!(
+                "the time column counts whole {} on 32 bits and wrapped {} time{} (at 2^32 {0}): \
+                 read on past each wrap",
+                self.unit,
+                self.count,
+                if self.count == 1 { "" } else { "s" }
+            )
+        })
+    }
 }
 
 /// The calls on a [`Timing`] sent at once.

@@ -1129,6 +1129,8 @@ struct Spread {
     places: Option<(u64, u64)>,
     spacing: u64,
     gaps: (f64, f64, f64),
+    /// The last gap, and the sum of the squares of the differences of successive gaps.
+    successive: (f64, f64),
 }
 
 impl Spread {
@@ -1137,10 +1139,25 @@ impl Spread {
         if let Some((_, last)) = self.places {
             let gap = at.abs_diff(last) as f64;
             let (n, sum, sq) = self.gaps;
+            if n > 0.0 {
+                let (before, d2) = self.successive;
+                self.successive.1 = d2 + (gap - before) * (gap - before);
+            }
+            self.successive.0 = gap;
             self.gaps = (n + 1.0, sum + gap, sq + gap * gap);
         }
         self.count += count;
         place(&mut self.places, &mut self.spacing, at, count);
+    }
+
+    /// Whether they come at random, as samples written twice do: 16 or more, their gaps
+    /// varying by over half their mean, each as far from the next as from any (a faster
+    /// clock's beat keeps them steady, or moves them slowly as it drifts).
+    fn scattered(&self) -> bool {
+        let (n, sum, sq) = self.gaps;
+        let mean = sum / n.max(1.0);
+        let variance = sq / n.max(1.0) - mean * mean;
+        n >= 15.0 && variance > 0.25 * mean * mean && self.successive.1 / (n - 1.0) >= variance
     }
 
     /// Whether they come as a clock a little faster than its stamps repeats them: at least
@@ -1471,12 +1488,24 @@ impl Timing {
     /// spacing (samples lost, or the clock drifting, space them wider; samples written twice
     /// come where they came).
     fn repeats_periodic(&self) -> bool {
+        self.repeats_are(Spread::periodic)
+    }
+
+    /// Whether the repeats left over on the stamps' grid (or those near no place left empty)
+    /// come at random, as samples written twice do ([`Spread::scattered`]).
+    fn repeats_scattered(&self) -> bool {
+        self.repeats_are(Spread::scattered)
+    }
+
+    /// Whether the repeats left over (or those near no place left empty), with the extras
+    /// placed, are as `test` asks.
+    fn repeats_are(&self, test: fn(&Spread) -> bool) -> bool {
         let l = &self.ledger;
         [l.left, l.near].into_iter().any(|mut spread| {
             for w in &l.extras {
                 spread.place(w.at, w.count);
             }
-            spread.periodic()
+            test(&spread)
         })
     }
 
@@ -2133,7 +2162,9 @@ impl Timing {
         // no repeat has a place nearby.
         let steady = || {
             self.random_repeats()
-                .map_or(ledger.matched == 0, |random| !random)
+                .map_or(ledger.matched == 0 && !self.repeats_scattered(), |random| {
+                    !random
+                })
         };
         let coarse = if grid {
             left > 0 && (self.repeats_periodic() || 100 * near >= self.kept && steady())
@@ -2399,7 +2430,9 @@ impl Timing {
         let faster = if grid {
             self.repeats_periodic() || 100 * near >= self.kept && steady()
         } else {
-            100 * self.dropped_repeats >= intervals + self.dropped_repeats || self.every.periodic()
+            100 * self.dropped_repeats >= intervals + self.dropped_repeats
+                && !self.every.scattered()
+                || self.every.periodic()
         };
         if resolution.is_some_and(|q| q as f64 == median) && self.dropped_repeats > 0 && faster {
             return Err(format!(
@@ -3491,7 +3524,9 @@ impl Timing {
                     None => match (Self::drifting_beat(t, (q, share)), unsure) {
                         (Some(beat), _) => Some(beat),
                         // Read as the quantum's rate, every place left empty a sample lost.
-                        (None, Some(unsure)) if q * hz == 1.0 => return Err(unsure),
+                        (None, Some((unsure, always))) if always || q * hz == 1.0 => {
+                            return Err(unsure);
+                        }
                         (None, _) => None,
                     },
                 }
@@ -3853,7 +3888,7 @@ impl Timing {
         t: &[i64],
         (q, share): (f64, u64),
         span: f64,
-        unsure: &mut Option<String>,
+        unsure: &mut Option<(String, bool)>,
     ) -> Result<Option<Lattice>, String> {
         let secs = |x: i64| (i128::from(x) - i128::from(t[0])) as f64 * 1e-9;
         let quantum = q * 1e9;
@@ -4003,15 +4038,7 @@ impl Timing {
         // no lattice holds: a slower clock's beat among samples lost, which the intervals
         // read as the quantum's rate.
         if found.is_empty() {
-            let mut r = repeated.iter().peekable();
-            let lone: Vec<f64> = empty
-                .iter()
-                .copied()
-                .filter(|&e| {
-                    while r.next_if(|&&x| x < e - 32.5 * q).is_some() {}
-                    r.peek().is_none_or(|&&x| x > e + 32.5 * q)
-                })
-                .collect();
+            let lone = lone(&empty, &repeated, 32.5 * q);
             let most = 0.45 / q;
             // (Where repeats are fewer than a tenth of them: a float's floor repeats stamps
             // by the thousand, and the samples lost within its runs leave places on its
@@ -4031,25 +4058,45 @@ impl Timing {
                 .flatten()
                 .or_else(|| marks.then(even).flatten())
             {
-                *unsure = Some(format!(
-                    "the timestamps, stamped to {q:e} s, leave {} places empty with no repeat \
+                *unsure = Some((
+                    format!(
+                        "the timestamps, stamped to {q:e} s, leave {} places empty with no repeat \
                      nearby, which fold on a beat of {} Hz (or a fraction of it) as a clock \
                      slower than its stamps leaves them, among others at random as samples \
                      lost leave them: the rate is not told (the quantum's rate, {} Hz, takes \
                      them all for samples lost); give --rate",
-                    lone.len(),
-                    short(f),
-                    short(1.0 / q)
+                        lone.len(),
+                        short(f),
+                        short(1.0 / q)
+                    ),
+                    false,
                 ));
             } else if let Some(every) = evenly(&extra, &fewer, q) {
-                *unsure = Some(format!(
-                    "the timestamps, stamped to {q:e} s, repeat or leave places empty in \
+                *unsure = Some((
+                    format!(
+                        "the timestamps, stamped to {q:e} s, repeat or leave places empty in \
                      bunches that come evenly, about every {} s, as a clock off its stamps' \
                      rate does on a beat that drifts (samples lost come at random): the rate \
                      is not told (the quantum's rate, {} Hz, takes the places left empty for \
                      samples lost); give --rate",
-                    short(every),
-                    short(1.0 / q)
+                        short(every),
+                        short(1.0 / q)
+                    ),
+                    false,
+                ));
+            } else if let Some(spread) = scattered(&repeated, &empty, q) {
+                *unsure = Some((
+                    format!(
+                        "the timestamps, stamped to {q:e} s, hold {} samples past {share} a \
+                         place, at random (their spacings' coefficient of variation {spread:.2}) \
+                         and with no place left empty near them: a clock faster than its stamps \
+                         repeats them evenly, a host catching up on late samples leaves a place \
+                         empty before; samples written twice? --drop-backward drops them (the \
+                         stamps' rate, {} Hz), or give --rate",
+                        extra.len(),
+                        short(share as f64 / q)
+                    ),
+                    true,
                 ));
             }
         }
@@ -4288,6 +4335,48 @@ fn empty_places(t: &[i64], rate: f64) -> (u64, f64, f64) {
     let mean = sum / spacings;
     let spread = (squares / spacings - mean * mean).max(0.0).sqrt() / mean;
     (count, mean, spread)
+}
+
+/// The `marks` (s, in order) with none of the `others` (in order) within `reach` s.
+fn lone(marks: &[f64], others: &[f64], reach: f64) -> Vec<f64> {
+    let mut o = others.iter().peekable();
+    marks
+        .iter()
+        .copied()
+        .filter(|&m| {
+            while o.next_if(|&&x| x < m - reach).is_some() {}
+            o.peek().is_none_or(|&&x| x > m + reach)
+        })
+        .collect()
+}
+
+/// Where the places holding more samples than their share (`repeated`, s from the first
+/// stamp) are 16 or more with no place holding fewer (`empty`) within 32 quanta (`q`, s),
+/// spaced at random (the coefficient of variation of their spacings over a half, each
+/// spacing as far from the next as from any: a beat's are steady, or move slowly as its
+/// clock drifts; and on no lattice of reads), that coefficient: samples written twice, not
+/// a clock's.
+fn scattered(repeated: &[f64], empty: &[f64], q: f64) -> Option<f64> {
+    let lone = lone(repeated, empty, 32.5 * q);
+    if lone.len() < 16 || 2 * lone.len() < repeated.len() {
+        return None;
+    }
+    let gaps: Vec<f64> = lone.windows(2).map(|w| w[1] - w[0]).collect();
+    let mean = gaps.iter().sum::<f64>() / gaps.len() as f64;
+    let sd = (gaps.iter().map(|g| (g - mean).powi(2)).sum::<f64>() / gaps.len() as f64).sqrt();
+    let spread = sd / mean;
+    // (Neighbouring gaps as apart as any two, where a drifting clock's beat moves them
+    // slowly: their differences' mean square half their variance's double or more.)
+    let successive =
+        gaps.windows(2).map(|w| (w[1] - w[0]).powi(2)).sum::<f64>() / (gaps.len() - 1) as f64;
+    let independent = successive >= sd * sd;
+    // (On a lattice of reads: four in five of the gaps a whole number of some 2 to 64
+    // quanta, as a FIFO's reads stamped back repeat a stamp where they overlap; gaps at
+    // random are so one in that many.)
+    let quanta: Vec<u64> = gaps.iter().map(|g| (g / q).round() as u64).collect();
+    let read =
+        (2..=64).any(|d| 5 * quanta.iter().filter(|&&k| k % d == 0).count() >= 4 * quanta.len());
+    (spread > 0.5 && independent && !read).then_some(spread)
 }
 
 /// Whether a clock at `hz` stamped to `q` (s) leaves a lost sample's interval rounded like
@@ -4937,7 +5026,9 @@ impl TimingSummary {
              at most; {} gaps ({} samples missing), {} short intervals, {} backward dropped",
             self.unit,
             short(self.rate_hz),
-            self.median_interval_s,
+            // (To a thousandth of a ns: the mean of a bucket's intervals prints no float's
+            // tail.)
+            (self.median_interval_s * 1e12).round() / 1e12,
             100.0 * self.jitter_rms,
             100.0 * self.jitter_max,
             self.gaps,
@@ -6729,6 +6820,36 @@ mod tests {
             .summary(TimeUnit::Nanoseconds)
             .unwrap_err();
         assert!(e.contains("read it without --drop-backward"), "{e}");
+    }
+
+    #[test]
+    fn rows_written_twice_at_random_on_a_clock_of_its_quantum_are_no_faster_clock() {
+        // 1 kHz on whole ms (and 2 kHz, two a stamp), one row in a hundred written twice at
+        // random (pass 46 F4: 1011.25 Hz read, a faster clock's rate, with no warning; with
+        // --drop-backward, refused as a faster clock's repeats). Refused, naming them; with
+        // them dropped, the clock's rate. A clock 1 % faster repeats evenly: read.
+        let mut next = crate::xorshift(46);
+        for per in [1, 2] {
+            let mut t = Vec::new();
+            for k in 0..20_000 * per {
+                let stamp = 1_000_000 * (k / per) as i64;
+                t.push(stamp);
+                if next().is_multiple_of(100) {
+                    t.push(stamp);
+                }
+            }
+            let e = pushed(&t, true).summary(TimeUnit::Nanoseconds).unwrap_err();
+            assert!(e.contains("samples written twice?"), "{per}: {e}");
+            let s = pushed(&t, false).summary(TimeUnit::Nanoseconds);
+            if per == 1 {
+                assert_eq!(s.unwrap().rate_hz, 1000.0);
+            }
+        }
+        let t: Vec<i64> = (0..20_000)
+            .map(|k| (k as f64 * 1e9 / 1010.0).floor() as i64 / 1_000_000 * 1_000_000)
+            .collect();
+        let s = summary_keeping_repeats(&t);
+        assert!((s.rate_hz / 1010.0 - 1.0).abs() < 1e-4, "{}", s.rate_hz);
     }
 
     #[test]

@@ -752,27 +752,14 @@ fn fifo_rate(messages: &[(f64, usize)]) -> Option<(f64, Option<String>, Option<S
     };
     let whole = fitted(messages);
     let rate = whole.rate()?;
-    // One rate: each tenth's fit (each half's, under 200 messages) within half a percent of
-    // the whole's, or four standard errors (a sensor whose rate steps, its dt field
-    // unchanged, reads between the two rates; a step and back, or one in a tenth, leaves
-    // the halves alike).
-    let parts = if messages.len() >= 200 { 10 } else { 2 };
-    let size = messages.len().div_ceil(parts);
-    let mixed = messages.chunks(size).enumerate().find_map(|(k, part)| {
-        let part = fitted(part);
-        let r = part.rate()?;
-        let apart = 0.005f64.max(4.0 * (part.relative_error() + whole.relative_error()));
-        ((r / rate - 1.0).abs() > apart).then(|| {
-            format!(
-                "the FIFO messages' part {} of {parts} gives {} Hz and the whole {} Hz, their \
-                 stamps on the samples they count: mixed rates (one record must have one \
-                 rate; give --rate)",
-                k + 1,
-                crate::timing::short(r),
-                crate::timing::short(rate)
-            )
-        })
-    });
+    // The most time a message lost may take unseen: a message's samples within the time a
+    // run is parted at and the most a stamp comes short.
+    let unseen = messages
+        .iter()
+        .map(|m| m.1 as f64 * period)
+        .filter(|&t| t <= parted + short)
+        .fold(0.0, f64::max);
+    let mixed = apart(messages, &fitted, (rate, period, parted, unseen));
     let caveat = (1.2 * short > 0.5 * fewest * period).then(|| {
         format!(
             "the FIFO messages' stamps come up to {} us short of their samples' time from one \
@@ -786,7 +773,104 @@ fn fifo_rate(messages: &[(f64, usize)]) -> Option<(f64, Option<String>, Option<S
             crate::timing::short(rate)
         )
     });
+    // (A third of the rate's tolerance, 1e-4: few messages, heavily jittered.)
+    let error = whole.relative_error();
+    let loose = (3.0 * error > 1e-4).then(|| {
+        format!(
+            "the FIFO messages' stamps scatter about their line by {} us RMS, so over {} \
+             messages the rate read, {} Hz, has a standard error of {:.1e} of it; --rate \
+             sets it",
+            crate::timing::short(whole.scatter()),
+            messages.len(),
+            crate::timing::short(rate),
+            error
+        )
+    });
+    let caveat = match (caveat, loose) {
+        (Some(a), Some(b)) => Some(format!("{a}; {b}")),
+        (a, b) => a.or(b),
+    };
     Some((rate, caveat, mixed))
+}
+
+/// Where stretches of the FIFO `messages` give rates apart (`fitted` as [`fifo_rate`] fits
+/// them; the whole's rate `rate`, Hz; a message lost unseen takes up to `unseen` µs): halves, tenths,
+/// fortieths and so on, down to 20 messages a part, each its samples over its runs' time
+/// (from each run's first fitted stamp to its last), any two of one cut more than half a
+/// percent apart, by more than five of their standard errors and a message lost unseen in
+/// each (as many as the stamps suggest, and three standard errors: `unseen` µs each, runs
+/// parted past `parted` µs at the median `period`): the refusal that names them. A part's error is from the parts' median
+/// scatter about their lines, not its own: a stretch at another rate bends its part's line
+/// and would widen its own. Parts are compared with one another, not with the whole, which
+/// a step between halves splits (0.8 % read 3212.8 Hz, between 3200 and 3225.6); a part's
+/// span counts the time a short stretch takes in full, where its line's slope leans on it
+/// by where it lies (5 % faster for 30 messages of 2,000 read 3203.4 Hz for 3200; 30 %
+/// slower for 50 of 10,000, 3189.7).
+fn apart(
+    messages: &[(f64, usize)],
+    fitted: &impl Fn(&[(f64, usize)]) -> Line,
+    (rate, period, parted, unseen): (f64, f64, f64, f64),
+) -> Option<String> {
+    // The time the messages a part may have lost unseen take: where the time from a stamp
+    // to the next passes its samples' by half such a message more often than it comes as
+    // short (jitter alone makes the two alike), the difference, and three standard errors
+    // of it, and one.
+    let lost = |part: &[(f64, usize)]| {
+        if unseen <= 0.0 {
+            return 0.0;
+        }
+        let (mut long, mut short) = (0.0, 0.0);
+        for w in part.windows(2) {
+            let d = w[1].0 - w[0].0 - w[1].1 as f64 * period;
+            if w[1].0 > w[0].0 && d <= parted {
+                long += f64::from(u8::from(d > 0.5 * unseen));
+                short += f64::from(u8::from(d < -0.5 * unseen));
+            }
+        }
+        unseen * ((long - short).max(0.0) + 3.0 * (long + short).sqrt() + 1.0)
+    };
+    let mut parts = 2;
+    while messages.len() >= 20 * parts {
+        let size = messages.len().div_ceil(parts);
+        let chunks: Vec<&[(f64, usize)]> = messages.chunks(size).collect();
+        let lines: Vec<Line> = chunks.iter().map(|c| fitted(c)).collect();
+        let mut scatter: Vec<f64> = lines.iter().map(Line::variance).collect();
+        let mid = (scatter.len() - 1) / 2;
+        let sigma = scatter.select_nth_unstable_by(mid, f64::total_cmp).1.sqrt();
+        // Each part's rate and what it may be off by, both relative.
+        let each: Vec<Option<(f64, f64)>> = lines
+            .iter()
+            .zip(&chunks)
+            .map(|(l, c)| {
+                let (samples, time) = l.span;
+                let r = 1e6 * samples / time;
+                let off = (5.0 * sigma * (2.0 * l.runs).sqrt() + lost(c)) / time;
+                (samples > 0.0 && time > 0.0 && r.is_finite()).then_some((r, off))
+            })
+            .collect();
+        let found = (0..each.len())
+            .flat_map(|i| (i + 1..each.len()).map(move |j| (i, j)))
+            .filter_map(|(i, j)| {
+                let ((a, ea), (b, eb)) = (each[i]?, each[j]?);
+                let off = (a / b - 1.0).abs();
+                (off > 0.005f64.max(ea + eb)).then_some((off, i, a, j, b))
+            })
+            .max_by(|x, y| x.0.total_cmp(&y.0));
+        if let Some((_, i, a, j, b)) = found {
+            return Some(format!(
+                "the FIFO messages' part {} of {parts} gives {} Hz and part {} gives {} Hz (the \
+                 whole {} Hz), their samples over their stamps' time: mixed rates (one record \
+                 must have one rate; give --rate)",
+                i + 1,
+                crate::timing::short(a),
+                j + 1,
+                crate::timing::short(b),
+                crate::timing::short(rate)
+            ));
+        }
+        parts = if parts == 2 { 10 } else { 4 * parts };
+    }
+    None
 }
 
 /// A straight line through the stamps of a run of FIFO messages that follow one another
@@ -809,6 +893,12 @@ struct Line {
     sxx: f64,
     sxy: f64,
     syy: f64,
+    /// The run's first and last points fitted; pooled, the runs' samples and time (µs)
+    /// between those, and how many runs gave them.
+    from: Option<(f64, f64)>,
+    to: (f64, f64),
+    span: (f64, f64),
+    runs: f64,
 }
 
 impl Line {
@@ -828,6 +918,8 @@ impl Line {
             self.sxx += dx * (x - self.mean.0);
             self.sxy += dx * (y - self.mean.1);
             self.syy += dy * (y - self.mean.1);
+            self.from.get_or_insert((x, y));
+            self.to = (x, y);
         }
         self.first = false;
     }
@@ -839,6 +931,11 @@ impl Line {
         self.sxy += run.sxy;
         self.syy += run.syy;
         self.n += (run.n - 1.0).max(0.0);
+        if let Some(from) = run.from.filter(|_| run.n >= 2.0) {
+            self.span.0 += run.to.0 - from.0;
+            self.span.1 += run.to.1 - from.1;
+            self.runs += 1.0;
+        }
     }
 
     /// The rate of the pooled slope, Hz, where it is one.
@@ -850,9 +947,19 @@ impl Line {
     /// The standard error of the pooled slope relative to it (the residuals' spread about
     /// each run's line, over the points less the runs' offsets and the slope).
     fn relative_error(&self) -> f64 {
+        (self.variance() / self.sxx).sqrt() * self.sxx / self.sxy
+    }
+
+    /// The residuals' variance about the runs' lines, µs² (over the points less the runs'
+    /// offsets and the slope).
+    fn variance(&self) -> f64 {
         let slope = self.sxy / self.sxx;
-        let residual = (self.syy - slope * self.sxy).max(0.0) / (self.n - 1.0).max(1.0);
-        (residual / self.sxx).sqrt() / slope
+        (self.syy - slope * self.sxy).max(0.0) / (self.n - 1.0).max(1.0)
+    }
+
+    /// The residuals' RMS about the runs' lines, µs.
+    fn scatter(&self) -> f64 {
+        self.variance().sqrt()
     }
 }
 
@@ -2115,11 +2222,21 @@ mod tests {
         // line through both halves (pass 44 F1). One rate, jittered, is one.
         // So too 5 % faster from 40 to 60 % of the log (1015.23 Hz), or from 92 % on
         // (1001.31 Hz), which leave the halves alike or nearly (pass 45 F1, F2).
+        // And where tenths were each compared with the whole on their lines' slopes (pass 46,
+        // 3200 Hz in 8-sample messages, read with no warning): 0.8 % faster from half way
+        // (3212.76 Hz, between 3200 and 3225.6), 0.9 % for a tenth across two (3204.10 Hz),
+        // 5 % faster for 1.5 % of the log (3203.44 Hz), 30 % slower or 50 % faster for 0.5
+        // % of it (3189.75, 3208.02 Hz).
         for (step, from, to) in [
             (1.05, 5_000, 10_000),
             (0.98, 5_000, 10_000),
             (1.05, 4_000, 6_000),
             (1.05, 9_200, 10_000),
+            (1.008, 5_000, 10_000),
+            (1.009, 5_500, 6_500),
+            (1.05, 5_000, 5_150),
+            (0.7, 5_020, 5_070),
+            (1.5, 5_020, 5_070),
             (1.0, 0, 0),
         ] {
             let mut t = 1e6;
@@ -2129,7 +2246,7 @@ mod tests {
                     let rate = 1000.37 * if (from..to).contains(&k) { step } else { 1.0 };
                     t += 4.0 * 1e6 / rate;
                     let jitter = (next() >> 11) as f64 / (1u64 << 53) as f64 * 40.0;
-                    (t + if step == 1.0 { jitter } else { 0.0 }, 4)
+                    (t + jitter, 4)
                 })
                 .collect();
             let (_, _, mixed) = fifo_rate(&messages).unwrap();
@@ -2137,6 +2254,44 @@ mod tests {
                 mixed.is_some_and(|m| m.contains("mixed rates")),
                 step != 1.0,
                 "{step} from {from} to {to}"
+            );
+        }
+        // One rate, its stamps heavy-tailed (Student's t of two degrees, 75 us), 2 % of the
+        // messages lost unseen among them: read (low by the share lost, with the warning),
+        // not refused (the stretches its losses bunch in are no other rate).
+        let t2 = |u: f64| 75.0 * (2.0 * u - 1.0) / (2.0 * u * (1.0 - u)).sqrt();
+        let (rate, warned, mixed) =
+            fifo_rate(&fifo_messages(8000.0, |_| 8, t2, |u| u < 0.02)).unwrap();
+        assert!(mixed.is_none(), "{mixed:?}");
+        assert!(rate < 8000.0 && warned.is_some(), "{rate} {warned:?}");
+    }
+
+    #[test]
+    fn few_messages_heavily_jittered_warn_of_their_rates_standard_error() {
+        // 220 messages of 8 samples at 3200 Hz, stamps jittered by 300 us RMS: a standard
+        // error of about 1.3e-4 (pass 46 F5: 3200.39 Hz and 3199.54 Hz read with no
+        // warning). With 10,000 messages, no such warning.
+        for (count, warns) in [(220, true), (10_000, false)] {
+            let mut next = crate::xorshift(8);
+            let mut normal = move || {
+                let u = |x: u64| ((x >> 11) as f64 + 0.5) / (1u64 << 53) as f64;
+                let (a, b) = (u(next()), u(next()));
+                (-2.0 * a.ln()).sqrt() * (std::f64::consts::TAU * b).cos()
+            };
+            let messages: Vec<(f64, usize)> = (1..=count)
+                .map(|k| (1e6 + k as f64 * 2500.0 + 300.0 * normal(), 8))
+                .collect();
+            let (rate, warned, mixed) = fifo_rate(&messages).unwrap();
+            assert!(
+                mixed.is_none() && (rate / 3200.0 - 1.0).abs() < 1e-3,
+                "{rate}"
+            );
+            assert_eq!(
+                warned
+                    .as_ref()
+                    .is_some_and(|w| w.contains("standard error")),
+                warns,
+                "{count}: {warned:?}"
             );
         }
     }

@@ -591,9 +591,10 @@ pub fn vins(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
     );
     Ok(format!("%YAML:1.0\n\n{}\n", comments(&lines))
         + &format!(
-            "acc_n: {}  # m/s^2, per sample\ngyr_n: {}  # rad/s, per sample\n\
-             acc_w: {}  # m/s^2 per sample step of the bias\ngyr_w: {}  # rad/s per sample \
-             step of the bias\n",
+            "acc_n: {}  # m/s^2: N sqrt(2 rate), on each of a mid-point step's two samples\n\
+             gyr_n: {}  # rad/s: N sqrt(2 rate), on each of a mid-point step's two samples\n\
+             acc_w: {}  # m/s^3: K sqrt(rate), the bias stepping by acc_w dt a sample\n\
+             gyr_w: {}  # rad/s^2: K sqrt(rate), the bias stepping by gyr_w dt a sample\n",
             num(white(a.n)?),
             num(white(g.n)?),
             num(walk(a.k)?),

@@ -162,6 +162,11 @@ pub fn px4(model: &ImuModel, horizon: Option<f64>) -> Result<String, Fail> {
             "PX4: IMU_INTEG_RATE {integ} Hz is outside its range, 100 to 1000 Hz"
         )));
     }
+    if integ.fract() != 0.0 {
+        return Err(Fail(format!(
+            "PX4: IMU_INTEG_RATE {integ} Hz is not a whole number (an INT32 parameter)"
+        )));
+    }
     // (Whole us, as the parameter holds them.)
     let (step, imu) = ekf2_step(asked, model.rate_hz, integ);
     let predict_us = step.round();

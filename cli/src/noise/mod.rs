@@ -162,16 +162,27 @@ pub struct Bounds {
 }
 
 impl Bounds {
+    /// (A lower end below the smallest normal number is 0: a search that ran to the floor.)
     fn of(value: f64, i: Interval) -> Self {
         Self {
             value,
-            low: i.low,
+            low: if i.low.abs() < f64::MIN_POSITIVE {
+                0.0
+            } else {
+                i.low
+            },
             high: i.high,
         }
     }
 
+    /// `[low, high]`, an upper end the data do not bound `unbounded`.
     fn text(&self) -> String {
-        format!("[{}, {}]", json(&self.low), json(&self.high))
+        let high = if self.high.is_infinite() {
+            "unbounded".to_string()
+        } else {
+            json(&self.high)
+        };
+        format!("[{}, {high}]", json(&self.low))
     }
 }
 
@@ -876,4 +887,31 @@ impl Output for NoiseResult {
 /// ` unit` after a value that is there.
 fn unit(v: Option<f64>, unit: &str) -> String {
     v.map_or(String::new(), |_| format!(" {unit}"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_interval_a_search_ran_to_the_floor_of_reads_from_zero_and_unbounded() {
+        // A quantised record's correlation time printed [9.3289004e-316, null] (pass 47 F8).
+        let b = Bounds::of(
+            0.5,
+            Interval {
+                low: 9.3289004e-316,
+                high: f64::INFINITY,
+            },
+        );
+        assert_eq!(b.low, 0.0);
+        assert_eq!(b.text(), "[0.0, unbounded]");
+        let b = Bounds::of(
+            0.5,
+            Interval {
+                low: 0.25,
+                high: 2.0,
+            },
+        );
+        assert_eq!(b.text(), "[0.25, 2.0]");
+    }
 }

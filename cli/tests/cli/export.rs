@@ -127,6 +127,16 @@ fn continuous(format: Format, text: &str) -> [(f64, f64); 2] {
         }
         // Per sample: Var(step) = 0.5 n^2 dt^2 and w^2 dt^2 (integration_base.h).
         Format::Vins => {
+            // Each value's unit (gyr_w and acc_w were said to be the bias's step a sample,
+            // gyr_n a sample's deviation: pass 47 F7).
+            for (key, unit) in [
+                ("gyr_n", "rad/s:"),
+                ("gyr_w", "rad/s^2:"),
+                ("acc_w", "m/s^3:"),
+            ] {
+                let line = text.lines().find(|l| l.starts_with(key)).unwrap();
+                assert!(line.contains(&format!("# {unit}")), "{line}");
+            }
             let dt = 1.0 / RATE;
             let back = |w: f64, b: f64| (w * (dt / 2.0).sqrt(), b * dt.sqrt());
             [back(n("gyr_n"), n("gyr_w")), back(n("acc_n"), n("acc_w"))]
@@ -536,6 +546,14 @@ fn the_filter_rate_sets_the_autopilots_step_and_bad_models_are_refused() {
     imu.imu_integ_rate_hz = Some(50.0);
     let e = write(Format::Px4, &imu, None, &dir).unwrap_err().0;
     assert!(e.contains("IMU_INTEG_RATE 50 Hz is outside"), "{e}");
+    // An INT32 parameter: 100.5 Hz was taken, the file saying "1.0000e4 us apart at
+    // IMU_INTEG_RATE 100.5 Hz" (pass 47 F6).
+    imu.imu_integ_rate_hz = Some(100.5);
+    let e = write(Format::Px4, &imu, None, &dir).unwrap_err().0;
+    assert!(
+        e.contains("IMU_INTEG_RATE 100.5 Hz is not a whole number"),
+        "{e}"
+    );
     (imu.imu_integ_rate_hz, imu.filter_rate_hz) = (None, Some(250.0));
     // EKF3's step is not the filter rate: its loop rate sets it (EKF_TARGET_DT 12 ms less
     // half a loop, in whole loops), 12.5 ms at the default 400 Hz.

@@ -595,3 +595,78 @@ fn a_level_that_moves_is_named_and_counted() {
         "{text}"
     );
 }
+
+#[test]
+fn a_32_bit_counter_of_us_or_ms_is_read_on_past_its_wrap() {
+    // 1 kHz stamped by a microcontroller's micros() (whole us, on 32 bits), begun 4.967 s
+    // before it wraps (pass 46 F3: "not after the one before", and with --drop-backward
+    // "dropped 15032 samples in a row"); the same samples stamped past 2^32 us are the
+    // reference. And millis() at 100 Hz past its wrap.
+    // (splitmix64 of k: white.)
+    let value = |k: u64| {
+        let mut z = k.wrapping_add(1).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    for (unit, per_second, start) in [("us", 1_000_000u64, 4_290_000_000u64), ("ms", 1000, 0)] {
+        let rate = if unit == "us" { 1000 } else { 100 };
+        let start = if unit == "ms" {
+            (1u64 << 32) - 2000
+        } else {
+            start
+        };
+        let step = per_second / rate;
+        let rows = |wrap: bool| {
+            let mut s = format!("t_{unit},gx\n");
+            for k in 0..20_000u64 {
+                let t = start + k * step + (k % 3);
+                let t = if wrap { t % (1u64 << 32) } else { t };
+                s += &format!("{t},{}\n", value(k));
+            }
+            s
+        };
+        let wrapped = temp_file(&format!("wrapped-{unit}.csv"), rows(true));
+        let straight = temp_file(&format!("straight-{unit}.csv"), rows(false));
+        let run = imu_ar(&[
+            "noise",
+            wrapped.to_str().unwrap(),
+            "--column",
+            "gx",
+            "--json",
+        ]);
+        let e = common::stderr(&run);
+        assert!(run.status.success(), "{unit}: {e}");
+        assert!(
+            e.contains(&format!(
+                "counts whole {unit} on 32 bits and wrapped 1 time"
+            )),
+            "{unit}: {e}"
+        );
+        let reference = imu_ar(&[
+            "noise",
+            straight.to_str().unwrap(),
+            "--column",
+            "gx",
+            "--json",
+        ]);
+        assert!(common::stderr(&reference).is_empty());
+        let (a, b) = (json(&run), json(&reference));
+        assert_eq!(a["rate_hz"], b["rate_hz"], "{unit}");
+        assert_eq!(a["n"], 20_000, "{unit}");
+        assert_eq!(
+            a["axes"][0]["model"]["white_noise"], b["axes"][0]["model"]["white_noise"],
+            "{unit}"
+        );
+    }
+    // A stamp that goes back from nowhere near the counter's top is no wrap: refused.
+    let mut s = String::from("t_us,gx\n");
+    for k in 0..20_000u64 {
+        let t = 2_000_000_000 + k * 1000 - if k >= 10_000 { 1_999_990_000 } else { 0 };
+        s += &format!("{t},{}\n", value(k));
+    }
+    let back = temp_file("back-not-wrapped.csv", s);
+    let run = imu_ar(&["noise", back.to_str().unwrap(), "--column", "gx"]);
+    assert_eq!(run.status.code(), Some(2));
+    assert!(common::stderr(&run).contains("is not after the one before"));
+}

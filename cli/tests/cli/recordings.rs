@@ -1894,3 +1894,88 @@ fn stamps_put_on_a_fifos_reads_at_another_period_need_the_rate() {
         assert_one_line_failure(&run);
     }
 }
+
+#[test]
+fn a_rosbag2_folder_is_checked_against_its_metadatas_counts_and_files_order() {
+    // Its one file split in two by time, x_0.db3 and x_1.db3, with the metadata listing them.
+    let dir = temp_dir("rosbag2-split");
+    let split = |to: &str, list: &[&str], count: u64| {
+        let folder = copied_folder(&dir, "rosbag2-sqlite3", to, |t| {
+            let files: String = list.iter().map(|f| format!("  - {f}\n")).collect();
+            t.replace("  - rosbag2-sqlite3.db3\n", &files).replace(
+                "  - message_count: 1200\n",
+                &format!("  - message_count: {count}\n"),
+            )
+        });
+        let whole = folder.join("rosbag2-sqlite3.db3");
+        for (k, keep) in ["<=", ">"].into_iter().enumerate() {
+            let part = folder.join(format!("x_{k}.db3"));
+            std::fs::copy(&whole, &part).unwrap();
+            let db = rusqlite::Connection::open(&part).unwrap();
+            let cut = "(SELECT timestamp FROM messages ORDER BY timestamp LIMIT 1 OFFSET 599)";
+            let kept = db
+                .execute(
+                    &format!("DELETE FROM messages WHERE NOT timestamp {keep} {cut}"),
+                    [],
+                )
+                .unwrap();
+            assert_eq!(kept, 600);
+        }
+        std::fs::remove_file(whole).unwrap();
+        folder
+    };
+    // In order: the record, as the one file reads it.
+    let (got, result) = read(&split("ordered", &["x_0.db3", "x_1.db3"], 1200), None);
+    assert_eq!(result, Ok(0));
+    assert_bits(&got, &noise_frames(), "split in order");
+    // Listed out of order: named as such (refused as 600 stamps "not after the one before",
+    // with a --drop-backward hint, which then read half the record, before).
+    let e = read(&split("reversed", &["x_1.db3", "x_0.db3"], 1200), None)
+        .1
+        .unwrap_err();
+    assert!(
+        e.contains("'x_0.db3' begins at") && e.contains("lists the files out of order"),
+        "{e}"
+    );
+    // One file left off the list, the metadata counting both: refused naming it (half the
+    // record read with no warning, before).
+    let e = read(&split("one-listed", &["x_0.db3"], 1200), None)
+        .1
+        .unwrap_err();
+    assert!(
+        e.contains("it counts 1200 messages on '/imu0' and its storage files hold 600")
+            && e.contains("the folder holds 'x_1.db3', which relative_file_paths does not list"),
+        "{e}"
+    );
+    // Both listed, the metadata counting more: a file is damaged.
+    let e = read(&split("more-counted", &["x_0.db3", "x_1.db3"], 1300), None)
+        .1
+        .unwrap_err();
+    assert!(e.contains("a storage file is damaged or cut short"), "{e}");
+    let meta = rosbag2::Metadata::parse(
+        &std::fs::read_to_string(fixture_dir("rosbag2-mcap").join("metadata.yaml")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(meta.topic_counts, [("/imu0".to_string(), 1200)]);
+}
+
+#[test]
+fn a_bag_whose_index_holds_fewer_connections_than_its_header_declares_is_named_damaged() {
+    // The header's conn_count past the connection records in the index: refused as "no
+    // topics" where the index lost the IMU's connection, before (pass 47 F4).
+    let dir = temp_dir("bag-conn-count");
+    let mut bytes = std::fs::read(fixture("noise.bag")).unwrap();
+    let at = bytes.windows(11).position(|w| w == b"conn_count=").unwrap() + 11;
+    let held = u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap());
+    bytes[at..at + 4].copy_from_slice(&(held + 1).to_le_bytes());
+    let file = dir.join("conn-count.bag");
+    std::fs::write(&file, bytes).unwrap();
+    let e = read(&file, None).1.unwrap_err();
+    assert!(
+        e.contains(&format!(
+            "its header declares {} connections and its index holds {held}",
+            held + 1
+        )) && e.contains("`rosbag reindex` rebuilds it"),
+        "{e}"
+    );
+}

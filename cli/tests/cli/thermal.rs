@@ -1709,6 +1709,7 @@ fn batches_are_read_at_their_headers_rate_with_a_warning_that_no_stamp_checks_it
         if later != 1000.0 {
             assert_eq!(run.status.code(), Some(2), "case {case}: {out}{e}");
             assert!(e.contains("sample rates from 1000 to 2000 Hz"), "{e}");
+            assert!(!e.contains("  "), "one line, no runs of spaces: {e}");
             continue;
         }
         assert!(run.status.success(), "case {case}: {e}");
