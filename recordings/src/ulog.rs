@@ -794,18 +794,19 @@ fn fifo_rate(messages: &[(f64, usize)]) -> Option<(f64, Option<String>, Option<S
 }
 
 /// Where stretches of the FIFO `messages` give rates apart (`fitted` as [`fifo_rate`] fits
-/// them; the whole's rate `rate`, Hz; a message lost unseen takes up to `unseen` µs): halves, tenths,
-/// fortieths and so on, down to 20 messages a part, each its samples over its runs' time
-/// (from each run's first fitted stamp to its last), any two of one cut more than half a
-/// percent apart, by more than five of their standard errors and a message lost unseen in
-/// each (as many as the stamps suggest, and three standard errors: `unseen` µs each, runs
-/// parted past `parted` µs at the median `period`): the refusal that names them. A part's error is from the parts' median
-/// scatter about their lines, not its own: a stretch at another rate bends its part's line
-/// and would widen its own. Parts are compared with one another, not with the whole, which
-/// a step between halves splits (0.8 % read 3212.8 Hz, between 3200 and 3225.6); a part's
-/// span counts the time a short stretch takes in full, where its line's slope leans on it
-/// by where it lies (5 % faster for 30 messages of 2,000 read 3203.4 Hz for 3200; 30 %
-/// slower for 50 of 10,000, 3189.7).
+/// them; the whole's rate `rate`, Hz; a message lost unseen takes up to `unseen` µs):
+/// halves, tenths, fortieths and so on to 640 parts, down to 20 messages a part, each its
+/// samples over its runs' time (from each run's first fitted stamp to its last), any two of
+/// one cut more than half a percent apart, by more than five of their standard errors and
+/// the messages lost unseen in each (as many as the stamps suggest, and three standard
+/// errors: `unseen` µs each, runs parted past `parted` µs at the median `period`): the
+/// refusal that names them. A part's error is from the parts' median scatter about their
+/// lines, not its own: a stretch at another rate bends its part's line and would widen its
+/// own. Parts are compared with one another, not with the whole, which a step between
+/// halves splits (0.8 % read 3212.8 Hz, between 3200 and 3225.6); a part's span counts the
+/// time a short stretch takes in full, where its line's slope leans on it by where it lies
+/// (5 % faster for 30 messages of 2,000 read 3203.4 Hz for 3200; 30 % slower for 50 of
+/// 10,000, 3189.7).
 fn apart(
     messages: &[(f64, usize)],
     fitted: &impl Fn(&[(f64, usize)]) -> Line,
@@ -830,7 +831,8 @@ fn apart(
         unseen * ((long - short).max(0.0) + 3.0 * (long + short).sqrt() + 1.0)
     };
     let mut parts = 2;
-    while messages.len() >= 20 * parts {
+    // (Up to 640 parts: every pair of them compared.)
+    while messages.len() >= 20 * parts && parts <= 640 {
         let size = messages.len().div_ceil(parts);
         let chunks: Vec<&[(f64, usize)]> = messages.chunks(size).collect();
         let lines: Vec<Line> = chunks.iter().map(|c| fitted(c)).collect();
