@@ -53,6 +53,22 @@ impl Drop for Scratch {
     }
 }
 
+/// A timer's `count` reads, `reads` Hz from 1 s, of a sensor at `rate` Hz: each read's time
+/// (µs) and the samples it finds (reads that find none left out).
+#[cfg(test)]
+pub(crate) fn timer_reads(rate: f64, reads: f64, count: u64) -> Vec<(f64, usize)> {
+    let mut held = 0u64;
+    (1..=count)
+        .filter_map(|k| {
+            let read = 1e6 + k as f64 * 1e6 / reads;
+            let all = ((read - 1e6) * rate / 1e6).floor() as u64;
+            let n = (all - held) as usize;
+            held = all;
+            (n > 0).then_some((read, n))
+        })
+        .collect()
+}
+
 /// A fixed generator for the unit tests' random inputs (xorshift64).
 #[cfg(test)]
 pub(crate) fn xorshift(mut state: u64) -> impl FnMut() -> u64 {

@@ -173,11 +173,21 @@ pub(crate) fn read_compressed(
     };
     while let Some(event) = reader.next_event() {
         let event = event.map_err(|e| match e {
-            ::mcap::McapError::UnexpectedEof => corrupt(
-                &"it ends in the middle of a record: cut short (a recording not closed, or a \
-                  copy cut off; `mcap recover` keeps its whole chunks)",
-                state.messages,
-            ),
+            ::mcap::McapError::UnexpectedEof => match whole_records(path, len) {
+                Some(end) if end == len => corrupt(
+                    &"it ends after its last whole record, without its footer and closing \
+                      magic: a recording not closed (`mcap recover` writes them)",
+                    state.messages,
+                ),
+                end => corrupt(
+                    &format!(
+                        "it ends in the middle of a record{}: cut short (a recording not \
+                         closed, or a copy cut off; `mcap recover` keeps its whole chunks)",
+                        end.map_or(String::new(), |end| format!(" begun at byte {end}"))
+                    ),
+                    state.messages,
+                ),
+            },
             e => corrupt(&e, state.messages),
         })?;
         match event {
@@ -485,6 +495,27 @@ impl State<'_> {
 /// chunk index, or they cannot be read.
 fn chunk_starts(file: &mut File, len: u64) -> Vec<u64> {
     chunk_index(file, len).unwrap_or_default()
+}
+
+/// Where the whole records of the MCAP file `path` (`len` bytes) end, walked from the
+/// magic by their lengths: the file's length where it ends on a record's end, else the
+/// start of the record it cuts; `None` where it cannot be read.
+fn whole_records(path: &Path, len: u64) -> Option<u64> {
+    let mut file = File::open(path).ok()?;
+    let mut at = ::mcap::MAGIC.len() as u64;
+    let mut head = [0u8; 9];
+    while at < len {
+        file.seek(SeekFrom::Start(at)).ok()?;
+        if file.read_exact(&mut head).is_err() {
+            return Some(at);
+        }
+        let body = u64::from_le_bytes(head[1..].try_into().ok()?);
+        match at.checked_add(9).and_then(|a| a.checked_add(body)) {
+            Some(end) if end <= len => at = end,
+            _ => return Some(at),
+        }
+    }
+    Some(at)
 }
 
 /// [`chunk_starts`], `None` where it finds none.

@@ -82,10 +82,17 @@ impl Metadata {
                     topics = Some((key, item.or(begins.then_some(indent))));
                     let pair = trimmed.strip_prefix("- ").unwrap_or(trimmed);
                     if let Some((k, v)) = pair.split_once(':') {
-                        let v = unquoted(v.trim());
+                        let v = unquoted(uncommented(v));
                         match k.trim() {
                             "name" if entry.0.is_none() => entry.0 = Some(v.to_string()),
-                            "message_count" if entry.1.is_none() => entry.1 = v.parse().ok(),
+                            "message_count" if entry.1.is_none() => {
+                                entry.1 = Some(v.parse().map_err(|_| {
+                                    format!(
+                                        "its message_count '{}' is not a count",
+                                        crate::error::escaped(v)
+                                    )
+                                })?);
+                            }
                             _ => {}
                         }
                     }
@@ -94,14 +101,14 @@ impl Metadata {
                 topics = None;
             }
             if in_files && let Some(item) = trimmed.strip_prefix("- ") {
-                meta.files.push(unquoted(item).to_string());
+                meta.files.push(unquoted(uncommented(item)).to_string());
                 continue;
             }
             in_files = false;
             let Some((key, value)) = trimmed.split_once(':') else {
                 continue;
             };
-            let value = unquoted(value.trim());
+            let value = unquoted(uncommented(value));
             match key.trim() {
                 "storage_identifier" => meta.storage = value.to_string(),
                 "compression_mode" => meta.compression_mode = value.to_string(),
@@ -134,6 +141,21 @@ impl Metadata {
         }
         Ok(meta)
     }
+}
+
+/// `v` trimmed, without a comment after it (from a `#` after a space, outside quotes: a
+/// file named `- b_0.db3  # first file`).
+fn uncommented(v: &str) -> &str {
+    let v = v.trim();
+    let end = match v.chars().next() {
+        Some(q @ ('\'' | '"')) => v[1..].find(q).map_or(v.len(), |i| i + 2),
+        _ => 0,
+    };
+    let cut = v[end..]
+        .char_indices()
+        .find(|&(i, c)| c == '#' && (end + i == 0 || v[..end + i].ends_with([' ', '\t'])))
+        .map_or(v.len(), |(i, _)| end + i);
+    v[..cut].trim_end()
 }
 
 /// `v` without the quotes around it, if it has them.

@@ -4918,6 +4918,25 @@ pub struct TimingSummary {
 }
 
 impl TimingSummary {
+    /// The warning for a rate whose standard error passes a third of 1e-4 (the rate's
+    /// tolerance): white jitter on each stamp moves the span's ends alone, so the mean
+    /// interval is off by the intervals' jitter over their number (a 1 kHz clock's 1000
+    /// stamps jittered by 50 us RMS, its end stamps 100 us off: 1000.20 Hz).
+    pub fn loose_warning(&self) -> Option<String> {
+        let intervals = (self.span_s * self.rate_hz).max(1.0);
+        let error = self.jitter_rms / intervals;
+        (3.0 * error > 1e-4).then(|| {
+            format!(
+                "the timestamps jitter by {:.3} % RMS of the period over {} intervals, so the \
+                 rate read from them, {} Hz, has a standard error of {error:.1e} of it; --rate \
+                 sets it",
+                100.0 * self.jitter_rms,
+                intervals.round(),
+                short(self.rate_hz)
+            )
+        })
+    }
+
     /// The warning for a rate read from stamps that hold samples repeated, their median
     /// interval four and a half periods or more: a sample lost within a stamp leaves no mark,
     /// so the rate, the samples kept over the span, is the sensor's only where none was lost
@@ -6820,6 +6839,36 @@ mod tests {
             .summary(TimeUnit::Nanoseconds)
             .unwrap_err();
         assert!(e.contains("read it without --drop-backward"), "{e}");
+    }
+
+    #[test]
+    fn a_short_jittered_clock_warns_of_its_rates_standard_error() {
+        // 1 kHz, each stamp jittered by up to 120 us (69 us RMS): over 1000 stamps the rate's
+        // standard error is about 1e-4 (pass 48 F3: 1000.20 Hz read with no warning); over
+        // 100,000, about 1e-6, no warning. A clean clock, none.
+        let mut next = crate::xorshift(3);
+        for (n, most, warns) in [
+            (1_000i64, 120_000, true),
+            (100_000, 120_000, false),
+            (1_000, 0, false),
+        ] {
+            let t: Vec<i64> = (0..n)
+                .map(|k| {
+                    let jitter = if most > 0 {
+                        (next() % (2 * most)) as i64 - most as i64
+                    } else {
+                        0
+                    };
+                    1_000_000_000 + k * 1_000_000 + jitter
+                })
+                .collect();
+            let s = summary_of(&t);
+            let w = s.loose_warning();
+            assert_eq!(w.is_some(), warns, "{n}: {w:?}");
+            if let Some(w) = w {
+                assert!(w.contains("has a standard error of"), "{w}");
+            }
+        }
     }
 
     #[test]

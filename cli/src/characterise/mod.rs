@@ -273,6 +273,8 @@ fn characterise(
     }
     if let Some(w) = read.caveat.filter(|_| args.rate.is_none()) {
         eprintln!("imu-ar: warning: {}", with_file(&args.files, w).0);
+    } else if let Some(w) = crate::input::loose(args.rate, timing.as_ref()) {
+        eprintln!("imu-ar: warning: {}", with_file(&args.files, w).0);
     }
     check_span("--rate", rate, n as usize)?;
     crate::input::check_gaps(timing.as_ref(), n as usize)

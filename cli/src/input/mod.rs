@@ -189,6 +189,8 @@ impl Series {
         }
         if let Some(w) = self.caveat.as_ref().filter(|_| given.is_none()) {
             eprintln!("imu-ar: warning: {}", input.fail(w.clone()).0);
+        } else if let Some(w) = loose(given, self.timing.as_ref()) {
+            eprintln!("imu-ar: warning: {}", input.fail(w).0);
         }
         Ok(rate)
     }
@@ -317,6 +319,14 @@ pub fn coarse(given: Option<f64>, timing: Option<&TimingSummary>) -> Option<Stri
     timing
         .filter(|_| given.is_none())
         .and_then(TimingSummary::coarse_warning)
+}
+
+/// The warning, where no rate is `given`, that the stamps' jitter leaves the rate's
+/// standard error past a third of 1e-4 ([`TimingSummary::loose_warning`]).
+pub fn loose(given: Option<f64>, timing: Option<&TimingSummary>) -> Option<String> {
+    timing
+        .filter(|_| given.is_none())
+        .and_then(TimingSummary::loose_warning)
 }
 
 /// The warning, where a rate is `given`, of what the stamps show that would refuse them

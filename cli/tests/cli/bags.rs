@@ -289,6 +289,29 @@ fn truncated_files_are_errors_even_after_frames() {
         got.len()
     );
     assert_bits(&got, &frames(800, 13)[..got.len()], "chunks before the cut");
+    // Cut where a record ends (a recording killed between two chunks): said so, not "in the
+    // middle of a record" (pass 49 F3); cut within the next, the byte its record began at.
+    let mut ends = Vec::new();
+    let mut at = 8;
+    while at + 9 <= bytes.len() {
+        at += 9 + u64::from_le_bytes(bytes[at + 1..at + 9].try_into().unwrap()) as usize;
+        ends.push(at);
+    }
+    let boundary = ends[ends.len() / 2];
+    std::fs::write(&cut, &bytes[..boundary]).unwrap();
+    let p = problem(&cut, collect(mcap_reader::read, &cut, "/imu").1);
+    assert!(
+        p.contains("it ends after its last whole record, without its footer"),
+        "{p}"
+    );
+    std::fs::write(&cut, &bytes[..boundary + 20]).unwrap();
+    let p = problem(&cut, collect(mcap_reader::read, &cut, "/imu").1);
+    assert!(
+        p.contains(&format!(
+            "in the middle of a record begun at byte {boundary}"
+        )),
+        "{p}"
+    );
     // A bag whose second chunk is damaged: the first chunk's frames, then the error.
     let mut bytes = fixture_bytes("frames-none.bag");
     let chunks: Vec<usize> = find_all(&bytes, b"compression=none");

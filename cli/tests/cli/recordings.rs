@@ -516,6 +516,30 @@ fn rosbag2_metadata_is_read_in_its_block_and_flow_forms() {
     assert_eq!(meta.compression_mode, "FILE");
     assert!(rosbag2::Metadata::parse("relative_file_paths: []\n").is_err());
     assert!(rosbag2::Metadata::parse("storage_identifier: mcap\n").is_err());
+    // Comments after values, outside quotes (pass 49 F1, F2: the file was looked for as
+    // 'b_0.db3  # first file', and a count with a comment went unchecked).
+    let meta = rosbag2::Metadata::parse(
+        "storage_identifier: sqlite3  # the default\nrelative_file_paths:\n  - b_0.db3  # first\n  \
+         - 'b#1.db3' # second\ntopics_with_message_count:\n  - topic_metadata:\n      name: \
+         /imu # the IMU\n    message_count: 40001 # all\n",
+    )
+    .unwrap();
+    assert_eq!(meta.storage, "sqlite3");
+    assert_eq!(meta.files, ["b_0.db3", "b#1.db3"]);
+    assert_eq!(meta.topic_counts, [("/imu".to_string(), 40_001)]);
+    // A count that is none: refused, not passed over (2^64 and 1e30 went unchecked).
+    for count in ["18446744073709551616", "1e30", "-1", "many"] {
+        let e = rosbag2::Metadata::parse(&format!(
+            "storage_identifier: mcap\nrelative_file_paths: [a.mcap]\n\
+             topics_with_message_count:\n- message_count: {count}\n  topic_metadata:\n    \
+             name: /imu\n"
+        ))
+        .unwrap_err();
+        assert!(
+            e.contains(&format!("message_count '{count}' is not a count")),
+            "{e}"
+        );
+    }
 }
 
 /// `imu-ar noise FILE --topic /imu0 --column gx EXTRA..`.
