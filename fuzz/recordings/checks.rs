@@ -297,8 +297,8 @@ pub fn dataflash_read(data: &[u8]) {
                         Ok(report) => {
                             assert!(samples > 0 && report.delivered == samples);
                             // The batches' rates are rates, the least first.
-                            assert!(report.batch_rates.is_none_or(|(least, most)| {
-                                least.is_finite() && least > 0.0 && least <= most
+                            assert!(report.batch_rates.is_none_or(|(least, most, mean)| {
+                                least.is_finite() && least > 0.0 && least <= mean && mean <= most
                             }));
                         }
                         Err(e) => assert_one_line(&e, &path),

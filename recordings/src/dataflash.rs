@@ -381,9 +381,9 @@ pub struct Report {
     /// [`MAX_TIME_US`], and those whose `I` is not below [`MAX_IMUS`] (whose instance the
     /// garbage hides); none for a read of batches.
     pub corrupt: u64,
-    /// The least and the most `smp_rate` of the batches delivered (Hz); none for a read of
-    /// `IMU` messages.
-    pub batch_rates: Option<(f64, f64)>,
+    /// The least, the most and the mean (by samples) `smp_rate` of the batches delivered
+    /// (Hz); none for a read of `IMU` messages.
+    pub batch_rates: Option<(f64, f64, f64)>,
 }
 
 /// What the log holds of IMU data and its parameters, read in one pass without delivering
@@ -544,6 +544,8 @@ pub fn read_surveyed(
     let mut previous: Option<(f64, f64, usize)> = None;
     let mut overlap: Option<Overlap> = None;
     let mut batch_rates: Option<(f64, f64)> = None;
+    // The batches' samples and the sum of their rates, each a sample's.
+    let mut weighed = (0.0f64, 0.0f64);
     let mut batch = |c: Closed,
                      interp: &mut Option<Interp<Sample>>,
                      deliver: &mut dyn FnMut(Sample, Option<f64>)| {
@@ -570,6 +572,8 @@ pub fn read_surveyed(
             previous = Some((c.sample_us, c.time(c.count - 1), c.count));
             let (least, most) = batch_rates.get_or_insert((c.rate, c.rate));
             (*least, *most) = (least.min(c.rate), most.max(c.rate));
+            weighed.0 += c.count as f64;
+            weighed.1 += c.count as f64 * c.rate;
         }
         for (j, raw) in c.samples.iter().enumerate().take(c.count) {
             let xyz = raw.map(|r| f64::from(r) / c.mul);
@@ -652,7 +656,8 @@ pub fn read_surveyed(
         skipped_bytes: log.skipped_bytes,
         resyncs: log.resyncs,
         truncated: log.truncated,
-        batch_rates,
+        batch_rates: batch_rates
+            .map(|(least, most)| (least, most, (weighed.1 / weighed.0).clamp(least, most))),
         // Its own, and those that name no IMU (any instance's); a batch read reads none.
         corrupt: if kind == Kind::Imu {
             log.corrupt_of

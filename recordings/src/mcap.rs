@@ -173,21 +173,7 @@ pub(crate) fn read_compressed(
     };
     while let Some(event) = reader.next_event() {
         let event = event.map_err(|e| match e {
-            ::mcap::McapError::UnexpectedEof => match whole_records(path, len) {
-                Some(end) if end == len => corrupt(
-                    &"it ends after its last whole record, without its footer and closing \
-                      magic: a recording not closed (`mcap recover` writes them)",
-                    state.messages,
-                ),
-                end => corrupt(
-                    &format!(
-                        "it ends in the middle of a record{}: cut short (a recording not \
-                         closed, or a copy cut off; `mcap recover` keeps its whole chunks)",
-                        end.map_or(String::new(), |end| format!(" begun at byte {end}"))
-                    ),
-                    state.messages,
-                ),
-            },
+            ::mcap::McapError::UnexpectedEof => corrupt(&cut_where(path, len), state.messages),
             e => corrupt(&e, state.messages),
         })?;
         match event {
@@ -497,25 +483,38 @@ fn chunk_starts(file: &mut File, len: u64) -> Vec<u64> {
     chunk_index(file, len).unwrap_or_default()
 }
 
-/// Where the whole records of the MCAP file `path` (`len` bytes) end, walked from the
-/// magic by their lengths: the file's length where it ends on a record's end, else the
-/// start of the record it cuts; `None` where it cannot be read.
-fn whole_records(path: &Path, len: u64) -> Option<u64> {
-    let mut file = File::open(path).ok()?;
+/// Where the MCAP file `path` (`len` bytes), read to its end, was cut: its records walked
+/// from the magic by their lengths, within one (the byte it began at), after its last whole
+/// one with no footer, or after its footer (its closing magic short).
+fn cut_where(path: &Path, len: u64) -> String {
+    let cut = "cut short (a recording not closed, or a copy cut off; `mcap recover` keeps its \
+               whole chunks)";
+    let Ok(mut file) = File::open(path) else {
+        return format!("it ends in the middle of a record: {cut}");
+    };
     let mut at = ::mcap::MAGIC.len() as u64;
     let mut head = [0u8; 9];
     while at < len {
-        file.seek(SeekFrom::Start(at)).ok()?;
-        if file.read_exact(&mut head).is_err() {
-            return Some(at);
-        }
-        let body = u64::from_le_bytes(head[1..].try_into().ok()?);
-        match at.checked_add(9).and_then(|a| a.checked_add(body)) {
-            Some(end) if end <= len => at = end,
-            _ => return Some(at),
+        let read = file
+            .seek(SeekFrom::Start(at))
+            .and_then(|_| file.read_exact(&mut head));
+        let end = u64::from_le_bytes(head[1..].try_into().unwrap_or_default())
+            .checked_add(at + 9)
+            .filter(|&end| read.is_ok() && end <= len);
+        match end {
+            Some(end) if head[0] == op::FOOTER => {
+                return format!(
+                    "its closing magic is cut short after its footer (at byte {end}): a copy \
+                     cut off"
+                );
+            }
+            Some(end) => at = end,
+            None => return format!("it ends in the middle of a record begun at byte {at}: {cut}"),
         }
     }
-    Some(at)
+    "it ends after its last whole record, without its footer and closing magic: a recording \
+     not closed (`mcap recover` writes them)"
+        .into()
 }
 
 /// [`chunk_starts`], `None` where it finds none.

@@ -64,6 +64,7 @@ impl Metadata {
         // item being read (its topic's name and count, each the first given).
         let mut topics: Option<(usize, Option<usize>)> = None;
         let mut entry: (Option<String>, Option<u64>) = (None, None);
+        let mut base: Option<usize> = None;
         for line in text.lines() {
             let trimmed = line.trim();
             if trimmed.is_empty() || trimmed.starts_with('#') {
@@ -83,13 +84,13 @@ impl Metadata {
                     let pair = trimmed.strip_prefix("- ").unwrap_or(trimmed);
                     if let Some((k, v)) = pair.split_once(':') {
                         let v = unquoted(uncommented(v));
-                        match k.trim() {
+                        match unquoted(k.trim()).as_ref() {
                             "name" if entry.0.is_none() => entry.0 = Some(v.to_string()),
                             "message_count" if entry.1.is_none() => {
                                 entry.1 = Some(v.parse().map_err(|_| {
                                     format!(
                                         "its message_count '{}' is not a count",
-                                        crate::error::escaped(v)
+                                        crate::error::escaped(&v)
                                     )
                                 })?);
                             }
@@ -105,11 +106,25 @@ impl Metadata {
                 continue;
             }
             in_files = false;
+            // (A second document is not the bag's.)
+            if indent == 0 && (trimmed == "---" || trimmed == "...") && base.is_some() {
+                break;
+            }
             let Some((key, value)) = trimmed.split_once(':') else {
                 continue;
             };
+            let key = unquoted(key.trim());
+            // The keys of the bag's information: those at the first key's indent under it
+            // (not those of `custom_data` or any other map within).
+            if key == "rosbag2_bagfile_information" && base.is_none() {
+                continue;
+            }
+            if *base.get_or_insert(indent) != indent {
+                continue;
+            }
             let value = unquoted(uncommented(value));
-            match key.trim() {
+            let value = value.as_ref();
+            match key.as_ref() {
                 "storage_identifier" => meta.storage = value.to_string(),
                 "compression_mode" => meta.compression_mode = value.to_string(),
                 "compression_format" => meta.compression_format = value.to_string(),
@@ -147,10 +162,7 @@ impl Metadata {
 /// file named `- b_0.db3  # first file`).
 fn uncommented(v: &str) -> &str {
     let v = v.trim();
-    let end = match v.chars().next() {
-        Some(q @ ('\'' | '"')) => v[1..].find(q).map_or(v.len(), |i| i + 2),
-        _ => 0,
-    };
+    let end = closing(v).map_or(0, |i| i + 1);
     let cut = v[end..]
         .char_indices()
         .find(|&(i, c)| c == '#' && (end + i == 0 || v[..end + i].ends_with([' ', '\t'])))
@@ -158,14 +170,36 @@ fn uncommented(v: &str) -> &str {
     v[..cut].trim_end()
 }
 
-/// `v` without the quotes around it, if it has them.
-fn unquoted(v: &str) -> &str {
-    for q in ['\'', '"'] {
-        if let Some(inner) = v.strip_prefix(q).and_then(|v| v.strip_suffix(q)) {
-            return inner;
+/// Where the quote that opens `v` closes (a single-quoted scalar's `''` is a quote within
+/// it, a double-quoted one's `\"`); none where `v` opens with none, or it does not close.
+fn closing(v: &str) -> Option<usize> {
+    let q = v.chars().next().filter(|c| matches!(c, '\'' | '"'))?;
+    let mut chars = v.char_indices().skip(1).peekable();
+    while let Some((i, c)) = chars.next() {
+        match c {
+            '\\' if q == '"' => {
+                chars.next();
+            }
+            '\'' if q == '\'' && chars.peek().is_some_and(|&(_, n)| n == '\'') => {
+                chars.next();
+            }
+            c if c == q => return Some(i),
+            _ => {}
         }
     }
-    v
+    None
+}
+
+/// `v` without the quotes around it, if it has them, its escaped quotes and backslashes
+/// read (`''` in single quotes, `\"` and `\\` in double).
+fn unquoted(v: &str) -> std::borrow::Cow<'_, str> {
+    match (v.chars().next(), closing(v)) {
+        (Some('\''), Some(end)) if end + 1 == v.len() => v[1..end].replace("''", "'").into(),
+        (Some('"'), Some(end)) if end + 1 == v.len() => {
+            v[1..end].replace("\\\"", "\"").replace("\\\\", "\\").into()
+        }
+        _ => v.into(),
+    }
 }
 
 /// The storage files of the rosbag2 folder `dir`, in order, and whether they are MCAP
@@ -239,6 +273,17 @@ fn storage(dir: &Path) -> Result<Storage, DataError> {
         return Err(fail(
             "it names no storage file (relative_file_paths is empty)".into(),
         ));
+    }
+    if let Some(twice) = meta
+        .files
+        .iter()
+        .enumerate()
+        .find_map(|(i, f)| meta.files[..i].contains(f).then_some(f))
+    {
+        return Err(fail(format!(
+            "relative_file_paths lists '{}' twice",
+            crate::error::escaped(twice)
+        )));
     }
     // Up to version 3, each path starts with the folder's name (as it was when recorded;
     // rosbag2 reads it from the folder's parent): the folder is where the rest lies.

@@ -467,19 +467,22 @@ fn autopilot_stream(
             take(s.time_us, [g[0], g[1], g[2], a[0], a[1], a[2]]);
         })
         .map_err(|e| Fail(e.to_string()))?;
-        if let Some((least, most)) = report.batch_rates {
-            if most > least {
+        // ArduPilot writes each batch's smp_rate from the rate it keeps estimating
+        // (`AP_InertialSensor_Backend::_update_sensor_rate`): headers a little apart are one
+        // sensor's, read at their mean; more than half a percent apart, two rates.
+        if let Some((least, most, mean)) = report.batch_rates {
+            if most > 1.005 * least {
                 return Err(with_file(
                     files,
                     format!(
-                        "its ISB batches' headers give sample rates from {least} to {most} Hz: \
-                         each batch's samples are placed at its own, and one record is read at \
-                         one rate"
+                        "its ISB batches' headers give sample rates from {least} to {most} Hz, \
+                         more than half a percent apart: each batch's samples are placed at \
+                         its own, and one record is read at one rate"
                     ),
                 ));
             }
-            timing.placed_at(least);
-            caveat = Some(batches_unchecked(least));
+            timing.placed_at(mean);
+            caveat = Some(batches_unchecked(mean, most > least));
         }
         skipped.non_finite = report.non_finite;
         // Corrupt IMU messages (a TimeUS or an instance no IMU has) are undecodable ones.
@@ -508,7 +511,12 @@ fn autopilot_stream(
 /// stamp counts in samples; so the rate read is the header's, which nothing checks (a sensor
 /// 0.05 % faster, a sample skipped between batches, stamps the batches as one 0.05 % slower
 /// does back to back).
-fn batches_unchecked(rate: f64) -> String {
+fn batches_unchecked(rate: f64, spread: bool) -> String {
+    let rate = if spread {
+        format!("their mean {}", crate::timing::short(rate))
+    } else {
+        rate.to_string()
+    };
     format!(
         "its samples are ISB batches, each placed at its header's smp_rate, {rate} Hz, from \
          its first sample, the only one timed: between batches the sampler turns to the other \

@@ -284,11 +284,15 @@ impl FromStr for Format {
             .find(|f| f.name() == s)
             .ok_or_else(|| {
                 let names: Vec<&str> = Self::ALL.iter().map(|f| f.name()).collect();
-                Fail(format!(
-                    "format {:?}: one of {} (or a comma-separated list, or all)",
-                    crate::error::escaped(s),
-                    names.join(", ")
-                ))
+                Fail(if s == "all" {
+                    "format \"all\" stands alone: it is every format, not one of a list".into()
+                } else {
+                    format!(
+                        "format {:?}: one of {} (or a comma-separated list, or all)",
+                        crate::error::escaped(s),
+                        names.join(", ")
+                    )
+                })
             })
     }
 }

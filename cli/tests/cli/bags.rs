@@ -312,6 +312,20 @@ fn truncated_files_are_errors_even_after_frames() {
         )),
         "{p}"
     );
+    // Cut within the closing magic, or just before it: its footer whole (said to end
+    // "without its footer", or within a record begun at the magic, pass 51 F8).
+    let n = bytes.len();
+    for at in [n - 8, n - 3] {
+        std::fs::write(&cut, &bytes[..at]).unwrap();
+        let p = problem(&cut, collect(mcap_reader::read, &cut, "/imu").1);
+        assert!(
+            p.contains(&format!(
+                "closing magic is cut short after its footer (at byte {}",
+                n - 8
+            )),
+            "{at}: {p}"
+        );
+    }
     // A bag whose second chunk is damaged: the first chunk's frames, then the error.
     let mut bytes = fixture_bytes("frames-none.bag");
     let chunks: Vec<usize> = find_all(&bytes, b"compression=none");

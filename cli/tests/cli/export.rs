@@ -623,3 +623,12 @@ fn the_filter_rate_sets_the_autopilots_step_and_bad_models_are_refused() {
         Some(Format::StateSpace)
     );
 }
+
+#[test]
+fn all_in_a_list_of_formats_is_said_to_stand_alone() {
+    // `--format px4,all` said "all" was not one of the formats, then listed it (pass 51 F9).
+    let e = "all".parse::<Format>().unwrap_err().0;
+    assert!(e.contains("\"all\" stands alone"), "{e}");
+    let e = "kalbr".parse::<Format>().unwrap_err().0;
+    assert!(e.contains("one of kalibr"), "{e}");
+}

@@ -527,6 +527,21 @@ fn rosbag2_metadata_is_read_in_its_block_and_flow_forms() {
     assert_eq!(meta.storage, "sqlite3");
     assert_eq!(meta.files, ["b_0.db3", "b#1.db3"]);
     assert_eq!(meta.topic_counts, [("/imu".to_string(), 40_001)]);
+    // Quotes escaped within quoted names, quoted keys, keys of a map within (custom_data),
+    // a second document (pass 51 F1, F2, F4, F6: 'it''s #0.db3' was cut at its '#', a
+    // quoted "message_count" went unchecked, custom_data's keys were taken for the bag's,
+    // the second document's files were read too).
+    let meta = rosbag2::Metadata::parse(
+        "rosbag2_bagfile_information:\n  custom_data:\n    storage_identifier: nope\n    \
+         relative_file_paths:\n    - ghost.db3\n  \"storage_identifier\": sqlite3\n  \
+         relative_file_paths:\n  - 'it''s #0.db3' # first\n  - \"b \\\" #1.db3\"\n  \
+         topics_with_message_count:\n  - \"message_count\": 7\n    topic_metadata:\n      \
+         name: /imu\n---\nrelative_file_paths:\n- other.db3\n",
+    )
+    .unwrap();
+    assert_eq!(meta.storage, "sqlite3");
+    assert_eq!(meta.files, ["it's #0.db3", "b \" #1.db3"]);
+    assert_eq!(meta.topic_counts, [("/imu".to_string(), 7)]);
     // A count that is none: refused, not passed over (2^64 and 1e30 went unchecked).
     for count in ["18446744073709551616", "1e30", "-1", "many"] {
         let e = rosbag2::Metadata::parse(&format!(
@@ -1969,6 +1984,14 @@ fn a_rosbag2_folder_is_checked_against_its_metadatas_counts_and_files_order() {
     assert!(
         e.contains("it counts 1200 messages on '/imu0' and its storage files hold 600")
             && e.contains("the folder holds 'x_1.db3', which relative_file_paths does not list"),
+        "{e}"
+    );
+    // One file listed twice (read as "not after the one before", pass 51 F7): named.
+    let e = read(&split("twice", &["x_0.db3", "x_0.db3"], 1200), None)
+        .1
+        .unwrap_err();
+    assert!(
+        e.contains("relative_file_paths lists 'x_0.db3' twice"),
         "{e}"
     );
     // Both listed, the metadata counting more: a file is damaged.
