@@ -1884,6 +1884,7 @@ impl Timing {
             *intervals.select_nth_unstable(mid).1 as f64
         };
         Ok(TimingSummary {
+            grid_s: None,
             unit: unit.name(),
             header_stamps: unit == TimeUnit::HeaderStamps,
             rate_hz: rate,
@@ -2291,6 +2292,7 @@ impl Timing {
             }
         }
         let summary = TimingSummary {
+            grid_s: common_step(buckets, self.bits).map(|g| g as f64 * 1e-9),
             per_stamp,
             jittered_repeats,
             batched: None,
@@ -4412,6 +4414,21 @@ fn median(buckets: &[Bucket]) -> Option<f64> {
     })
 }
 
+/// The greatest common divisor (ns) of the intervals, where every interval has a bucket of
+/// its own (`bits` 64) and none is empty.
+fn common_step(buckets: &[Bucket], bits: u32) -> Option<i64> {
+    if bits < 64 {
+        return None;
+    }
+    let gcd = |mut a: i64, mut b: i64| {
+        while b != 0 {
+            (a, b) = (b, a % b);
+        }
+        a
+    };
+    buckets.iter().map(|b| b.key).filter(|&k| k > 0).reduce(gcd)
+}
+
 /// The largest power of ten (ns) that divides every interval: the stamps' resolution, known
 /// while every interval has a bucket of its own (`bits` 64).
 fn resolution(buckets: &[Bucket], bits: u32) -> Option<i64> {
@@ -4892,6 +4909,10 @@ pub struct TimingSummary {
     /// thousandth of it (a power of ten, or a second over a power of two), on which they
     /// were read.
     pub resolution_s: Option<f64>,
+    /// The finest step every interval is a whole number of, s, where the histogram holds
+    /// each interval exactly (a tick of another form than the quantum's: 250 us).
+    #[serde(skip)]
+    pub grid_s: Option<f64>,
     /// The rate of the samples over the span (every stamp kept, repeats too, less one, over
     /// it), Hz: the rate, where no sample is missing.
     pub span_rate_hz: f64,
@@ -4940,7 +4961,11 @@ impl TimingSummary {
         // (Stamps rounded to a quantum off a clock's lattice move each end by a quantum's
         // uniform spread, a sixth of its square each: 200.3 Hz to whole ms over 2.5 s read
         // 200.24 Hz, its intervals' jitter a fifth of that.)
-        let rounding = match self.resolution_s {
+        let step = match (self.resolution_s, self.grid_s) {
+            (Some(a), Some(b)) => Some(a.max(b)),
+            (a, b) => a.or(b),
+        };
+        let rounding = match step {
             Some(q) if self.jitter_rms > 0.0 && self.span_s > 0.0 => {
                 q / (6.0f64.sqrt() * self.span_s)
             }
@@ -4954,10 +4979,33 @@ impl TimingSummary {
                  --rate sets it",
                 100.0 * self.jitter_rms,
                 intervals.round(),
-                match self.resolution_s {
+                match step {
                     Some(q) if rounding > 0.0 => format!(", rounded to {q:e} s"),
                     _ => String::new(),
                 },
+                short(self.rate_hz)
+            )
+        })
+    }
+
+    /// The warning for a rate read as its stamps' quantum's (a clock of one quantum's period)
+    /// whose stamps leave a few places empty, under 16 and more than 1e-4 of the samples:
+    /// samples lost, or the beat of a clock that much slower than its stamps, which too few
+    /// places do not tell apart (999.85 Hz on whole ms jittered by 50 us over 20 s leaves
+    /// three, read 1000 Hz with three samples missing and no warning); the rate lies between
+    /// the span's and the quantum's.
+    pub fn quantum_warning(&self) -> Option<String> {
+        let q = self.resolution_s?;
+        let samples = self.span_s * self.rate_hz + 1.0;
+        let few =
+            (1..16).contains(&self.missing_samples) && self.missing_samples as f64 > 1e-4 * samples;
+        ((q * self.rate_hz - 1.0).abs() < 1e-9 && few).then(|| {
+            format!(
+                "the timestamps step by their quantum, {q:e} s, and leave {} places empty: \
+                 samples lost, or the beat of a clock slower than its stamps, which so few do \
+                 not tell apart; the rate lies between {} Hz and {} Hz; --rate sets it",
+                self.missing_samples,
+                short(self.span_rate_hz),
                 short(self.rate_hz)
             )
         })
@@ -6929,6 +6977,25 @@ mod tests {
         }
         let e = timing.summary(TimeUnit::Nanoseconds).unwrap_err();
         assert!(e.contains("bunches that come evenly"), "{e}");
+        // 999.85 Hz so over 20 s: three bunches, too few to space; read as 1000 Hz with
+        // three samples missing, now with the range the rate lies in (pass 52 F1).
+        let t: Vec<i64> = (0..20_000)
+            .map(|k| ((k as f64 / 999.85 + 50e-6 * normal()) * 1e3).round() as i64 * 1_000_000)
+            .collect();
+        let s = summary_keeping_repeats(&t);
+        let w = s.quantum_warning();
+        assert!(
+            w.as_ref().is_some_and(|w| w.contains("leave 3 places empty")
+                && w.contains("Hz and 1000 Hz")),
+            "{s:?}: {w:?}"
+        );
+        // 399.85 Hz rounded to 250 us, 300 stamps, a step no power of ten (pass 52 F5:
+        // 399.73 Hz with no warning).
+        let t: Vec<i64> = (0..300)
+            .map(|k| ((k as f64 / 399.85 + 1e-4) * 4e3).round() as i64 * 250_000)
+            .collect();
+        let w = summary_of(&t).loose_warning();
+        assert!(w.is_some_and(|w| w.contains("rounded to 2.5e-4 s")));
     }
 
     #[test]

@@ -321,12 +321,16 @@ pub fn coarse(given: Option<f64>, timing: Option<&TimingSummary>) -> Option<Stri
         .and_then(TimingSummary::coarse_warning)
 }
 
-/// The warning, where no rate is `given`, that the stamps' jitter leaves the rate's
+/// The warnings, where no rate is `given`, that a few places left empty on the stamps'
+/// quantum do not tell samples lost from a slower clock
+/// ([`TimingSummary::quantum_warning`]), and that the stamps' jitter leaves the rate's
 /// standard error past a third of 1e-4 ([`TimingSummary::loose_warning`]).
 pub fn loose(given: Option<f64>, timing: Option<&TimingSummary>) -> Option<String> {
-    timing
-        .filter(|_| given.is_none())
-        .and_then(TimingSummary::loose_warning)
+    let timing = timing.filter(|_| given.is_none())?;
+    match (timing.quantum_warning(), timing.loose_warning()) {
+        (Some(a), Some(b)) => Some(format!("{a}; {b}")),
+        (a, b) => a.or(b),
+    }
 }
 
 /// The warning, where a rate is `given`, of what the stamps show that would refuse them
