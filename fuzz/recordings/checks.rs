@@ -90,6 +90,13 @@ pub fn timing_summary(data: &[u8]) {
             s.span_s,
             s.rate_hz
         );
+        // The warnings the summary gives are one line each, with no NaN.
+        for w in [s.loose_warning(), s.quantum_warning(), s.coarse_warning()]
+            .into_iter()
+            .flatten()
+        {
+            assert!(!w.contains('\n') && !w.contains("NaN"), "{w}");
+        }
     }
 }
 
