@@ -758,7 +758,10 @@ fn fifo_rate(messages: &[(f64, usize)]) -> Option<(f64, Option<String>, Option<S
         .windows(2)
         .map(|w| -excess(w))
         .fold(0.0f64, f64::max);
-    let fewest = messages.iter().map(|m| m.1).min().unwrap_or(1) as f64;
+    let (fewest, most) = messages
+        .iter()
+        .fold((usize::MAX, 0), |(a, b), m| (a.min(m.1), b.max(m.1)));
+    let fewest = fewest as f64;
     let least = if timer { spacing } else { fewest * period };
     let parted = (0.5 * least).max(1.2 * short);
     let fitted = |messages: &[(f64, usize)]| {
@@ -793,7 +796,11 @@ fn fifo_rate(messages: &[(f64, usize)]) -> Option<(f64, Option<String>, Option<S
             .filter(|&t| t <= parted + short)
             .fold(0.0, f64::max)
     };
-    let mixed = apart(messages, &fitted, &excess, (rate, period, parted, unseen));
+    // Where the messages hold more samples or fewer (a timer's reads of a sensor off its
+    // rate), a read's stamp may lie up to a sample's time past its last sample; where each
+    // holds as many, the reads keep one phase with the samples.
+    let phase = if fewest < most as f64 { period } else { 0.0 };
+    let mixed = apart(messages, &fitted, &excess, (rate, phase, parted, unseen));
     let caveat = (1.2 * short > 0.5 * least).then(|| {
         format!(
             "the FIFO messages' stamps come up to {} us short of {} from one to the next, as \
@@ -844,11 +851,12 @@ fn fifo_rate(messages: &[(f64, usize)]) -> Option<(f64, Option<String>, Option<S
 /// samples over its runs' time (from each run's first fitted stamp to its last), any two of
 /// one cut more than half a percent apart, by more than five of their standard errors, the
 /// messages lost unseen in each (as many as the stamps suggest, and three standard errors:
-/// `unseen` µs each, runs parted past `parted` µs at the median `period`) and, where the
-/// messages hold more samples or fewer, a sample's time a run (a read's stamp is its own
-/// time, not its last sample's: a timer reading a sensor 0.03 % fast takes a sample more now
-/// and then, which moves a part of 20 messages of 4 by 1.25 %): the refusal that names them. A part's error is from the parts' median scatter about their
-/// lines, not its own: a stretch at another rate bends its part's line and would widen its
+/// `unseen` µs each, runs parted past `parted` µs, the time to a message past what it
+/// should take its `excess`) and `phase` µs a run (where the messages hold more samples or
+/// fewer, a sample's time: a read's stamp is its own time, not its last sample's, and a timer
+/// reading a sensor 0.03 % fast takes a sample more now and then, which moves a part of 20
+/// messages of 4 by 1.25 %): the refusal that names them. A part's error is from the parts'
+/// median scatter about their lines, not its own: a stretch at another rate bends its part's line and would widen its
 /// own. Parts are compared with one another, not with the whole, which a step between
 /// halves splits (0.8 % read 3212.8 Hz, between 3200 and 3225.6); a part's span counts the
 /// time a short stretch takes in full, where its line's slope leans on it by where it lies
@@ -858,7 +866,7 @@ fn apart(
     messages: &[(f64, usize)],
     fitted: &impl Fn(&[(f64, usize)]) -> Line,
     excess: &impl Fn(&[(f64, usize)]) -> f64,
-    (rate, period, parted, unseen): (f64, f64, f64, f64),
+    (rate, phase, parted, unseen): (f64, f64, f64, f64),
 ) -> Option<String> {
     // The time the messages a part may have lost unseen take: where the time from a stamp
     // to the next passes its samples' by half such a message more often than it comes as
@@ -878,13 +886,6 @@ fn apart(
         }
         unseen * ((long - short).max(0.0) + 3.0 * (long + short).sqrt() + 1.0)
     };
-    // Where the messages hold more samples or fewer (a timer's reads of a sensor off its
-    // rate), a read's stamp may lie up to a sample's time past its last sample; where each
-    // holds as many, the reads keep one phase with the samples.
-    let (fewest, most) = messages
-        .iter()
-        .fold((usize::MAX, 0), |(a, b), m| (a.min(m.1), b.max(m.1)));
-    let phase = if fewest < most { period } else { 0.0 };
     let mut parts = 2;
     // (Up to 640 parts: every pair of them compared.)
     while messages.len() >= 20 * parts && parts <= 640 {
