@@ -1817,6 +1817,132 @@ impl Timing {
     /// The summary of the stamps taken; an error when they give no rate (fewer than two) or
     /// several (less than 90 % of the intervals within 25 % of the median).
     pub fn summary(&self, unit: TimeUnit) -> Result<TimingSummary, String> {
+        let mut summary = self.summary_of(unit)?;
+        summary.slower = self.slower(&summary);
+        Ok(summary)
+    }
+
+    /// How much slower than its stamps' quantum a clock the stamps allow, where `summary`
+    /// reads its rate as the quantum's: the lag of each stamp behind its sample's place (in
+    /// quanta) rises by one at each place left empty, and a clock a fraction `e` slower
+    /// leaves its own places every `1/e` quanta, within the stamps' spread of where a steady
+    /// clock puts them, from the record's start to its end. The largest such `e` among the
+    /// places left empty (none, one, or an even chain of them) bounds the rate from below.
+    fn slower(&self, summary: &TimingSummary) -> Option<Slower> {
+        let q = summary.resolution_s? * 1e9;
+        let n = self.stamps.len();
+        if (q * 1e-9 * summary.rate_hz - 1.0).abs() >= 1e-9 || n < 2 {
+            return None;
+        }
+        let first = self.stamps[0];
+        // The places left empty (where each ends, quanta from the first stamp: samples lost
+        // at random do not move a clock's own), the deepest a stamp's lag falls back under
+        // the highest before it (a jittered clock's stamps either side of a quantum's edge).
+        let (mut top, mut dip) = (0i64, 0i64);
+        let mut places: Vec<f64> = Vec::new();
+        for (i, &t) in self.stamps.iter().enumerate().skip(1) {
+            let at = ((t as f64 - first as f64) / q).round();
+            let lag = at as i64 - i as i64;
+            if lag > top {
+                places.push(at);
+                top = lag;
+            } else {
+                dip = dip.max(top - lag);
+            }
+        }
+        // How far a clock's place may lie off its steady count, quanta: one, or more where
+        // the stamps are jittered across the quantum's edges, and then a share of its period
+        // too (jitter of RMS `s` quanta moves the stamp that first crosses an edge by up to
+        // some 4 `s` periods of the beat; a clock of one quantum's period so jittered
+        // repeats `s / sqrt(pi)` of its stamps, wherever its phase lies near an edge).
+        let spread = if dip == 0 { 1.0 } else { dip as f64 + 0.5 };
+        let blur = (4.0 * std::f64::consts::PI.sqrt() * self.repeats as f64 / n as f64).min(0.5);
+        let tol = |period: f64| spread + blur * period;
+        let last = ((self.stamps[n - 1] as f64 - first as f64) / q).round();
+        // The shortest period a clock may have (quanta), and the places of its own: one
+        // slow enough to leave none within the record, no more than the spread over the
+        // span.
+        let mut best = (0u64, last / spread, 0.0);
+        // Every run between two places (or an end) is no longer than the clock's period,
+        // give or take the spread.
+        let longest = places
+            .iter()
+            .copied()
+            .chain([last + 1.0])
+            .scan(0.0, |before, x| {
+                let run = x - *before;
+                *before = x;
+                Some(run)
+            })
+            .fold(0.0f64, f64::max);
+        let shortest = ((longest - spread) / (1.0 + blur)).max(2.0);
+        let widest = SLOWER_PERIODS.min(last);
+        let covers = |from: f64, to: f64, period: f64| from.max(last - to) <= period + tol(period);
+        // One place: the one nearest the middle.
+        for &x in &places {
+            let period = (x.max(last - x) - spread) / (1.0 + blur);
+            if period >= shortest && period < best.1 {
+                best = (1, period.max(1.0), 0.0);
+            }
+        }
+        // Chains of two places or more, each a period on from the one before.
+        let mut budget = SLOWER_BUDGET;
+        'anchors: for (a, &from) in places.iter().enumerate() {
+            if from > widest + tol(widest) {
+                break;
+            }
+            for &second in &places[a + 1..] {
+                let period = second - from;
+                if period > widest + tol(widest) {
+                    break;
+                }
+                if period < shortest || period >= best.1 || from > period + tol(period) {
+                    continue;
+                }
+                let (mut count, mut to, mut step) = (2u64, second, period);
+                loop {
+                    if budget == 0 {
+                        break 'anchors;
+                    }
+                    budget -= 1;
+                    let next = to + step;
+                    if next > last + tol(step) {
+                        break;
+                    }
+                    let j = places.partition_point(|&x| x < next - tol(step));
+                    match places.get(j) {
+                        Some(&x) if x <= next + tol(step) => {
+                            (count, to) = (count + 1, x);
+                            step = (to - from) / (count - 1) as f64;
+                        }
+                        _ => {
+                            count = 0;
+                            break;
+                        }
+                    }
+                }
+                // (Each end of the chain a spread off.)
+                let shortest = step - 2.0 * tol(step) / (count.max(2) - 1) as f64;
+                if count >= 2 && covers(from, to, step) && shortest < best.1 {
+                    best = (count, shortest.max(1.0), step);
+                }
+            }
+        }
+        if budget == 0 {
+            // Too many places to search: the runs alone bound it.
+            best = (0, shortest, 0.0);
+        }
+        Some(Slower {
+            fraction: 1.0 / best.1,
+            apart: best.2,
+            chain: best.0,
+            samples: n as u64,
+            spread,
+        })
+    }
+
+    /// [`Timing::summary`] before the bound on a slower clock.
+    fn summary_of(&self, unit: TimeUnit) -> Result<TimingSummary, String> {
         if let Some(rate) = self.placed {
             return self.placed_summary(unit, rate);
         }
@@ -1884,6 +2010,7 @@ impl Timing {
             *intervals.select_nth_unstable(mid).1 as f64
         };
         Ok(TimingSummary {
+            slower: None,
             grid_s: None,
             unit: unit.name(),
             header_stamps: unit == TimeUnit::HeaderStamps,
@@ -2292,6 +2419,7 @@ impl Timing {
             }
         }
         let summary = TimingSummary {
+            slower: None,
             grid_s: common_step(buckets, self.bits).map(|g| g as f64 * 1e-9),
             per_stamp,
             jittered_repeats,
@@ -4873,6 +5001,31 @@ struct Classes {
     gap_sum: f64,
 }
 
+/// How much slower than its stamps' quantum a clock read at the quantum's rate may be: the
+/// places it leaves empty are samples lost, or its own, one every `1/fraction` quanta.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Slower {
+    /// The largest fraction slower the places allow.
+    pub fraction: f64,
+    /// The places that clock's own are (0: it leaves none within the record).
+    pub chain: u64,
+    /// Their mean spacing, quanta (0 for one place or none).
+    pub apart: f64,
+    /// The samples (stamps kept).
+    pub samples: u64,
+    /// How far, in quanta, a clock's place may lie off its steady count at the record's ends
+    /// (one, or more where the stamps are jittered across the quantum's edges).
+    pub spread: f64,
+}
+
+/// The longest period, in quanta, searched for a slower clock's places: a clock 1e-4 slower
+/// (the rate's tolerance) leaves one every 10,000.
+const SLOWER_PERIODS: f64 = 10_000.0;
+
+/// The steps a search for a slower clock's places may take (a record of many places stops
+/// there and is bounded by its runs alone).
+const SLOWER_BUDGET: u64 = 2_000_000;
+
 /// What a record's timestamps show.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct TimingSummary {
@@ -4913,6 +5066,9 @@ pub struct TimingSummary {
     /// each interval exactly (a tick of another form than the quantum's: 250 us).
     #[serde(skip)]
     pub grid_s: Option<f64>,
+    /// Where the rate is the stamps' quantum's, how much slower a clock they allow.
+    #[serde(skip)]
+    pub slower: Option<Slower>,
     /// The rate of the samples over the span (every stamp kept, repeats too, less one, over
     /// it), Hz: the rate, where no sample is missing.
     pub span_rate_hz: f64,
@@ -4965,14 +5121,26 @@ impl TimingSummary {
             (Some(a), Some(b)) => Some(a.max(b)),
             (a, b) => a.or(b),
         };
+        // (Where the rate is the quantum's, [`TimingSummary::quantum_warning`] bounds it.)
         let rounding = match step {
-            Some(q) if self.jitter_rms > 0.0 && self.span_s > 0.0 => {
+            Some(q) if self.slower.is_none() && self.span_s > 0.0 => {
                 q / (6.0f64.sqrt() * self.span_s)
             }
             _ => 0.0,
         };
-        let error = (self.jitter_rms / intervals).hypot(rounding);
+        // (The intervals' jitter holds the rounding's where the clock is off its lattice: the
+        // larger of the two, not their sum.)
+        let error = (self.jitter_rms / intervals).max(rounding);
         (3.0 * error > 1e-4).then(|| {
+            let q = step.unwrap_or(0.0);
+            if self.jitter_rms == 0.0 {
+                return format!(
+                    "the timestamps, rounded to {q:e} s, span {} s, so the rate read from \
+                     them, {} Hz, has a standard error of {error:.1e} of it; --rate sets it",
+                    short(self.span_s),
+                    short(self.rate_hz)
+                );
+            }
             format!(
                 "the timestamps jitter by {:.3} % RMS of the period over {} intervals{}, so \
                  the rate read from them, {} Hz, has a standard error of {error:.1e} of it; \
@@ -4989,26 +5157,46 @@ impl TimingSummary {
     }
 
     /// The warning for a rate read as its stamps' quantum's (a clock of one quantum's period)
-    /// whose stamps leave a few places empty, under 16 and more than 1e-4 of the samples:
-    /// samples lost, or the beat of a clock that much slower than its stamps, which too few
-    /// places do not tell apart (999.85 Hz on whole ms jittered by 50 us over 20 s leaves
-    /// three, read 1000 Hz with three samples missing and no warning); the rate lies between
-    /// the span's and the quantum's.
+    /// where the stamps leave the rate loose by more than 1e-4 ([`Slower`]): a short record,
+    /// whose ends place it only to a quantum over its span (999.05 Hz on whole ms over 1000
+    /// samples steps by 1 ms each, read 1000 Hz), or places left empty that are samples lost
+    /// or a slower clock's own (999.81 Hz over 10,000 samples leaves one; 999.385 Hz among
+    /// 0.1 % lost at random leaves twelve every 1626 samples among twenty others). The rate
+    /// lies between the slowest clock the places allow and the quantum's, or a hair past it
+    /// where the ends leave room.
     pub fn quantum_warning(&self) -> Option<String> {
         let q = self.resolution_s?;
-        let samples = self.span_s * self.rate_hz + 1.0;
-        let few =
-            (1..16).contains(&self.missing_samples) && self.missing_samples as f64 > 1e-4 * samples;
-        ((q * self.rate_hz - 1.0).abs() < 1e-9 && few).then(|| {
-            format!(
-                "the timestamps step by their quantum, {q:e} s, and leave {} places empty: \
-                 samples lost, or the beat of a clock slower than its stamps, which so few do \
-                 not tell apart; the rate lies between {} Hz and {} Hz; --rate sets it",
-                self.missing_samples,
-                short(self.span_rate_hz),
-                short(self.rate_hz)
-            )
-        })
+        let slower = self.slower?;
+        let ends = slower.spread / slower.samples as f64;
+        if slower.fraction <= 1e-4 && ends <= 1e-4 {
+            return None;
+        }
+        let high = if ends > 1e-4 {
+            self.rate_hz * (1.0 + ends)
+        } else {
+            self.rate_hz
+        };
+        let low = self.rate_hz * (1.0 - slower.fraction.max(if ends > 1e-4 { ends } else { 0.0 }));
+        let why = match (self.missing_samples, slower.chain) {
+            (0, _) => "which place a clock's rate no closer than a quantum over their span".into(),
+            (k, c) if c >= 3 => format!(
+                "and leave {k} places empty, {c} of them {} s apart as a clock that much \
+                 slower leaves its own: samples lost, or that clock, which they do not tell \
+                 apart",
+                short(q * slower.apart)
+            ),
+            (k, _) => format!(
+                "and leave {k} places empty: samples lost, or a clock slower than its \
+                 stamps, which they do not tell apart"
+            ),
+        };
+        Some(format!(
+            "the timestamps step by their quantum, {q:e} s, over {} samples {why}; the rate \
+             lies between {} Hz and {} Hz; --rate sets it",
+            slower.samples,
+            short(low),
+            short(high)
+        ))
     }
 
     /// The warning for a rate read from stamps that hold samples repeated, their median
@@ -6996,6 +7184,69 @@ mod tests {
             .collect();
         let w = summary_of(&t).loose_warning();
         assert!(w.is_some_and(|w| w.contains("rounded to 2.5e-4 s")));
+    }
+
+    #[test]
+    fn a_rate_read_as_its_stamps_quantum_warns_with_the_range_its_places_allow() {
+        // Samples of a clock at `rate`, their stamps floored to `tick` s (in ns), one in
+        // `one_in` lost at random (0: none).
+        let floored = |rate: f64, n: usize, tick: f64, one_in: u64, seed: u64| {
+            let mut next = crate::xorshift(seed);
+            (0..n)
+                .filter(|_| one_in == 0 || !next().is_multiple_of(one_in))
+                .map(|k| ((k as f64 / (rate * tick)).floor() * tick * 1e9).round() as i64)
+                .collect::<Vec<i64>>()
+        };
+        let (ms, binary) = (1e-3, 1.0 / 1024.0);
+        // Pass 53: each read as the quantum's rate with no warning (F1: one or two places in
+        // 1e-4 of the samples; F2: short records, no place; F3: a slower clock's places
+        // among 0.1 % lost at random, 999.385 Hz read 1000 Hz, 6.2e-4 off). Each now warns
+        // with a range that holds the clock's rate (and, where a chain of its places shows,
+        // says so).
+        for (rate, n, tick, one_in, chain) in [
+            (999.81, 10_000, ms, 0, None),
+            (999.855, 20_000, ms, 0, None),
+            (1023.81568, 10_000, binary, 0, None),
+            (999.05, 1000, ms, 0, None),
+            (999.6833, 3000, ms, 0, None),
+            (1000.8, 1000, ms, 0, None),
+            (1023.1808, 1000, binary, 0, None),
+            (1024.27307, 3000, binary, 0, None),
+            (999.385, 20_000, ms, 1000, Some("12 of them 1.626 s apart")),
+            (998.985, 20_000, ms, 1000, Some("20 of them")),
+            (999.662, 60_000, ms, 1000, Some("20 of them")),
+        ] {
+            let s = summary_keeping_repeats(&floored(rate, n, tick, one_in, 53));
+            let w = s
+                .quantum_warning()
+                .unwrap_or_else(|| panic!("{rate} {n}: {s:?}"));
+            let range: Vec<f64> = w
+                .split("between ")
+                .nth(1)
+                .and_then(|r| r.split(" Hz; ").next())
+                .map(|r| r.split(" Hz and ").map(|x| x.parse().unwrap()).collect())
+                .unwrap();
+            assert!(range[0] <= rate && rate <= range[1], "{rate} {n}: {w}");
+            assert!(chain.is_none_or(|c| w.contains(c)), "{rate} {n}: {w}");
+            assert!(s.loose_warning().is_none(), "{rate}: one warning, not two");
+        }
+        // The quantum's own clock, long enough, losing samples at random or none: no warning
+        // (20,000 samples with 0.1 % lost leave two places a clock 1.4e-4 slower may leave:
+        // a warning).
+        for (n, one_in, warns) in [
+            (20_000, 0, false),
+            (60_000, 1000, false),
+            (200_000, 1000, false),
+            (60_000, 100, false),
+            (20_000, 1000, true),
+        ] {
+            for seed in 1..4 {
+                let s = summary_keeping_repeats(&floored(1000.0, n, ms, one_in, seed));
+                assert_eq!(s.rate_hz, 1000.0);
+                let w = s.quantum_warning();
+                assert_eq!(w.is_some(), warns, "{n} {one_in} {seed}: {w:?}");
+            }
+        }
     }
 
     #[test]

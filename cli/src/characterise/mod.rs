@@ -265,17 +265,19 @@ fn characterise(
         summary(read.timing, args.rate.is_none()).map_err(|e| with_file(&args.files, e))?;
     let rate = resolve_rate(args.rate, timing.as_ref()).map_err(|e| with_file(&args.files, e.0))?;
     crate::input::check_packed(args.rate, stamped).map_err(|e| with_file(&args.files, e))?;
-    if let Some(w) = crate::input::unchecked(args.rate, unchecked.as_deref()) {
-        eprintln!("imu-ar: warning: {}", with_file(&args.files, w).0);
-    }
-    if let Some(w) = crate::input::coarse(args.rate, timing.as_ref()) {
-        eprintln!("imu-ar: warning: {}", with_file(&args.files, w).0);
-    }
-    if let Some(w) = read.caveat.filter(|_| args.rate.is_none()) {
-        eprintln!("imu-ar: warning: {}", with_file(&args.files, w).0);
-    } else if let Some(w) = crate::input::loose(args.rate, timing.as_ref()) {
-        eprintln!("imu-ar: warning: {}", with_file(&args.files, w).0);
-    }
+    // The rate's warnings, printed once the record is known to be read (a refusal is one
+    // line).
+    let warnings: Vec<String> = [
+        crate::input::unchecked(args.rate, unchecked.as_deref()),
+        crate::input::coarse(args.rate, timing.as_ref()),
+        read.caveat
+            .clone()
+            .filter(|_| args.rate.is_none())
+            .or_else(|| crate::input::loose(args.rate, timing.as_ref())),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
     check_span("--rate", rate, n as usize)?;
     crate::input::check_gaps(timing.as_ref(), n as usize)
         .and_then(|()| crate::input::check_subsampled(&args.files, timing.as_ref()))
@@ -294,6 +296,9 @@ fn characterise(
         })
         .collect::<Result<_, _>>()
         .map_err(|e| with_file(&args.files, e.0))?;
+    for w in warnings {
+        eprintln!("imu-ar: warning: {}", with_file(&args.files, w).0);
+    }
     if let Some(w) = gravity(
         std::array::from_fn(|k| axes[3 + k].mean() * units[3 + k].to_si),
         units[3].name,
