@@ -1888,14 +1888,15 @@ impl Timing {
         // Chains of two places or more, each a period on from the one before.
         let mut budget = SLOWER_BUDGET;
         'anchors: for (a, &from) in places.iter().enumerate() {
-            if from > widest + tol(widest) {
+            if from > widest + tol(widest) || budget == 0 {
                 break;
             }
             for &second in &places[a + 1..] {
                 let period = second - from;
-                if period > widest + tol(widest) {
+                if period > widest + tol(widest) || budget == 0 {
                     break;
                 }
+                budget -= 1;
                 if period < shortest || period >= best.1 || from > period + tol(period) {
                     continue;
                 }
