@@ -1829,20 +1829,29 @@ impl Timing {
     /// clock puts them, from the record's start to its end. The largest such `e` among the
     /// places left empty (none, one, or an even chain of them) bounds the rate from below.
     fn slower(&self, summary: &TimingSummary) -> Option<Slower> {
-        let q = summary.resolution_s? * 1e9;
+        // The quantum, or the intervals' common step (250 us), where the rate is its.
+        let quantum = [summary.resolution_s, summary.grid_s]
+            .into_iter()
+            .flatten()
+            .find(|q| (q * summary.rate_hz - 1.0).abs() < 1e-9)?;
+        let q = quantum * 1e9;
         let n = self.stamps.len();
-        if (q * 1e-9 * summary.rate_hz - 1.0).abs() >= 1e-9 || n < 2 {
+        if n < 2 {
             return None;
         }
         let first = self.stamps[0];
         // The places left empty (where each ends, quanta from the first stamp: samples lost
-        // at random do not move a clock's own), the deepest a stamp's lag falls back under
-        // the highest before it (a jittered clock's stamps either side of a quantum's edge).
+        // at random do not move a clock's own) and the stamps repeated, the deepest a
+        // stamp's lag falls back under the highest before it (a jittered clock's stamps
+        // either side of a quantum's edge).
         let (mut top, mut dip) = (0i64, 0i64);
-        let mut places: Vec<f64> = Vec::new();
-        for (i, &t) in self.stamps.iter().enumerate().skip(1) {
-            let at = ((t as f64 - first as f64) / q).round();
-            let lag = at as i64 - i as i64;
+        let (mut places, mut repeats): (Vec<f64>, Vec<f64>) = (Vec::new(), Vec::new());
+        for (i, w) in self.stamps.windows(2).enumerate() {
+            let at = ((w[1] as f64 - first as f64) / q).round();
+            let lag = at as i64 - (i + 1) as i64;
+            if w[1] == w[0] {
+                repeats.push(at);
+            }
             if lag > top {
                 places.push(at);
                 top = lag;
@@ -1857,86 +1866,16 @@ impl Timing {
         // repeats `s / sqrt(pi)` of its stamps, wherever its phase lies near an edge).
         let spread = if dip == 0 { 1.0 } else { dip as f64 + 0.5 };
         let blur = (4.0 * std::f64::consts::PI.sqrt() * self.repeats as f64 / n as f64).min(0.5);
-        let tol = |period: f64| spread + blur * period;
         let last = ((self.stamps[n - 1] as f64 - first as f64) / q).round();
-        // The shortest period a clock may have (quanta), and the places of its own: one
-        // slow enough to leave none within the record, no more than the spread over the
-        // span.
-        let mut best = (0u64, last / spread, 0.0);
-        // Every run between two places (or an end) is no longer than the clock's period,
-        // give or take the spread.
-        let longest = places
-            .iter()
-            .copied()
-            .chain([last + 1.0])
-            .scan(0.0, |before, x| {
-                let run = x - *before;
-                *before = x;
-                Some(run)
-            })
-            .fold(0.0f64, f64::max);
-        let shortest = ((longest - spread) / (1.0 + blur)).max(2.0);
-        let widest = SLOWER_PERIODS.min(last);
-        let covers = |from: f64, to: f64, period: f64| from.max(last - to) <= period + tol(period);
-        // One place: the one nearest the middle.
-        for &x in &places {
-            let period = (x.max(last - x) - spread) / (1.0 + blur);
-            if period >= shortest && period < best.1 {
-                best = (1, period.max(1.0), 0.0);
-            }
-        }
-        // Chains of two places or more, each a period on from the one before.
-        let mut budget = SLOWER_BUDGET;
-        'anchors: for (a, &from) in places.iter().enumerate() {
-            if from > widest + tol(widest) || budget == 0 {
-                break;
-            }
-            for &second in &places[a + 1..] {
-                let period = second - from;
-                if period > widest + tol(widest) || budget == 0 {
-                    break;
-                }
-                budget -= 1;
-                if period < shortest || period >= best.1 || from > period + tol(period) {
-                    continue;
-                }
-                let (mut count, mut to, mut step) = (2u64, second, period);
-                loop {
-                    if budget == 0 {
-                        break 'anchors;
-                    }
-                    budget -= 1;
-                    let next = to + step;
-                    if next > last + tol(step) {
-                        break;
-                    }
-                    let j = places.partition_point(|&x| x < next - tol(step));
-                    match places.get(j) {
-                        Some(&x) if x <= next + tol(step) => {
-                            (count, to) = (count + 1, x);
-                            step = (to - from) / (count - 1) as f64;
-                        }
-                        _ => {
-                            count = 0;
-                            break;
-                        }
-                    }
-                }
-                // (Each end of the chain a spread off.)
-                let shortest = step - 2.0 * tol(step) / (count.max(2) - 1) as f64;
-                if count >= 2 && covers(from, to, step) && shortest < best.1 {
-                    best = (count, shortest.max(1.0), step);
-                }
-            }
-        }
-        if budget == 0 {
-            // Too many places to search: the runs alone bound it.
-            best = (0, shortest, 0.0);
-        }
+        let (chain, shortest, apart) = beat_chain(&places, last, spread, blur);
+        // A faster clock repeats a stamp where a slower one leaves a place.
+        let (_, fastest, _) = beat_chain(&repeats, last, spread, blur);
         Some(Slower {
-            fraction: 1.0 / best.1,
-            apart: best.2,
-            chain: best.0,
+            fraction: 1.0 / shortest,
+            faster: 1.0 / fastest,
+            quantum,
+            apart,
+            chain,
             samples: n as u64,
             spread,
         })
@@ -5008,6 +4947,11 @@ struct Classes {
 pub struct Slower {
     /// The largest fraction slower the places allow.
     pub fraction: f64,
+    /// The largest fraction faster the stamps repeated allow (a clock faster than its
+    /// stamps repeats one where a slower leaves a place).
+    pub faster: f64,
+    /// The quantum (or the intervals' common step), s.
+    pub quantum: f64,
     /// The places that clock's own are (0: it leaves none within the record).
     pub chain: u64,
     /// Their mean spacing, quanta (0 for one place or none).
@@ -5017,6 +4961,95 @@ pub struct Slower {
     /// How far, in quanta, a clock's place may lie off its steady count at the record's ends
     /// (one, or more where the stamps are jittered across the quantum's edges).
     pub spread: f64,
+}
+
+/// The shortest period (quanta) of a clock's own places among `places` (quanta from the
+/// first stamp, in order, over a span of `last`), each within `spread` quanta and `blur` of
+/// a period of where a steady count puts it, from the record's start to its end: a clock
+/// with none within the record, one, or an even chain of them; its places, the shortest
+/// period, and the chain's mean spacing (0 for one place or none).
+fn beat_chain(places: &[f64], last: f64, spread: f64, blur: f64) -> (u64, f64, f64) {
+    let tol = |period: f64| spread + blur * period;
+    // A clock slow enough to leave none within the record: no more than the spread over the
+    // span.
+    let mut best = (0u64, last / spread, 0.0);
+    // Every run between two places (or an end) is no longer than the clock's period, give or
+    // take the spread.
+    let longest = places
+        .iter()
+        .copied()
+        .chain([last + 1.0])
+        .scan(0.0, |before, x| {
+            let run = x - *before;
+            *before = x;
+            Some(run)
+        })
+        .fold(0.0f64, f64::max);
+    let shortest = ((longest - spread) / (1.0 + blur)).max(2.0);
+    let widest = SLOWER_PERIODS.min(last);
+    let covers = |from: f64, to: f64, period: f64| from.max(last - to) <= period + tol(period);
+    // One place: the one nearest the middle.
+    for &x in places {
+        let period = (x.max(last - x) - spread) / (1.0 + blur);
+        if period >= shortest && period < best.1 {
+            best = (1, period.max(1.0), 0.0);
+        }
+    }
+    // Chains of two places or more, each a period on from the one before (foretold from the
+    // first, each off by up to a spread either way).
+    let mut budget = SLOWER_BUDGET;
+    'anchors: for (a, &from) in places.iter().enumerate() {
+        if from > widest + tol(widest) || budget == 0 {
+            break;
+        }
+        for &second in &places[a + 1..] {
+            let period = second - from;
+            if period > widest + tol(widest) || budget == 0 {
+                break;
+            }
+            budget -= 1;
+            if period < shortest || period >= best.1 || from > period + tol(period) {
+                continue;
+            }
+            let (mut count, mut to, mut step) = (2u64, second, period);
+            loop {
+                if budget == 0 {
+                    break 'anchors;
+                }
+                budget -= 1;
+                let next = from + count as f64 * step;
+                let off = 2.0 * tol(step);
+                // (The nearest: samples lost at random leave places beside a clock's own.)
+                let j = places.partition_point(|&x| x < next - off);
+                let nearest = places[j..]
+                    .iter()
+                    .take_while(|&&x| x <= next + off)
+                    .min_by(|a, b| (*a - next).abs().total_cmp(&(*b - next).abs()));
+                match nearest {
+                    Some(&x) => {
+                        (count, to) = (count + 1, x);
+                        step = (to - from) / (count - 1) as f64;
+                    }
+                    // (A place that may lie past the record's end.)
+                    None if next > last - off => break,
+                    None => {
+                        count = 0;
+                        break;
+                    }
+                }
+            }
+            // (Each end of the chain a spread off.)
+            let shortest = step - 2.0 * tol(step) / (count.max(2) - 1) as f64;
+            if count >= 2 && covers(from, to, step) && shortest < best.1 {
+                best = (count, shortest.max(1.0), step);
+            }
+        }
+    }
+    if budget == 0 {
+        // Too many places to search: the runs alone bound it.
+        best = (0, shortest, 0.0);
+    }
+    best
 }
 
 /// The longest period, in quanta, searched for a slower clock's places: a clock 1e-4 slower
@@ -5166,18 +5199,19 @@ impl TimingSummary {
     /// lies between the slowest clock the places allow and the quantum's, or a hair past it
     /// where the ends leave room.
     pub fn quantum_warning(&self) -> Option<String> {
-        let q = self.resolution_s?;
         let slower = self.slower?;
+        let q = slower.quantum;
         let ends = slower.spread / slower.samples as f64;
-        if slower.fraction <= 1e-4 && ends <= 1e-4 {
+        // (Past the tolerance, or not counted.)
+        let loose = |e: f64| if e > 1e-4 { e } else { 0.0 };
+        let (down, up) = (
+            loose(slower.fraction.max(ends)),
+            loose(slower.faster.max(ends)),
+        );
+        if down == 0.0 && up == 0.0 {
             return None;
         }
-        let high = if ends > 1e-4 {
-            self.rate_hz * (1.0 + ends)
-        } else {
-            self.rate_hz
-        };
-        let low = self.rate_hz * (1.0 - slower.fraction.max(if ends > 1e-4 { ends } else { 0.0 }));
+        let (low, high) = (self.rate_hz * (1.0 - down), self.rate_hz * (1.0 + up));
         let why = match (self.missing_samples, slower.chain) {
             (0, _) => "which place a clock's rate no closer than a quantum over their span".into(),
             (k, c) if c >= 3 => format!(
@@ -5185,6 +5219,11 @@ impl TimingSummary {
                  slower leaves its own: samples lost, or that clock, which they do not tell \
                  apart",
                 short(q * slower.apart)
+            ),
+            (k, _) if self.repeated > 0 => format!(
+                "and leave {k} places empty and repeat {} stamps: samples lost, or a clock \
+                 off its stamps' rate, which they do not tell apart",
+                self.repeated
             ),
             (k, _) => format!(
                 "and leave {k} places empty: samples lost, or a clock slower than its \
@@ -7174,10 +7213,17 @@ mod tests {
         let s = summary_keeping_repeats(&t);
         let w = s.quantum_warning();
         assert!(
-            w.as_ref().is_some_and(|w| w.contains("leave 3 places empty")
-                && w.contains("Hz and 1000 Hz")),
+            w.as_ref()
+                .is_some_and(|w| w.contains("leave 3 places empty")),
             "{s:?}: {w:?}"
         );
+        let low: f64 = w
+            .as_deref()
+            .and_then(|w| w.split("between ").nth(1))
+            .and_then(|r| r.split(" Hz").next())
+            .and_then(|x| x.parse().ok())
+            .unwrap();
+        assert!(low <= 999.85, "{w:?}");
         // 399.85 Hz rounded to 250 us, 300 stamps, a step no power of ten (pass 52 F5:
         // 399.73 Hz with no warning).
         let t: Vec<i64> = (0..300)
@@ -7216,6 +7262,11 @@ mod tests {
             (999.385, 20_000, ms, 1000, Some("12 of them 1.626 s apart")),
             (998.985, 20_000, ms, 1000, Some("20 of them")),
             (999.662, 60_000, ms, 1000, Some("20 of them")),
+            // Pass 54: a 250 us grid (3960 Hz, 1 % lost: read 4000 Hz, no warning); a
+            // slower clock among 3 % lost, whose chain was found at twice its spacing and
+            // the range left it out (998 Hz: 999 to 1000 Hz).
+            (3960.0, 20_000, 250e-6, 100, None),
+            (998.0, 65_000, ms, 33, Some("0.5 s apart")),
         ] {
             let s = summary_keeping_repeats(&floored(rate, n, tick, one_in, 53));
             let w = s
