@@ -5375,13 +5375,19 @@ impl TimingSummary {
         if self.phased || share <= 1.0 {
             return None;
         }
+        // (The end stamps, each rounded by up to a quantum, move the span either way: 1024 Hz
+        // on whole ms over 500 samples read 1022.63 Hz.)
+        let ends = self.resolution_s.unwrap_or(self.median_interval_s) / self.span_s.max(1e-300);
+        let low = self.rate_hz * (1.0 - ends);
         let upper = hidden_losses(
             self.span_rate_hz * self.span_s + 1.0,
             self.repeated as f64,
             self.missing_samples as f64,
         )
-        .map(|hidden| self.rate_hz * (1.0 + hidden / (self.span_s * self.rate_hz + 1.0)));
-        let room = upper.map_or(f64::INFINITY, |u| u / self.rate_hz - 1.0);
+        .map(|hidden| {
+            self.rate_hz * (1.0 + hidden / (self.span_s * self.rate_hz + 1.0)) * (1.0 + ends)
+        });
+        let room = upper.map_or(f64::INFINITY, |u| u / low - 1.0);
         (room > 1e-4).then(|| {
             format!(
                 "the timestamps step by {} s and hold one or two samples each ({} share \
@@ -5396,7 +5402,7 @@ impl TimingSummary {
                     Some(u) => format!(
                         "where samples are lost at random, the rate lies between {} Hz and {} \
                          Hz",
-                        short(self.rate_hz),
+                        short(low),
                         short(u)
                     ),
                     None => "the rate may be higher, by as many as were lost".into(),
@@ -7568,6 +7574,13 @@ mod tests {
                 assert!(s.coarse_warning().is_some(), "{rms} {seed}: {s:?}");
                 assert!(right_or_held(&s, 1501.63, 0.0), "{rms} {seed}: {s:?}");
             }
+        }
+        // 1024 Hz on whole ms over 500 to 800 samples, none lost (pass 55 F3: "between
+        // 1022.633745 Hz and 1022.945785 Hz", the range starting at the rate read, which the
+        // end stamps' rounding moves either way): read to 3e-4, or the range holds it.
+        for n in [500, 600, 700, 800] {
+            let s = summary_keeping_repeats(&jittered(1024.0, n, 1e-3, 0.0, 0.0, 1));
+            assert!(right_or_held(&s, 1024.0, 3e-4), "{n}: {s:?}");
         }
     }
 
